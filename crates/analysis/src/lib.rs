@@ -1,0 +1,1 @@
+//! colloidsim-analysis (see the crate description).

@@ -1,0 +1,54 @@
+//! What every `run` shares: options, output folders, progress bars, summaries.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Options of `colloidsim run` common to all methods.
+pub struct RunOptions {
+    /// Output folder.
+    pub out: PathBuf,
+    /// Seed overriding the scenario's.
+    pub seed: Option<u64>,
+    /// No progress bar.
+    pub quiet: bool,
+    /// Overwrite a non-empty output folder.
+    pub force: bool,
+    /// Continue from the checkpoint in this folder.
+    pub restart: Option<PathBuf>,
+}
+
+/// Default output folder: the scenario's file stem plus `suffix`, in the current folder.
+pub fn default_out(scenario: &Path, out: Option<PathBuf>, suffix: &str) -> PathBuf {
+    out.unwrap_or_else(|| {
+        let stem = scenario
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "colloidsim".into());
+        PathBuf::from(format!("{stem}{suffix}"))
+    })
+}
+
+/// A progress bar over `total` units that appears only on a terminal, only when not quiet, and
+/// only after the run has lasted a second.
+pub fn progress(total: u64, quiet: bool, what: &str) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template(&format!(
+            "{what} {{bar:40}} {{percent:>3}}% {{elapsed_precise}} eta {{eta}} {{msg}}"
+        ))
+        .expect("static template"),
+    );
+    pb.enable_steady_tick(Duration::from_millis(500));
+    pb
+}
+
+/// Validate a seed from the scenario or the command line: the counter-based streams take 32 bits.
+pub fn seed32(seed: u64) -> anyhow::Result<u32> {
+    u32::try_from(seed)
+        .map_err(|_| anyhow::anyhow!("seed: must lie in [0, 4294967295], got {seed}"))
+}

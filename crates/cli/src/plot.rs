@@ -1,0 +1,145 @@
+//! Pictures of the main observables (PNG, text rendered with the embedded DejaVu Sans font).
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn register_font() {
+    REGISTER.call_once(|| {
+        // The font is embedded, so registration cannot fail for a missing file.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// One curve of a line plot.
+pub struct Series<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// Abscissae.
+    pub x: &'a [f64],
+    /// Ordinates.
+    pub y: &'a [f64],
+    /// Draw points instead of a line.
+    pub points: bool,
+}
+
+/// Axis scaling.
+#[derive(Clone, Copy, PartialEq)]
+pub enum Scale {
+    /// Linear axes.
+    Linear,
+    /// Both axes logarithmic.
+    LogLog,
+}
+
+const COLOURS: [RGBColor; 5] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+];
+
+/// Draw `series` into a PNG at `path` (800x500 px).
+pub fn line_plot(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    scale: Scale,
+) -> Result<()> {
+    register_font();
+    let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
+    let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in series {
+        for (&x, &y) in s.x.iter().zip(s.y) {
+            if finite(x) && finite(y) {
+                xr = (xr.0.min(x), xr.1.max(x));
+                yr = (yr.0.min(y), yr.1.max(y));
+            }
+        }
+    }
+    if !(xr.0 < xr.1) {
+        return Err(anyhow!("plot {}: no finite data to draw", path.display()));
+    }
+    if !(yr.0 < yr.1) {
+        yr = (yr.0 - 1.0, yr.1 + 1.0);
+    }
+    let root = BitMapBackend::new(path, (800, 500)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+    macro_rules! draw {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(xlabel)
+                .y_desc(ylabel)
+                .label_style(("sans-serif", 16))
+                .draw()
+                .map_err(|e| anyhow!("plot: {e}"))?;
+            for (k, s) in series.iter().enumerate() {
+                let c = COLOURS[k % COLOURS.len()];
+                let data = s
+                    .x
+                    .iter()
+                    .zip(s.y)
+                    .filter(|(x, y)| finite(**x) && finite(**y))
+                    .map(|(x, y)| (*x, *y));
+                if s.points {
+                    chart
+                        .draw_series(data.map(|p| Circle::new(p, 2, c.filled())))
+                        .map_err(|e| anyhow!("plot: {e}"))?
+                        .label(s.label)
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(data, c.stroke_width(2)))
+                        .map_err(|e| anyhow!("plot: {e}"))?
+                        .label(s.label)
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                        });
+                }
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 16))
+                .draw()
+                .map_err(|e| anyhow!("plot: {e}"))?;
+        }};
+    }
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70);
+    match scale {
+        Scale::Linear => {
+            let pad = 0.05 * (yr.1 - yr.0);
+            draw!(
+                builder
+                    .build_cartesian_2d(xr.0..xr.1, (yr.0 - pad)..(yr.1 + pad))
+                    .map_err(|e| anyhow!("plot: {e}"))?
+            )
+        }
+        Scale::LogLog => draw!(
+            builder
+                .build_cartesian_2d(
+                    (xr.0..xr.1).log_scale(),
+                    (yr.0 * 0.8..yr.1 * 1.25).log_scale()
+                )
+                .map_err(|e| anyhow!("plot: {e}"))?
+        ),
+    }
+    root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    Ok(())
+}
