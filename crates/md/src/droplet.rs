@@ -1,0 +1,560 @@
+//! The drying-droplet scenario: hard-sphere colloids confined by a shrinking spherical harmonic
+//! interface (METHODS.md section 3).
+//!
+//! [`DropletScenario`] is the typed form of a `method = "droplet-bd"` scenario file (every key is
+//! documented with its unit and default in `docs/droplet.md`); [`DropletScenario::validate`]
+//! resolves it into [`DropletParams`] (initial radius, evaporation rate, free diffusivity,
+//! drying time) or returns a [`ParamError`] naming the key and the allowed range. Both the
+//! particle engine (`colloidsim run`) and the radial DDFT (`colloidsim theory`) read it.
+
+use colloidsim_core::ParamError;
+use colloidsim_core::param::{at_least, in_range, positive};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// Highest initial volume fraction accepted: random insertion of hard spheres in a sphere.
+pub const MAX_PHI0: f64 = 0.3;
+/// Highest final mean volume fraction accepted (random close packing).
+pub const MAX_PHI_FINAL: f64 = 0.64;
+
+/// A `droplet-bd` scenario file.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DropletScenario {
+    /// Must be `"droplet-bd"`.
+    pub method: String,
+    /// Seed of the counter-based random streams (0 ..= 2^32 - 1).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Independent droplets whose profiles are averaged.
+    #[serde(default = "default_replicas")]
+    pub replicas: usize,
+    /// Particles, solvent and initial droplet.
+    pub system: SystemSection,
+    /// Drying law.
+    #[serde(default)]
+    pub drying: DryingSection,
+    /// Harmonic droplet interface.
+    #[serde(default)]
+    pub interface: InterfaceSection,
+    /// Time stepping.
+    #[serde(default)]
+    pub run: RunSection,
+    /// Observables.
+    #[serde(default)]
+    pub observe: ObserveSection,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_replicas() -> usize {
+    1
+}
+
+/// `[system]`: particles, solvent, initial droplet.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SystemSection {
+    /// Number of colloids N.
+    pub particles: usize,
+    /// Colloid diameter d (length unit).
+    #[serde(default = "one")]
+    pub diameter: f64,
+    /// Thermal energy kT (energy unit).
+    #[serde(default = "one", rename = "kT")]
+    pub kt: f64,
+    /// Solvent viscosity eta.
+    #[serde(default = "one")]
+    pub viscosity: f64,
+    /// Initial volume fraction `phi0 = N d^3 / (8 R0^3)`; give this or `radius`.
+    #[serde(default)]
+    pub phi0: Option<f64>,
+    /// Initial droplet radius R0; give this or `phi0`.
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Start from the last frame of this GSD file instead of random insertion.
+    #[serde(default)]
+    pub initial: Option<PathBuf>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[drying]`: `R(t) = sqrt(R0^2 - alpha t / (4 pi))`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DryingSection {
+    /// Peclet number `Pe = R |dR/dt| / D0` (default 10); give this or `alpha`.
+    #[serde(default)]
+    pub peclet: Option<f64>,
+    /// Rate of loss of surface area `alpha = -dA/dt` (length^2 / time); give this or `peclet`.
+    #[serde(default)]
+    pub alpha: Option<f64>,
+    /// Stop when the mean volume fraction `N d^3 / (8 R^3)` reaches this (default 0.55);
+    /// give this or `duration`.
+    #[serde(default)]
+    pub final_volume_fraction: Option<f64>,
+    /// Stop after this time instead (time units).
+    #[serde(default)]
+    pub duration: Option<f64>,
+}
+
+/// `[interface]`: harmonic wall `V = k/2 s^2` for `0 <= s < range`, linear beyond, with
+/// `s = r - (R(t) + offset)`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InterfaceSection {
+    /// Spring constant k (energy / length^2; default 50 kT / d^2).
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// Range Delta of the harmonic part (length; default d / 2).
+    #[serde(default)]
+    pub range: Option<f64>,
+    /// Offset of the wall from R(t) (length; default -d / 2: the surface touches the interface).
+    #[serde(default)]
+    pub offset: Option<f64>,
+}
+
+/// `[run]`: time stepping and neighbour list.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RunSection {
+    /// Time step (time units; default 2e-4 d^2 / D0).
+    #[serde(default)]
+    pub dt: Option<f64>,
+    /// Verlet skin (length; default 0.3 d).
+    #[serde(default)]
+    pub skin: Option<f64>,
+}
+
+/// `[observe]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ObserveSection {
+    /// Radial volume-fraction profiles.
+    #[serde(default)]
+    pub profile: ProfileSection,
+    /// GSD trajectory of the first replica.
+    #[serde(default)]
+    pub trajectory: TrajectorySection,
+}
+
+/// `[observe.profile]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileSection {
+    /// Number of radial bins between 0 and R(t).
+    #[serde(default = "default_bins")]
+    pub bins: usize,
+    /// Fractions of the drying time at which profiles are taken.
+    #[serde(default = "default_fractions")]
+    pub fractions: Vec<f64>,
+}
+
+fn default_bins() -> usize {
+    50
+}
+fn default_fractions() -> Vec<f64> {
+    vec![0.0, 0.25, 0.5, 0.75, 1.0]
+}
+
+impl Default for ProfileSection {
+    fn default() -> Self {
+        Self {
+            bins: default_bins(),
+            fractions: default_fractions(),
+        }
+    }
+}
+
+/// `[observe.trajectory]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TrajectorySection {
+    /// Write a GSD frame every this many steps (0: no trajectory).
+    #[serde(default)]
+    pub every: u64,
+}
+
+/// Resolved, validated parameters of a drying droplet.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct DropletParams {
+    /// Seed (32 bits).
+    pub seed: u32,
+    /// Independent replicas.
+    pub replicas: usize,
+    /// Number of colloids.
+    pub particles: usize,
+    /// Colloid diameter d.
+    pub diameter: f64,
+    /// Thermal energy kT.
+    pub kt: f64,
+    /// Solvent viscosity.
+    pub viscosity: f64,
+    /// Stokes friction `3 pi eta d`.
+    pub friction: f64,
+    /// Free diffusivity `D0 = kT / (3 pi eta d)`.
+    pub d0: f64,
+    /// Initial volume fraction.
+    pub phi0: f64,
+    /// Initial radius R0.
+    pub r0: f64,
+    /// Peclet number.
+    pub peclet: f64,
+    /// Rate of loss of surface area.
+    pub alpha: f64,
+    /// Drying time (end of the run).
+    pub t_end: f64,
+    /// Radius at the end.
+    pub r_end: f64,
+    /// Mean volume fraction at the end.
+    pub phi_end: f64,
+    /// Interface spring constant.
+    pub stiffness: f64,
+    /// Interface harmonic range.
+    pub range: f64,
+    /// Interface offset.
+    pub offset: f64,
+    /// Time step.
+    pub dt: f64,
+    /// Number of steps `ceil(t_end / dt)`.
+    pub steps: u64,
+    /// Verlet skin.
+    pub skin: f64,
+    /// Profile bins.
+    pub bins: usize,
+    /// Profile fractions of the drying time.
+    pub fractions: Vec<f64>,
+    /// Steps at which profiles are taken (`round(fraction * steps)`).
+    pub profile_steps: Vec<u64>,
+    /// GSD frame period (0: none).
+    pub trajectory_every: u64,
+    /// Initial configuration file, if any.
+    pub initial: Option<PathBuf>,
+}
+
+impl DropletParams {
+    /// Droplet radius at time `t`.
+    pub fn radius_at(&self, t: f64) -> f64 {
+        (self.r0 * self.r0 - self.alpha * t / (4.0 * PI))
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// Mean volume fraction `N d^3 / (8 R^3)` at radius `r`.
+    pub fn volume_fraction_at_radius(&self, r: f64) -> f64 {
+        self.particles as f64 * self.diameter.powi(3) / (8.0 * r.powi(3))
+    }
+}
+
+/// Number of particles that fill a sphere of radius `r0` to volume fraction `phi`
+/// (`8 phi r0^3 / d^3`).
+pub fn particles_for(phi: f64, r0: f64, d: f64) -> f64 {
+    8.0 * phi * r0.powi(3) / d.powi(3)
+}
+
+impl DropletScenario {
+    /// Parse a scenario from TOML text; unknown keys are errors.
+    pub fn from_toml(text: &str) -> Result<Self, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    /// Check every key and resolve the derived parameters.
+    pub fn validate(&self) -> Result<DropletParams, ParamError> {
+        if self.method != "droplet-bd" {
+            return Err(ParamError::new(
+                "method",
+                format!("must be \"droplet-bd\", got \"{}\"", self.method),
+            ));
+        }
+        let seed = u32::try_from(self.seed).map_err(|_| {
+            ParamError::new(
+                "seed",
+                format!("must lie in [0, 4294967295], got {}", self.seed),
+            )
+        })?;
+        let replicas = at_least("replicas", self.replicas, 1)?;
+        let s = &self.system;
+        let particles = at_least("system.particles", s.particles, 1)?;
+        let d = positive("system.diameter", s.diameter)?;
+        let kt = positive("system.kT", s.kt)?;
+        let eta = positive("system.viscosity", s.viscosity)?;
+        let friction = 3.0 * PI * eta * d;
+        let d0 = kt / friction;
+        let n = particles as f64;
+        let (phi0, r0) = match (s.phi0, s.radius) {
+            (Some(phi), None) => {
+                let phi = in_range("system.phi0", phi, 0.0, MAX_PHI0)?;
+                if phi <= 0.0 {
+                    return Err(ParamError::new(
+                        "system.phi0",
+                        format!("must lie in (0, {MAX_PHI0}], got {phi}"),
+                    ));
+                }
+                (phi, d * (n / (8.0 * phi)).cbrt())
+            }
+            (None, Some(r)) => {
+                let r = positive("system.radius", r)?;
+                let phi = n * d.powi(3) / (8.0 * r.powi(3));
+                if phi > MAX_PHI0 {
+                    return Err(ParamError::new(
+                        "system.radius",
+                        format!(
+                            "{particles} particles of diameter {d} in radius {r} give phi0 = {phi:.4}, \
+                             which cannot be packed by random insertion (at most {MAX_PHI0}); \
+                             the radius must be at least {:.4}",
+                            d * (n / (8.0 * MAX_PHI0)).cbrt()
+                        ),
+                    ));
+                }
+                (phi, r)
+            }
+            (Some(_), Some(_)) => {
+                return Err(ParamError::new(
+                    "system.phi0",
+                    "give either system.phi0 or system.radius, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(ParamError::new(
+                    "system.phi0",
+                    "missing: give system.phi0 (initial volume fraction, (0, 0.3]) or system.radius",
+                ));
+            }
+        };
+        if r0 < d {
+            return Err(ParamError::new(
+                "system.particles",
+                format!("the initial droplet radius {r0:.4} is smaller than a diameter {d}"),
+            ));
+        }
+
+        let dr = &self.drying;
+        let (peclet, alpha) = match (dr.peclet, dr.alpha) {
+            (Some(_), Some(_)) => {
+                return Err(ParamError::new(
+                    "drying.peclet",
+                    "give either drying.peclet or drying.alpha, not both",
+                ));
+            }
+            (None, Some(a)) => {
+                let a = positive("drying.alpha", a)?;
+                (a / (8.0 * PI * d0), a)
+            }
+            (pe, None) => {
+                let pe = positive("drying.peclet", pe.unwrap_or(10.0))?;
+                (pe, 8.0 * PI * pe * d0)
+            }
+        };
+        // R(t)^2 = R0^2 - alpha t / (4 pi).
+        let t_dry = 4.0 * PI * r0 * r0 / alpha; // time at which R^2 = 0
+        let (t_end, r_end) = match (dr.final_volume_fraction, dr.duration) {
+            (Some(_), Some(_)) => {
+                return Err(ParamError::new(
+                    "drying.final_volume_fraction",
+                    "give either drying.final_volume_fraction or drying.duration, not both",
+                ));
+            }
+            (None, Some(t)) => {
+                let t = positive("drying.duration", t)?;
+                if t >= t_dry {
+                    return Err(ParamError::new(
+                        "drying.duration",
+                        format!(
+                            "a drying time of {t} would need R^2 = {:.4} < 0 (the droplet vanishes at t = {t_dry:.6}); \
+                             use a shorter duration or drying.final_volume_fraction",
+                            r0 * r0 - alpha * t / (4.0 * PI)
+                        ),
+                    ));
+                }
+                (t, (r0 * r0 - alpha * t / (4.0 * PI)).sqrt())
+            }
+            (phi_f, None) => {
+                let phi_f = phi_f.unwrap_or(0.55);
+                if !(phi_f.is_finite() && phi_f > phi0 && phi_f <= MAX_PHI_FINAL) {
+                    return Err(ParamError::new(
+                        "drying.final_volume_fraction",
+                        format!(
+                            "must lie in (phi0 = {phi0:.4}, {MAX_PHI_FINAL}], got {phi_f}: \
+                             the drying would end before it starts"
+                        ),
+                    ));
+                }
+                let r_end = r0 * (phi0 / phi_f).cbrt();
+                ((r0 * r0 - r_end * r_end) * 4.0 * PI / alpha, r_end)
+            }
+        };
+        let phi_end = n * d.powi(3) / (8.0 * r_end.powi(3));
+        if phi_end > MAX_PHI_FINAL {
+            return Err(ParamError::new(
+                "drying.duration",
+                format!(
+                    "the mean volume fraction would reach {phi_end:.4} > {MAX_PHI_FINAL} (random close packing)"
+                ),
+            ));
+        }
+
+        let it = &self.interface;
+        let stiffness = positive(
+            "interface.stiffness",
+            it.stiffness.unwrap_or(50.0 * kt / (d * d)),
+        )?;
+        let range = positive("interface.range", it.range.unwrap_or(0.5 * d))?;
+        let offset = in_range("interface.offset", it.offset.unwrap_or(-0.5 * d), -r0, r0)?;
+        if r_end + offset <= 0.0 {
+            return Err(ParamError::new(
+                "interface.offset",
+                format!(
+                    "the wall R(t) + offset would reach {:.4} <= 0",
+                    r_end + offset
+                ),
+            ));
+        }
+
+        let dt = positive("run.dt", self.run.dt.unwrap_or(2e-4 * d * d / d0))?;
+        let steps = (t_end / dt).ceil();
+        if steps > 1e12 {
+            return Err(ParamError::new(
+                "run.dt",
+                format!("{steps:e} steps: dt = {dt} is far too small for a drying time {t_end}"),
+            ));
+        }
+        let steps = (steps as u64).max(1);
+        let skin = in_range(
+            "run.skin",
+            self.run.skin.unwrap_or(0.3 * d),
+            1e-3 * d,
+            5.0 * d,
+        )?;
+
+        let p = &self.observe.profile;
+        let bins = at_least("observe.profile.bins", p.bins, 1)?;
+        if p.fractions.is_empty() {
+            return Err(ParamError::new(
+                "observe.profile.fractions",
+                "must list at least one fraction in [0, 1]",
+            ));
+        }
+        for &f in &p.fractions {
+            in_range("observe.profile.fractions", f, 0.0, 1.0)?;
+        }
+        let profile_steps = p
+            .fractions
+            .iter()
+            .map(|f| (f * steps as f64).round() as u64)
+            .collect();
+
+        Ok(DropletParams {
+            seed,
+            replicas,
+            particles,
+            diameter: d,
+            kt,
+            viscosity: eta,
+            friction,
+            d0,
+            phi0,
+            r0,
+            peclet,
+            alpha,
+            t_end,
+            r_end,
+            phi_end,
+            stiffness,
+            range,
+            offset,
+            dt,
+            steps,
+            skin,
+            bins,
+            fractions: p.fractions.clone(),
+            profile_steps,
+            trajectory_every: self.observe.trajectory.every,
+            initial: s.initial.clone(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PAPER: &str = r#"
+method = "droplet-bd"
+seed = 3
+replicas = 4
+[system]
+particles = 6250
+phi0 = 0.05
+[drying]
+peclet = 10
+final_volume_fraction = 0.5
+"#;
+
+    #[test]
+    fn paper_case_resolves_to_r0_25_and_alpha_8_pi_pe_d0() {
+        let p = DropletScenario::from_toml(PAPER)
+            .unwrap()
+            .validate()
+            .unwrap();
+        assert!((p.r0 - 25.0).abs() < 1e-12, "R0 {}", p.r0);
+        let d0 = 1.0 / (3.0 * PI);
+        assert!((p.d0 - d0).abs() < 1e-15);
+        assert!((p.alpha - 8.0 * PI * 10.0 * d0).abs() < 1e-12);
+        // Pe = R |dR/dt| / D0 = alpha / (8 pi D0) at every time.
+        let t = 0.3 * p.t_end;
+        let h = 1e-6 * p.t_end;
+        let drdt = (p.radius_at(t + h) - p.radius_at(t - h)) / (2.0 * h);
+        assert!((p.radius_at(t) * drdt.abs() / p.d0 - 10.0).abs() < 1e-5);
+        assert!((p.volume_fraction_at_radius(p.radius_at(p.t_end)) - 0.5).abs() < 1e-9);
+        assert_eq!(p.profile_steps.len(), 5);
+        assert_eq!(*p.profile_steps.last().unwrap(), p.steps);
+    }
+
+    fn err_key(text: &str) -> String {
+        match DropletScenario::from_toml(text) {
+            Err(e) => format!("parse: {e}"),
+            Ok(s) => s.validate().unwrap_err().key,
+        }
+    }
+
+    #[test]
+    fn bad_input_names_the_key() {
+        // Unknown key.
+        let e = err_key(&PAPER.replace("peclet = 10", "peclet = 10\nspeed = 3"));
+        assert!(e.starts_with("parse") && e.contains("speed"), "{e}");
+        // Cannot be packed.
+        assert_eq!(
+            err_key(&PAPER.replace("phi0 = 0.05", "phi0 = 0.45")),
+            "system.phi0"
+        );
+        assert_eq!(
+            err_key(&PAPER.replace("phi0 = 0.05", "radius = 10.0")),
+            "system.radius"
+        );
+        // Ends before it starts.
+        assert_eq!(
+            err_key(&PAPER.replace(
+                "final_volume_fraction = 0.5",
+                "final_volume_fraction = 0.04"
+            )),
+            "drying.final_volume_fraction"
+        );
+        // R^2 < 0.
+        assert_eq!(
+            err_key(&PAPER.replace("final_volume_fraction = 0.5", "duration = 1e6")),
+            "drying.duration"
+        );
+        assert_eq!(
+            err_key(&PAPER.replace("peclet = 10", "peclet = -1")),
+            "drying.peclet"
+        );
+        assert_eq!(
+            err_key(&PAPER.replace("[drying]", "[run]\ndt = 0\n[drying]")),
+            "run.dt"
+        );
+    }
+}
