@@ -1,0 +1,60 @@
+//! Rosenfeld fundamental-measure DDFT of hard spheres in spherical symmetry (drying droplet).
+//!
+//! METHODS.md section 3; paper `drying-droplet-hydrodynamics.md` Secs. II.2, III.1, III.4.
+//!
+//! - [`grid`]: cell-centred radial finite-volume grid.
+//! - [`fmt`]: radial weighted densities `n3, n2, nv2` (and `n0, n1, nv1` by proportionality), the
+//!   Rosenfeld free-energy density and its functional derivative.
+//! - [`interface`]: the harmonic droplet interface and the shrinking radius `R(t)`.
+//! - [`equilibrium`]: equilibrium profile at fixed particle number (Picard + Anderson mixing).
+//! - [`ddft`]: implicit-Euler DDFT on spherical shells, free-draining or with pairwise RPY flux.
+//! - [`rpy`]: the dilute-limit radial RPY kernel of the hydrodynamic flux.
+//! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
+
+mod anderson;
+pub mod bulk;
+pub mod ddft;
+pub mod equilibrium;
+pub mod fmt;
+pub mod grid;
+pub mod interface;
+pub mod rpy;
+
+pub use ddft::{Ddft, DdftOptions, Hydrodynamics, StepReport};
+pub use equilibrium::{Equilibrium, EquilibriumOptions, solve_equilibrium};
+pub use fmt::Rosenfeld;
+pub use grid::RadialGrid;
+pub use interface::{DryingSchedule, HarmonicInterface};
+
+use colloidsim_core::ParamError;
+use thiserror::Error;
+
+/// Errors of the radial DFT/DDFT solvers.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum RadialError {
+    /// An input parameter is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// An iterative solve stopped without reaching its tolerance.
+    #[error(
+        "{what} did not converge after {iterations} iterations: residual {residual:.3e} > tolerance {tolerance:.1e}"
+    )]
+    NotConverged {
+        /// Which solve.
+        what: String,
+        /// Iterations done.
+        iterations: usize,
+        /// Final residual.
+        residual: f64,
+        /// Requested tolerance.
+        tolerance: f64,
+    },
+    /// The density became unphysical (negative, packing fraction >= 1, particles ejected).
+    #[error("unphysical solution at t = {time:.6}: {message}")]
+    Unphysical {
+        /// Time at which it was detected.
+        time: f64,
+        /// What was detected.
+        message: String,
+    },
+}
