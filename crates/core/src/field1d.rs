@@ -355,8 +355,12 @@ mod tests {
 
     #[test]
     fn non_periodic_table_is_refused() {
-        let e = PeriodicSpline::new("potential.table", vec![0., 1., 2., 3.], vec![0., 1., 2., 3.])
-            .unwrap_err();
+        let e = PeriodicSpline::new(
+            "potential.table",
+            vec![0., 1., 2., 3.],
+            vec![0., 1., 2., 3.],
+        )
+        .unwrap_err();
         assert!(e.message.contains("not periodic"), "{e}");
         assert!(PeriodicSpline::new("k", vec![0., 1., 1., 3.], vec![0., 1., 2., 0.]).is_err());
     }

@@ -74,10 +74,7 @@ impl OutputDir {
     pub fn create(root: impl Into<PathBuf>, overwrite: bool) -> Result<Self, OutputError> {
         let root = root.into();
         if root.exists() {
-            let non_empty = fs::read_dir(&root)
-                .map_err(io_err(&root))?
-                .next()
-                .is_some();
+            let non_empty = fs::read_dir(&root).map_err(io_err(&root))?.next().is_some();
             if non_empty && !overwrite {
                 return Err(OutputError::Exists(root));
             }
@@ -230,6 +227,9 @@ mod tests {
             Err(OutputError::Exists(_))
         ));
         assert!(OutputDir::create(tmp.path().join("out"), true).is_ok());
-        assert!(dir.write_table("bad.csv", &[("x", &x), ("y", &y[..2])]).is_err());
+        assert!(
+            dir.write_table("bad.csv", &[("x", &x), ("y", &y[..2])])
+                .is_err()
+        );
     }
 }

@@ -84,6 +84,9 @@ mod tests {
         let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
         // Standard errors: 1/sqrt(n) ~ 0.0022 for the mean, sqrt(2/n) ~ 0.0032 for the variance.
         assert!(mean.abs() < 5.0 * (1.0 / n as f64).sqrt(), "mean {mean}");
-        assert!((var - 1.0).abs() < 5.0 * (2.0 / n as f64).sqrt(), "var {var}");
+        assert!(
+            (var - 1.0).abs() < 5.0 * (2.0 / n as f64).sqrt(),
+            "var {var}"
+        );
     }
 }

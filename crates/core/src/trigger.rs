@@ -8,7 +8,7 @@ impl Every {
     /// Does the trigger fire at `step`?
     #[inline]
     pub fn fires(&self, step: u64) -> bool {
-        self.0 > 0 && step % self.0 == 0
+        self.0 > 0 && step.is_multiple_of(self.0)
     }
 }
 

@@ -1,0 +1,811 @@
+//! The BCD time step: forces, fragmentation, premerging (or the chronological event-driven
+//! update), and the position update.
+//!
+//! Rods are kept in ring order with unwrapped positions, `x[0] < x[1] < ... < x[N-1]`, and on
+//! the ring `x[N-1] < x[0] + L`, so positions are also the displacements needed for the MSD.
+//! A *virtual index* `w` counts around the ring from the first cluster start (`origin`);
+//! `w >= N` denotes rod `w - N` seen one period further on (position `+ L`).
+//!
+//! The ring is cut into chunks of about [`CHUNK`] rods at cluster boundaries; each chunk computes
+//! its forces, fragments its clusters and premerges them independently (in parallel), then one
+//! short sequential pass premerges across chunk boundaries and the periodic seam. Chunking
+//! depends only on N and the configuration, never on the thread count, so results are
+//! bitwise identical for any number of threads.
+
+use crate::cluster::{Cluster, FragmentScratch, Wall, collide, fragment, merge, premerge};
+use crate::forces::{ExternalForce, PairForce};
+use colloidsim_core::ParamError;
+use colloidsim_core::param;
+use colloidsim_core::rng::{BLOCK, fill_normal_block};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Rods per chunk of the parallel step.
+pub const CHUNK: usize = 4096;
+
+/// What bounds the line of rods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Boundary {
+    /// A ring of length L.
+    Periodic,
+    /// Hard walls at 0 and L: rod centres stay in [sigma/2, L - sigma/2].
+    Walls,
+}
+
+/// How collisions within a step are resolved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Update {
+    /// Premerging, O(N) per step (fast-bcd Secs. IV–V).
+    Premerge,
+    /// Chronological event-driven update, O(N^2) per step (hard-rods paper Sec. III B).
+    Chronological,
+}
+
+/// Physical and numerical parameters of a BCD run (units: the scenario's length, time and energy).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BcdConfig {
+    /// System length L.
+    pub length: f64,
+    /// Rod length sigma.
+    pub sigma: f64,
+    /// Mobility mu (velocity per force).
+    pub mobility: f64,
+    /// Thermal energy kT (0 gives deterministic cluster dynamics).
+    pub kt: f64,
+    /// Time step.
+    pub dt: f64,
+    /// Ring or walls.
+    pub boundary: Boundary,
+    /// Seed of the counter-based noise.
+    pub seed: u32,
+    /// Collision resolution.
+    pub update: Update,
+}
+
+impl BcdConfig {
+    /// Check ranges for `n` rods; errors name the scenario key.
+    pub fn validate(&self, n: usize) -> Result<(), ParamError> {
+        param::positive("system.length", self.length)?;
+        param::positive("system.diameter", self.sigma)?;
+        param::positive("system.mobility", self.mobility)?;
+        param::non_negative("system.kT", self.kt)?;
+        param::positive("run.dt", self.dt)?;
+        param::at_least("system.particles", n, 1)?;
+        if n > u32::MAX as usize / 4 {
+            return Err(ParamError::new(
+                "system.particles",
+                format!("at most {} rods, got {n}", u32::MAX / 4),
+            ));
+        }
+        let packed = n as f64 * self.sigma;
+        if packed >= self.length {
+            return Err(ParamError::new(
+                "system.particles",
+                format!(
+                    "{n} rods of length {} fill {packed} >= system.length {}: N sigma must be < L",
+                    self.sigma, self.length
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Diffusion coefficient D = mu kT.
+    pub fn diffusion(&self) -> f64 {
+        self.mobility * self.kt
+    }
+}
+
+/// Errors of the engine.
+#[derive(Debug, Error)]
+pub enum BcdError {
+    /// Invalid parameter.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// Initial positions violate the hard core or the walls.
+    #[error("initial positions: {0}")]
+    Positions(String),
+    /// A force or position became NaN or infinite.
+    #[error(
+        "the run went non-finite at step {step}: rod {particle} at x = {position} has velocity {velocity}; reduce run.dt or check the potential"
+    )]
+    NonFinite {
+        /// Step at which it happened.
+        step: u64,
+        /// Rod index.
+        particle: usize,
+        /// Its position.
+        position: f64,
+        /// Its (non-finite) velocity.
+        velocity: f64,
+    },
+}
+
+/// Dynamic state that a checkpoint must hold (with the config and the step counter).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BcdState {
+    /// Unwrapped rod centres in ring order.
+    pub x: Vec<f64>,
+    /// `bond[i] = 1` when rods i and i+1 (mod N) belong to one cluster.
+    pub bond: Vec<u8>,
+    /// The first rod is stuck to the left wall.
+    pub left_contact: bool,
+    /// The last rod is stuck to the right wall.
+    pub right_contact: bool,
+    /// Steps done.
+    pub step: u64,
+}
+
+#[derive(Debug, Default, Clone)]
+struct Chunk {
+    vs: usize,
+    ve: usize,
+    u: Vec<f64>,
+    stack: Vec<Cluster>,
+    frag: FragmentScratch,
+    bad: Option<usize>,
+}
+
+/// Read-only view of the configuration shared by the chunks of one step.
+struct Ring<'a> {
+    x: &'a [f64],
+    bond: &'a [u8],
+    n: usize,
+    length: f64,
+    periodic: bool,
+}
+
+impl Ring<'_> {
+    #[inline]
+    fn actual(&self, w: usize) -> usize {
+        if w < self.n {
+            w
+        } else if w < 2 * self.n {
+            w - self.n
+        } else {
+            w - 2 * self.n
+        }
+    }
+    /// Unwrapped position of virtual index `w`.
+    #[inline]
+    fn pos(&self, w: usize) -> f64 {
+        if w < self.n {
+            self.x[w]
+        } else if w < 2 * self.n {
+            self.x[w - self.n] + self.length
+        } else {
+            self.x[w - 2 * self.n] + 2.0 * self.length
+        }
+    }
+    #[inline]
+    fn bonded_right(&self, w: usize) -> bool {
+        self.bond[self.actual(w)] != 0
+    }
+}
+
+/// Brownian cluster dynamics of N hard rods, generic over the external and pair forces.
+pub struct Bcd<E: ExternalForce, P: PairForce> {
+    cfg: BcdConfig,
+    ext: E,
+    pair: P,
+    state: BcdState,
+    chunks: Vec<Chunk>,
+    global: Vec<Cluster>,
+    noise_amp: f64,
+}
+
+impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
+    /// Set up a run from rod centres `x` (sorted, non-overlapping; unwrapped on the ring).
+    pub fn new(cfg: BcdConfig, x: Vec<f64>, ext: E, pair: P) -> Result<Self, BcdError> {
+        cfg.validate(x.len())?;
+        check_positions(&cfg, &x)?;
+        let n = x.len();
+        let tol = 1e-12 * cfg.sigma.max(cfg.length / n as f64);
+        let mut bond = vec![0u8; n];
+        for i in 0..n {
+            let gap = if i + 1 < n {
+                x[i + 1] - x[i]
+            } else if cfg.boundary == Boundary::Periodic && n > 1 {
+                x[0] + cfg.length - x[n - 1]
+            } else {
+                f64::INFINITY
+            };
+            bond[i] = u8::from(gap <= cfg.sigma + tol);
+        }
+        let (left_contact, right_contact) = match cfg.boundary {
+            Boundary::Walls => (
+                x[0] <= 0.5 * cfg.sigma + tol,
+                x[n - 1] >= cfg.length - 0.5 * cfg.sigma - tol,
+            ),
+            Boundary::Periodic => (false, false),
+        };
+        let state = BcdState {
+            x,
+            bond,
+            left_contact,
+            right_contact,
+            step: 0,
+        };
+        Self::from_state(cfg, state, ext, pair)
+    }
+
+    /// Continue from a saved state (checkpoint).
+    pub fn from_state(cfg: BcdConfig, state: BcdState, ext: E, pair: P) -> Result<Self, BcdError> {
+        cfg.validate(state.x.len())?;
+        if state.bond.len() != state.x.len() {
+            return Err(BcdError::Positions(
+                "bond array length differs from N".into(),
+            ));
+        }
+        check_positions(&cfg, &state.x)?;
+        let n = state.x.len();
+        let chunks = vec![Chunk::default(); n.div_ceil(CHUNK)];
+        let noise_amp = (2.0 * cfg.diffusion() / cfg.dt).sqrt();
+        Ok(Self {
+            cfg,
+            ext,
+            pair,
+            state,
+            chunks,
+            global: Vec::new(),
+            noise_amp,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &BcdConfig {
+        &self.cfg
+    }
+    /// Number of rods.
+    pub fn len(&self) -> usize {
+        self.state.x.len()
+    }
+    /// Always false (a run has at least one rod).
+    pub fn is_empty(&self) -> bool {
+        self.state.x.is_empty()
+    }
+    /// Unwrapped rod centres in ring order.
+    pub fn positions(&self) -> &[f64] {
+        &self.state.x
+    }
+    /// The dynamic state (for checkpoints).
+    pub fn state(&self) -> &BcdState {
+        &self.state
+    }
+    /// Steps done.
+    pub fn steps(&self) -> u64 {
+        self.state.step
+    }
+    /// Time reached.
+    pub fn time(&self) -> f64 {
+        self.state.step as f64 * self.cfg.dt
+    }
+    /// The external force.
+    pub fn external(&self) -> &E {
+        &self.ext
+    }
+
+    /// Sizes of the clusters present at the end of the last step (rods in contact that moved
+    /// together), in ring order starting from the first cluster start.
+    pub fn cluster_sizes(&self, mut visit: impl FnMut(usize)) {
+        let n = self.len();
+        let origin = self.origin();
+        let mut size = 0;
+        for w in origin..origin + n {
+            size += 1;
+            if self.state.bond[w % n] == 0 {
+                visit(size);
+                size = 0;
+            }
+        }
+        if size > 0 {
+            visit(size);
+        }
+    }
+
+    fn origin(&self) -> usize {
+        let n = self.len();
+        match self.cfg.boundary {
+            Boundary::Walls => 0,
+            Boundary::Periodic => (0..n)
+                .find(|&i| self.state.bond[(i + n - 1) % n] == 0)
+                .unwrap_or(0),
+        }
+    }
+
+    /// Advance by one time step.
+    pub fn step(&mut self) -> Result<(), BcdError> {
+        let n = self.len();
+        let origin = self.origin();
+        let periodic = self.cfg.boundary == Boundary::Periodic;
+        let chronological = self.cfg.update == Update::Chronological;
+        let (sigma, dt, length) = (self.cfg.sigma, self.cfg.dt, self.cfg.length);
+
+        // Chunk boundaries at cluster starts, about CHUNK rods apart.
+        {
+            let ring = Ring {
+                x: &self.state.x,
+                bond: &self.state.bond,
+                n,
+                length,
+                periodic,
+            };
+            let end = origin + n;
+            let k = self.chunks.len();
+            let mut prev = origin;
+            for c in 0..k {
+                let mut s = (origin + c * CHUNK).min(end);
+                while s > origin && s < end && ring.bonded_right(s - 1) {
+                    s += 1;
+                }
+                if c > 0 {
+                    self.chunks[c - 1].ve = s;
+                }
+                self.chunks[c].vs = s.max(prev);
+                prev = self.chunks[c].vs;
+            }
+            self.chunks[k - 1].ve = end;
+        }
+
+        // Forces, fragmentation and chunk-local premerging, in parallel.
+        {
+            let ring = Ring {
+                x: &self.state.x,
+                bond: &self.state.bond,
+                n,
+                length,
+                periodic,
+            };
+            let ctx = StepCtx {
+                ring: &ring,
+                ext: &self.ext,
+                pair: &self.pair,
+                mobility: self.cfg.mobility,
+                noise_amp: self.noise_amp,
+                seed: self.cfg.seed,
+                step: self.state.step,
+                sigma,
+                dt,
+                left_wall: !periodic && self.state.left_contact,
+                right_wall: !periodic && self.state.right_contact,
+                premerge: !chronological,
+            };
+            self.chunks
+                .par_iter_mut()
+                .for_each(|c| chunk_phase(c, &ctx));
+        }
+        if let Some(i) = self.chunks.iter().filter_map(|c| c.bad).min() {
+            let c = self
+                .chunks
+                .iter()
+                .find(|c| c.bad == Some(i))
+                .expect("found");
+            let w = (c.vs..c.ve).find(|&w| w % n == i).unwrap_or(c.vs);
+            return Err(BcdError::NonFinite {
+                step: self.state.step,
+                particle: i,
+                position: self.state.x[i],
+                velocity: c.u[w - c.vs],
+            });
+        }
+
+        // Sequential pass across chunk boundaries, then walls or the periodic seam.
+        let g = &mut self.global;
+        g.clear();
+        if !periodic {
+            g.push(Cluster {
+                start: 0,
+                n: 0,
+                left: 0.5 * sigma,
+                v: 0.0,
+                wall: Wall::Left,
+            });
+        }
+        for c in &self.chunks {
+            for &cl in &c.stack {
+                if cl.wall == Wall::Left {
+                    let top = g.last_mut().expect("left wall sentinel");
+                    *top = merge(top, &cl, sigma);
+                } else if chronological {
+                    g.push(cl);
+                } else {
+                    premerge(g, cl, sigma, dt);
+                }
+            }
+        }
+        let mut head = 0;
+        let mut write_dt = dt;
+        if !periodic {
+            let right = Cluster {
+                start: n as u32,
+                n: 0,
+                left: length + 0.5 * sigma,
+                v: 0.0,
+                wall: Wall::Right,
+            };
+            if chronological {
+                g.push(right);
+            } else {
+                premerge(g, right, sigma, dt);
+            }
+        }
+        if chronological {
+            head = chronological_events(g, periodic, n, length, sigma, dt);
+            write_dt = 0.0;
+        } else if periodic {
+            head = stitch_seam(g, n, length, sigma, dt);
+        }
+
+        // Position and bond update, in parallel over fixed ranges of rods.
+        let live = &self.global[head..];
+        let first_start = live
+            .iter()
+            .find(|c| c.n > 0)
+            .map_or(0, |c| c.start as usize);
+        let back = *live
+            .iter()
+            .rev()
+            .find(|c| c.n > 0)
+            .expect("at least one rod");
+        let periodic_origin = if periodic { origin } else { 0 };
+        let len = length;
+        self.state
+            .x
+            .par_chunks_mut(CHUNK)
+            .zip(self.state.bond.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(k, (xs, bs))| {
+                let a0 = k * CHUNK;
+                let a1 = a0 + xs.len();
+                let write = |w0: usize, w1: usize, xs: &mut [f64], bs: &mut [u8]| {
+                    write_range(
+                        live,
+                        &back,
+                        first_start,
+                        n,
+                        len,
+                        sigma,
+                        write_dt,
+                        w0,
+                        w1,
+                        xs,
+                        bs,
+                    )
+                };
+                if periodic_origin > a0 {
+                    let m = periodic_origin.min(a1) - a0;
+                    let (xl, xr) = xs.split_at_mut(m);
+                    let (bl, br) = bs.split_at_mut(m);
+                    write(a0 + n, a0 + m + n, xl, bl);
+                    if !xr.is_empty() {
+                        write(a0 + m, a1, xr, br);
+                    }
+                } else {
+                    write(a0, a1, xs, bs);
+                }
+            });
+        if !periodic {
+            self.state.left_contact = live
+                .first()
+                .is_some_and(|c| c.wall == Wall::Left && c.n > 0);
+            self.state.right_contact = back.wall == Wall::Right;
+            // The last rod is never bonded to the right (no ring).
+            self.state.bond[n - 1] = 0;
+        }
+        self.state.step += 1;
+        Ok(())
+    }
+
+    /// Run `steps` steps.
+    pub fn run(&mut self, steps: u64) -> Result<(), BcdError> {
+        for _ in 0..steps {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Check the hard core and the walls (for tests): returns the smallest gap minus sigma.
+    pub fn min_clearance(&self) -> f64 {
+        let x = &self.state.x;
+        let n = x.len();
+        let s = self.cfg.sigma;
+        let mut m = f64::INFINITY;
+        for i in 0..n.saturating_sub(1) {
+            m = m.min(x[i + 1] - x[i] - s);
+        }
+        match self.cfg.boundary {
+            Boundary::Periodic if n > 1 => m.min(x[0] + self.cfg.length - x[n - 1] - s),
+            Boundary::Periodic => m,
+            Boundary::Walls => m
+                .min(x[0] - 0.5 * s)
+                .min(self.cfg.length - 0.5 * s - x[n - 1]),
+        }
+    }
+}
+
+struct StepCtx<'a, E, P> {
+    ring: &'a Ring<'a>,
+    ext: &'a E,
+    pair: &'a P,
+    mobility: f64,
+    noise_amp: f64,
+    seed: u32,
+    step: u64,
+    sigma: f64,
+    dt: f64,
+    left_wall: bool,
+    right_wall: bool,
+    premerge: bool,
+}
+
+/// Free velocities `u_i = mu F_i` (Eq. 3 of fast-bcd; Eq. 12 of the hard-rods paper) for the
+/// chunk's rods, then fragmentation of its clusters and premerging of the fragments.
+fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P>) {
+    c.stack.clear();
+    c.bad = None;
+    let (vs, ve) = (c.vs, c.ve);
+    if vs >= ve {
+        return;
+    }
+    let ring = ctx.ring;
+    let n = ring.n;
+    c.u.clear();
+    c.u.resize(ve - vs, 0.0);
+    let range = ctx.pair.range();
+    let has_pair = range > ctx.sigma;
+    let mut block = usize::MAX;
+    let mut noise = [0.0f64; BLOCK];
+    for w in vs..ve {
+        let i = ring.actual(w);
+        let xi = ring.pos(w);
+        let mut f = ctx.ext.force(xi);
+        if has_pair {
+            // Right neighbours push i to the left, left neighbours to the right.
+            let mut k = 1;
+            while k < n && (ring.periodic || i + k < n) {
+                let r = ring.pos(w + k) - xi;
+                if r >= range {
+                    break;
+                }
+                f -= ctx.pair.force(r);
+                k += 1;
+            }
+            let mut k = 1;
+            while k < n && (ring.periodic || i >= k) {
+                let r = xi - (ring.pos(w + n - k) - ring.length);
+                if r >= range {
+                    break;
+                }
+                f += ctx.pair.force(r);
+                k += 1;
+            }
+        }
+        let mut u = ctx.mobility * f;
+        if ctx.noise_amp > 0.0 {
+            let b = i / BLOCK;
+            if b != block {
+                block = b;
+                let m = BLOCK.min(n - b * BLOCK);
+                fill_normal_block(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+            }
+            u += ctx.noise_amp * noise[i - b * BLOCK];
+        }
+        if !u.is_finite() && c.bad.is_none() {
+            c.bad = Some(i);
+        }
+        c.u[w - vs] = u;
+    }
+    if c.bad.is_some() {
+        return;
+    }
+    let mut s = vs;
+    while s < ve {
+        let mut e = s + 1;
+        while e < ve && ring.bonded_right(e - 1) {
+            e += 1;
+        }
+        let lw = ctx.left_wall && s == 0;
+        let rw = ctx.right_wall && e == n && !ring.periodic;
+        let (stack, frag, u) = (&mut c.stack, &mut c.frag, &c.u);
+        fragment(&u[s - vs..e - vs], lw, rw, frag, |a, len, v, wall| {
+            let cl = Cluster {
+                start: (s + a) as u32,
+                n: len as u32,
+                left: ring.pos(s + a),
+                v,
+                wall,
+            };
+            // A fragment stuck to the left wall joins the wall sentinel in the sequential pass.
+            if ctx.premerge && wall != Wall::Left {
+                premerge(stack, cl, ctx.sigma, ctx.dt);
+            } else {
+                stack.push(cl);
+            }
+        });
+        s = e;
+    }
+}
+
+/// Premerge across the periodic seam: the last cluster meets the first one a period further
+/// on. Returns how many clusters at the front were absorbed into the last one.
+fn stitch_seam(g: &mut Vec<Cluster>, n: usize, length: f64, sigma: f64, dt: f64) -> usize {
+    let mut head = 0;
+    while g.len() - head >= 2 {
+        let last = g.len() - 1;
+        let mut front = g[head];
+        front.start += n as u32;
+        front.left += length;
+        if collide(&g[last], &front, sigma, dt) {
+            g[last] = merge(&g[last], &front, sigma);
+            head += 1;
+            // The grown cluster may now reach its left neighbours.
+            while g.len() - head >= 2 {
+                let l = g.len() - 1;
+                if collide(&g[l - 1], &g[l], sigma, dt) {
+                    g[l - 1] = merge(&g[l - 1], &g[l], sigma);
+                    g.pop();
+                } else {
+                    break;
+                }
+            }
+        } else {
+            break;
+        }
+    }
+    head
+}
+
+/// The chronological update of the hard-rods paper (Eqs. 14–20): move every cluster to the
+/// earliest collision, merge the colliding pair inelastically, repeat until the step ends.
+/// O(N) per collision, O(N^2) per step. Positions are advanced in place; returns the number of
+/// front clusters absorbed across the periodic seam.
+fn chronological_events(
+    g: &mut Vec<Cluster>,
+    periodic: bool,
+    n: usize,
+    length: f64,
+    sigma: f64,
+    dt: f64,
+) -> usize {
+    let mut head = 0;
+    let mut remaining = dt;
+    let shifted = |c: &Cluster| Cluster {
+        start: c.start + n as u32,
+        left: c.left + length,
+        ..*c
+    };
+    loop {
+        let mut best = f64::INFINITY;
+        let mut which = usize::MAX;
+        let len = g.len();
+        let pair_time = |a: &Cluster, b: &Cluster| {
+            let closing = a.v - b.v;
+            if closing > 0.0 {
+                ((b.left - a.left - a.n as f64 * sigma).max(0.0)) / closing
+            } else {
+                f64::INFINITY
+            }
+        };
+        for k in head..len.saturating_sub(1) {
+            let t = pair_time(&g[k], &g[k + 1]);
+            if t < best {
+                best = t;
+                which = k;
+            }
+        }
+        if periodic && len - head >= 2 {
+            let t = pair_time(&g[len - 1], &shifted(&g[head]));
+            if t < best {
+                best = t;
+                which = len - 1;
+            }
+        }
+        let t = best.min(remaining);
+        for c in &mut g[head..] {
+            c.left += c.v * t;
+        }
+        if best > remaining || which == usize::MAX {
+            break;
+        }
+        remaining -= best;
+        if which == len - 1 {
+            let f = shifted(&g[head]);
+            g[len - 1] = merge(&g[len - 1], &f, sigma);
+            head += 1;
+        } else {
+            g[which] = merge(&g[which], &g[which + 1], sigma);
+            g.remove(which + 1);
+        }
+    }
+    head
+}
+
+/// Write positions and bonds of the rods with virtual indices `[w0, w1)` from the cluster
+/// list `live` (sorted by start); rods before `first_start` belong to `back` one period on.
+fn write_range(
+    live: &[Cluster],
+    back: &Cluster,
+    first_start: usize,
+    n: usize,
+    length: f64,
+    sigma: f64,
+    dt: f64,
+    w0: usize,
+    w1: usize,
+    xs: &mut [f64],
+    bs: &mut [u8],
+) {
+    let mut put = |c: &Cluster, w: usize, k: usize| {
+        let start = c.start as usize;
+        let pos = c.left + c.v * dt + (w - start) as f64 * sigma;
+        xs[k] = pos - (w / n) as f64 * length;
+        bs[k] = u8::from(w + 1 < start + c.n as usize);
+    };
+    let mut w = w0;
+    while w < w1.min(first_start) {
+        put(back, w + n, w - w0);
+        w += 1;
+    }
+    if w >= w1 {
+        return;
+    }
+    let mut idx = live.partition_point(|c| (c.start + c.n) as usize <= w);
+    while w < w1 {
+        let c = &live[idx];
+        let end = (c.start + c.n) as usize;
+        while w < w1 && w < end {
+            put(c, w, w - w0);
+            w += 1;
+        }
+        idx += 1;
+    }
+}
+
+fn check_positions(cfg: &BcdConfig, x: &[f64]) -> Result<(), BcdError> {
+    let n = x.len();
+    let s = cfg.sigma;
+    let tol = 1e-9 * s;
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        return Err(BcdError::Positions(format!(
+            "rod {i} has a non-finite position"
+        )));
+    }
+    for i in 0..n.saturating_sub(1) {
+        if x[i + 1] - x[i] < s - tol {
+            return Err(BcdError::Positions(format!(
+                "rods {i} (x = {}) and {} (x = {}) overlap: centres closer than the rod length {s} (positions must be sorted and at least sigma apart)",
+                x[i],
+                i + 1,
+                x[i + 1]
+            )));
+        }
+    }
+    match cfg.boundary {
+        Boundary::Periodic => {
+            if n > 1 && x[0] + cfg.length - x[n - 1] < s - tol {
+                return Err(BcdError::Positions(format!(
+                    "rods {} (x = {}) and 0 (x = {}) overlap across the periodic seam (L = {})",
+                    n - 1,
+                    x[n - 1],
+                    x[0],
+                    cfg.length
+                )));
+            }
+        }
+        Boundary::Walls => {
+            if x[0] < 0.5 * s - tol || x[n - 1] > cfg.length - 0.5 * s + tol {
+                return Err(BcdError::Positions(format!(
+                    "rod centres must lie in [sigma/2, L - sigma/2] = [{}, {}] between walls; found {} and {}",
+                    0.5 * s,
+                    cfg.length - 0.5 * s,
+                    x[0],
+                    x[n - 1]
+                )));
+            }
+        }
+    }
+    Ok(())
+}

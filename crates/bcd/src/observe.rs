@@ -1,0 +1,233 @@
+//! Observables of a BCD run, sampled on triggers: density profile (hard-rods paper Eq. 26),
+//! two-particle density at contact (Eq. 27), mean-square displacement, particle current and
+//! cluster-size statistics.
+
+use crate::engine::{Bcd, Boundary};
+use crate::forces::{ExternalForce, PairForce};
+
+/// Histogram of rod centres over `[0, period)`, folded when the system is longer.
+/// `rho(x_a + dx/2) = p_a / (M dx (L / period))`, so its mean is the mean density N/L.
+#[derive(Debug, Clone)]
+pub struct DensityProfile {
+    period: f64,
+    counts: Vec<u64>,
+    samples: u64,
+    folds: f64,
+}
+
+impl DensityProfile {
+    /// `bins` bins over one `period` of a system of length `length`.
+    pub fn new(bins: usize, period: f64, length: f64) -> Self {
+        Self {
+            period,
+            counts: vec![0; bins],
+            samples: 0,
+            folds: length / period,
+        }
+    }
+
+    /// Add one configuration.
+    pub fn sample(&mut self, x: &[f64]) {
+        let m = self.counts.len();
+        let scale = m as f64 / self.period;
+        for &xi in x {
+            let b = ((xi.rem_euclid(self.period)) * scale) as usize;
+            self.counts[b.min(m - 1)] += 1;
+        }
+        self.samples += 1;
+    }
+
+    /// Bin centres and densities.
+    pub fn profile(&self) -> (Vec<f64>, Vec<f64>) {
+        let m = self.counts.len();
+        let dx = self.period / m as f64;
+        let norm = 1.0 / (self.samples.max(1) as f64 * dx * self.folds);
+        (
+            (0..m).map(|a| (a as f64 + 0.5) * dx).collect(),
+            self.counts.iter().map(|&p| p as f64 * norm).collect(),
+        )
+    }
+
+    /// Number of configurations sampled.
+    pub fn samples(&self) -> u64 {
+        self.samples
+    }
+}
+
+/// Two-particle density at contact, `rho2(x, x + sigma)`: a rod in bin `a` whose right
+/// neighbour lies within `[x + sigma, x + sigma + window)` counts once,
+/// `rho2 = q_a / (M dx window (L / period))` (hard-rods paper Eq. 27).
+#[derive(Debug, Clone)]
+pub struct ContactDensity {
+    inner: DensityProfile,
+    window: f64,
+    sigma: f64,
+    length: f64,
+    periodic: bool,
+}
+
+impl ContactDensity {
+    /// `bins` bins over `period`, contact window `window` (Delta').
+    pub fn new(
+        bins: usize,
+        window: f64,
+        period: f64,
+        sigma: f64,
+        length: f64,
+        boundary: Boundary,
+    ) -> Self {
+        Self {
+            inner: DensityProfile::new(bins, period, length),
+            window,
+            sigma,
+            length,
+            periodic: boundary == Boundary::Periodic,
+        }
+    }
+
+    /// Add one configuration.
+    pub fn sample(&mut self, x: &[f64]) {
+        let n = x.len();
+        let m = self.inner.counts.len();
+        let scale = m as f64 / self.inner.period;
+        let reach = self.sigma + self.window;
+        for i in 0..n {
+            let right = if i + 1 < n {
+                x[i + 1]
+            } else if self.periodic && n > 1 {
+                x[0] + self.length
+            } else {
+                continue;
+            };
+            if right - x[i] < reach {
+                let b = ((x[i].rem_euclid(self.inner.period)) * scale) as usize;
+                self.inner.counts[b.min(m - 1)] += 1;
+            }
+        }
+        self.inner.samples += 1;
+    }
+
+    /// Bin centres and contact densities.
+    pub fn profile(&self) -> (Vec<f64>, Vec<f64>) {
+        let (x, mut r) = self.inner.profile();
+        for v in &mut r {
+            *v /= self.window;
+        }
+        (x, r)
+    }
+}
+
+/// Mean-square displacement at log-spaced lags (in steps), averaged over rods and over time
+/// origins taken every `origin_every` steps.
+#[derive(Debug, Clone)]
+pub struct Msd {
+    lags: Vec<u64>,
+    origin_every: u64,
+    /// Stored origins: (step, positions).
+    origins: std::collections::VecDeque<(u64, Vec<f64>)>,
+    spare: Vec<Vec<f64>>,
+    sum: Vec<f64>,
+    sum_sq: Vec<f64>,
+    count: Vec<u64>,
+}
+
+impl Msd {
+    /// MSD at the given lags (steps, sorted ascending), origins every `origin_every` steps.
+    pub fn new(lags: Vec<u64>, origin_every: u64) -> Self {
+        let k = lags.len();
+        Self {
+            lags,
+            origin_every: origin_every.max(1),
+            origins: Default::default(),
+            spare: Vec::new(),
+            sum: vec![0.0; k],
+            sum_sq: vec![0.0; k],
+            count: vec![0; k],
+        }
+    }
+
+    /// Offer the configuration at `step` (call every step of the sampled part of the run).
+    pub fn sample(&mut self, step: u64, x: &[f64]) {
+        let max_lag = *self.lags.last().unwrap_or(&0);
+        for (t0, x0) in &self.origins {
+            let lag = step - t0;
+            if let Ok(k) = self.lags.binary_search(&lag) {
+                let n = x.len() as f64;
+                let m: f64 = x
+                    .iter()
+                    .zip(x0)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    / n;
+                self.sum[k] += m;
+                self.sum_sq[k] += m * m;
+                self.count[k] += 1;
+            }
+        }
+        while self
+            .origins
+            .front()
+            .is_some_and(|(t0, _)| step - t0 >= max_lag)
+        {
+            let (_, v) = self.origins.pop_front().expect("non-empty");
+            self.spare.push(v);
+        }
+        if step.is_multiple_of(self.origin_every) {
+            let mut v = self.spare.pop().unwrap_or_default();
+            v.clear();
+            v.extend_from_slice(x);
+            self.origins.push_back((step, v));
+        }
+    }
+
+    /// Rows `(lag steps, msd, standard error)`; the error treats origin averages separated by
+    /// more than the lag as independent.
+    pub fn rows(&self) -> Vec<(u64, f64, f64)> {
+        let mut out = Vec::new();
+        for (k, &lag) in self.lags.iter().enumerate() {
+            let c = self.count[k];
+            if c == 0 {
+                continue;
+            }
+            let mean = self.sum[k] / c as f64;
+            let var = (self.sum_sq[k] / c as f64 - mean * mean).max(0.0);
+            let independent =
+                (c as f64 * (self.origin_every as f64 / lag as f64).min(1.0)).max(1.0);
+            out.push((lag, mean, (var / independent).sqrt()));
+        }
+        out
+    }
+}
+
+/// Histogram of cluster sizes (rods in contact moving together).
+#[derive(Debug, Clone, Default)]
+pub struct ClusterSizes {
+    counts: Vec<u64>,
+}
+
+impl ClusterSizes {
+    /// Add the clusters of the current configuration.
+    pub fn sample<E: ExternalForce, P: PairForce>(&mut self, bcd: &Bcd<E, P>) {
+        let counts = &mut self.counts;
+        bcd.cluster_sizes(|s| {
+            if counts.len() <= s {
+                counts.resize(s + 1, 0);
+            }
+            counts[s] += 1;
+        });
+    }
+
+    /// Rows `(size, probability)`: the fraction of clusters of each size.
+    pub fn rows(&self) -> (Vec<f64>, Vec<f64>) {
+        let total: u64 = self.counts.iter().sum();
+        let mut s = Vec::new();
+        let mut p = Vec::new();
+        for (size, &c) in self.counts.iter().enumerate() {
+            if c > 0 {
+                s.push(size as f64);
+                p.push(c as f64 / total.max(1) as f64);
+            }
+        }
+        (s, p)
+    }
+}
