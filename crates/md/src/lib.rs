@@ -1,6 +1,21 @@
 //! colloidsim-md: 3D particles (state and box, neighbour search, pair and external forces,
-//! Brownian dynamics) and the drying-droplet scenario.
+//! Brownian dynamics, initial configurations, GSD input/output) and the drying-droplet
+//! scenario.
 
+pub mod bench;
+pub mod brownian;
 pub mod droplet;
+pub mod gsd;
+pub mod init;
+pub mod neighbor;
+pub mod potential;
+pub mod state;
 
+pub use brownian::{BdError, BdParams, Brownian};
 pub use droplet::{DropletParams, DropletScenario};
+pub use neighbor::NeighborList;
+pub use potential::{
+    External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair, Pair, PairSum,
+    SphereAreaLaw,
+};
+pub use state::{Particles, SimBox};

@@ -1,0 +1,394 @@
+//! GSD input and output in the HOOMD schema (via `hoomd-gsd`).
+//!
+//! Frames hold `configuration/step`, `configuration/box`, `configuration/dimensions`,
+//! `particles/N`, `particles/types`, `particles/typeid`, `particles/diameter`,
+//! `particles/position` (f32, as the schema says) and `particles/image`, which the `gsd`
+//! Python package, freud and OVITO read. Checkpoint frames add the exact double-precision
+//! positions as `log/particles/position_f64` so that a restart continues bitwise identically.
+//! Readers fall back to frame 0 for chunks a frame lacks, as the schema specifies, and to the
+//! schema's defaults after that.
+
+use crate::state::{Particles, SimBox};
+use hoomd_gsd::file_layer::{GsdFile, Mode};
+use std::path::{Path, PathBuf};
+
+const NAME_LEN: usize = 64;
+const POS64: &str = "log/particles/position_f64";
+
+/// A GSD error with the file involved.
+#[derive(Debug, thiserror::Error)]
+pub enum GsdError {
+    /// Opening or creating the file failed.
+    #[error("{path}: {message}")]
+    Open {
+        /// File.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// Writing failed.
+    #[error("{path}: cannot write frame: {message}")]
+    Write {
+        /// File.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// The file is readable but does not hold what a configuration needs.
+    #[error("{path}: {message}")]
+    Content {
+        /// File.
+        path: PathBuf,
+        /// What is missing or inconsistent.
+        message: String,
+    },
+}
+
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = e.source();
+    while let Some(x) = src {
+        s.push_str(": ");
+        s.push_str(&x.to_string());
+        src = x.source();
+    }
+    s
+}
+
+/// Appends frames to a new GSD file.
+pub struct GsdWriter {
+    file: GsdFile,
+    path: PathBuf,
+}
+
+impl GsdWriter {
+    /// Create a new file; an existing file is an error (nothing is overwritten).
+    pub fn create_new(path: &Path) -> Result<Self, GsdError> {
+        let application = format!("colloidsim {}", env!("CARGO_PKG_VERSION"));
+        let file = GsdFile::create_new(path, &application, "hoomd", (1, 4)).map_err(|e| {
+            GsdError::Open {
+                path: path.to_path_buf(),
+                message: chain(&e),
+            }
+        })?;
+        Ok(Self {
+            file,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Open an existing file to append frames (restarts).
+    pub fn append(path: &Path) -> Result<Self, GsdError> {
+        let file = GsdFile::open(path, Mode::Write).map_err(|e| GsdError::Open {
+            path: path.to_path_buf(),
+            message: chain(&e),
+        })?;
+        Ok(Self {
+            file,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Number of frames in the file.
+    pub fn frames(&self) -> u64 {
+        self.file.n_frames()
+    }
+
+    /// Append one frame; `exact` adds double-precision positions for restarts, `log` adds
+    /// scalars as `log/NAME`.
+    pub fn write_frame(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        exact: bool,
+        log: &[(&str, f64)],
+    ) -> Result<(), GsdError> {
+        self.write_inner(step, sbox, p, exact, log)
+            .map_err(|message| GsdError::Write {
+                path: self.path.clone(),
+                message,
+            })
+    }
+
+    fn write_inner(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        exact: bool,
+        log: &[(&str, f64)],
+    ) -> Result<(), String> {
+        let f = &mut self.file;
+        let e = |e: hoomd_gsd::file_layer::WriteError| chain(&e);
+        f.write_scalars("configuration/step", [step]).map_err(e)?;
+        f.write_scalars("configuration/dimensions", [3u8])
+            .map_err(e)?;
+        f.write_scalars(
+            "configuration/box",
+            [
+                sbox.l[0] as f32,
+                sbox.l[1] as f32,
+                sbox.l[2] as f32,
+                0.0,
+                0.0,
+                0.0,
+            ],
+        )
+        .map_err(e)?;
+        let n = u32::try_from(p.len()).map_err(|_| "too many particles".to_string())?;
+        f.write_scalars("particles/N", [n]).map_err(e)?;
+        let names: Vec<[u8; NAME_LEN]> = p
+            .type_names
+            .iter()
+            .map(|s| {
+                let mut a = [0u8; NAME_LEN];
+                for (k, b) in s.bytes().take(NAME_LEN - 1).enumerate() {
+                    a[k] = b;
+                }
+                a
+            })
+            .collect();
+        f.write_arrays("particles/types", names).map_err(e)?;
+        f.write_scalars("particles/typeid", p.typeid.iter().copied())
+            .map_err(e)?;
+        f.write_scalars("particles/diameter", p.diameter.iter().map(|&d| d as f32))
+            .map_err(e)?;
+        f.write_arrays(
+            "particles/position",
+            p.pos
+                .iter()
+                .map(|x| [x[0] as f32, x[1] as f32, x[2] as f32]),
+        )
+        .map_err(e)?;
+        f.write_arrays("particles/image", p.image.iter().copied())
+            .map_err(e)?;
+        if exact {
+            f.write_arrays(POS64, p.pos.iter().copied()).map_err(e)?;
+        }
+        for (name, v) in log {
+            f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
+        }
+        f.end_frame().map_err(|x| chain(&x))?;
+        Ok(())
+    }
+
+    /// Flush buffered frames to the file system.
+    pub fn sync(&mut self) -> Result<(), GsdError> {
+        self.file.sync_all().map_err(|e| GsdError::Write {
+            path: self.path.clone(),
+            message: chain(&e),
+        })
+    }
+}
+
+/// A configuration read from a GSD frame.
+#[derive(Debug, Clone)]
+pub struct GsdFrame {
+    /// `configuration/step`.
+    pub step: u64,
+    /// Box (tilt factors must be zero).
+    pub sbox: SimBox,
+    /// Particles (velocities zero, masses one unless stored).
+    pub particles: Particles,
+    /// Whether exact (f64) positions were present.
+    pub exact: bool,
+}
+
+/// Number of frames in a GSD file.
+pub fn frame_count(path: &Path) -> Result<u64, GsdError> {
+    Ok(open_read(path)?.n_frames())
+}
+
+fn open_read(path: &Path) -> Result<GsdFile, GsdError> {
+    GsdFile::open(path, Mode::Read).map_err(|e| GsdError::Open {
+        path: path.to_path_buf(),
+        message: format!("not a readable GSD file: {}", chain(&e)),
+    })
+}
+
+/// Read frame `frame` (default: the last) of a GSD file.
+pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError> {
+    let f = open_read(path)?;
+    let content = |message: String| GsdError::Content {
+        path: path.to_path_buf(),
+        message,
+    };
+    let frames = f.n_frames();
+    if frames == 0 {
+        return Err(content("the file holds no frames".into()));
+    }
+    let k = frame.unwrap_or(frames - 1);
+    if k >= frames {
+        return Err(content(format!(
+            "frame {k} requested, the file holds {frames}"
+        )));
+    }
+    // A chunk missing from frame k is taken from frame 0 (HOOMD schema).
+    let at = |name: &str| -> Option<u64> {
+        if f.find_chunk(k, name).is_some() {
+            Some(k)
+        } else if f.find_chunk(0, name).is_some() {
+            Some(0)
+        } else {
+            None
+        }
+    };
+    let rd = |e: hoomd_gsd::file_layer::ReadError| content(chain(&e));
+    let step = match at("configuration/step") {
+        Some(fr) => f
+            .iter_scalars::<u64>(fr, "configuration/step")
+            .map_err(rd)?
+            .next()
+            .unwrap_or(0),
+        None => 0,
+    };
+    let fr = at("configuration/box").ok_or_else(|| content("no configuration/box".into()))?;
+    let b: Vec<f32> = f
+        .iter_scalars::<f32>(fr, "configuration/box")
+        .map_err(rd)?
+        .collect();
+    if b.len() != 6 {
+        return Err(content(format!(
+            "configuration/box has {} values, expected 6",
+            b.len()
+        )));
+    }
+    if b[3] != 0.0 || b[4] != 0.0 || b[5] != 0.0 {
+        return Err(content(
+            "triclinic boxes (non-zero tilt factors) are not supported".into(),
+        ));
+    }
+    if !(b[..3].iter().all(|x| x.is_finite() && *x > 0.0)) {
+        return Err(content(format!("invalid box edges {:?}", &b[..3])));
+    }
+    let sbox = SimBox::new([b[0] as f64, b[1] as f64, b[2] as f64]);
+    let n = match at("particles/N") {
+        Some(fr) => f
+            .iter_scalars::<u32>(fr, "particles/N")
+            .map_err(rd)?
+            .next()
+            .unwrap_or(0) as usize,
+        None => 0,
+    };
+    let exact = f.find_chunk(k, POS64).is_some();
+    let pos: Vec<[f64; 3]> = if exact {
+        f.iter_arrays::<f64, 3>(k, POS64).map_err(rd)?.collect()
+    } else {
+        let fr = at("particles/position").ok_or_else(|| content("no particles/position".into()))?;
+        f.iter_arrays::<f32, 3>(fr, "particles/position")
+            .map_err(rd)?
+            .map(|x| [x[0] as f64, x[1] as f64, x[2] as f64])
+            .collect()
+    };
+    if pos.len() != n {
+        return Err(content(format!(
+            "particles/N = {n} but {} positions",
+            pos.len()
+        )));
+    }
+    let image: Vec<[i32; 3]> = match at("particles/image") {
+        Some(fr) => f
+            .iter_arrays::<i32, 3>(fr, "particles/image")
+            .map_err(rd)?
+            .collect(),
+        None => vec![[0; 3]; n],
+    };
+    let typeid: Vec<u32> = match at("particles/typeid") {
+        Some(fr) => f
+            .iter_scalars::<u32>(fr, "particles/typeid")
+            .map_err(rd)?
+            .collect(),
+        None => vec![0; n],
+    };
+    let diameter: Vec<f64> = match at("particles/diameter") {
+        Some(fr) => f
+            .iter_scalars::<f32>(fr, "particles/diameter")
+            .map_err(rd)?
+            .map(|d| d as f64)
+            .collect(),
+        None => vec![1.0; n],
+    };
+    let mass: Vec<f64> = match at("particles/mass") {
+        Some(fr) => f
+            .iter_scalars::<f32>(fr, "particles/mass")
+            .map_err(rd)?
+            .map(|d| d as f64)
+            .collect(),
+        None => vec![1.0; n],
+    };
+    let n_types = typeid.iter().map(|&t| t as usize + 1).max().unwrap_or(1);
+    let mut type_names: Vec<String> = match at("particles/types") {
+        Some(fr) => match f.iter_arrays::<u8, NAME_LEN>(fr, "particles/types") {
+            Ok(it) => it
+                .map(|a| {
+                    let end = a.iter().position(|&c| c == 0).unwrap_or(NAME_LEN);
+                    String::from_utf8_lossy(&a[..end]).into_owned()
+                })
+                .collect(),
+            Err(_) => Vec::new(),
+        },
+        None => Vec::new(),
+    };
+    while type_names.len() < n_types {
+        type_names.push(((b'A' + (type_names.len() % 26) as u8) as char).to_string());
+    }
+    let particles = Particles {
+        vel: vec![[0.0; 3]; n],
+        pos,
+        image,
+        typeid,
+        diameter,
+        mass,
+        type_names,
+    };
+    particles
+        .check()
+        .map_err(|m| content(format!("frame {k}: {m}")))?;
+    Ok(GsdFrame {
+        step,
+        sbox,
+        particles,
+        exact,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_exact_and_refuses_to_overwrite() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gsd");
+        let sbox = SimBox::new([10.0, 11.0, 12.0]);
+        let mut p = Particles::monodisperse(vec![[0.1, 0.2, 0.3], [-1.0 / 3.0, 4.0, -5.5]], 1.5);
+        p.image[1] = [1, -2, 3];
+        {
+            let mut w = GsdWriter::create_new(&path).unwrap();
+            w.write_frame(7, &sbox, &p, false, &[]).unwrap();
+            w.write_frame(9, &sbox, &p, true, &[("droplet/radius", 3.5)])
+                .unwrap();
+        }
+        assert!(GsdWriter::create_new(&path).is_err());
+        let f = read_frame(&path, None).unwrap();
+        assert_eq!(f.step, 9);
+        assert!(f.exact);
+        assert_eq!(f.particles.pos, p.pos);
+        assert_eq!(f.particles.image, p.image);
+        assert_eq!(f.particles.type_names, vec!["A".to_string()]);
+        assert_eq!(f.sbox, sbox);
+        let f0 = read_frame(&path, Some(0)).unwrap();
+        assert!(!f0.exact && (f0.particles.pos[1][0] + 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(frame_count(&path).unwrap(), 2);
+        // Unreadable files give a clear error naming the file.
+        let bad = dir.path().join("bad.gsd");
+        std::fs::write(&bad, b"this is not a gsd file at all").unwrap();
+        let e = read_frame(&bad, None).unwrap_err().to_string();
+        assert!(
+            e.contains("bad.gsd") && e.contains("not a readable GSD file"),
+            "{e}"
+        );
+        assert!(read_frame(&path, Some(5)).is_err());
+    }
+}
