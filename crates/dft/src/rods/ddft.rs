@@ -14,8 +14,11 @@
 //! positive; a stationary state without drive satisfies `ln rho + psi = const` at every grid
 //! point, i.e. exactly the discrete structure equation solved by [`super::equilibrium()`].
 //! Stability: `psi` is explicit; for sticky rods it contains the density at `x` and `x + sigma`
-//! pointwise, so `dt` must stay below about `dx^2 / (D gamma rho_max / g_min)`; halve `dt` until
-//! the result does not change.
+//! pointwise, so fixed steps must stay below about `dx^2 / (D gamma rho_max / g_min)`. With
+//! [`DdftProblem::step_tolerance`] set, steps are controlled by step doubling instead (one step
+//! of `h` against two of `h/2`; the local error estimate in max-norm relative to `max rho` must stay
+//! below the tolerance, the more accurate two-half-step result is kept), which also rejects
+//! unstable steps.
 
 use super::functional::{self, Work};
 use super::grid::Grid;
@@ -42,8 +45,11 @@ pub struct DdftProblem {
     pub diffusion: f64,
     /// Drive `beta f` (constant force over kT, per length); 0 for relaxation to equilibrium.
     pub beta_drive: f64,
-    /// Time step.
+    /// Time step (fixed), or the first and largest step when `step_tolerance` is set.
     pub dt: f64,
+    /// Adaptive steps by step doubling with this local error tolerance (relative to `max rho`);
+    /// `None`: fixed steps of `dt`.
+    pub step_tolerance: Option<f64>,
     /// Times at which the density is reported (ascending, >= 0).
     pub output_times: Vec<f64>,
     /// Initial density.
@@ -71,8 +77,12 @@ pub struct DdftFrame<'a> {
 /// Summary of a DDFT run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DdftSummary {
-    /// Time steps done.
+    /// Time steps done (accepted).
     pub steps: usize,
+    /// Steps rejected by the step-size control.
+    pub rejected_steps: usize,
+    /// Smallest accepted step (excluding steps shortened to hit an output time).
+    pub min_step: f64,
     /// Grid spacing used.
     pub dx: f64,
     /// Particle number at t = 0.
@@ -93,6 +103,9 @@ pub fn ddft(
     param::positive("diffusion", problem.diffusion)?;
     param::finite("beta_drive", problem.beta_drive)?;
     param::positive("dt", problem.dt)?;
+    if let Some(tol) = problem.step_tolerance {
+        param::positive("step_tolerance", tol)?;
+    }
     let mut prev = 0.0;
     for (k, &t) in problem.output_times.iter().enumerate() {
         if !(t.is_finite() && t >= prev) {
@@ -111,16 +124,41 @@ pub fn ddft(
     let mut t = 0.0;
     let mut steps = 0usize;
     let mut current = 0.0;
+    let mut rejected = 0usize;
+    let mut h = problem.dt;
+    let mut min_step = f64::INFINITY;
     for &t_out in &problem.output_times {
         while t < t_out {
             let remaining = t_out - t;
-            let (h, next) = if remaining <= problem.dt * (1.0 + 1e-9) {
-                (remaining, t_out)
-            } else {
-                (problem.dt, t + problem.dt)
+            let last = remaining <= h * (1.0 + 1e-9);
+            let try_h = if last { remaining } else { h };
+            let (done, next_h, rej) = match problem.step_tolerance {
+                None => (try_h, h, 0),
+                Some(tol) => {
+                    let r = st.adaptive_step(try_h, tol, problem.dt)?;
+                    (r.0, r.1, r.2)
+                }
             };
-            current = st.step(h)?;
-            t = next;
+            if problem.step_tolerance.is_none() {
+                current = st.step(done)?;
+            } else {
+                current = st.current;
+            }
+            rejected += rej;
+            t = if last && done == try_h {
+                t_out
+            } else {
+                t + done
+            };
+            if !(last && done == try_h) {
+                min_step = min_step.min(done);
+            }
+            // a step shortened to land on an output time does not shrink the next one
+            h = if last && done == try_h {
+                h.max(next_h)
+            } else {
+                next_h
+            };
             steps += 1;
             max_dm = max_dm.max((st.particles() / n0 - 1.0).abs());
         }
@@ -137,6 +175,8 @@ pub fn ddft(
     }
     Ok(DdftSummary {
         steps,
+        rejected_steps: rejected,
+        min_step,
         dx: st.grid.dx,
         particles_initial: n0,
         max_relative_mass_change: max_dm,
@@ -165,6 +205,11 @@ struct Stepper {
     z: Vec<f64>,
     cp: Vec<f64>,
     bb: Vec<f64>,
+    // step doubling
+    save: Vec<f64>,
+    full: Vec<f64>,
+    current: f64,
+    last_current: f64,
 }
 
 impl Stepper {
@@ -230,6 +275,10 @@ impl Stepper {
             z: vec![0.0; m],
             cp: vec![0.0; m],
             bb: vec![0.0; m],
+            save: vec![0.0; m],
+            full: vec![0.0; m],
+            current: 0.0,
+            last_current: 0.0,
             grid,
         })
     }
@@ -257,6 +306,59 @@ impl Stepper {
             hi = hi.max(v);
         }
         Ok(0.5 * (hi - lo))
+    }
+
+    /// Step doubling from the current state, trying `h` first. Returns (step done, suggested
+    /// next step, rejections); the state advances by the step done.
+    fn adaptive_step(
+        &mut self,
+        mut h: f64,
+        tol: f64,
+        h_max: f64,
+    ) -> Result<(f64, f64, usize), RodsError> {
+        let mut rejected = 0;
+        self.save.copy_from_slice(&self.rho);
+        loop {
+            let trial = (|| -> Result<f64, RodsError> {
+                self.step(h)?;
+                self.full.copy_from_slice(&self.rho);
+                self.rho.copy_from_slice(&self.save);
+                self.step(0.5 * h)?;
+                self.step(0.5 * h)?;
+                let scale = self.rho.iter().cloned().fold(0.0, f64::max);
+                let mut err: f64 = 0.0;
+                for i in 0..self.grid.m {
+                    err = err.max((self.rho[i] - self.full[i]).abs());
+                }
+                Ok(err / scale)
+            })();
+            match trial {
+                Ok(err) if err <= tol => {
+                    // first-order scheme: local error ~ h^2
+                    let grow = if err > 0.0 {
+                        (0.9 * (tol / err).sqrt()).clamp(0.2, 2.0)
+                    } else {
+                        2.0
+                    };
+                    self.current = self.last_current;
+                    return Ok((h, (h * grow).min(h_max), rejected));
+                }
+                Ok(err) => {
+                    rejected += 1;
+                    h *= (0.9 * (tol / err).sqrt()).clamp(0.1, 0.5);
+                }
+                Err(_) => {
+                    rejected += 1;
+                    h *= 0.25;
+                }
+            }
+            self.rho.copy_from_slice(&self.save);
+            if h < 1e-14 * h_max.max(1.0) {
+                return Err(RodsError::Ddft(format!(
+                    "step size control failed: step fell to {h:e} (step_tolerance {tol:e})"
+                )));
+            }
+        }
     }
 
     /// One linearly implicit step of length `h`; returns the mean current of the new state.
@@ -307,7 +409,8 @@ impl Stepper {
             let j = if i + 1 == m { 0 } else { i + 1 };
             jsum += self.ea[i] * self.rho[i] - self.eb[i] * self.rho[j];
         }
-        Ok(jsum / m as f64)
+        self.last_current = jsum / m as f64;
+        Ok(self.last_current)
     }
 }
 
