@@ -8,12 +8,14 @@
 //! - [`interface`]: the harmonic droplet interface and the shrinking radius `R(t)`.
 //! - [`equilibrium`]: equilibrium profile at fixed particle number (Picard + Anderson mixing).
 //! - [`ddft`]: implicit-Euler DDFT on spherical shells, free-draining or with pairwise RPY flux.
+//! - [`droplet`]: a drying droplet end to end (setup validation, equilibrium start, snapshots).
 //! - [`rpy`]: the dilute-limit radial RPY kernel of the hydrodynamic flux.
 //! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
 
 mod anderson;
 pub mod bulk;
 pub mod ddft;
+pub mod droplet;
 pub mod equilibrium;
 pub mod fmt;
 pub mod grid;
@@ -21,6 +23,7 @@ pub mod interface;
 pub mod rpy;
 
 pub use ddft::{Ddft, DdftOptions, Hydrodynamics, StepReport};
+pub use droplet::{DropletOutcome, DropletSetup, Snapshot, bin_average, run_droplet};
 pub use equilibrium::{Equilibrium, EquilibriumOptions, solve_equilibrium};
 pub use fmt::Rosenfeld;
 pub use grid::RadialGrid;
