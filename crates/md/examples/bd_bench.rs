@@ -18,7 +18,7 @@ fn main() {
         let mut nl = colloidsim_md::NeighborList::new(2f64.powf(1.0 / 6.0), 0.3);
         let t2 = std::time::Instant::now();
         for _ in 0..50 {
-            nl.build(&sim.sbox, &pos).unwrap();
+            nl.build(&sim.sbox, &pos, sim.tags()).unwrap();
         }
         println!(
             "build: {:.1} ns/particle",

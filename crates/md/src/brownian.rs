@@ -115,11 +115,11 @@ pub struct Brownian<P: Pair, E: External> {
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
-/// positions and the first blow-up (internal index, |F|, drift).
+/// positions and the blow-up of lowest tag (internal index, |F|, drift, tag).
 #[derive(Clone, Copy)]
 struct ChunkReport {
     max_disp2: f64,
-    blow_up: Option<(usize, f64, f64)>,
+    blow_up: Option<(usize, f64, f64, u32)>,
 }
 
 impl ChunkReport {
@@ -132,7 +132,7 @@ impl ChunkReport {
         Self {
             max_disp2: a.max_disp2.max(b.max_disp2),
             blow_up: match (a.blow_up, b.blow_up) {
-                (Some(x), Some(y)) => Some(if x.0 <= y.0 { x } else { y }),
+                (Some(x), Some(y)) => Some(if x.3 <= y.3 { x } else { y }),
                 (x, None) => x,
                 (None, y) => y,
             },
@@ -332,7 +332,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
 
     /// Reorder the particles by cell (when there is a pair potential) and rebuild the list.
     fn sort_and_rebuild(&mut self) -> Result<(), BdError> {
-        if self.nlist.r_cut > 0.0 {
+        if self.nlist.range() > 0.0 {
             let order = self.nlist.bin(&self.sbox, &self.particles.pos);
             self.perm.clear();
             self.perm.extend_from_slice(order);
@@ -349,7 +349,8 @@ impl<P: Pair, E: External> Brownian<P, E> {
             permute(&mut self.noise_amp, perm, &mut self.scratch_f64);
             permute(&mut self.drift_limit2, perm, &mut self.scratch_f64);
         }
-        self.nlist.build(&self.sbox, &self.particles.pos)?;
+        self.nlist
+            .build(&self.sbox, &self.particles.pos, &self.tag)?;
         Ok(())
     }
 
@@ -402,11 +403,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
                     let drift2 = drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
                     // NaN forces fail the comparison and count as a blow-up too.
                     let ok = drift2 <= drift_limit2[i];
-                    if !ok && rep.blow_up.is_none() {
+                    if !ok && rep.blow_up.is_none_or(|b| tag[i] < b.3) {
                         rep.blow_up = Some((
                             i,
                             (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt(),
                             drift2.sqrt(),
+                            tag[i],
                         ));
                     }
                     let mut rng = stream(seed, step, Purpose::Noise, tag[i] as u64);
@@ -430,7 +432,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 rep
             })
             .reduce(|| ChunkReport::EMPTY, ChunkReport::merge);
-        if let Some((i, force, drift)) = report.blow_up {
+        if let Some((i, force, drift, _)) = report.blow_up {
             self.new_pos = new_pos;
             self.new_image = new_image;
             return Err(BdError::BlowUp {
@@ -448,7 +450,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.new_pos = new_pos;
         self.new_image = new_image;
         self.step += 1;
-        if report.max_disp2 > 0.25 * self.nlist.skin * self.nlist.skin {
+        if self.nlist.range() > 0.0 && report.max_disp2 > 0.25 * self.nlist.skin * self.nlist.skin {
             self.sort_and_rebuild()?;
         }
         Ok(())

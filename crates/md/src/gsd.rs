@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 const NAME_LEN: usize = 64;
 const POS64: &str = "log/particles/position_f64";
+const BOX64: &str = "log/configuration/box_f64";
 
 /// A GSD error with the file involved.
 #[derive(Debug, thiserror::Error)]
@@ -165,6 +166,7 @@ impl GsdWriter {
             .map_err(e)?;
         if exact {
             f.write_arrays(POS64, p.pos.iter().copied()).map_err(e)?;
+            f.write_scalars(BOX64, sbox.l).map_err(e)?;
         }
         for (name, v) in log {
             f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
@@ -262,7 +264,13 @@ pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError>
     if !(b[..3].iter().all(|x| x.is_finite() && *x > 0.0)) {
         return Err(content(format!("invalid box edges {:?}", &b[..3])));
     }
-    let sbox = SimBox::new([b[0] as f64, b[1] as f64, b[2] as f64]);
+    let mut sbox = SimBox::new([b[0] as f64, b[1] as f64, b[2] as f64]);
+    if f.find_chunk(k, BOX64).is_some() {
+        let l: Vec<f64> = f.iter_scalars::<f64>(k, BOX64).map_err(rd)?.collect();
+        if l.len() == 3 && l.iter().all(|x| x.is_finite() && *x > 0.0) {
+            sbox = SimBox::new([l[0], l[1], l[2]]);
+        }
+    }
     let n = match at("particles/N") {
         Some(fr) => f
             .iter_scalars::<u32>(fr, "particles/N")

@@ -32,11 +32,19 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(origin: [f64; 3], extent: [f64; 3], d: f64, periodic: Option<SimBox>) -> Self {
+    fn new(
+        origin: [f64; 3],
+        extent: [f64; 3],
+        d: f64,
+        periodic: Option<SimBox>,
+        particles: usize,
+    ) -> Self {
+        // Cells at least d wide, and never more than about two per particle.
+        let cap = ((2 * particles.max(1)) as f64).cbrt().ceil().max(1.0);
         let mut n = [1; 3];
         let mut cell = [0.0; 3];
         for k in 0..3 {
-            n[k] = ((extent[k] / d).floor() as usize).clamp(1, 1 << 10);
+            n[k] = ((extent[k] / d).floor().min(cap) as usize).max(1);
             cell[k] = extent[k] / n[k] as f64;
         }
         Self {
@@ -156,7 +164,7 @@ pub fn random_in_sphere(
     let r = centre_radius;
     let phi = n as f64 * (d / 2.0).powi(3) / ((r + d / 2.0).powi(3));
     let origin = [centre[0] - r, centre[1] - r, centre[2] - r];
-    let grid = Grid::new(origin, [2.0 * r; 3], d, None);
+    let grid = Grid::new(origin, [2.0 * r; 3], d, None, n);
     insert_all(n, d, phi, grid, seed, stream_index, |u| {
         loop {
             let v = [2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0];
@@ -181,7 +189,13 @@ pub fn random_in_box(
 ) -> Result<Vec<[f64; 3]>, PackingError> {
     let phi = n as f64 * std::f64::consts::PI * d.powi(3) / 6.0 / sbox.volume();
     let l = sbox.l;
-    let grid = Grid::new([-0.5 * l[0], -0.5 * l[1], -0.5 * l[2]], l, d, Some(*sbox));
+    let grid = Grid::new(
+        [-0.5 * l[0], -0.5 * l[1], -0.5 * l[2]],
+        l,
+        d,
+        Some(*sbox),
+        n,
+    );
     insert_all(n, d, phi, grid, seed, stream_index, |u| {
         [(u() - 0.5) * l[0], (u() - 0.5) * l[1], (u() - 0.5) * l[2]]
     })

@@ -64,9 +64,13 @@ impl NeighborList {
         }
     }
 
-    /// Range of the list, `r_cut + skin`.
+    /// Range of the list, `r_cut + skin` (0 without interactions: the list stays empty).
     pub fn range(&self) -> f64 {
-        self.r_cut + self.skin
+        if self.r_cut > 0.0 {
+            self.r_cut + self.skin
+        } else {
+            0.0
+        }
     }
 
     /// Number of builds so far.
@@ -107,8 +111,15 @@ impl NeighborList {
         d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     }
 
-    /// Build the list for wrapped positions `pos`.
-    pub fn build(&mut self, sbox: &SimBox, pos: &[[f64; 3]]) -> Result<(), BoxTooSmall> {
+    /// Build the list for wrapped positions `pos`; each particle's neighbours are listed in
+    /// increasing `key` (e.g. the particles' tags), so that sums over them have an order that
+    /// does not depend on how particles are stored or when the list was built.
+    pub fn build(
+        &mut self,
+        sbox: &SimBox,
+        pos: &[[f64; 3]],
+        key: &[u32],
+    ) -> Result<(), BoxTooSmall> {
         let n = pos.len();
         let range = self.range();
         let edge = sbox.l.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -164,6 +175,9 @@ impl NeighborList {
                         }
                     }
                     *cnt = m.min(stride) as u32;
+                    if m <= stride {
+                        slot[..m].sort_unstable_by_key(|&j| key[j as usize]);
+                    }
                     m
                 })
                 .max()
@@ -310,11 +324,11 @@ mod tests {
             })
             .collect();
         let mut nl = NeighborList::new(1.5, 0.4);
-        nl.build(&sbox, &pos).unwrap();
+        let key: Vec<u32> = (0..pos.len() as u32).collect();
+        nl.build(&sbox, &pos, &key).unwrap();
         let r2 = 1.9f64 * 1.9;
         for i in 0..pos.len() {
-            let mut got: Vec<u32> = nl.neighbors(i).to_vec();
-            got.sort();
+            let got: Vec<u32> = nl.neighbors(i).to_vec();
             let want: Vec<u32> = (0..pos.len() as u32)
                 .filter(|&j| {
                     let (p, q) = (pos[i], pos[j as usize]);
@@ -331,7 +345,7 @@ mod tests {
         // A box shorter than twice the range is refused.
         assert!(
             NeighborList::new(1.5, 0.4)
-                .build(&SimBox::cube(3.0), &pos)
+                .build(&SimBox::cube(3.0), &pos, &key)
                 .is_err()
         );
     }
