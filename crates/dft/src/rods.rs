@@ -35,7 +35,8 @@ pub enum RodsError {
     #[error(
         "rods equilibrium did not converge: residual {residual:.3e} (max-norm of the structure \
          equation in ln rho form) after {iterations} iterations, tolerance {tolerance:.1e}; \
-         raise max_iterations or the tolerance, or refine dx"
+         raise max_iterations or the tolerance, or refine dx{}",
+        jam_hint(*min_vacancy)
     )]
     NotConverged {
         /// Iterations done on the finest grid.
@@ -44,10 +45,24 @@ pub enum RodsError {
         residual: f64,
         /// Tolerance asked for.
         tolerance: f64,
+        /// Smallest `1 - eta(x + sigma)` of the last iterate (probability that a window of length
+        /// sigma holds no rod centre); near 0 the state is nearly jammed.
+        min_vacancy: f64,
     },
     /// The DDFT time step was too large (a window `int rho` reached close packing).
     #[error("ddft: {0}")]
     Ddft(String),
+}
+
+fn jam_hint(min_vacancy: f64) -> String {
+    if min_vacancy > 0.0 && min_vacancy < 1e-6 {
+        format!(
+            ". The state is nearly jammed (min 1 - eta = {min_vacancy:.1e}): rounding limits the \
+             residual to about 1e-16 / min(1 - eta); lower the density or the potential amplitude"
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// Rod–rod interaction.

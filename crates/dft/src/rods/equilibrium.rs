@@ -269,6 +269,7 @@ impl Solver {
                             iterations: it,
                             residual: res,
                             tolerance: tol,
+                            min_vacancy: self.work.g.iter().cloned().fold(1.0, f64::min),
                         });
                     }
                     self.u_ok.copy_from_slice(&self.u);
@@ -293,6 +294,7 @@ impl Solver {
                             iterations: it,
                             residual: best,
                             tolerance: tol,
+                            min_vacancy: 0.0,
                         });
                     }
                     // Halve the step back towards the last admissible iterate.
