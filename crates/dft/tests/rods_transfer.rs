@@ -173,7 +173,7 @@ mod rods {
                 if m == 200 {
                     // sigma 10% off must be caught far outside that tolerance (10% too short: 10% too
                     // long jams the densest state, rho sigma = 0.89 at one rod per period)
-                    let mut wrong =
+                    let wrong =
                         RodsProblem::new(0.9 * sigma, r.rho_bar, Domain::Periodic { period: 1.0 })
                             .with_dx(1.0 / m as f64)
                             .with_interaction(RodInteraction::Sticky { gamma })
