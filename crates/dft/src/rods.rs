@@ -132,10 +132,33 @@ impl BetaPotential {
         Self::Function(Arc::new(move |x| u(x) / kt))
     }
 
-    /// `beta U` of a scenario's external field (its drive is not a potential: see [`DdftProblem`]).
+    /// `beta U` of a scenario's external field, ignoring its drive (for DDFT, which takes the
+    /// drive as [`DdftProblem::beta_drive`] = `field.drive / kT`).
     pub fn from_field(field: &colloidsim_core::field1d::ExternalField, kt: f64) -> Self {
         let f = field.clone();
         Self::Function(Arc::new(move |x| f.potential(x) / kt))
+    }
+
+    /// `beta U` of a field for the equilibrium solver: an error if the field has a drive (a
+    /// tilted potential has no equilibrium; use [`ddft()`] for the driven steady state) or if
+    /// `kT <= 0`.
+    pub fn for_equilibrium(
+        field: &colloidsim_core::field1d::ExternalField,
+        kt: f64,
+    ) -> Result<Self, RodsError> {
+        param::positive("kT", kt)?;
+        if field.drive != 0.0 {
+            return Err(ParamError::new(
+                "field.drive",
+                format!(
+                    "a driven system (drive = {}) has no equilibrium; the equilibrium theory needs \
+                     drive = 0 (use the DDFT for the driven steady state)",
+                    field.drive
+                ),
+            )
+            .into());
+        }
+        Ok(Self::from_field(field, kt))
     }
 }
 
@@ -251,6 +274,26 @@ impl RodsProblem {
             }
         }
         let g = self.grid(self.dx)?;
+        if let (BetaPotential::Function(f), Domain::Periodic { period }) =
+            (&self.beta_u, self.domain)
+        {
+            // The density is solved on one period: the potential must repeat with that period.
+            for k in 0..4 {
+                let x = period * k as f64 / 4.0 + 0.1234 * period;
+                let (a, b) = (f(x), f(x + period));
+                if (a - b).abs() > 1e-6 * (1.0 + a.abs()) {
+                    return Err(ParamError::new(
+                        "period",
+                        format!(
+                            "beta_u does not repeat with period {period}: beta U({x}) = {a} but \
+                             beta U({}) = {b}; use the potential's period (or a multiple)",
+                            x + period
+                        ),
+                    )
+                    .into());
+                }
+            }
+        }
         if let BetaPotential::OnGrid(v) = &self.beta_u
             && v.len() != g.active
         {

@@ -269,6 +269,37 @@ mod rods {
     }
 
     #[test]
+    fn sticky_rods_at_walls_obey_the_contact_theorem() {
+        // The hard-wall contact theorem rho(contact) = beta p(bulk) holds for any rod-rod
+        // interaction; with the Baxter pressure beta p(1 + gamma beta p) = rho/(1 - rho sigma).
+        // First order in dx (smeared wall jump): 3% at sigma/dx = 40.
+        let eq = equilibrium(
+            &RodsProblem::new(1.0, 0.5, Domain::Walls { length: 20.0 })
+                .with_dx(1.0 / 40.0)
+                .with_interaction(RodInteraction::Sticky { gamma: 1.0 }),
+        )
+        .unwrap();
+        let mid = eq.rho[eq.x.len() / 2];
+        let p = bulk::beta_pressure(1.0, 1.0, mid);
+        let err = (eq.rho[0] / p - 1.0).abs();
+        assert!(err < 0.03, "{err}");
+    }
+
+    #[test]
+    fn sampled_potential_gives_the_same_profile_as_the_closure() {
+        // 2000 points: the closure uses grid sequencing, the samples do not; both must meet the
+        // same 1e-10 residual, so the profiles agree to ~1e-9 relative.
+        let base =
+            periodic(0.5, 0.8, 0.0005).with_interaction(RodInteraction::Sticky { gamma: 1.0 });
+        let a = equilibrium(&base.clone().with_potential(cosine(6.0))).unwrap();
+        let x = base.grid_points().unwrap();
+        let samples = x.iter().map(|&x| 3.0 * (TAU * x).cos()).collect();
+        let b = equilibrium(&base.with_potential(BetaPotential::OnGrid(samples))).unwrap();
+        assert!(a.levels > 1 && b.levels == 1);
+        assert!(max_abs_diff(&a.rho, &b.rho) / max(&a.rho) < 1e-8);
+    }
+
+    #[test]
     fn bin_average_conserves_mass_and_repeats_over_periods() {
         let eq = equilibrium(&periodic(0.3, 1.2, 0.3 / 17.0).with_potential(cosine(4.0))).unwrap();
         // L = 3 periods, 700 bins (not commensurate with the grid): total mass = 3 * 1.2.
@@ -314,6 +345,21 @@ mod rods {
             msg(RodsProblem::new(1.0, 0.5, Domain::Walls { length: 0.9 }).with_dx(0.01))
                 .contains("length")
         );
+        // potential period 2 on a domain of period 1
+        assert!(
+            msg(periodic(0.5, 0.5, 0.01)
+                .with_potential(BetaPotential::from_fn(1.0, |x| { (0.5 * TAU * x).cos() })))
+            .contains("period")
+        );
+        // a tilted washboard has no equilibrium
+        let field = colloidsim_core::field1d::ExternalField {
+            terms: vec![],
+            drive: 1.0,
+        };
+        match BetaPotential::for_equilibrium(&field, 1.0) {
+            Err(RodsError::Param(e)) => assert_eq!(e.key, "field.drive"),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]
