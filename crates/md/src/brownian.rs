@@ -36,6 +36,9 @@ pub struct BdParams {
     pub dt: f64,
     /// Seed of the noise streams.
     pub seed: u32,
+    /// Independent replica of the same seed: its noise streams are keyed by
+    /// `replica * 2^32 + tag`.
+    pub replica: u32,
     /// Verlet skin.
     pub skin: f64,
     /// A step whose deterministic displacement `|F| dt / gamma` exceeds this fraction of the
@@ -51,6 +54,7 @@ impl BdParams {
             viscosity: 1.0,
             dt,
             seed,
+            replica: 0,
             skin: 0.3,
             max_drift: 0.2,
         }
@@ -367,6 +371,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let t = self.time();
         let step = self.step;
         let seed = self.params.seed;
+        let key0 = (self.params.replica as u64) << 32;
         let dt = self.params.dt;
         let n = self.particles.len();
         let mut new_pos = std::mem::take(&mut self.new_pos);
@@ -411,7 +416,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
                             tag[i],
                         ));
                     }
-                    let mut rng = stream(seed, step, Purpose::Noise, tag[i] as u64);
+                    let mut rng = stream(seed, step, Purpose::Noise, key0 | tag[i] as u64);
                     let xi: [f64; 3] = [
                         rng.sample(StandardNormal),
                         rng.sample(StandardNormal),

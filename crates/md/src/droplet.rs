@@ -7,6 +7,11 @@
 //! drying time) or returns a [`ParamError`] naming the key and the allowed range. Both the
 //! particle engine (`colloidsim run`) and the radial DDFT (`colloidsim theory`) read it.
 
+use crate::brownian::{BdError, BdParams, Brownian};
+use crate::gsd::read_frame;
+use crate::init::random_in_sphere;
+use crate::potential::{HarmonicInterface, LennardJones, SphereAreaLaw};
+use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{at_least, in_range, positive};
 use serde::{Deserialize, Serialize};
@@ -556,5 +561,112 @@ final_volume_fraction = 0.5
             err_key(&PAPER.replace("[drying]", "[run]\ndt = 0\n[drying]")),
             "run.dt"
         );
+    }
+}
+
+/// Errors while setting up a droplet replica.
+#[derive(Debug, thiserror::Error)]
+pub enum DropletError {
+    /// Random insertion failed.
+    #[error("system.phi0: {0}")]
+    Packing(#[from] crate::init::PackingError),
+    /// The initial GSD file could not be used.
+    #[error("system.initial: {0}")]
+    Initial(String),
+    /// The engine refused the configuration.
+    #[error(transparent)]
+    Engine(#[from] BdError),
+}
+
+/// The engine a droplet replica runs: WCA colloids inside the moving harmonic interface.
+pub type DropletSim = Brownian<LennardJones, HarmonicInterface>;
+
+impl DropletParams {
+    /// The droplet interface (centred on the origin).
+    pub fn interface(&self) -> HarmonicInterface {
+        HarmonicInterface {
+            centre: [0.0; 3],
+            radius: SphereAreaLaw {
+                r0: self.r0,
+                alpha: self.alpha,
+            },
+            stiffness: self.stiffness,
+            range: self.range,
+            offset: self.offset,
+        }
+    }
+
+    /// Edge of the (periodic) simulation box: the droplet with its interface range and
+    /// two neighbour ranges of margin, so that no interaction crosses the boundary.
+    pub fn box_edge(&self) -> f64 {
+        let reach = self.r0 + self.offset.max(0.0) + self.range;
+        2.0 * (reach + 2.0 * (2f64.powf(1.0 / 6.0) * self.diameter + self.skin))
+            + 2.0 * self.diameter
+    }
+
+    /// Set up replica `replica` (0-based) at step 0: random insertion (stream index
+    /// `replica`) or the last frame of `system.initial`, noise keyed by the replica.
+    pub fn build_replica(&self, replica: u32) -> Result<DropletSim, DropletError> {
+        let sbox = SimBox::cube(self.box_edge());
+        let particles = match &self.initial {
+            None => Particles::monodisperse(
+                random_in_sphere(
+                    self.particles,
+                    self.diameter,
+                    [0.0; 3],
+                    self.r0 + self.offset,
+                    self.seed,
+                    replica as u64,
+                )?,
+                self.diameter,
+            ),
+            Some(path) => {
+                let f = read_frame(path, None).map_err(|e| DropletError::Initial(e.to_string()))?;
+                let mut p = f.particles;
+                if p.len() != self.particles {
+                    return Err(DropletError::Initial(format!(
+                        "{} holds {} particles, system.particles is {}",
+                        path.display(),
+                        p.len(),
+                        self.particles
+                    )));
+                }
+                // Unwrap with the file's box; the droplet is centred on the origin.
+                for (x, img) in p.pos.iter_mut().zip(p.image.iter_mut()) {
+                    *x = f.sbox.unwrap(*x, *img);
+                    *img = [0; 3];
+                }
+                let limit = self.r0 + self.offset + self.range;
+                if let Some(i) = p
+                    .pos
+                    .iter()
+                    .position(|x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() > limit)
+                {
+                    return Err(DropletError::Initial(format!(
+                        "{}: particle {i} lies outside the initial droplet (|r| > R0 + offset + range = {limit:.4})",
+                        path.display()
+                    )));
+                }
+                p.diameter.iter_mut().for_each(|d| *d = self.diameter);
+                p
+            }
+        };
+        let params = BdParams {
+            kt: self.kt,
+            viscosity: self.viscosity,
+            dt: self.dt,
+            seed: self.seed,
+            replica,
+            skin: self.skin,
+            max_drift: 0.2,
+        };
+        Ok(Brownian::new(
+            particles,
+            sbox,
+            LennardJones::wca(self.kt, self.diameter),
+            self.interface(),
+            params,
+            0,
+        )?)
     }
 }

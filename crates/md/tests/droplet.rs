@@ -1,0 +1,118 @@
+//! The drying droplet: conservation and confinement, bad input.
+
+use colloidsim_md::{BdError, DropletScenario, External};
+
+fn scenario(extra_run: &str) -> String {
+    format!(
+        r#"
+method = "droplet-bd"
+seed = 5
+[system]
+particles = 400
+phi0 = 0.1
+[drying]
+peclet = 10
+final_volume_fraction = 0.45
+[run]
+{extra_run}
+"#
+    )
+}
+
+/// N is constant and no particle gets beyond the interface's soft range: beyond
+/// `s = range` the potential is linear with slope `k range`, so an excursion of 10 kT / (k range)
+/// further has Boltzmann weight e^-10 per sample.
+#[test]
+fn drying_keeps_every_particle_inside_the_interface_range() {
+    let p = DropletScenario::from_toml(&scenario(""))
+        .unwrap()
+        .validate()
+        .unwrap();
+    let mut sim = p.build_replica(0).unwrap();
+    let slack = 10.0 * p.kt / (p.stiffness * p.range);
+    let mut worst: f64 = f64::NEG_INFINITY;
+    let mut in_wall = 0usize;
+    let mut done = 0;
+    while done < p.steps {
+        let k = 50.min(p.steps - done);
+        sim.run(k).unwrap();
+        done += k;
+        let t = sim.time();
+        let wall = p.radius_at(t) + p.offset;
+        let snap = sim.snapshot();
+        assert_eq!(snap.len(), p.particles);
+        for x in &snap.pos {
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            worst = worst.max(r - wall);
+            if r > wall {
+                in_wall += 1;
+            }
+        }
+    }
+    assert!(
+        worst < p.range + slack,
+        "a particle reached s = {worst} beyond the wall (range {}, slack {slack})",
+        p.range
+    );
+    // The check is not vacuous: the drying front does push particles into the interface.
+    assert!(
+        in_wall > 0 && worst > 0.0,
+        "nobody ever touched the interface"
+    );
+    // The end state is at the requested mean volume fraction.
+    let r_end = p.radius_at(sim.time());
+    assert!(r_end <= p.r_end + 1e-9);
+    // The interface energy is finite everywhere and zero inside.
+    assert_eq!(p.interface().energy([0.0; 3], sim.time()), 0.0);
+}
+
+#[test]
+fn too_large_a_time_step_is_reported_with_step_and_particle() {
+    let p = DropletScenario::from_toml(&scenario("dt = 0.5"))
+        .unwrap()
+        .validate()
+        .unwrap();
+    let mut sim = p.build_replica(0).unwrap();
+    match sim.run(p.steps) {
+        Err(e @ BdError::BlowUp { .. }) => assert!(e.to_string().contains("run.dt")),
+        other => panic!("expected a blow-up, got {other:?}"),
+    }
+}
+
+#[test]
+fn replicas_differ_and_initial_configuration_is_inside() {
+    let p = DropletScenario::from_toml(&scenario(""))
+        .unwrap()
+        .validate()
+        .unwrap();
+    let a = p.build_replica(0).unwrap().snapshot();
+    let b = p.build_replica(1).unwrap().snapshot();
+    assert!(a.pos != b.pos);
+    let wall = p.r0 + p.offset;
+    assert!(
+        a.pos
+            .iter()
+            .all(|x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() <= wall + 1e-12)
+    );
+    // An unreadable initial file is a clear error naming the key.
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("x.gsd");
+    std::fs::write(&bad, "not gsd").unwrap();
+    let text = scenario("").replace(
+        "phi0 = 0.1",
+        &format!("phi0 = 0.1\ninitial = \"{}\"", bad.display()),
+    );
+    let p = DropletScenario::from_toml(&text)
+        .unwrap()
+        .validate()
+        .unwrap();
+    let e = p
+        .build_replica(0)
+        .err()
+        .expect("unreadable GSD accepted")
+        .to_string();
+    assert!(
+        e.starts_with("system.initial") && e.contains("x.gsd"),
+        "{e}"
+    );
+}
