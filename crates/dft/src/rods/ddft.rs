@@ -89,6 +89,10 @@ pub struct DdftSummary {
     pub particles_initial: f64,
     /// Largest `|N(t) / N(0) - 1|` over all steps.
     pub max_relative_mass_change: f64,
+    /// Smallest rule-of-thumb stability limit of fixed steps seen at t = 0 and the output
+    /// times (sticky rods; infinite for hard rods). A fixed `dt` above it is warned about (`log`)
+    /// and likely unstable; see the module docs.
+    pub explicit_step_estimate: f64,
     /// Mean current at the last time.
     pub final_mean_current: f64,
 }
@@ -127,6 +131,15 @@ pub fn ddft(
     let mut rejected = 0usize;
     let mut h = problem.dt;
     let mut min_step = f64::INFINITY;
+    st.psi()?;
+    let mut step_estimate = st.explicit_step_estimate();
+    if problem.step_tolerance.is_none() && problem.dt > step_estimate {
+        log::warn!(
+            "ddft: dt = {} exceeds the explicit stability estimate {step_estimate:.2e} of the \
+             sticky-rod excess potential; the run may be unstable (set step_tolerance or reduce dt)",
+            problem.dt
+        );
+    }
     for &t_out in &problem.output_times {
         while t < t_out {
             let remaining = t_out - t;
@@ -163,6 +176,7 @@ pub fn ddft(
             max_dm = max_dm.max((st.particles() / n0 - 1.0).abs());
         }
         let stationarity = st.stationarity()?;
+        step_estimate = step_estimate.min(st.explicit_step_estimate());
         let act = st.grid.active;
         on_output(&DdftFrame {
             time: t,
@@ -180,6 +194,7 @@ pub fn ddft(
         dx: st.grid.dx,
         particles_initial: n0,
         max_relative_mass_change: max_dm,
+        explicit_step_estimate: step_estimate,
         final_mean_current: current,
     })
 }
@@ -293,6 +308,49 @@ impl Stepper {
                 "a window of length sigma reached close packing; reduce dt or dx".to_string(),
             )
         })
+    }
+
+    /// Rule-of-thumb stability limit of the explicit `psi` for the current state (call after
+    /// [`Stepper::psi`]): `dx^2 / (2 max_x D rho (|k0| + |k+| + |k-|))`, with `k0, k+-` the
+    /// derivatives of the pointwise terms of `psi(x)` with respect to `rho(x)`, `rho(x +- sigma)`
+    /// (at fixed `g`). Infinite for hard rods, whose `psi` has no pointwise terms.
+    fn explicit_step_estimate(&self) -> f64 {
+        if self.gamma == 0.0 {
+            return f64::INFINITY;
+        }
+        let m = self.grid.m;
+        let n = self.grid.n + usize::from(self.grid.f >= 0.5);
+        let gamma = self.gamma;
+        let w = &self.work;
+        // per point y: q = gamma/(g S), r1 = (S - a2)/(a1 + S), r2 = (S - a1)/(a2 + S)
+        let pt = |i: usize| -> (f64, f64, f64) {
+            let g = w.g[i];
+            let (r, rp) = (self.rho[i], w.rho_p[i]);
+            let s = (rp + r) / g;
+            let d = (rp - r) / g;
+            let big_s = (1.0 + gamma * (2.0 * s + gamma * d * d)).sqrt();
+            let sg = g.sqrt();
+            let (a1s, a2s) = (w.t1[i] / sg, w.t2[i] / sg);
+            let q = gamma / (g * big_s);
+            (
+                q,
+                (big_s - (1.0 - gamma * d)) / a1s,
+                (big_s - (1.0 + gamma * d)) / a2s,
+            )
+        };
+        let mut cmax: f64 = 0.0;
+        for i in 0..self.grid.active {
+            let j = (i + m - n % m) % m;
+            let (q, r1, _) = pt(i);
+            let (qm, _, r2m) = pt(j);
+            let k0 = q * r1.abs() + qm * r2m.abs();
+            cmax = cmax.max(self.diffusion * self.rho[i] * (k0 + q + qm));
+        }
+        if cmax > 0.0 {
+            self.grid.dx * self.grid.dx / (2.0 * cmax)
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// `max |ln rho + psi - mean|` over active points.
