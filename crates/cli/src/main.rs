@@ -3,6 +3,7 @@
 mod bcd_cmd;
 mod common;
 mod plot;
+mod theory_droplet;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -145,6 +146,7 @@ fn main() -> Result<()> {
             let out = common::default_out(&scenario, out, "-theory");
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::theory(&scenario, &text, &out, dx, force),
+                "droplet-bd" => theory_droplet::theory(&scenario, &text, &out, dx, force),
                 m => bail!(
                     "{}: method '{m}' has no theory counterpart",
                     scenario.display()

@@ -1,0 +1,268 @@
+//! `colloidsim theory` for `method = "droplet-bd"`: radial Rosenfeld FMT DDFT of the drying
+//! droplet (free-draining), on the Brownian-dynamics run's radial bins and output times.
+//!
+//! Reads the same scenario as `colloidsim run`; writes `profile_<fraction>.csv` (`r,phi`: bin
+//! centres and the bin-averaged `pi d^3 rho / 6` on `observe.profile.bins` equal bins of
+//! `[0, R(t)]`, at `t = round(fraction * steps) * dt` like the BD run), the fine-grid profiles
+//! `theory_profile_<fraction>.csv` (`r,rho,phi,n3`), `summary.json` and `profiles.png` (with the
+//! BD profiles of the run folder overlaid when they exist). See `docs/theory-droplet.md`.
+
+use std::f64::consts::PI;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use colloidsim_core::output::{OutputDir, read_table};
+use colloidsim_dft::radial::{
+    DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError,
+    RadialGrid, Snapshot, bin_average, run_droplet,
+};
+use colloidsim_md::droplet::{DropletParams, DropletScenario};
+
+use crate::common;
+use crate::plot::{self, Scale, Series};
+
+/// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,
+/// more when the fraction needs them).
+pub fn profile_name(fraction: f64) -> String {
+    if ((fraction * 100.0).round() - fraction * 100.0).abs() < 1e-9 {
+        format!("profile_{fraction:.2}.csv")
+    } else {
+        format!("profile_{fraction}.csv")
+    }
+}
+
+/// Theory grid spacing: `--dx`, else `d / 100`.
+fn grid_spacing(p: &DropletParams, dx: Option<f64>) -> Result<f64> {
+    let dr = dx.unwrap_or(p.diameter / 100.0);
+    if !(dr.is_finite() && dr > 0.0) {
+        bail!("--dx must be a finite number > 0, got {dr}");
+    }
+    Ok(dr)
+}
+
+/// The library setup for a validated BD scenario (stiffness converted to kT units).
+pub fn setup_from(p: &DropletParams, dr: f64) -> Result<DropletSetup> {
+    Ok(DropletSetup {
+        particles: p.particles as f64,
+        diameter: p.diameter,
+        d0: p.d0,
+        r0: p.r0,
+        alpha: p.alpha,
+        interface: HarmonicInterface::new(p.stiffness / p.kt, p.range, p.offset)?,
+        t_end: p.t_end,
+        dr,
+        hydrodynamics: Hydrodynamics::FreeDraining,
+    })
+}
+
+/// One written output time.
+struct Written {
+    fraction: f64,
+    r: Vec<f64>,
+    phi: Vec<f64>,
+}
+
+/// `colloidsim theory SCENARIO` for a drying droplet.
+pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool) -> Result<()> {
+    let sc =
+        DropletScenario::from_toml(text).map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
+    let p = sc
+        .validate()
+        .map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
+    let dr = grid_spacing(&p, dx)?;
+    let setup = setup_from(&p, dr)?;
+    setup
+        .validate()
+        .map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
+    // Output times of the BD run, in ascending order (fractions may be listed in any order).
+    let mut order: Vec<usize> = (0..p.fractions.len()).collect();
+    let time_of = |k: usize| (p.profile_steps[k] as f64 * p.dt).min(p.t_end);
+    order.sort_by(|&a, &b| time_of(a).total_cmp(&time_of(b)));
+    let times: Vec<f64> = order.iter().map(|&k| time_of(k)).collect();
+
+    let dir = OutputDir::create(out, force)
+        .with_context(|| format!("cannot use output folder {}", out.display()))?;
+    let opts = DdftOptions::new(p.d0, p.diameter);
+    let eq_opts = EquilibriumOptions::default();
+    let pb = common::progress(1000, false, "theory");
+    let vp = PI * p.diameter.powi(3) / 6.0;
+    let mut written: Vec<Written> = Vec::new();
+    let mut write_err: Option<anyhow::Error> = None;
+    let mut next = 0usize;
+    let start = Instant::now();
+    let result = run_droplet(
+        &setup,
+        &times,
+        &opts,
+        &eq_opts,
+        |grid: &RadialGrid, s: &Snapshot| {
+            let fraction = p.fractions[order[next]];
+            next += 1;
+            if let Err(e) = write_snapshot(&dir, grid, s, fraction, p.bins, vp, &p, &mut written) {
+                write_err.get_or_insert(e);
+            }
+        },
+        |rep| pb.set_position((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
+    );
+    pb.finish_and_clear();
+    let wall = start.elapsed().as_secs_f64();
+    if let Some(e) = write_err {
+        return Err(e);
+    }
+    let (status, message) = match &result {
+        Ok(_) => ("ok".to_string(), String::new()),
+        Err(e @ RadialError::Unphysical { .. }) => ("unphysical".to_string(), e.to_string()),
+        Err(e) => ("failed".to_string(), e.to_string()),
+    };
+    let outcome = result.as_ref().ok();
+    let summary = serde_json::json!({
+        "method": "droplet-bd",
+        "engine": "theory: radial Rosenfeld FMT DDFT (free-draining), implicit Euler",
+        "software_version": env!("CARGO_PKG_VERSION"),
+        "status": status,
+        "message": message,
+        "parameters": p,
+        "theory": {
+            "dr": dr,
+            "cells": outcome.map(|o| o.cells),
+            "dt_max": opts.dt_max,
+            "step_tolerance": opts.tolerance,
+            "equilibrium_tolerance": eq_opts.tolerance,
+            "eject_potential_kT": opts.eject_potential,
+            "eject_tolerance": opts.eject_tolerance,
+        },
+        "equilibrium_iterations": outcome.map(|o| o.equilibrium_iterations),
+        "equilibrium_residual": outcome.map(|o| o.equilibrium_residual),
+        "steps": outcome.map(|o| o.steps),
+        "fixed_point_iterations": outcome.map(|o| o.iterations),
+        "particle_number_drift": outcome.map(|o| o.particle_drift),
+        "profile_times": times,
+        "profiles_written": written.iter().map(|w| profile_name(w.fraction)).collect::<Vec<_>>(),
+        "wall_seconds": wall,
+    });
+    dir.write_json("summary.json", &summary)?;
+    if !written.is_empty() {
+        draw(scenario, &dir, &written)?;
+    }
+    match result {
+        Ok(_) => {
+            println!(
+                "theory: {} profiles in {} ({wall:.1} s)",
+                written.len(),
+                dir.path().display()
+            );
+            Ok(())
+        }
+        Err(e) => bail!(
+            "theory stopped after {} of {} profiles: {e}",
+            written.len(),
+            times.len()
+        ),
+    }
+}
+
+/// Write `profile_<f>.csv` on the BD bins and `theory_profile_<f>.csv` on the theory grid.
+#[allow(clippy::too_many_arguments)]
+fn write_snapshot(
+    dir: &OutputDir,
+    grid: &RadialGrid,
+    s: &Snapshot,
+    fraction: f64,
+    bins: usize,
+    vp: f64,
+    p: &DropletParams,
+    written: &mut Vec<Written>,
+) -> Result<()> {
+    let width = s.radius / bins as f64;
+    let edges: Vec<f64> = (0..=bins).map(|k| k as f64 * width).collect();
+    let r: Vec<f64> = (0..bins).map(|k| (k as f64 + 0.5) * width).collect();
+    let phi: Vec<f64> = bin_average(grid, &s.rho, &edges)
+        .iter()
+        .map(|x| x * vp)
+        .collect();
+    dir.write_table(&profile_name(fraction), &[("r", &r), ("phi", &phi)])?;
+    // Fine profile up to one diameter beyond the interface's harmonic range.
+    let edge = s.radius + p.offset + p.range + p.diameter;
+    let m = grid.centres().iter().take_while(|x| **x <= edge).count();
+    let rf = &grid.centres()[..m];
+    let rho = &s.rho[..m];
+    let phif: Vec<f64> = rho.iter().map(|x| x * vp).collect();
+    let name = format!("theory_{}", profile_name(fraction));
+    dir.write_table(
+        &name,
+        &[("r", rf), ("rho", rho), ("phi", &phif), ("n3", &s.n3[..m])],
+    )?;
+    written.push(Written { fraction, r, phi });
+    Ok(())
+}
+
+/// `profiles.png`: theory lines, BD points from the run folder (`<scenario stem>/`) when present.
+fn draw(scenario: &Path, dir: &OutputDir, written: &[Written]) -> Result<()> {
+    let labels: Vec<String> = written
+        .iter()
+        .map(|w| format!("DDFT {:.0}%", 100.0 * w.fraction))
+        .collect();
+    let mut series: Vec<Series> = written
+        .iter()
+        .zip(&labels)
+        .map(|(w, l)| Series {
+            label: l,
+            x: &w.r,
+            y: &w.phi,
+            points: false,
+        })
+        .collect();
+    let run_dir = common::default_out(scenario, None, "");
+    let bd: Vec<(String, Vec<f64>, Vec<f64>)> = written
+        .iter()
+        .filter_map(|w| {
+            let path = run_dir.join(profile_name(w.fraction));
+            let (h, c) = read_table(&path).ok()?;
+            let ir = h.iter().position(|x| x == "r")?;
+            let ip = h.iter().position(|x| x == "phi")?;
+            Some((
+                format!("BD {:.0}%", 100.0 * w.fraction),
+                c[ir].clone(),
+                c[ip].clone(),
+            ))
+        })
+        .collect();
+    for (l, x, y) in &bd {
+        series.push(Series {
+            label: l,
+            x,
+            y,
+            points: true,
+        });
+    }
+    let title = if bd.is_empty() {
+        "Drying droplet: radial FMT DDFT".to_string()
+    } else {
+        format!(
+            "Drying droplet: DDFT (lines) and BD (points, {})",
+            run_dir.display()
+        )
+    };
+    plot::line_plot(
+        &dir.join("profiles.png"),
+        &title,
+        "r",
+        "phi (bin average of pi d^3 rho / 6)",
+        &series,
+        Scale::Linear,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn profile_names_match_the_fractions() {
+        assert_eq!(profile_name(0.0), "profile_0.00.csv");
+        assert_eq!(profile_name(0.25), "profile_0.25.csv");
+        assert_eq!(profile_name(1.0), "profile_1.00.csv");
+        assert_eq!(profile_name(0.125), "profile_0.125.csv");
+    }
+}
