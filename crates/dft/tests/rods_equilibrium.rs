@@ -380,3 +380,39 @@ mod rods {
         }
     }
 }
+
+/// The paper's parameter grid (Secs. III C and IV B): sigma in {0.2, 0.5, 0.8} x mean density in
+/// {0.2, 0.5, 0.8}, U0 = 6, hard and sticky gamma in {0.1, 1, 10}; every case must converge to
+/// 1e-10 (these are the profiles `colloidsim theory` computes next to BCD runs).
+mod paper_cases {
+    use colloidsim_dft::rods::{BetaPotential, Domain, RodInteraction, RodsProblem, equilibrium};
+    use std::f64::consts::TAU;
+
+    fn all_converge(dx: f64) {
+        for &sigma in &[0.2, 0.5, 0.8] {
+            for &rho in &[0.2, 0.5, 0.8] {
+                for &gamma in &[0.0, 0.1, 1.0, 10.0] {
+                    let p = RodsProblem::new(sigma, rho, Domain::Periodic { period: 1.0 })
+                        .with_dx(dx)
+                        .with_interaction(RodInteraction::Sticky { gamma })
+                        .with_potential(BetaPotential::from_fn(1.0, |x| 3.0 * (TAU * x).cos()));
+                    let eq = equilibrium(&p)
+                        .unwrap_or_else(|e| panic!("sigma {sigma} rho {rho} gamma {gamma}: {e}"));
+                    assert!(eq.residual < 1e-10);
+                    let n: f64 = eq.rho.iter().sum::<f64>() * eq.dx;
+                    assert!((n / rho - 1.0).abs() < 1e-9, "normalisation {n}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rods_paper_cases_converge_at_dx_1e_3() {
+        all_converge(1e-3);
+    }
+
+    #[test]
+    fn rods_paper_cases_converge_at_dx_1e_4() {
+        all_converge(1e-4);
+    }
+}
