@@ -18,7 +18,7 @@ mod functional;
 mod grid;
 
 pub use ddft::{DdftFrame, DdftProblem, DdftSummary, InitialProfile, ddft};
-pub use equilibrium::{BinnedProfile, Equilibrium, equilibrium};
+pub use equilibrium::{BinnedProfile, Equilibrium, EquilibriumSummary, equilibrium};
 
 use colloidsim_core::param::{self, ParamError};
 use std::fmt;

@@ -47,6 +47,29 @@ pub struct Equilibrium {
     gamma: f64,
 }
 
+/// The diagnostics of an [`Equilibrium`], ready for `summary.json`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EquilibriumSummary {
+    /// Always true for a returned [`Equilibrium`] (non-convergence is an error).
+    pub converged: bool,
+    /// Max-norm of the structure equation in `ln rho` form at the returned profile.
+    pub residual: f64,
+    /// Tolerance asked for.
+    pub tolerance: f64,
+    /// Iterations on the finest grid.
+    pub iterations: usize,
+    /// Iterations on all grids.
+    pub total_iterations: usize,
+    /// Grids used (grid sequencing).
+    pub levels: usize,
+    /// Grid spacing used.
+    pub dx: f64,
+    /// Number of grid points carrying density.
+    pub grid_points: usize,
+    /// Chemical potential `beta mu` (thermal wavelength 1).
+    pub beta_mu: f64,
+}
+
 /// An [`Equilibrium`] averaged over histogram bins (the same bins as a simulation's).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BinnedProfile {
@@ -61,6 +84,21 @@ pub struct BinnedProfile {
 }
 
 impl Equilibrium {
+    /// Diagnostics for `summary.json`.
+    pub fn summary(&self) -> EquilibriumSummary {
+        EquilibriumSummary {
+            converged: self.residual < self.tolerance,
+            residual: self.residual,
+            tolerance: self.tolerance,
+            iterations: self.iterations,
+            total_iterations: self.total_iterations,
+            levels: self.levels,
+            dx: self.dx,
+            grid_points: self.x.len(),
+            beta_mu: self.beta_mu,
+        }
+    }
+
     /// Averages over `bins` equal bins covering `[0, over]` (e.g. the simulation box or one
     /// period; periodic profiles are continued periodically, profiles between walls are zero
     /// outside `[sigma/2, length - sigma/2]`). Each value is the exact average of the piecewise-linear
