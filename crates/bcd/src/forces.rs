@@ -39,6 +39,7 @@ impl ExternalForce for NoField {
 pub struct ForceTable {
     inv_h: f64,
     h: f64,
+    /// Cells per period (a power of two, so the periodic wrap is a bit mask).
     cells: usize,
     /// (f, h f') at the knots; one extra knot closes the period.
     knots: Vec<[f64; 2]>,
@@ -108,7 +109,7 @@ impl ExternalForce for ForceTable {
         let s = x * self.inv_h;
         let fl = s.floor();
         let t = s - fl;
-        let i = (fl as i64).rem_euclid(self.cells as i64) as usize;
+        let i = ((fl as i64) & (self.cells as i64 - 1)) as usize;
         let [f0, m0] = self.knots[i];
         let [f1, m1] = self.knots[i + 1];
         // Cubic Hermite basis.

@@ -15,5 +15,6 @@ pub mod engine;
 pub mod forces;
 pub mod init;
 pub mod observe;
+pub mod scenario;
 
 pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Update};

@@ -4,10 +4,11 @@
 
 use crate::engine::{Bcd, Boundary};
 use crate::forces::{ExternalForce, PairForce};
+use serde::{Deserialize, Serialize};
 
 /// Histogram of rod centres over `[0, period)`, folded when the system is longer.
 /// `rho(x_a + dx/2) = p_a / (M dx (L / period))`, so its mean is the mean density N/L.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct DensityProfile {
     period: f64,
     counts: Vec<u64>,
@@ -57,7 +58,7 @@ impl DensityProfile {
 /// Two-particle density at contact, `rho2(x, x + sigma)`: a rod in bin `a` whose right
 /// neighbour lies within `[x + sigma, x + sigma + window)` counts once,
 /// `rho2 = q_a / (M dx window (L / period))` (hard-rods paper Eq. 27).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ContactDensity {
     inner: DensityProfile,
     window: f64,
@@ -119,7 +120,7 @@ impl ContactDensity {
 
 /// Mean-square displacement at log-spaced lags (in steps), averaged over rods and over time
 /// origins taken every `origin_every` steps.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Msd {
     lags: Vec<u64>,
     origin_every: u64,
@@ -200,7 +201,7 @@ impl Msd {
 }
 
 /// Histogram of cluster sizes (rods in contact moving together).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ClusterSizes {
     counts: Vec<u64>,
 }

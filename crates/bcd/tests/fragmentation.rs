@@ -25,6 +25,45 @@ fn satisfies(f: &[f64], parts: &[(usize, usize)]) -> bool {
         .all(|w| mean(&f[w[0].0..w[0].1]) < mean(&f[w[1].0..w[1].1]))
 }
 
+/// The paper's successive pair fragmentation (fast-bcd Sec. III, Eqs. 7–8): split where the
+/// mean velocity right minus left is largest and positive (leftmost on ties), recurse.
+fn greedy(f: &[f64], a: usize, b: usize, out: &mut Vec<(usize, usize)>) {
+    let mut best = 0.0;
+    let mut split = None;
+    for j in a + 1..b {
+        let d = mean(&f[j..b]) - mean(&f[a..j]);
+        if d > best {
+            best = d;
+            split = Some(j);
+        }
+    }
+    match split {
+        Some(j) => {
+            greedy(f, a, j, out);
+            greedy(f, j, b, out);
+        }
+        None => out.push((a, b)),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+    /// The O(n) hull construction equals the paper's successive pair fragmentation, also for
+    /// large clusters.
+    #[test]
+    fn hull_equals_successive_pair_fragmentation(
+        f in prop::collection::vec(-10.0f64..10.0, 1..300)
+    ) {
+        let mut ours = Vec::new();
+        fragment(&f, false, false, &mut FragmentScratch::default(), |a, len, _, _| {
+            ours.push((a, a + len))
+        });
+        let mut paper = Vec::new();
+        greedy(&f, 0, f.len(), &mut paper);
+        prop_assert_eq!(ours, paper);
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
     #[test]

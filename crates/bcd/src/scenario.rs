@@ -1,0 +1,619 @@
+//! The BCD scenario file (TOML) and its resolution into validated parameters.
+//!
+//! Every key is documented in `docs/bcd.md` with its unit and default; unknown keys are errors.
+//! Units: lengths in the unit of `system.length`, energies in units of the energy scale of the
+//! potential (kT = 1 by default), time in (length unit)^2 / D when mobility = kT = 1.
+
+use crate::engine::{BcdConfig, Boundary, Update};
+use crate::forces::{ForceTable, PairForce, Sticky, TabulatedPair, Yukawa};
+use crate::init;
+use colloidsim_core::ParamError;
+use colloidsim_core::field1d::{ExternalField, FieldTerm, PeriodicSpline};
+use colloidsim_core::output::read_table;
+use colloidsim_core::param;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A BCD scenario as written in the TOML file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// `bcd` (premerging) or `bcd-chronological`.
+    pub method: String,
+    /// Seed of all random streams (0 ..= 4294967295).
+    #[serde(default = "one")]
+    pub seed: u64,
+    /// Physical system.
+    pub system: System,
+    /// External potential.
+    #[serde(default)]
+    pub potential: Potential,
+    /// Pair interactions beyond the hard core.
+    #[serde(default)]
+    pub interaction: Interaction,
+    /// Initial configuration.
+    #[serde(default)]
+    pub initial: Initial,
+    /// Time stepping.
+    pub run: Run,
+    /// Observables.
+    #[serde(default)]
+    pub observe: Observe,
+}
+
+fn one() -> u64 {
+    1
+}
+fn unit() -> f64 {
+    1.0
+}
+
+/// `[system]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct System {
+    /// Length L of the ring or channel.
+    pub length: f64,
+    /// Number of rods N.
+    pub particles: usize,
+    /// Rod length sigma (the hard-core diameter).
+    pub diameter: f64,
+    /// Mobility mu (default 1).
+    #[serde(default = "unit")]
+    pub mobility: f64,
+    /// Thermal energy kT (default 1; 0 for deterministic dynamics).
+    #[serde(default = "unit", rename = "kT")]
+    pub kt: f64,
+    /// `periodic` (default) or `walls`.
+    #[serde(default = "periodic")]
+    pub boundary: Boundary,
+}
+
+fn periodic() -> Boundary {
+    Boundary::Periodic
+}
+
+/// `[potential]`: a sum of the terms given.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Potential {
+    /// `U = (amplitude/2) cos(2 pi x / wavelength)`.
+    pub cosine: Option<Cosine>,
+    /// Constant force (tilted washboard).
+    #[serde(default)]
+    pub drive: f64,
+    /// `U = stiffness/2 (x - centre)^2`.
+    pub harmonic: Option<Harmonic>,
+    /// `U = sum_n cos[n] cos(2 pi (n+1) x / wavelength) + sin[n] sin(...)`.
+    pub fourier: Option<Fourier>,
+    /// CSV file with columns `x,U` over exactly one period (last U equal to the first).
+    pub table: Option<PathBuf>,
+}
+
+/// `potential.cosine`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cosine {
+    /// Peak-to-peak height U0.
+    pub amplitude: f64,
+    /// Period lambda.
+    pub wavelength: f64,
+}
+
+/// `potential.harmonic`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Harmonic {
+    /// Spring constant.
+    pub stiffness: f64,
+    /// Trap centre (default L/2).
+    pub centre: Option<f64>,
+}
+
+/// `potential.fourier`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fourier {
+    /// Fundamental period.
+    pub wavelength: f64,
+    /// Cosine amplitudes of modes 1, 2, ...
+    #[serde(default)]
+    pub cos: Vec<f64>,
+    /// Sine amplitudes of modes 1, 2, ...
+    #[serde(default)]
+    pub sin: Vec<f64>,
+}
+
+/// `[interaction]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Interaction {
+    /// Baxter sticky contact (hard-rods paper Eq. 33).
+    pub sticky: Option<StickySpec>,
+    /// Screened-Coulomb repulsion of the surfaces.
+    pub yukawa: Option<YukawaSpec>,
+    /// CSV file with columns `r,f` (pair force, positive repulsive).
+    pub table: Option<PathBuf>,
+}
+
+/// `interaction.sticky`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StickySpec {
+    /// Strength gamma.
+    pub gamma: f64,
+    /// Virtual range eps (default 0.05).
+    #[serde(default = "eps_default")]
+    pub range: f64,
+    /// Order p (default 3).
+    #[serde(default = "order_default")]
+    pub order: f64,
+}
+fn eps_default() -> f64 {
+    0.05
+}
+fn order_default() -> f64 {
+    3.0
+}
+
+/// `interaction.yukawa`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct YukawaSpec {
+    /// Energy at contact.
+    pub strength: f64,
+    /// Screening length.
+    pub screening: f64,
+    /// Cutoff (centre distance).
+    pub cutoff: f64,
+}
+
+/// `[initial]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// `random` (default), `lattice` or `file`.
+    #[serde(default = "random")]
+    pub placement: String,
+    /// CSV file with a column `x` (placement = "file").
+    pub file: Option<PathBuf>,
+}
+fn random() -> String {
+    "random".into()
+}
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            placement: random(),
+            file: None,
+        }
+    }
+}
+
+/// `[run]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Run {
+    /// Time step.
+    pub dt: f64,
+    /// Time run before sampling starts (default 0).
+    #[serde(default)]
+    pub equilibrate: f64,
+    /// Time sampled.
+    pub time: f64,
+    /// Steps between checkpoints (default: about every 10% of the run).
+    pub checkpoint_every: Option<u64>,
+}
+
+/// `[observe]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Observe {
+    /// Steps between samples of density, contact density and clusters (default 1).
+    pub every: Option<u64>,
+    /// Density histogram.
+    pub density: Option<Bins>,
+    /// Two-particle density at contact.
+    pub contact_density: Option<ContactSpec>,
+    /// Mean-square displacement.
+    pub msd: Option<MsdSpec>,
+    /// Mean particle current.
+    #[serde(default)]
+    pub current: bool,
+    /// Cluster-size distribution.
+    #[serde(default)]
+    pub clusters: bool,
+    /// GSD trajectory.
+    pub trajectory: Option<Trajectory>,
+}
+
+/// `observe.density`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bins {
+    /// Number of bins over one period (or over L without a periodic potential).
+    pub bins: usize,
+}
+
+/// `observe.contact_density`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Number of bins.
+    pub bins: usize,
+    /// Contact window Delta'.
+    pub window: f64,
+}
+
+/// `observe.msd`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MsdSpec {
+    /// Number of log-spaced lag times (default 40).
+    #[serde(default = "msd_points")]
+    pub points: usize,
+    /// Longest lag time (default: half the sampled time).
+    pub max_lag: Option<f64>,
+}
+fn msd_points() -> usize {
+    40
+}
+
+/// `observe.trajectory`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Trajectory {
+    /// Steps between frames.
+    pub every: u64,
+}
+
+/// External force as the engine sees it.
+#[derive(Debug, Clone)]
+pub enum Field {
+    /// No field.
+    None,
+    /// Periodic field from a table (exact to 1e-9).
+    Table(ForceTable),
+    /// Non-periodic field evaluated exactly.
+    Exact(ExternalField),
+}
+
+impl crate::forces::ExternalForce for Field {
+    #[inline]
+    fn force(&self, x: f64) -> f64 {
+        match self {
+            Field::None => 0.0,
+            Field::Table(t) => t.force(x),
+            Field::Exact(f) => f.force(x),
+        }
+    }
+}
+
+/// Pair force as the engine sees it: any combination of the specified terms.
+#[derive(Debug, Clone, Default)]
+pub struct Pair {
+    /// Sticky contact.
+    pub sticky: Option<Sticky>,
+    /// Yukawa.
+    pub yukawa: Option<Yukawa>,
+    /// Tabulated.
+    pub table: Option<TabulatedPair>,
+    range: f64,
+}
+
+impl PairForce for Pair {
+    #[inline]
+    fn range(&self) -> f64 {
+        self.range
+    }
+    #[inline]
+    fn force(&self, r: f64) -> f64 {
+        let mut f = 0.0;
+        if let Some(s) = &self.sticky {
+            f += s.force(r);
+        }
+        if let Some(y) = &self.yukawa {
+            f += y.force(r);
+        }
+        if let Some(t) = &self.table {
+            f += t.force(r);
+        }
+        f
+    }
+}
+
+/// Resolved, validated scenario.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    /// Engine configuration.
+    pub config: BcdConfig,
+    /// The external field (potential and drive).
+    pub field: ExternalField,
+    /// Force as evaluated by the engine.
+    pub engine_field: Field,
+    /// Pair forces.
+    pub pair: Pair,
+    /// Initial rod centres.
+    pub initial: Vec<f64>,
+    /// Steps before sampling.
+    pub equilibrate_steps: u64,
+    /// Sampled steps.
+    pub sampled_steps: u64,
+    /// Folding period of profiles (the potential's period, or L).
+    pub period: f64,
+    /// Warnings worth showing to the user.
+    pub warnings: Vec<String>,
+}
+
+impl Scenario {
+    /// Validate and resolve. Relative file names are taken relative to `base`.
+    pub fn resolve(&self, base: &Path, seed_override: Option<u64>) -> Result<Resolved, ParamError> {
+        let update = match self.method.as_str() {
+            "bcd" => Update::Premerge,
+            "bcd-chronological" => Update::Chronological,
+            m => {
+                return Err(ParamError::new(
+                    "method",
+                    format!("'{m}' is not a BCD method (bcd, bcd-chronological)"),
+                ));
+            }
+        };
+        let seed = seed_override.unwrap_or(self.seed);
+        let seed = u32::try_from(seed).map_err(|_| {
+            ParamError::new("seed", format!("must lie in [0, 4294967295], got {seed}"))
+        })?;
+        let s = &self.system;
+        let config = BcdConfig {
+            length: s.length,
+            sigma: s.diameter,
+            mobility: s.mobility,
+            kt: s.kt,
+            dt: self.run.dt,
+            boundary: s.boundary,
+            seed,
+            update,
+        };
+        config.validate(s.particles)?;
+        let mut warnings = Vec::new();
+
+        let field = self.field(base)?;
+        if let (Some(p), Boundary::Periodic) = (field.period(), s.boundary) {
+            let k = s.length / p;
+            if (k - k.round()).abs() > 1e-9 * k {
+                return Err(ParamError::new(
+                    "system.length",
+                    format!(
+                        "on a ring the length must be a whole number of potential periods ({p}); got {} = {k} periods",
+                        s.length
+                    ),
+                ));
+            }
+        }
+        let engine_field = if field.is_zero() {
+            Field::None
+        } else if let Some(t) = ForceTable::from_field(&field) {
+            Field::Table(t)
+        } else {
+            Field::Exact(field.clone())
+        };
+
+        let pair = self.pair(base, s.diameter, s.kt)?;
+        if let Some(st) = &pair.sticky {
+            // Time-step criterion, hard-rods paper Eq. (34): mu max|f| dt << eps.
+            let jump = s.mobility * st.max_force() * self.run.dt;
+            if jump > st.eps {
+                return Err(ParamError::new(
+                    "run.dt",
+                    format!(
+                        "too large for the sticky range: mu max|f| dt = {jump:.3e} exceeds eps = {} (Eq. 34 needs << eps); use dt <= {:.2e}",
+                        st.eps,
+                        0.1 * st.eps / (s.mobility * st.max_force())
+                    ),
+                ));
+            } else if jump > 0.1 * st.eps {
+                warnings.push(format!(
+                    "run.dt: mu max|f| dt = {jump:.3e} is not much smaller than the sticky range {} (Eq. 34); results may depend on dt",
+                    st.eps
+                ));
+            }
+        }
+
+        let initial = match self.initial.placement.as_str() {
+            "random" => init::random(&config, s.particles, seed)?,
+            "lattice" => init::lattice(&config, s.particles)?,
+            "file" => {
+                let f = self.initial.file.as_ref().ok_or_else(|| {
+                    ParamError::new("initial.file", "placement = \"file\" needs a file name")
+                })?;
+                let x = read_column(&base.join(f), "x", "initial.file")?;
+                if x.len() != s.particles {
+                    return Err(ParamError::new(
+                        "initial.file",
+                        format!(
+                            "{} holds {} positions but system.particles = {}",
+                            f.display(),
+                            x.len(),
+                            s.particles
+                        ),
+                    ));
+                }
+                init::from_positions(&config, x)?
+            }
+            p => {
+                return Err(ParamError::new(
+                    "initial.placement",
+                    format!("'{p}' is not one of: random, lattice, file"),
+                ));
+            }
+        };
+
+        param::non_negative("run.equilibrate", self.run.equilibrate)?;
+        param::positive("run.time", self.run.time)?;
+        let equilibrate_steps = (self.run.equilibrate / self.run.dt).round() as u64;
+        let sampled_steps = (self.run.time / self.run.dt).round().max(1.0) as u64;
+        if sampled_steps > 1 << 50 {
+            return Err(ParamError::new(
+                "run.time",
+                format!("run.time / run.dt = {sampled_steps} steps is too many"),
+            ));
+        }
+        let o = &self.observe;
+        if let Some(e) = o.every {
+            param::at_least("observe.every", e as usize, 1)?;
+        }
+        if let Some(d) = &o.density {
+            param::at_least("observe.density.bins", d.bins, 1)?;
+        }
+        if let Some(c) = &o.contact_density {
+            param::at_least("observe.contact_density.bins", c.bins, 1)?;
+            param::positive("observe.contact_density.window", c.window)?;
+            // Colliding pairs end a BCD step at exactly zero gap: weight that continuous-time
+            // dynamics spreads over ~ sqrt(2 D dt). The window must be wider than that.
+            let spread = (2.0 * s.mobility * s.kt * self.run.dt).sqrt();
+            if c.window < 3.0 * spread {
+                warnings.push(format!(
+                    "observe.contact_density.window = {} is not much wider than the collision spread sqrt(2 D dt) = {spread:.2e}: rho2 is biased upwards; widen the window or reduce run.dt",
+                    c.window
+                ));
+            }
+        }
+        if let Some(m) = &o.msd {
+            param::at_least("observe.msd.points", m.points, 2)?;
+            if let Some(l) = m.max_lag {
+                param::in_range("observe.msd.max_lag", l, self.run.dt, self.run.time)?;
+            }
+        }
+        if let Some(t) = &o.trajectory {
+            param::at_least("observe.trajectory.every", t.every as usize, 1)?;
+        }
+        let period = match (field.period(), s.boundary) {
+            (Some(p), Boundary::Periodic) => p,
+            _ => s.length,
+        };
+        Ok(Resolved {
+            config,
+            field,
+            engine_field,
+            pair,
+            initial,
+            equilibrate_steps,
+            sampled_steps,
+            period,
+            warnings,
+        })
+    }
+
+    fn field(&self, base: &Path) -> Result<ExternalField, ParamError> {
+        let p = &self.potential;
+        let mut terms = Vec::new();
+        if let Some(c) = &p.cosine {
+            param::finite("potential.cosine.amplitude", c.amplitude)?;
+            param::positive("potential.cosine.wavelength", c.wavelength)?;
+            terms.push(FieldTerm::Cosine {
+                amplitude: c.amplitude,
+                wavelength: c.wavelength,
+            });
+        }
+        if let Some(h) = &p.harmonic {
+            param::non_negative("potential.harmonic.stiffness", h.stiffness)?;
+            let centre = h.centre.unwrap_or(0.5 * self.system.length);
+            param::finite("potential.harmonic.centre", centre)?;
+            terms.push(FieldTerm::Harmonic {
+                stiffness: h.stiffness,
+                centre,
+                ring: (self.system.boundary == Boundary::Periodic).then_some(self.system.length),
+            });
+        }
+        if let Some(f) = &p.fourier {
+            param::positive("potential.fourier.wavelength", f.wavelength)?;
+            for v in f.cos.iter().chain(&f.sin) {
+                param::finite("potential.fourier", *v)?;
+            }
+            let m = f.cos.len().max(f.sin.len());
+            let mut c = f.cos.clone();
+            let mut s = f.sin.clone();
+            c.resize(m, 0.0);
+            s.resize(m, 0.0);
+            terms.push(FieldTerm::Fourier {
+                wavelength: f.wavelength,
+                cos: c,
+                sin: s,
+            });
+        }
+        if let Some(t) = &p.table {
+            let path = base.join(t);
+            let (x, u) = read_pair(&path, ("x", "U"), "potential.table")?;
+            terms.push(FieldTerm::Tabulated(PeriodicSpline::new(
+                "potential.table",
+                x,
+                u,
+            )?));
+        }
+        param::finite("potential.drive", p.drive)?;
+        Ok(ExternalField {
+            terms,
+            drive: p.drive,
+        })
+    }
+
+    fn pair(&self, base: &Path, sigma: f64, kt: f64) -> Result<Pair, ParamError> {
+        let i = &self.interaction;
+        let sticky = i
+            .sticky
+            .as_ref()
+            .map(|s| Sticky::new(s.gamma, s.range, s.order, sigma, kt))
+            .transpose()?;
+        let yukawa = i
+            .yukawa
+            .as_ref()
+            .map(|y| Yukawa::new(y.strength, y.screening, y.cutoff, sigma))
+            .transpose()?;
+        let table = match &i.table {
+            Some(t) => {
+                let (r, f) = read_pair(&base.join(t), ("r", "f"), "interaction.table")?;
+                Some(TabulatedPair::new(r, f, sigma)?)
+            }
+            None => None,
+        };
+        let range = [
+            sticky.as_ref().map(|s| s.range()),
+            yukawa.as_ref().map(|y| y.range()),
+            table.as_ref().map(|t| t.range()),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f64::max);
+        Ok(Pair {
+            sticky,
+            yukawa,
+            table,
+            range,
+        })
+    }
+}
+
+fn read_column(path: &Path, name: &str, key: &str) -> Result<Vec<f64>, ParamError> {
+    let (h, cols) = read_table(path).map_err(|e| ParamError::new(key, e))?;
+    let j = h.iter().position(|c| c == name).ok_or_else(|| {
+        ParamError::new(
+            key,
+            format!(
+                "{} has no column '{name}' (header: {})",
+                path.display(),
+                h.join(",")
+            ),
+        )
+    })?;
+    Ok(cols[j].clone())
+}
+
+fn read_pair(
+    path: &Path,
+    names: (&str, &str),
+    key: &str,
+) -> Result<(Vec<f64>, Vec<f64>), ParamError> {
+    Ok((
+        read_column(path, names.0, key)?,
+        read_column(path, names.1, key)?,
+    ))
+}
