@@ -2,6 +2,7 @@
 
 mod bcd_cmd;
 mod common;
+mod droplet;
 mod plot;
 mod theory_droplet;
 
@@ -11,7 +12,11 @@ use common::RunOptions;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "colloidsim", version, about = "Simulations of colloidal suspensions")]
+#[command(
+    name = "colloidsim",
+    version,
+    about = "Simulations of colloidal suspensions"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -73,6 +78,8 @@ enum Command {
 enum BenchKind {
     /// Fast BCD scaling case of fast-bcd Fig. 6 (sigma = 0.99, U0 = 6, density 1, dt = 1e-3).
     Bcd(bcd_cmd::BenchArgs),
+    /// WCA Brownian dynamics, 25,000 particles at phi = 0.1 in a periodic box, beside LAMMPS.
+    Bd(droplet::BenchArgs),
 }
 
 /// The `method` key of a scenario decides which engine reads the rest of the file.
@@ -85,7 +92,7 @@ fn method_of(doc: &toml::Table, path: &std::path::Path) -> Result<String> {
             other.type_str()
         ),
         None => bail!(
-            "{}: missing key 'method' (one of: bcd, bcd-chronological)",
+            "{}: missing key 'method' (one of: bcd, bcd-chronological, droplet-bd)",
             path.display()
         ),
     }
@@ -94,8 +101,8 @@ fn method_of(doc: &toml::Table, path: &std::path::Path) -> Result<String> {
 fn read_scenario(path: &std::path::Path) -> Result<(String, String)> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read scenario {}", path.display()))?;
-    let doc: toml::Table = toml::from_str(&text)
-        .with_context(|| format!("{} is not valid TOML", path.display()))?;
+    let doc: toml::Table =
+        toml::from_str(&text).with_context(|| format!("{} is not valid TOML", path.display()))?;
     Ok((method_of(&doc, path)?, text))
 }
 
@@ -130,8 +137,9 @@ fn main() -> Result<()> {
             };
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::run(&scenario, &text, &opts),
+                "droplet-bd" => droplet::run(&scenario, &text, &opts),
                 m => bail!(
-                    "{}: unknown method '{m}' (one of: bcd, bcd-chronological)",
+                    "{}: unknown method '{m}' (one of: bcd, bcd-chronological, droplet-bd)",
                     scenario.display()
                 ),
             }
@@ -157,11 +165,13 @@ fn main() -> Result<()> {
             let (method, text) = read_scenario(&scenario)?;
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::check(&scenario, &text),
+                "droplet-bd" => droplet::check(&scenario, &text),
                 m => bail!("{}: unknown method '{m}'", scenario.display()),
             }
         }
         Command::Bench { which } => match which {
             BenchKind::Bcd(args) => bcd_cmd::bench(&args),
+            BenchKind::Bd(args) => droplet::bench(&args),
         },
     }
 }
