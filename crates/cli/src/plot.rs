@@ -65,10 +65,10 @@ pub fn line_plot(
             }
         }
     }
-    if !(xr.0 < xr.1) {
+    if xr.0 >= xr.1 {
         return Err(anyhow!("plot {}: no finite data to draw", path.display()));
     }
-    if !(yr.0 < yr.1) {
+    if yr.0 >= yr.1 {
         yr = (yr.0 - 1.0, yr.1 + 1.0);
     }
     let root = BitMapBackend::new(path, (800, 500)).into_drawing_area();
@@ -85,12 +85,11 @@ pub fn line_plot(
                 .map_err(|e| anyhow!("plot: {e}"))?;
             for (k, s) in series.iter().enumerate() {
                 let c = COLOURS[k % COLOURS.len()];
-                let data = s
-                    .x
-                    .iter()
-                    .zip(s.y)
-                    .filter(|(x, y)| finite(**x) && finite(**y))
-                    .map(|(x, y)| (*x, *y));
+                let data =
+                    s.x.iter()
+                        .zip(s.y)
+                        .filter(|(x, y)| finite(**x) && finite(**y))
+                        .map(|(x, y)| (*x, *y));
                 if s.points {
                     chart
                         .draw_series(data.map(|p| Circle::new(p, 2, c.filled())))
