@@ -4,7 +4,9 @@
 //! Reads the same scenario as `colloidsim run`; writes `profile_<fraction>.csv` (`r,phi`: bin
 //! centres and the bin-averaged `pi d^3 rho / 6` on `observe.profile.bins` equal bins of
 //! `[0, R(t)]`, at `t = round(fraction * steps) * dt` like the BD run), the fine-grid profiles
-//! `theory_profile_<fraction>.csv` (`r,rho,phi,n3`), `summary.json` and `profiles.png` (with the
+//! `theory_profile_<fraction>.csv` (`r,rho,phi,n3`), the equilibrium of the same N in a static
+//! droplet of radius R(t) on the same bins (`equilibrium_<fraction>.csv`, `r,phi`; the paper's
+//! Fig. 2a references), `summary.json` and `profiles.png` (with the
 //! BD profiles of the run folder overlaid when they exist). See `docs/theory-droplet.md`.
 
 use std::f64::consts::PI;
@@ -15,7 +17,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use colloidsim_core::output::{OutputDir, read_table};
 use colloidsim_dft::radial::{
     DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError,
-    RadialGrid, Snapshot, bin_average, run_droplet,
+    RadialGrid, Snapshot, bin_average, equilibrium_at, run_droplet,
 };
 use colloidsim_md::droplet::{DropletParams, DropletScenario};
 
@@ -90,6 +92,7 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
     let mut written: Vec<Written> = Vec::new();
     let mut write_err: Option<anyhow::Error> = None;
     let mut next = 0usize;
+    let mut equilibria: Vec<serde_json::Value> = Vec::new();
     let start = Instant::now();
     let result = run_droplet(
         &setup,
@@ -101,6 +104,33 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
             next += 1;
             if let Err(e) = write_snapshot(&dir, grid, s, fraction, p.bins, vp, &p, &mut written) {
                 write_err.get_or_insert(e);
+            }
+            // Reference: equilibrium of the same N in a static droplet of radius R(t).
+            match equilibrium_at(&setup, s.radius, &eq_opts) {
+                Ok((g, eq)) => {
+                    let width = s.radius / p.bins as f64;
+                    let edges: Vec<f64> = (0..=p.bins).map(|k| k as f64 * width).collect();
+                    let r: Vec<f64> = (0..p.bins).map(|k| (k as f64 + 0.5) * width).collect();
+                    let phi: Vec<f64> = bin_average(&g, &eq.rho, &edges)
+                        .iter()
+                        .map(|x| x * vp)
+                        .collect();
+                    let name = profile_name(fraction).replacen("profile", "equilibrium", 1);
+                    if let Err(e) = dir.write_table(&name, &[("r", &r), ("phi", &phi)]) {
+                        write_err.get_or_insert(e.into());
+                    }
+                    equilibria.push(serde_json::json!({
+                        "file": name,
+                        "radius": s.radius,
+                        "iterations": eq.iterations,
+                        "residual": eq.residual,
+                        "beta_mu": eq.beta_mu,
+                    }));
+                }
+                Err(e) => equilibria.push(serde_json::json!({
+                    "radius": s.radius,
+                    "error": e.to_string(),
+                })),
             }
         },
         |rep| pb.set_position((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
@@ -138,6 +168,7 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
         "fixed_point_iterations": outcome.map(|o| o.iterations),
         "particle_number_drift": outcome.map(|o| o.particle_drift),
         "profile_times": times,
+        "equilibria": equilibria,
         "profiles_written": written.iter().map(|w| profile_name(w.fraction)).collect::<Vec<_>>(),
         "wall_seconds": wall,
     });

@@ -23,7 +23,9 @@ pub mod interface;
 pub mod rpy;
 
 pub use ddft::{Ddft, DdftOptions, Hydrodynamics, StepReport};
-pub use droplet::{DropletOutcome, DropletSetup, Snapshot, bin_average, run_droplet};
+pub use droplet::{
+    DropletOutcome, DropletSetup, Snapshot, bin_average, equilibrium_at, run_droplet,
+};
 pub use equilibrium::{Equilibrium, EquilibriumOptions, solve_equilibrium};
 pub use fmt::Rosenfeld;
 pub use grid::RadialGrid;

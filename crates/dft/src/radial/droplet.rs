@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 use colloidsim_core::{ParamError, param};
 
 use super::{
-    Ddft, DdftOptions, DryingSchedule, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
-    RadialError, RadialGrid, Rosenfeld, StepReport, solve_equilibrium,
+    Ddft, DdftOptions, DryingSchedule, Equilibrium, EquilibriumOptions, HarmonicInterface,
+    Hydrodynamics, RadialError, RadialGrid, Rosenfeld, StepReport, solve_equilibrium,
 };
 
 /// Random close packing: the largest mean volume fraction accepted.
@@ -206,6 +206,29 @@ pub fn run_droplet(
         particle_drift: drift,
         cells: grid.len(),
     })
+}
+
+/// Equilibrium of the setup's `N` particles in a static droplet of radius `radius` (the paper's
+/// reference profiles at the mean volume fraction of each output time), on a grid that reaches
+/// `beta V = 100 kT` beyond the interface.
+pub fn equilibrium_at(
+    setup: &DropletSetup,
+    radius: f64,
+    eq_opts: &EquilibriumOptions,
+) -> Result<(RadialGrid, Equilibrium), RadialError> {
+    let static_setup = DropletSetup {
+        r0: radius,
+        alpha: 0.0,
+        t_end: 0.0,
+        ..*setup
+    };
+    static_setup.validate()?;
+    let grid = static_setup.grid(100.0)?;
+    let mut fmt = Rosenfeld::new(&grid, setup.diameter)?;
+    let mut v = vec![0.0; grid.len()];
+    setup.interface.fill(grid.centres(), radius, &mut v);
+    let eq = solve_equilibrium(&grid, &mut fmt, &v, setup.particles, None, eq_opts)?;
+    Ok((grid, eq))
 }
 
 /// Averages of the cell values `values` over radial bins `[edges[k], edges[k+1]]`, weighted by
