@@ -261,6 +261,19 @@ impl RodsProblem {
             }
             Domain::Walls { length } => {
                 param::positive("length", length)?;
+                let fit = (length / self.sigma * (1.0 + 1e-12)).floor();
+                if length > self.sigma && self.mean_density * length >= fit {
+                    return Err(ParamError::new(
+                        "mean_density",
+                        format!(
+                            "between walls at most {fit} rods of length {} fit in length {length}; \
+                             mean_density * length must be < {fit}, got {}",
+                            self.sigma,
+                            self.mean_density * length
+                        ),
+                    )
+                    .into());
+                }
                 if length <= self.sigma {
                     return Err(ParamError::new(
                         "length",

@@ -269,6 +269,20 @@ mod rods {
     }
 
     #[test]
+    fn a_dense_short_box_converges_from_separated_peaks() {
+        // 2.85 rods of length 0.8 between walls 3 apart (3 fit): the uniform start overlaps
+        // (eta = 1.03), the solver starts from separated peaks instead.
+        let eq =
+            equilibrium(&RodsProblem::new(0.8, 0.95, Domain::Walls { length: 3.0 }).with_dx(0.005))
+                .unwrap();
+        let m = eq.rho.len();
+        assert!(eq.residual < 1e-10);
+        assert!((eq.rho[0] - eq.rho[m - 1]).abs() < 1e-8 * eq.rho[0]);
+        let n: f64 = eq.bin_average(300, 3.0).unwrap().rho.iter().sum::<f64>() * 0.01;
+        assert!((n / 2.85 - 1.0).abs() < 1e-9, "{n}");
+    }
+
+    #[test]
     fn sticky_rods_at_walls_obey_the_contact_theorem() {
         // The hard-wall contact theorem rho(contact) = beta p(bulk) holds for any rod-rod
         // interaction; with the Baxter pressure beta p(1 + gamma beta p) = rho/(1 - rho sigma).
@@ -344,6 +358,11 @@ mod rods {
         assert!(
             msg(RodsProblem::new(1.0, 0.5, Domain::Walls { length: 0.9 }).with_dx(0.01))
                 .contains("length")
+        );
+        // 3.6 rods of length 0.8 between walls 3 apart: only 3 fit
+        assert!(
+            msg(RodsProblem::new(0.8, 1.2, Domain::Walls { length: 3.0 }).with_dx(0.01))
+                .contains("at most 3 rods")
         );
         // potential period 2 on a domain of period 1
         assert!(

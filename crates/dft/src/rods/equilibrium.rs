@@ -223,6 +223,39 @@ impl Solver {
         self.u.fill(rho0.ln());
     }
 
+    /// Start between walls when the uniform density overlaps: `k = floor(length / sigma)` (the
+    /// most rods that fit) narrow peaks spread evenly over the centre range, each holding N/k < 1.
+    fn peaked_start(&mut self, sigma: f64) {
+        let act = self.grid.active;
+        let span = (act - 1) as f64 * self.grid.dx;
+        let k = ((span / sigma).floor() as usize + 1).max(1);
+        let spacing = if k > 1 { span / (k - 1) as f64 } else { span };
+        let w = ((spacing - sigma) / 6.0)
+            .max(2.0 * self.grid.dx)
+            .min(sigma / 4.0);
+        let x0 = self.grid.x(0);
+        let dx = self.grid.dx;
+        self.rho[..act].fill(0.0);
+        // each peak (half peaks at the walls included) holds N/k
+        for p in 0..k {
+            let c = if k > 1 {
+                p as f64 * spacing
+            } else {
+                0.5 * span
+            };
+            let z = |i: usize| (self.grid.x(i) - x0 - c) / w;
+            let mass: f64 = (0..act).map(|i| (-0.5 * z(i) * z(i)).exp()).sum::<f64>() * dx;
+            let scale = self.particles / k as f64 / mass;
+            for i in 0..act {
+                self.rho[i] += scale * (-0.5 * z(i) * z(i)).exp();
+            }
+        }
+        let floor = 1e-12 * self.particles / span.max(dx);
+        for i in 0..act {
+            self.u[i] = (self.rho[i] + floor).ln();
+        }
+    }
+
     /// Linear interpolation of a coarser solution (by position; clamped at walls).
     fn interpolate_start(&mut self, gc: &Grid, uc: &[f64]) {
         let periodic = gc.active == gc.m;
@@ -294,6 +327,7 @@ impl Solver {
         let mut anderson = Anderson::new(self.grid.m, problem.anderson_memory, problem.mixing);
         let mut best = f64::INFINITY;
         let mut have_ok = false;
+        let mut tried_peaks = false;
         let mut it = 0;
         loop {
             match self.eval() {
@@ -315,12 +349,19 @@ impl Solver {
                     anderson.step(&mut self.u, &self.r);
                 }
                 Err(Overlap) => {
+                    if !have_ok && !tried_peaks && self.grid.active < self.grid.m {
+                        // dense box: start from separated peaks instead of the uniform density
+                        tried_peaks = true;
+                        self.peaked_start(problem.sigma);
+                        continue;
+                    }
                     if !have_ok {
                         return Err(ParamError::new(
                             "mean_density",
                             format!(
                                 "no admissible starting profile: the uniform density {} overlaps \
-                                 rods of length {} in this domain; lower mean_density",
+                                 rods of length {} in this domain (and separated peaks too); \
+                                 the state is too close to jamming for this grid",
                                 self.particles / (self.grid.active as f64 * self.grid.dx),
                                 problem.sigma
                             ),
