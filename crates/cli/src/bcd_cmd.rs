@@ -3,7 +3,7 @@
 use crate::common::{RunOptions, progress};
 use crate::plot::{Scale, Series, line_plot};
 use anyhow::{Context, Result, bail};
-use colloidsim_bcd::forces::{ForceTable, NoPair};
+use colloidsim_bcd::forces::{ForceTable, NoField, NoPair};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
 use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
 use colloidsim_bcd::{Bcd, BcdConfig, BcdState, Boundary, Update, init};
@@ -37,6 +37,9 @@ pub fn check(path: &Path, text: &str) -> Result<()> {
     for w in &r.warnings {
         eprintln!("warning: {w}");
     }
+    // Building the engine checks the initial positions (overlaps, walls).
+    Bcd::new(r.config.clone(), r.initial.clone(), NoField, NoPair)
+        .with_context(|| format!("scenario {}", path.display()))?;
     println!("{}", serde_json::to_string_pretty(&resolved_json(&sc, &r))?);
     println!("scenario {} is valid", path.display());
     Ok(())
@@ -209,6 +212,10 @@ fn simulate<P: PairForce + Clone>(
         Some(_) => Some(open_trajectory(out, frames > 0 || bcd.steps() > 0)?),
         None => None,
     };
+    // Test hook: behave as if Ctrl-C arrived at this step.
+    let stop_at: Option<u64> = std::env::var("COLLOIDSIM_INTERRUPT_AT_STEP")
+        .ok()
+        .and_then(|v| v.parse().ok());
     let pb = progress(total, opts.quiet, "bcd");
     pb.set_position(bcd.steps());
     let start = Instant::now();
@@ -226,6 +233,9 @@ fn simulate<P: PairForce + Clone>(
         Ok(())
     };
     while bcd.steps() < total {
+        if stop_at == Some(bcd.steps()) {
+            INTERRUPTED.store(true, Ordering::SeqCst);
+        }
         if INTERRUPTED.load(Ordering::Relaxed) {
             if let Some(g) = gsd.as_mut() {
                 g.sync_all()?;
@@ -351,7 +361,12 @@ where
 {
     let c = &r.config;
     let n = r.initial.len();
-    let mut files = vec!["scenario.toml".to_string(), CHECKPOINT.to_string()];
+    let mut files = vec![
+        "scenario.toml".to_string(),
+        CHECKPOINT.to_string(),
+        "final_configuration.csv".to_string(),
+    ];
+    out.write_table("final_configuration.csv", &[("x", bcd.positions())])?;
     let theory = equilibrium_counterpart(sc, r, None, obs)?;
     if let Some(d) = &obs.density {
         let (x, rho) = d.profile();
