@@ -13,12 +13,16 @@
 //! The update is in flux form, so the particle number is conserved to rounding; the density stays
 //! positive; a stationary state without drive satisfies `ln rho + psi = const` at every grid
 //! point, i.e. exactly the discrete structure equation solved by [`super::equilibrium()`].
-//! Stability: `psi` is explicit; for sticky rods it contains the density at `x` and `x + sigma`
-//! pointwise, so fixed steps must stay below about `dx^2 / (D gamma rho_max / g_min)`. With
-//! [`DdftProblem::step_tolerance`] set, steps are controlled by step doubling instead (one step
-//! of `h` against two of `h/2`; the local error estimate in max-norm relative to `max rho` must stay
-//! below the tolerance, the more accurate two-half-step result is kept), which also rejects
-//! unstable steps.
+//! Stability: `psi` is explicit. For hard rods it has only window integrals (smooth), and steps of
+//! `10^4 dx^2 / D` are stable. For sticky rods it also depends pointwise on `rho(x)` and
+//! `rho(x +- sigma)` (stiffness `c = max D rho (|k0| + |k+| + |k-|)`, `k ~ gamma / (g S)`), which would
+//! limit explicit steps to `dx^2 / (2 c)`; the scheme therefore adds the stabilising term
+//! `A d^2/dx^2 (rho_new - rho_old)` with `A = max(c, (c^2 - D^2) / (2 D))` (implicit minus explicit:
+//! it vanishes in a stationary state, so steady states are unchanged, and it keeps particle
+//! conservation; it slows transients on length scales below `sqrt(A dt)`). A step that would
+//! make the density negative is split in halves. With [`DdftProblem::step_tolerance`] set, steps
+//! are controlled by step doubling (one step of `h` against two of `h/2`; the local error in
+//! max-norm relative to `max rho` must stay below the tolerance; the two-half-step result is kept).
 
 use super::functional::{self, Work};
 use super::grid::Grid;
@@ -89,10 +93,8 @@ pub struct DdftSummary {
     pub particles_initial: f64,
     /// Largest `|N(t) / N(0) - 1|` over all steps.
     pub max_relative_mass_change: f64,
-    /// Smallest rule-of-thumb stability limit of fixed steps seen at t = 0 and the output
-    /// times (sticky rods; infinite for hard rods). A fixed `dt` above it is warned about (`log`)
-    /// and likely unstable; see the module docs.
-    pub explicit_step_estimate: f64,
+    /// Largest stabilising diffusion coefficient `A` used (0 for hard rods); see the module docs.
+    pub max_stabilization: f64,
     /// Mean current at the last time.
     pub final_mean_current: f64,
 }
@@ -131,15 +133,6 @@ pub fn ddft(
     let mut rejected = 0usize;
     let mut h = problem.dt;
     let mut min_step = f64::INFINITY;
-    st.psi()?;
-    let mut step_estimate = st.explicit_step_estimate();
-    if problem.step_tolerance.is_none() && problem.dt > step_estimate {
-        log::warn!(
-            "ddft: dt = {} exceeds the explicit stability estimate {step_estimate:.2e} of the \
-             sticky-rod excess potential; the run may be unstable (set step_tolerance or reduce dt)",
-            problem.dt
-        );
-    }
     for &t_out in &problem.output_times {
         while t < t_out {
             let remaining = t_out - t;
@@ -153,7 +146,7 @@ pub fn ddft(
                 }
             };
             if problem.step_tolerance.is_none() {
-                current = st.step(done)?;
+                current = st.step_split(done, 0)?;
             } else {
                 current = st.current;
             }
@@ -176,7 +169,6 @@ pub fn ddft(
             max_dm = max_dm.max((st.particles() / n0 - 1.0).abs());
         }
         let stationarity = st.stationarity()?;
-        step_estimate = step_estimate.min(st.explicit_step_estimate());
         let act = st.grid.active;
         on_output(&DdftFrame {
             time: t,
@@ -194,7 +186,7 @@ pub fn ddft(
         dx: st.grid.dx,
         particles_initial: n0,
         max_relative_mass_change: max_dm,
-        explicit_step_estimate: step_estimate,
+        max_stabilization: st.max_stab,
         final_mean_current: current,
     })
 }
@@ -225,6 +217,7 @@ struct Stepper {
     full: Vec<f64>,
     current: f64,
     last_current: f64,
+    max_stab: f64,
 }
 
 impl Stepper {
@@ -294,6 +287,7 @@ impl Stepper {
             full: vec![0.0; m],
             current: 0.0,
             last_current: 0.0,
+            max_stab: 0.0,
             grid,
         })
     }
@@ -310,13 +304,13 @@ impl Stepper {
         })
     }
 
-    /// Rule-of-thumb stability limit of the explicit `psi` for the current state (call after
-    /// [`Stepper::psi`]): `dx^2 / (2 max_x D rho (|k0| + |k+| + |k-|))`, with `k0, k+-` the
-    /// derivatives of the pointwise terms of `psi(x)` with respect to `rho(x)`, `rho(x +- sigma)`
-    /// (at fixed `g`). Infinite for hard rods, whose `psi` has no pointwise terms.
-    fn explicit_step_estimate(&self) -> f64 {
+    /// Stiffness of the explicit pointwise terms of `psi`: `max_x D rho (|k0| + |k+| + |k-|)`,
+    /// with `k0, k+-` the derivatives of the pointwise terms of `psi(x)` with respect to `rho(x)`,
+    /// `rho(x +- sigma)` at fixed `g` (`~ gamma / (g S)`); 0 for hard rods, whose `psi` has
+    /// only window integrals. Explicit steps would need `dt < dx^2 / (2 c)`.
+    fn stiffness(&self) -> f64 {
         if self.gamma == 0.0 {
-            return f64::INFINITY;
+            return 0.0;
         }
         let m = self.grid.m;
         let n = self.grid.n + usize::from(self.grid.f >= 0.5);
@@ -346,11 +340,7 @@ impl Stepper {
             let k0 = q * r1.abs() + qm * r2m.abs();
             cmax = cmax.max(self.diffusion * self.rho[i] * (k0 + q + qm));
         }
-        if cmax > 0.0 {
-            self.grid.dx * self.grid.dx / (2.0 * cmax)
-        } else {
-            f64::INFINITY
-        }
+        cmax
     }
 
     /// `max |ln rho + psi - mean|` over active points.
@@ -419,9 +409,34 @@ impl Stepper {
         }
     }
 
+    /// A fixed step of `h`, split into halves (recursively) where a step fails.
+    fn step_split(&mut self, h: f64, depth: u32) -> Result<f64, RodsError> {
+        self.save.copy_from_slice(&self.rho);
+        match self.step(h) {
+            Ok(c) => Ok(c),
+            Err(e) if depth >= 30 => Err(e),
+            Err(_) => {
+                self.rho.copy_from_slice(&self.save);
+                self.step_split(0.5 * h, depth + 1)?;
+                self.step_split(0.5 * h, depth + 1)
+            }
+        }
+    }
+
     /// One linearly implicit step of length `h`; returns the mean current of the new state.
     fn step(&mut self, h: f64) -> Result<f64, RodsError> {
         self.psi()?;
+        // Stabilisation A d^2/dx^2 (rho_new - rho_old) against the explicit pointwise terms
+        let stab = {
+            let c = self.stiffness();
+            let d = self.diffusion;
+            if c > 0.0 {
+                c.max((c * c - d * d) / (2.0 * d))
+            } else {
+                0.0
+            }
+        };
+        self.max_stab = self.max_stab.max(stab);
         let m = self.grid.m;
         let act = self.grid.active;
         let dx = self.grid.dx;
@@ -442,12 +457,26 @@ impl Stepper {
             self.eb[i] = k * bernoulli(-d);
         }
         let w = dx / h;
+        let ks = stab / dx;
         for i in 0..m {
             let im = if i == 0 { m - 1 } else { i - 1 };
-            self.lower[i] = -self.ea[im];
-            self.upper[i] = -self.eb[i];
-            self.diag[i] = w + self.ea[i] + self.eb[im];
-            self.rhs[i] = w * self.rho[i];
+            let ip = if i + 1 == m { 0 } else { i + 1 };
+            // Laplacian edges share the SG mask (no edges into the gap between walls)
+            let sp = if self.ea[i] != 0.0 || self.eb[i] != 0.0 {
+                ks
+            } else {
+                0.0
+            };
+            let sm = if self.ea[im] != 0.0 || self.eb[im] != 0.0 {
+                ks
+            } else {
+                0.0
+            };
+            self.lower[i] = -self.ea[im] - sm;
+            self.upper[i] = -self.eb[i] - sp;
+            self.diag[i] = w + self.ea[i] + self.eb[im] + sp + sm;
+            self.rhs[i] = w * self.rho[i]
+                - (sp * (self.rho[ip] - self.rho[i]) - sm * (self.rho[i] - self.rho[im]));
         }
         solve_cyclic(
             &self.lower,
@@ -458,6 +487,17 @@ impl Stepper {
             &mut self.cp,
             &mut self.bb,
         );
+        let mut lowest: f64 = 0.0;
+        let mut highest: f64 = 0.0;
+        for i in 0..m {
+            lowest = lowest.min(self.rhs[i]);
+            highest = highest.max(self.rhs[i]);
+        }
+        if lowest < -1e-12 * highest || !highest.is_finite() {
+            return Err(RodsError::Ddft(format!(
+                "the step {h:e} produced a negative density ({lowest:e}); reduce dt"
+            )));
+        }
         for i in 0..m {
             // M-matrix solve: non-negative up to rounding
             self.rho[i] = self.rhs[i].max(0.0);

@@ -134,7 +134,7 @@ pub fn equilibrium(problem: &RodsProblem) -> Result<Equilibrium, RodsError> {
     problem.validate()?;
     let gamma = problem.interaction.gamma();
     let fine = problem.grid(problem.dx)?;
-    // Grid sequencing: coarser grids by factors of 2 while sigma/dx >= 20 and >= 512 active points.
+    // Grid sequencing: coarser grids by factors of 2 while sigma/dx >= 20 and >= 1024 active points.
     let mut levels = vec![fine.clone()];
     if !matches!(problem.beta_u, BetaPotential::OnGrid(_)) {
         loop {
@@ -163,7 +163,11 @@ pub fn equilibrium(problem: &RodsProblem) -> Result<Equilibrium, RodsError> {
         let (tol, max_it) = if last {
             (problem.tolerance, problem.max_iterations)
         } else {
-            (problem.tolerance.max(1e-8), problem.max_iterations)
+            // a coarse level that struggles is abandoned early (the fine level then starts cold)
+            (
+                problem.tolerance.max(1e-8),
+                problem.max_iterations.min(1000),
+            )
         };
         let out = solver.iterate(problem, tol, max_it);
         match out {
@@ -178,6 +182,9 @@ pub fn equilibrium(problem: &RodsProblem) -> Result<Equilibrium, RodsError> {
                 // A coarse grid may fail where the fine one converges: restart the fine one cold.
                 if last || !matches!(e, RodsError::NotConverged { .. }) {
                     return Err(e);
+                }
+                if let RodsError::NotConverged { iterations, .. } = e {
+                    total += iterations;
                 }
                 log::debug!("rods: coarse level {l} did not converge ({e}); continuing");
                 u_prev = None;
