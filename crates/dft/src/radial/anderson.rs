@@ -19,8 +19,13 @@ pub(crate) struct Anderson {
 }
 
 impl Anderson {
-    /// Mixing of depth `depth` (0: plain damped Picard) and damping `beta` in (0, 1].
+    /// Largest history kept.
+    pub(crate) const MAX_DEPTH: usize = 32;
+
+    /// Mixing of depth `depth` (0: plain damped Picard; at most [`Self::MAX_DEPTH`]) and damping
+    /// `beta` in (0, 1].
     pub(crate) fn new(n: usize, depth: usize, beta: f64) -> Self {
+        let depth = depth.min(Self::MAX_DEPTH);
         Self {
             depth,
             beta,
@@ -69,7 +74,7 @@ impl Anderson {
             self.has_prev = true;
         }
         let m = self.count;
-        let mut gamma = [0.0f64; 32];
+        let mut gamma = [0.0f64; Self::MAX_DEPTH];
         if m > 0 && self.solve_gamma(m, &mut gamma) {
             for i in 0..n {
                 let mut v = x[i] + self.beta * self.f[i];
@@ -87,7 +92,7 @@ impl Anderson {
     }
 
     /// Least squares `min |f - DF gamma|` by regularised normal equations; false if singular.
-    fn solve_gamma(&mut self, m: usize, gamma: &mut [f64; 32]) -> bool {
+    fn solve_gamma(&mut self, m: usize, gamma: &mut [f64; Self::MAX_DEPTH]) -> bool {
         let n = self.len;
         for a in 0..m {
             for b in a..m {

@@ -43,7 +43,7 @@ pub struct DdftOptions {
     pub tolerance: f64,
     /// Iterations per step attempt before the step is halved.
     pub max_iterations: usize,
-    /// Anderson depth.
+    /// Anderson depth (at most 32).
     pub depth: usize,
     /// Hydrodynamic approximation.
     pub hydrodynamics: Hydrodynamics,

@@ -17,7 +17,7 @@ pub struct EquilibriumOptions {
     pub tolerance: f64,
     /// Iteration limit; exceeding it is an error that reports the residual.
     pub max_iterations: usize,
-    /// Anderson depth (0: damped Picard).
+    /// Anderson depth (0: damped Picard; at most 32).
     pub depth: usize,
     /// Anderson damping in (0, 1].
     pub mixing: f64,
