@@ -9,7 +9,7 @@
 
 use std::f64::consts::PI;
 
-use colloidsim_dft::radial::{RadialGrid, Rosenfeld, bulk};
+use colloidsim_dft::radial::{RadialGrid, Rosenfeld, bulk, fmt::rosenfeld_phi};
 
 #[test]
 fn uniform_fluid_gives_percus_yevick_everywhere() {
@@ -49,28 +49,27 @@ fn uniform_fluid_gives_percus_yevick_everywhere() {
 }
 
 #[test]
-fn free_energy_density_is_the_percus_yevick_one() {
-    // beta F_ex / V of a uniform sphere of radius 20 d: bulk value plus a surface term O(d / R).
+fn rosenfeld_phi_of_bulk_weighted_densities_is_the_percus_yevick_free_energy() {
+    // Phi(n3 = eta, n2 = pi d^2 rho, nv2 = 0) = beta f_ex (PY compressibility), and its
+    // derivatives give mu_ex = sum_alpha dPhi/dn_alpha * (weight integral: V_sphere, S_sphere).
     let d = 1.0;
-    let grid = RadialGrid::covering(0.05, 20.0).unwrap();
-    let mut fmt = Rosenfeld::new(&grid, d).unwrap();
-    let eta = 0.3;
-    let rho0 = bulk::density(eta, d);
-    let rho = vec![rho0; grid.len()];
-    let fex = fmt.evaluate(&rho, grid.len()).unwrap();
-    // Sum only the interior rows (r < R - d): they see bulk weighted densities.
-    let inner: f64 = grid
-        .volumes()
-        .iter()
-        .zip(grid.centres())
-        .filter(|(_, r)| **r < 19.0)
-        .map(|(v, _)| v)
-        .sum();
-    assert!(fex > 0.0);
-    let per_volume_bulk = bulk::excess_free_energy_density(rho0, d);
-    // Outer rows (partially filled spheres) add a positive-or-negative surface part; check the
-    // bulk part is consistent to the surface order.
-    assert!((fex / inner / per_volume_bulk - 1.0).abs() < 3.0 * 3.0 * d / 20.0);
+    let a = 0.5 * d;
+    for eta in [0.05, 0.2, 0.35, 0.5] {
+        let rho = bulk::density(eta, d);
+        let (phi, p3, p2, pv) = rosenfeld_phi(eta, PI * d * d * rho, 0.0, a);
+        let f = bulk::excess_free_energy_density(rho, d);
+        assert!(
+            (phi - f).abs() < 1e-13 * f.abs().max(1.0),
+            "eta {eta}: {phi} vs {f}"
+        );
+        let mu = p3 * 4.0 / 3.0 * PI * a.powi(3) + p2 * 4.0 * PI * a * a;
+        let mu_py = bulk::excess_chemical_potential(rho, d);
+        assert!(
+            (mu - mu_py).abs() < 1e-12 * mu_py,
+            "eta {eta}: {mu} vs {mu_py}"
+        );
+        assert_eq!(pv, 0.0);
+    }
 }
 
 /// `mu_ex` of a smooth profile on a grid of spacing `h`, at cell centres.

@@ -25,6 +25,25 @@ use super::{RadialError, RadialGrid};
 /// Minimum number of cells per particle diameter.
 pub const MIN_CELLS_PER_DIAMETER: f64 = 10.0;
 
+/// Rosenfeld's `Phi` (paper Eq. 12) of `n3, n2, nv2` for spheres of radius `a`, with
+/// `n0 = n2 / (4 pi a^2)`, `n1 = n2 / (4 pi a)`, `nv1 = nv2 / (4 pi a)` substituted; returns
+/// `(Phi, dPhi/dn3, dPhi/dn2, dPhi/dnv2)` (total derivatives through the proportional densities).
+#[inline]
+pub fn rosenfeld_phi(n3: f64, n2: f64, nv2: f64, a: f64) -> (f64, f64, f64, f64) {
+    let ca = 1.0 / (4.0 * PI * a * a);
+    let cb = 1.0 / (4.0 * PI * a);
+    let l = (1.0 - n3).ln();
+    let q = 1.0 / (1.0 - n3);
+    let q2 = q * q;
+    let d2 = n2 * n2 - nv2 * nv2;
+    let c3 = n2 * n2 * n2 - 3.0 * n2 * nv2 * nv2;
+    let phi = -ca * n2 * l + cb * d2 * q + c3 * q2 / (24.0 * PI);
+    let p3 = ca * n2 * q + cb * d2 * q2 + c3 * q2 * q / (12.0 * PI);
+    let p2 = -ca * l + 2.0 * cb * n2 * q + d2 * q2 / (8.0 * PI);
+    let pv = -2.0 * cb * nv2 * q - n2 * nv2 * q2 / (4.0 * PI);
+    (phi, p3, p2, pv)
+}
+
 /// Rosenfeld hard-sphere functional on a [`RadialGrid`], with preallocated workspace.
 #[derive(Debug, Clone)]
 pub struct Rosenfeld {
@@ -174,8 +193,6 @@ impl Rosenfeld {
         let active = active.min(self.n).min(rho.len());
         let rows = self.rows_touched(active);
         let a = 0.5 * self.diameter;
-        let ca = 1.0 / (4.0 * PI * a * a);
-        let cb = 1.0 / (4.0 * PI * a);
         let mut fex = 0.0;
         for i in 0..rows {
             let start = self.j0[i];
@@ -205,15 +222,7 @@ impl Rosenfeld {
                     ),
                 });
             }
-            let l = (1.0 - n3).ln();
-            let q = 1.0 / (1.0 - n3);
-            let q2 = q * q;
-            let d2 = n2 * n2 - nv2 * nv2;
-            let c3 = n2 * n2 * n2 - 3.0 * n2 * nv2 * nv2;
-            let phi = -ca * n2 * l + cb * d2 * q + c3 * q2 / (24.0 * PI);
-            let p3 = ca * n2 * q + cb * d2 * q2 + c3 * q2 * q / (12.0 * PI);
-            let p2 = -ca * l + 2.0 * cb * n2 * q + d2 * q2 / (8.0 * PI);
-            let pv = -2.0 * cb * nv2 * q - n2 * nv2 * q2 / (4.0 * PI);
+            let (phi, p3, p2, pv) = rosenfeld_phi(n3, n2, nv2, a);
             fex += self.vol[i] * phi;
             self.s3[i] = p3;
             self.s2[i] = p2;
