@@ -467,13 +467,19 @@ impl Scenario {
         if let Some(c) = &o.contact_density {
             param::at_least("observe.contact_density.bins", c.bins, 1)?;
             param::positive("observe.contact_density.window", c.window)?;
-            // Colliding pairs end a BCD step at exactly zero gap: weight that continuous-time
-            // dynamics spreads over ~ sqrt(2 D dt). The window must be wider than that.
-            let spread = (2.0 * s.mobility * s.kt * self.run.dt).sqrt();
-            if c.window < 3.0 * spread {
+            // Colliding pairs end a BCD step at exactly zero gap. To leading order the gap is a
+            // random walk stopped at contact, whose stationary law is the continuous one with the
+            // wall moved out by delta = 0.5826 sqrt(2 D_rel dt), D_rel = 2D (Siegmund's
+            // corrected diffusion approximation): rho2 in a window w is too high by ~ delta / w.
+            let delta = 0.5826 * (4.0 * s.mobility * s.kt * self.run.dt).sqrt();
+            let bias = delta / c.window;
+            if bias > 0.05 {
                 warnings.push(format!(
-                    "observe.contact_density.window = {} is not much wider than the collision spread sqrt(2 D dt) = {spread:.2e}: rho2 is biased upwards; widen the window or reduce run.dt",
-                    c.window
+                    "observe.contact_density: rho2 in a window of {} is biased upwards by about {:.0}% at run.dt = {} (time-step boundary layer {delta:.2e}); widen the window or use dt <= {:.1e}",
+                    c.window,
+                    100.0 * bias,
+                    self.run.dt,
+                    (0.05 * c.window / 0.5826).powi(2) / (4.0 * s.mobility * s.kt.max(1e-300))
                 ));
             }
         }

@@ -367,7 +367,14 @@ where
         "final_configuration.csv".to_string(),
     ];
     out.write_table("final_configuration.csv", &[("x", bcd.positions())])?;
-    let theory = equilibrium_counterpart(sc, r, None, obs)?;
+    // The theory is a companion: if it fails, the simulation's outputs are still written.
+    let (theory, theory_error) = match equilibrium_counterpart(sc, r, None, obs) {
+        Ok(t) => (t, None),
+        Err(e) => {
+            eprintln!("warning: no theory curve: {e:#}");
+            (None, Some(format!("{e:#}")))
+        }
+    };
     if let Some(d) = &obs.density {
         let (x, rho) = d.profile();
         out.write_table("density.csv", &[("x", &x), ("rho", &rho)])?;
@@ -509,6 +516,7 @@ where
         "mean_velocity": mean_velocity,
         "particle_current": mean_velocity.map(|v| v * n as f64 / c.length),
         "theory": theory.as_ref().map(|(_, _)| "density_theory.csv: exact equilibrium (colloidsim theory) on the same bins"),
+        "theory_error": theory_error,
         "files": files,
     });
     out.write_json("summary.json", &summary)?;
