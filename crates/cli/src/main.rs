@@ -60,6 +60,11 @@ enum Command {
         /// Write into an output folder that already holds files.
         #[arg(long)]
         force: bool,
+        /// Droplet DDFT only: `free-draining` (default, like the BD run) or `rpy` (adds the
+        /// pairwise RPY flux with the dilute pair correlation; stops if the solution turns
+        /// unphysical).
+        #[arg(long)]
+        hydrodynamics: Option<String>,
     },
     /// Validate a scenario and print the resolved parameters.
     Check {
@@ -159,12 +164,23 @@ fn run_cli() -> Result<()> {
             out,
             dx,
             force,
+            hydrodynamics,
         } => {
             let (method, text) = read_scenario(&scenario)?;
             let out = common::default_out(&scenario, out, "-theory");
+            if hydrodynamics.is_some() && method != "droplet-bd" {
+                bail!("--hydrodynamics applies to droplet-bd scenarios only");
+            }
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::theory(&scenario, &text, &out, dx, force),
-                "droplet-bd" => theory_droplet::theory(&scenario, &text, &out, dx, force),
+                "droplet-bd" => theory_droplet::theory(
+                    &scenario,
+                    &text,
+                    &out,
+                    dx,
+                    force,
+                    hydrodynamics.as_deref(),
+                ),
                 m => bail!(
                     "{}: method '{m}' has no theory counterpart",
                     scenario.display()

@@ -1,5 +1,6 @@
 //! `colloidsim theory` for `method = "droplet-bd"`: radial Rosenfeld FMT DDFT of the drying
-//! droplet (free-draining), on the Brownian-dynamics run's radial bins and output times.
+//! droplet (free-draining, or with the pairwise RPY flux via `--hydrodynamics rpy`), on the
+//! Brownian-dynamics run's radial bins and output times.
 //!
 //! Reads the same scenario as `colloidsim run`; writes `profile_<fraction>.csv` (`r,phi`: bin
 //! centres and the bin-averaged `pi d^3 rho / 6` on `observe.profile.bins` equal bins of
@@ -65,8 +66,25 @@ struct Written {
     phi: Vec<f64>,
 }
 
+/// `--hydrodynamics`: `free-draining` (default) or `rpy`.
+fn parse_hydrodynamics(h: Option<&str>) -> Result<Hydrodynamics> {
+    match h {
+        None | Some("free-draining") => Ok(Hydrodynamics::FreeDraining),
+        Some("rpy") => Ok(Hydrodynamics::Rpy),
+        Some(other) => bail!("--hydrodynamics must be free-draining or rpy, got '{other}'"),
+    }
+}
+
 /// `colloidsim theory SCENARIO` for a drying droplet.
-pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool) -> Result<()> {
+pub fn theory(
+    scenario: &Path,
+    text: &str,
+    out: &Path,
+    dx: Option<f64>,
+    force: bool,
+    hydrodynamics: Option<&str>,
+) -> Result<()> {
+    let hydro = parse_hydrodynamics(hydrodynamics)?;
     let sc =
         DropletScenario::from_toml(text).map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
     let p = sc
@@ -81,6 +99,7 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
     let times: Vec<f64> = order.iter().map(|&k| time_of(k)).collect();
     let setup = DropletSetup {
         t_end: times.last().copied().unwrap_or(0.0).max(p.t_end),
+        hydrodynamics: hydro,
         ..setup_from(&p, dr)?
     };
     setup
@@ -152,7 +171,11 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
     let outcome = result.as_ref().ok();
     let summary = serde_json::json!({
         "method": "droplet-bd",
-        "engine": "theory: radial Rosenfeld FMT DDFT (free-draining), implicit Euler",
+        "engine": "theory: radial Rosenfeld FMT DDFT, implicit Euler",
+        "hydrodynamics": match hydro {
+            Hydrodynamics::FreeDraining => "free-draining",
+            Hydrodynamics::Rpy => "rpy (pairwise RPY flux, dilute pair correlation)",
+        },
         "software_version": env!("CARGO_PKG_VERSION"),
         "status": status,
         "message": message,
@@ -178,7 +201,11 @@ pub fn theory(scenario: &Path, text: &str, out: &Path, dx: Option<f64>, force: b
     });
     dir.write_json("summary.json", &summary)?;
     if !written.is_empty() {
-        draw(scenario, &dir, &written)?;
+        let tag = match hydro {
+            Hydrodynamics::FreeDraining => "free-draining",
+            Hydrodynamics::Rpy => "RPY",
+        };
+        draw(scenario, &dir, &written, tag)?;
     }
     match result {
         Ok(_) => {
@@ -233,7 +260,7 @@ fn write_snapshot(
 }
 
 /// `profiles.png`: theory lines, BD points from the run folder (`<scenario stem>/`) when present.
-fn draw(scenario: &Path, dir: &OutputDir, written: &[Written]) -> Result<()> {
+fn draw(scenario: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Result<()> {
     let labels: Vec<String> = written
         .iter()
         .map(|w| format!("DDFT {:.0}%", 100.0 * w.fraction))
@@ -272,10 +299,10 @@ fn draw(scenario: &Path, dir: &OutputDir, written: &[Written]) -> Result<()> {
         });
     }
     let title = if bd.is_empty() {
-        "Drying droplet: radial FMT DDFT".to_string()
+        format!("Drying droplet: radial FMT DDFT ({tag})")
     } else {
         format!(
-            "Drying droplet: DDFT (lines) and BD (points, {})",
+            "Drying droplet: DDFT {tag} (lines), BD (points, {})",
             run_dir.display()
         )
     };
