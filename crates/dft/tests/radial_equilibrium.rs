@@ -118,3 +118,39 @@ fn dense_droplet_converges_and_failure_reports_the_residual() {
         other => panic!("expected non-convergence, got {other:?}"),
     }
 }
+
+#[test]
+fn very_dense_droplet_equilibrium_falls_back_to_ddft_relaxation() {
+    // Mean phi 0.6 in R = 8 d: the direct Picard + Anderson iteration from the ideal-gas start
+    // does not converge; equilibrium_at relaxes by DDFT first and then converges to 1e-10.
+    use colloidsim_dft::radial::{DropletSetup, Hydrodynamics, equilibrium_at};
+    let radius: f64 = 8.0;
+    let setup = DropletSetup {
+        particles: 8.0 * 0.6 * radius.powi(3),
+        diameter: 1.0,
+        d0: 1.0,
+        r0: radius,
+        alpha: 0.0,
+        interface: HarmonicInterface::new(K, RANGE, OFFSET).unwrap(),
+        t_end: 0.0,
+        dr: 0.02,
+        hydrodynamics: Hydrodynamics::FreeDraining,
+    };
+    let (grid, eq) = equilibrium_at(&setup, radius, &EquilibriumOptions::default()).unwrap();
+    assert!(eq.residual < 1e-10);
+    assert!((grid.integrate(&eq.rho) / setup.particles - 1.0).abs() < 1e-12);
+    assert!(eq.n3.iter().all(|x| *x < 1.0));
+    // ... and the direct solver alone indeed fails there.
+    let mut fmt = Rosenfeld::new(&grid, 1.0).unwrap();
+    let mut v = vec![0.0; grid.len()];
+    setup.interface.fill(grid.centres(), radius, &mut v);
+    let direct = solve_equilibrium(
+        &grid,
+        &mut fmt,
+        &v,
+        setup.particles,
+        None,
+        &EquilibriumOptions::default(),
+    );
+    assert!(matches!(direct, Err(RadialError::NotConverged { .. })));
+}

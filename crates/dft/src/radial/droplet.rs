@@ -210,7 +210,8 @@ pub fn run_droplet(
 
 /// Equilibrium of the setup's `N` particles in a static droplet of radius `radius` (the paper's
 /// reference profiles at the mean volume fraction of each output time), on a grid that reaches
-/// `beta V = 100 kT` beyond the interface.
+/// `beta V = 100 kT` beyond the interface. When the direct solver does not converge (dense,
+/// strongly confined states), the profile is first relaxed by DDFT and then polished.
 pub fn equilibrium_at(
     setup: &DropletSetup,
     radius: f64,
@@ -227,8 +228,55 @@ pub fn equilibrium_at(
     let mut fmt = Rosenfeld::new(&grid, setup.diameter)?;
     let mut v = vec![0.0; grid.len()];
     setup.interface.fill(grid.centres(), radius, &mut v);
-    let eq = solve_equilibrium(&grid, &mut fmt, &v, setup.particles, None, eq_opts)?;
-    Ok((grid, eq))
+    let first = match solve_equilibrium(&grid, &mut fmt, &v, setup.particles, None, eq_opts) {
+        Ok(eq) => return Ok((grid, eq)),
+        Err(e @ RadialError::NotConverged { .. }) => e,
+        Err(e) => return Err(e),
+    };
+    // Dense, strongly confined states: relax by DDFT (robust: positive, N-conserving, stable at
+    // any packing the functional allows) in stretches of 10 d^2/D0, polishing with the direct
+    // solver after each; give up after 200 d^2/D0.
+    log::debug!("equilibrium at R = {radius}: {first}; relaxing by DDFT first");
+    let inside = radius + setup.interface.offset;
+    let mut rho0: Vec<f64> = grid
+        .centres()
+        .iter()
+        .map(|r| if *r < inside { 1.0 } else { 0.0 })
+        .collect();
+    let scale = setup.particles / grid.integrate(&rho0);
+    rho0.iter_mut().for_each(|x| *x *= scale);
+    let tau = setup.diameter * setup.diameter / setup.d0;
+    let mut opts = DdftOptions::new(setup.d0, setup.diameter);
+    opts.dt_max = tau;
+    let mut ddft = Ddft::new(
+        grid.clone(),
+        setup.diameter,
+        setup.interface,
+        DryingSchedule::new(radius, 0.0)?,
+        &rho0,
+        opts,
+    )?;
+    let polish = EquilibriumOptions {
+        max_iterations: 500,
+        ..*eq_opts
+    };
+    let mut last = first;
+    for k in 1..=20 {
+        ddft.advance_to(10.0 * tau * k as f64, |_| {})?;
+        match solve_equilibrium(
+            &grid,
+            &mut fmt,
+            &v,
+            setup.particles,
+            Some(ddft.rho()),
+            &polish,
+        ) {
+            Ok(eq) => return Ok((grid, eq)),
+            Err(e @ RadialError::NotConverged { .. }) => last = e,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last)
 }
 
 /// Averages of the cell values `values` over radial bins `[edges[k], edges[k+1]]`, weighted by
