@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 use colloidsim_dft::radial::{RadialGrid, Rosenfeld, bulk, fmt::rosenfeld_phi};
 
 #[test]
-fn uniform_fluid_gives_percus_yevick_everywhere() {
+fn radial_uniform_fluid_gives_percus_yevick_everywhere() {
     let d = 1.0;
     for dr in [0.1, 0.05, 0.02] {
         let grid = RadialGrid::covering(dr, 6.0).unwrap();
@@ -49,7 +49,7 @@ fn uniform_fluid_gives_percus_yevick_everywhere() {
 }
 
 #[test]
-fn rosenfeld_phi_of_bulk_weighted_densities_is_the_percus_yevick_free_energy() {
+fn radial_rosenfeld_phi_of_bulk_weighted_densities_is_the_percus_yevick_free_energy() {
     // Phi(n3 = eta, n2 = pi d^2 rho, nv2 = 0) = beta f_ex (PY compressibility), and its
     // derivatives give mu_ex = sum_alpha dPhi/dn_alpha * (weight integral: V_sphere, S_sphere).
     let d = 1.0;
@@ -86,7 +86,7 @@ fn mu_profile(h: f64) -> (Vec<f64>, Vec<f64>) {
 }
 
 #[test]
-fn non_uniform_profile_converges_at_second_order_including_the_centre() {
+fn radial_non_uniform_profile_converges_at_second_order_including_the_centre() {
     // Refinement by 3 keeps the coarse centres on the fine grids.
     let h = 0.1;
     let (r1, m1) = mu_profile(h);

@@ -47,7 +47,7 @@ fn run(setup: &DropletSetup, opts: &DdftOptions) -> (Result<f64, RadialError>, V
 }
 
 #[test]
-fn particle_number_is_conserved_to_rounding() {
+fn radial_particle_number_is_conserved_to_rounding() {
     // Several hundred implicit steps; each conserves N exactly in exact arithmetic, so the drift
     // is rounding: ~ steps * eps * (condition of the tridiagonal solve) << 1e-11.
     for hydro in [Hydrodynamics::FreeDraining, Hydrodynamics::Rpy] {
@@ -60,7 +60,7 @@ fn particle_number_is_conserved_to_rounding() {
 }
 
 #[test]
-fn free_draining_drying_to_half_packing_runs_and_the_rpy_flux_ejects_particles() {
+fn radial_free_draining_drying_to_half_packing_runs_and_the_rpy_flux_ejects_particles() {
     // Free-draining: phi 0.05 -> 0.5 completes, with nothing beyond the interface.
     let fd = drying(12.0, 0.05, 0.5, 0.05, Hydrodynamics::FreeDraining);
     let (res, snaps) = run(&fd, &DdftOptions::new(D0, 1.0));
@@ -98,7 +98,7 @@ fn free_draining_drying_to_half_packing_runs_and_the_rpy_flux_ejects_particles()
 }
 
 #[test]
-fn ddft_relaxes_to_the_equilibrium_solver_profile() {
+fn radial_ddft_relaxes_to_the_equilibrium_solver_profile() {
     // Static droplet (alpha = 0), uniform start inside the wall; after t = 20 d^2/D0 (>> the
     // slowest relaxation time ~ R^2 / (pi^2 D_coll) ~ 0.3 d^2/D0 here) the DDFT profile must equal
     // the equilibrium one. The Scharfetter-Gummel flux vanishes exactly on a discrete Boltzmann
@@ -148,7 +148,7 @@ fn ddft_relaxes_to_the_equilibrium_solver_profile() {
 }
 
 #[test]
-fn implicit_euler_converges_at_first_order_in_the_time_step() {
+fn radial_implicit_euler_converges_at_first_order_in_the_time_step() {
     let setup = drying(6.0, 0.1, 0.3, 0.05, Hydrodynamics::FreeDraining);
     let profile = |dt: f64| {
         let mut o = DdftOptions::new(D0, 1.0);
@@ -170,7 +170,7 @@ fn implicit_euler_converges_at_first_order_in_the_time_step() {
 }
 
 #[test]
-fn bad_input_is_rejected_with_the_key() {
+fn radial_bad_input_is_rejected_with_the_key() {
     let ok = drying(8.0, 0.1, 0.3, 0.05, Hydrodynamics::FreeDraining);
     let opts = DdftOptions::new(D0, 1.0);
     let err = |s: DropletSetup| run(&s, &opts).0.unwrap_err().to_string();

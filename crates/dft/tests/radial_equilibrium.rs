@@ -75,7 +75,7 @@ fn planar_limit(dr: f64, d_eos: f64) -> f64 {
 }
 
 #[test]
-fn contact_theorem_holds_in_the_planar_limit() {
+fn radial_contact_theorem_holds_in_the_planar_limit() {
     let e1 = planar_limit(0.05, 1.0) - 1.0;
     let e2 = planar_limit(0.025, 1.0) - 1.0;
     // Second order in dr: the error shrinks by ~4 when dr halves (measured 2.3e-3 -> 6e-4);
@@ -94,7 +94,7 @@ fn contact_theorem_holds_in_the_planar_limit() {
 }
 
 #[test]
-fn dense_droplet_converges_and_failure_reports_the_residual() {
+fn radial_dense_droplet_converges_and_failure_reports_the_residual() {
     let wall = HarmonicInterface::new(K, RANGE, OFFSET).unwrap();
     let radius = 8.0;
     let grid = RadialGrid::covering(0.05, radius + wall.reach(100.0)).unwrap();
@@ -120,7 +120,7 @@ fn dense_droplet_converges_and_failure_reports_the_residual() {
 }
 
 #[test]
-fn very_dense_droplet_equilibrium_falls_back_to_ddft_relaxation() {
+fn radial_very_dense_droplet_equilibrium_falls_back_to_ddft_relaxation() {
     // Mean phi 0.6 in R = 8 d: the direct Picard + Anderson iteration from the ideal-gas start
     // does not converge; equilibrium_at relaxes by DDFT first and then converges to 1e-10.
     use colloidsim_dft::radial::{DropletSetup, Hydrodynamics, equilibrium_at};

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 use colloidsim_dft::radial::{RadialGrid, rpy::RpyKernel};
 
 #[test]
-fn hydrodynamic_flux_hinders_like_one_minus_five_phi() {
+fn radial_hydrodynamic_flux_hinders_like_one_minus_five_phi() {
     let dr = 0.02;
     let grid = RadialGrid::covering(dr, 40.0).unwrap();
     let kernel = RpyKernel::new(&grid, 1.0);
