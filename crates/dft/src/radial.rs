@@ -11,6 +11,30 @@
 //! - [`droplet`]: a drying droplet end to end (setup validation, equilibrium start, snapshots).
 //! - [`rpy`]: the dilute-limit radial RPY kernel of the hydrodynamic flux.
 //! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
+//!
+//! ```no_run
+//! use colloidsim_dft::radial::*;
+//! // N = 6250 spheres (d = 1), R0 = 25 d, Pe = 10 with D0 = 1, dried to mean phi 0.5.
+//! let schedule = DryingSchedule::from_peclet(25.0, 10.0, 1.0)?;
+//! let setup = DropletSetup {
+//!     particles: 6250.0,
+//!     diameter: 1.0,
+//!     d0: 1.0,
+//!     r0: 25.0,
+//!     alpha: schedule.alpha,
+//!     interface: HarmonicInterface::new(50.0, 0.5, -0.5)?, // k in kT/d^2, Delta, offset
+//!     t_end: schedule.time_at_radius(25.0 * 0.1f64.cbrt()),
+//!     dr: 0.01,
+//!     hydrodynamics: Hydrodynamics::FreeDraining,
+//! };
+//! let times = [0.5 * setup.t_end, setup.t_end];
+//! let opts = DdftOptions::new(1.0, 1.0);
+//! run_droplet(&setup, &times, &opts, &EquilibriumOptions::default(),
+//!     |grid, snap| println!("t = {}: max n3 = {}", snap.time,
+//!         snap.n3.iter().cloned().fold(0.0, f64::max)),
+//!     |_step| {})?;
+//! # Ok::<(), RadialError>(())
+//! ```
 
 mod anderson;
 pub mod bulk;
