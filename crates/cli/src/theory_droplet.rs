@@ -41,6 +41,13 @@ fn grid_spacing(p: &DropletParams, dx: Option<f64>) -> Result<f64> {
     if !(dr.is_finite() && dr > 0.0) {
         bail!("--dx must be a finite number > 0, got {dr}");
     }
+    let min_cells = colloidsim_dft::radial::fmt::MIN_CELLS_PER_DIAMETER;
+    if p.diameter / dr < min_cells {
+        bail!(
+            "--dx {dr} does not resolve the particle: need --dx <= diameter / {min_cells} = {}",
+            p.diameter / min_cells
+        );
+    }
     Ok(dr)
 }
 
