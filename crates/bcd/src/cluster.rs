@@ -103,13 +103,15 @@ pub fn premerge(stack: &mut Vec<Cluster>, c: Cluster, sigma: f64, dt: f64) {
     stack.push(top);
 }
 
-/// A run of rods moving together during fragmentation: `n` rods from `start`, summed free
-/// velocity `sum`; wall blocks have infinite mass and velocity 0.
+/// A run of rods moving together during fragmentation: `n` rods from virtual index `start`
+/// (leftmost centre `left`), summed free velocity `sum`; wall blocks have infinite mass and
+/// velocity 0.
 #[derive(Debug, Clone, Copy)]
 struct Block {
     start: u32,
     n: u32,
     sum: f64,
+    left: f64,
     wall: Wall,
 }
 
@@ -126,10 +128,12 @@ impl Block {
 
     #[inline]
     fn join(&self, b: &Block) -> Block {
+        let first = if self.n == 0 { b } else { self };
         Block {
-            start: if self.n == 0 { b.start } else { self.start },
+            start: first.start,
             n: self.n + b.n,
             sum: self.sum + b.sum,
+            left: first.left,
             wall: if self.wall != Wall::None {
                 self.wall
             } else {
@@ -139,22 +143,114 @@ impl Block {
     }
 }
 
-/// Reusable work space of [`fragment`].
-#[derive(Debug, Default, Clone)]
-pub struct FragmentScratch {
-    blocks: Vec<Block>,
-}
-
-/// Fragment one cluster of rods with free velocities `u` (`mu F_i`) into the subclusters that
-/// move apart, emitted left to right as `(first, len, velocity, wall)` (`first` relative to `u`).
+/// Fragmentation of one cluster of touching rods, built rod by rod.
 ///
 /// The exact fragmentation (fast-bcd Eqs. 4a/4b) has strictly increasing subcluster velocities
 /// and, inside each subcluster, every leading part at least as fast as the rest. In terms of the
-/// cumulative sums `S_k = sum_{i<k} u_i` this is the lower convex hull of the points `(k, S_k)`:
-/// each subcluster is one hull edge, its velocity the edge slope. The hull is built by pooling
-/// adjacent violators on a stack in O(n), and it equals the paper's successive pair
-/// fragmentation (Eqs. 7–8; the tests check both against each other and against all 2^(n-1)
-/// compositions). A wall on either side acts as a member of infinite mass and velocity 0.
+/// cumulative sums `S_k = sum_{i<k} u_i` of the free velocities this is the lower convex hull of
+/// the points `(k, S_k)`: each subcluster is one hull edge, its velocity the edge slope. The hull
+/// is built by pooling adjacent violators on a stack, O(1) amortised per rod, and equals the
+/// paper's successive pair fragmentation (Eqs. 7–8; the tests check both against each other and
+/// against all 2^(n-1) compositions). A wall on either side acts as a member of infinite mass
+/// and velocity 0.
+#[derive(Debug, Default, Clone)]
+pub struct Hull {
+    blocks: Vec<Block>,
+}
+
+/// Former name of [`Hull`], the reusable work space of [`fragment`].
+pub type FragmentScratch = Hull;
+
+impl Hull {
+    /// Start a new cluster, stuck to the left wall or not.
+    #[inline]
+    pub fn begin(&mut self, left_wall: bool) {
+        self.blocks.clear();
+        if left_wall {
+            self.blocks.push(Block {
+                start: 0,
+                n: 0,
+                sum: 0.0,
+                left: 0.0,
+                wall: Wall::Left,
+            });
+        }
+    }
+
+    fn pool(&mut self, b: Block) {
+        self.blocks.push(b);
+        self.settle();
+    }
+
+    /// Merge the top block into the ones below for as long as they hold it.
+    fn settle(&mut self) {
+        while let [.., below, top] = self.blocks[..] {
+            if below.holds(&top) {
+                self.blocks.pop();
+                *self.blocks.last_mut().expect("two blocks") = below.join(&top);
+            } else {
+                break;
+            }
+        }
+    }
+
+    /// Add the next rod (virtual index `start`, centre `left`, free velocity `u`).
+    #[inline]
+    pub fn push(&mut self, start: u32, left: f64, u: f64) {
+        // Fast path: the rod is not faster than the free block before it, so it joins it;
+        // the slowed-down block may then be caught by the one below (rare).
+        if let Some(top) = self.blocks.last_mut()
+            && top.wall == Wall::None
+            && top.sum >= u * top.n as f64
+        {
+            top.sum += u;
+            top.n += 1;
+            if self.blocks.len() >= 2 {
+                self.settle();
+            }
+            return;
+        }
+        self.pool(Block {
+            start,
+            n: 1,
+            sum: u,
+            left,
+            wall: Wall::None,
+        });
+    }
+
+    /// Close the cluster (stuck to the right wall or not) and emit its fragments left to right.
+    #[inline]
+    pub fn finish(&mut self, right_wall: bool, mut emit: impl FnMut(Cluster)) {
+        if right_wall {
+            self.pool(Block {
+                start: 0,
+                n: 0,
+                sum: 0.0,
+                left: 0.0,
+                wall: Wall::Right,
+            });
+        }
+        for b in self.blocks.iter().filter(|b| b.n > 0) {
+            let v = if b.wall == Wall::None {
+                b.sum / b.n as f64
+            } else {
+                0.0
+            };
+            emit(Cluster {
+                start: b.start,
+                n: b.n,
+                left: b.left,
+                v,
+                wall: b.wall,
+            });
+        }
+    }
+}
+
+/// Fragment one cluster of rods with free velocities `u` (`mu F_i`) into the subclusters that
+/// move apart (see [`Hull`]), emitted left to right as `(first, len, velocity, wall)` with
+/// `first` relative to `u`.
 pub fn fragment(
     u: &[f64],
     left_wall: bool,
@@ -162,52 +258,13 @@ pub fn fragment(
     scratch: &mut FragmentScratch,
     mut emit: impl FnMut(usize, usize, f64, Wall),
 ) {
-    let blocks = &mut scratch.blocks;
-    blocks.clear();
-    let wall = |w| Block {
-        start: 0,
-        n: 0,
-        sum: 0.0,
-        wall: w,
-    };
-    if left_wall {
-        blocks.push(wall(Wall::Left));
-    }
-    let pool = |blocks: &mut Vec<Block>, mut b: Block| {
-        while let Some(top) = blocks.last() {
-            if top.holds(&b) {
-                b = top.join(&b);
-                blocks.pop();
-            } else {
-                break;
-            }
-        }
-        blocks.push(b);
-    };
+    scratch.begin(left_wall);
     for (i, &ui) in u.iter().enumerate() {
-        pool(
-            blocks,
-            Block {
-                start: i as u32,
-                n: 1,
-                sum: ui,
-                wall: Wall::None,
-            },
-        );
+        scratch.push(i as u32, 0.0, ui);
     }
-    if right_wall {
-        let mut r = wall(Wall::Right);
-        r.start = u.len() as u32;
-        pool(blocks, r);
-    }
-    for b in blocks.iter().filter(|b| b.n > 0) {
-        let v = if b.wall == Wall::None {
-            b.sum / b.n as f64
-        } else {
-            0.0
-        };
-        emit(b.start as usize, b.n as usize, v, b.wall);
-    }
+    scratch.finish(right_wall, |c| {
+        emit(c.start as usize, c.n as usize, c.v, c.wall)
+    });
 }
 
 #[cfg(test)]

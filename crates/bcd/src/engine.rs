@@ -12,7 +12,7 @@
 //! depends only on N and the configuration, never on the thread count, so results are
 //! bitwise identical for any number of threads.
 
-use crate::cluster::{Cluster, FragmentScratch, Wall, collide, fragment, merge, premerge};
+use crate::cluster::{Cluster, Hull, Wall, collide, merge, premerge};
 use crate::forces::{ExternalForce, PairForce};
 use colloidsim_core::ParamError;
 use colloidsim_core::param;
@@ -143,10 +143,10 @@ pub struct BcdState {
 struct Chunk {
     vs: usize,
     ve: usize,
-    u: Vec<f64>,
     stack: Vec<Cluster>,
-    frag: FragmentScratch,
-    bad: Option<usize>,
+    hull: Hull,
+    /// First rod whose velocity went non-finite, with that velocity.
+    bad: Option<(usize, f64)>,
 }
 
 /// Read-only view of the configuration shared by the chunks of one step.
@@ -377,18 +377,12 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 .par_iter_mut()
                 .for_each(|c| chunk_phase(c, &ctx));
         }
-        if let Some(i) = self.chunks.iter().filter_map(|c| c.bad).min() {
-            let c = self
-                .chunks
-                .iter()
-                .find(|c| c.bad == Some(i))
-                .expect("found");
-            let w = (c.vs..c.ve).find(|&w| w % n == i).unwrap_or(c.vs);
+        if let Some((i, u)) = self.chunks.iter().filter_map(|c| c.bad).min_by_key(|b| b.0) {
             return Err(BcdError::NonFinite {
                 step: self.state.step,
                 particle: i,
                 position: self.state.x[i],
-                velocity: c.u[w - c.vs],
+                velocity: u,
             });
         }
 
@@ -541,91 +535,86 @@ struct StepCtx<'a, E, P> {
     premerge: bool,
 }
 
-/// Free velocities `u_i = mu F_i` (Eq. 3 of fast-bcd; Eq. 12 of the hard-rods paper) for the
-/// chunk's rods, then fragmentation of its clusters and premerging of the fragments.
+/// Free velocities `u_i = mu F_i` (fast-bcd Eq. 3; hard-rods paper Eq. 12) of the chunk's rods,
+/// fed rod by rod into the fragmentation hull of their cluster; each cluster's fragments are
+/// premerged as soon as the cluster ends. One pass, no per-rod buffers.
 fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P>) {
     c.stack.clear();
     c.bad = None;
     let (vs, ve) = (c.vs, c.ve);
-    if vs >= ve {
-        return;
-    }
     let ring = ctx.ring;
     let n = ring.n;
-    c.u.clear();
-    c.u.resize(ve - vs, 0.0);
     let range = ctx.pair.range();
     let has_pair = range > ctx.sigma;
-    let mut block = usize::MAX;
+    let mut noise_block = usize::MAX;
     let mut noise = [0.0f64; BLOCK];
-    for w in vs..ve {
-        let i = ring.actual(w);
-        let xi = ring.pos(w);
-        let mut f = ctx.ext.force(xi);
-        if has_pair {
-            // Right neighbours push i to the left, left neighbours to the right.
-            let mut k = 1;
-            while k < n && (ring.periodic || i + k < n) {
-                let r = ring.pos(w + k) - xi;
-                if r >= range {
-                    break;
+    let (stack, hull) = (&mut c.stack, &mut c.hull);
+    let mut open = false;
+    let mut w = vs;
+    // Walk in segments of actual indices, so that the ring wrap is not a per-rod branch.
+    while w < ve {
+        let wraps = w / n;
+        let base = wraps * n;
+        let seg_end = ve.min(base + n);
+        let offset = wraps as f64 * ring.length;
+        for a in w - base..seg_end - base {
+            let vw = a + base;
+            let xi = ring.x[a] + offset;
+            let mut f = ctx.ext.force(xi);
+            if has_pair {
+                // Right neighbours push rod a to the left, left neighbours to the right.
+                let mut k = 1;
+                while k < n && (ring.periodic || a + k < n) {
+                    let r = ring.pos(vw + k) - xi;
+                    if r >= range {
+                        break;
+                    }
+                    f -= ctx.pair.force(r);
+                    k += 1;
                 }
-                f -= ctx.pair.force(r);
-                k += 1;
-            }
-            let mut k = 1;
-            while k < n && (ring.periodic || i >= k) {
-                let r = xi - (ring.pos(w + n - k) - ring.length);
-                if r >= range {
-                    break;
+                let mut k = 1;
+                while k < n && (ring.periodic || a >= k) {
+                    let r = xi - (ring.pos(vw + n - k) - ring.length);
+                    if r >= range {
+                        break;
+                    }
+                    f += ctx.pair.force(r);
+                    k += 1;
                 }
-                f += ctx.pair.force(r);
-                k += 1;
+            }
+            let mut u = ctx.mobility * f;
+            if ctx.noise_amp > 0.0 {
+                let b = a / BLOCK;
+                if b != noise_block {
+                    noise_block = b;
+                    let m = BLOCK.min(n - b * BLOCK);
+                    fill_normal_block(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+                }
+                u += ctx.noise_amp * noise[a % BLOCK];
+            }
+            if !u.is_finite() {
+                c.bad = Some((a, u));
+                return;
+            }
+            if !open {
+                hull.begin(ctx.left_wall && vw == 0);
+                open = true;
+            }
+            hull.push(vw as u32, xi, u);
+            if ring.bond[a] == 0 || vw + 1 == ve {
+                let rw = ctx.right_wall && !ring.periodic && a + 1 == n;
+                hull.finish(rw, |cl| {
+                    // A fragment stuck to the left wall joins the wall in the sequential pass.
+                    if ctx.premerge && cl.wall != Wall::Left {
+                        premerge(stack, cl, ctx.sigma, ctx.dt);
+                    } else {
+                        stack.push(cl);
+                    }
+                });
+                open = false;
             }
         }
-        let mut u = ctx.mobility * f;
-        if ctx.noise_amp > 0.0 {
-            let b = i / BLOCK;
-            if b != block {
-                block = b;
-                let m = BLOCK.min(n - b * BLOCK);
-                fill_normal_block(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
-            }
-            u += ctx.noise_amp * noise[i - b * BLOCK];
-        }
-        if !u.is_finite() && c.bad.is_none() {
-            c.bad = Some(i);
-        }
-        c.u[w - vs] = u;
-    }
-    if c.bad.is_some() {
-        return;
-    }
-    let mut s = vs;
-    while s < ve {
-        let mut e = s + 1;
-        while e < ve && ring.bonded_right(e - 1) {
-            e += 1;
-        }
-        let lw = ctx.left_wall && s == 0;
-        let rw = ctx.right_wall && e == n && !ring.periodic;
-        let (stack, frag, u) = (&mut c.stack, &mut c.frag, &c.u);
-        fragment(&u[s - vs..e - vs], lw, rw, frag, |a, len, v, wall| {
-            let cl = Cluster {
-                start: (s + a) as u32,
-                n: len as u32,
-                left: ring.pos(s + a),
-                v,
-                wall,
-            };
-            // A fragment stuck to the left wall joins the wall sentinel in the sequential pass.
-            if ctx.premerge && wall != Wall::Left {
-                premerge(stack, cl, ctx.sigma, ctx.dt);
-            } else {
-                stack.push(cl);
-            }
-        });
-        s = e;
+        w = seg_end;
     }
 }
 
@@ -738,16 +727,35 @@ fn write_range(
     xs: &mut [f64],
     bs: &mut [u8],
 ) {
-    let mut put = |c: &Cluster, w: usize, k: usize| {
+    // Every virtual index in one call has the same number of wraps around the ring.
+    let wraps_of = |w: usize| {
+        if w < n {
+            0.0
+        } else if w < 2 * n {
+            1.0
+        } else {
+            2.0
+        }
+    };
+    // Rods [wa, wb) of cluster c (virtual indices as c counts them) into xs[k0..].
+    let mut fill = |c: &Cluster, wa: usize, wb: usize, k0: usize| {
         let start = c.start as usize;
-        let pos = c.left + c.v * dt + (w - start) as f64 * sigma;
-        xs[k] = pos - (w / n) as f64 * length;
-        bs[k] = u8::from(w + 1 < start + c.n as usize);
+        let base = c.left + c.v * dt - wraps_of(wa) * length + (wa - start) as f64 * sigma;
+        let len = wb - wa;
+        for (j, x) in xs[k0..k0 + len].iter_mut().enumerate() {
+            *x = base + j as f64 * sigma;
+        }
+        let bonds = &mut bs[k0..k0 + len];
+        bonds.fill(1);
+        if wb == start + c.n as usize {
+            bonds[len - 1] = 0;
+        }
     };
     let mut w = w0;
-    while w < w1.min(first_start) {
-        put(back, w + n, w - w0);
-        w += 1;
+    let head_end = w1.min(first_start);
+    if w < head_end {
+        fill(back, w + n, head_end + n, 0);
+        w = head_end;
     }
     if w >= w1 {
         return;
@@ -755,11 +763,9 @@ fn write_range(
     let mut idx = live.partition_point(|c| (c.start + c.n) as usize <= w);
     while w < w1 {
         let c = &live[idx];
-        let end = (c.start + c.n) as usize;
-        while w < w1 && w < end {
-            put(c, w, w - w0);
-            w += 1;
-        }
+        let end = ((c.start + c.n) as usize).min(w1);
+        fill(c, w, end, w - w0);
+        w = end;
         idx += 1;
     }
 }

@@ -41,8 +41,8 @@ pub struct ForceTable {
     h: f64,
     /// Cells per period (a power of two, so the periodic wrap is a bit mask).
     cells: usize,
-    /// (f, h f') at the knots; one extra knot closes the period.
-    knots: Vec<[f64; 2]>,
+    /// Per cell, the cubic `c0 + c1 t + c2 t^2 + c3 t^3` in the cell coordinate t in [0, 1).
+    cubic: Vec<[f64; 4]>,
     drive: f64,
     /// Largest interpolation error found at the cell midpoints.
     pub max_error: f64,
@@ -80,11 +80,24 @@ impl ForceTable {
                 [f(x), slope * h]
             })
             .collect();
+        // Hermite data (f, h f') at the two ends of each cell, as polynomial coefficients.
+        let cubic = knots
+            .windows(2)
+            .map(|k| {
+                let ([f0, m0], [f1, m1]) = (k[0], k[1]);
+                [
+                    f0,
+                    m0,
+                    3.0 * (f1 - f0) - 2.0 * m0 - m1,
+                    2.0 * (f0 - f1) + m0 + m1,
+                ]
+            })
+            .collect();
         let mut t = Self {
             inv_h: 1.0 / h,
             h,
             cells,
-            knots,
+            cubic,
             drive,
             max_error: 0.0,
         };
@@ -107,19 +120,13 @@ impl ExternalForce for ForceTable {
     #[inline]
     fn force(&self, x: f64) -> f64 {
         let s = x * self.inv_h;
-        let fl = s.floor();
-        let t = s - fl;
-        let i = ((fl as i64) & (self.cells as i64 - 1)) as usize;
-        let [f0, m0] = self.knots[i];
-        let [f1, m1] = self.knots[i + 1];
-        // Cubic Hermite basis.
-        let t2 = t * t;
-        let t3 = t2 * t;
-        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
-        let h10 = t3 - 2.0 * t2 + t;
-        let h01 = -2.0 * t3 + 3.0 * t2;
-        let h11 = t3 - t2;
-        self.drive + h00 * f0 + h10 * m0 + h01 * f1 + h11 * m1
+        // floor without a libm call: truncate, then step down for negative non-integers.
+        let tr = s as i64;
+        let fl = if (tr as f64) > s { tr - 1 } else { tr };
+        let t = s - fl as f64;
+        let i = (fl & (self.cells as i64 - 1)) as usize;
+        let [c0, c1, c2, c3] = self.cubic[i];
+        self.drive + c0 + t * (c1 + t * (c2 + t * c3))
     }
 }
 
