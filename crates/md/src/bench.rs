@@ -15,11 +15,23 @@ pub fn wca_periodic(
     dt: f64,
     seed: u32,
 ) -> Result<Brownian<LennardJones, NoExternal>, BdError> {
+    wca_periodic_skin(n, phi, dt, seed, 0.3)
+}
+
+/// [`wca_periodic`] with a chosen Verlet skin.
+pub fn wca_periodic_skin(
+    n: usize,
+    phi: f64,
+    dt: f64,
+    seed: u32,
+    skin: f64,
+) -> Result<Brownian<LennardJones, NoExternal>, BdError> {
     let l = (n as f64 * PI / 6.0 / phi).cbrt();
     let sbox = SimBox::cube(l);
     let pos = random_in_box(n, 1.0, &sbox, seed, 0).map_err(|e| BdError::Invalid(e.to_string()))?;
     let mut params = BdParams::new(dt, seed);
     params.viscosity = 1.0 / (3.0 * PI);
+    params.skin = skin;
     Brownian::new(
         Particles::monodisperse(pos, 1.0),
         sbox,

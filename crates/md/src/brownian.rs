@@ -1,13 +1,19 @@
 //! Free-draining Brownian dynamics (Euler–Maruyama).
 //!
 //! `x(t + dt) = x + F / gamma_i dt + sqrt(2 kT dt / gamma_i) xi`, with Stokes friction
-//! `gamma_i = 3 pi eta d_i` from each particle's diameter. The noise of particle `i` at step `n`
-//! comes from the counter-based stream keyed by (seed, n, i), `i` being the particle's index in
-//! the input (its tag), so a run is a pure function of its inputs: the same for any number of
-//! threads, and a restart from a checkpoint at step n continues bitwise identically.
+//! `gamma_i = 3 pi eta d_i` from each particle's diameter.
 //!
-//! Internally particles are kept in cell order (re-sorted whenever the neighbour list is rebuilt)
-//! so that neighbours lie close in memory; [`Brownian::snapshot`] returns them in input order.
+//! Particles are stored in cell order so that neighbours lie close in memory: they are
+//! re-sorted every [`BdParams::sort_every`] steps (a fixed schedule) and the storage order is
+//! part of the state ([`Brownian::order`], saved in checkpoints). The noise of the particle in
+//! storage slot `k` at step `n` comes from the counter-based stream keyed by
+//! (seed, n, replica, k / BLOCK), one keyed stream per block of [`BLOCK`] slots. A run is
+//! therefore a pure function of its inputs: identical for any number of threads, and a restart
+//! from a checkpoint (positions, images, box and storage order in double precision) continues
+//! bitwise identically. Forces are summed over each particle's neighbours in the order of their
+//! input index, so sums do not depend on when the neighbour list was rebuilt.
+//! [`Brownian::snapshot`] returns the particles in input order.
+//!
 //! One step is a single parallel pass over chunks of particles: each chunk sums its particles'
 //! forces from the neighbour list (reading the old positions), draws its noise and writes the
 //! new positions into a second buffer; the buffers are then swapped. Nothing is allocated per
@@ -16,14 +22,14 @@
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
-use colloidsim_core::rng::{Purpose, stream};
+use colloidsim_core::rng::{BLOCK, Purpose, stream};
 use rand::RngExt;
 use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Particles per parallel work item.
-const CHUNK: usize = 256;
+/// Particles per parallel work item (a multiple of the noise block).
+const CHUNK: usize = 4 * BLOCK;
 
 /// Parameters of the Brownian integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,17 +43,19 @@ pub struct BdParams {
     /// Seed of the noise streams.
     pub seed: u32,
     /// Independent replica of the same seed: its noise streams are keyed by
-    /// `replica * 2^32 + tag`.
+    /// `replica * 2^32 + block`.
     pub replica: u32,
     /// Verlet skin.
     pub skin: f64,
+    /// Re-sort particles into cell order every this many steps (0: never after the start).
+    pub sort_every: u64,
     /// A step whose deterministic displacement `|F| dt / gamma` exceeds this fraction of the
     /// particle's diameter stops the run (the time step is too large for the potential).
     pub max_drift: f64,
 }
 
 impl BdParams {
-    /// Defaults: kT = 1, eta = 1, skin 0.3, max_drift 0.2.
+    /// Defaults: kT = 1, eta = 1, skin 0.3, sort every 500 steps, max_drift 0.2.
     pub fn new(dt: f64, seed: u32) -> Self {
         Self {
             kt: 1.0,
@@ -56,6 +64,7 @@ impl BdParams {
             seed,
             replica: 0,
             skin: 0.3,
+            sort_every: 500,
             max_drift: 0.2,
         }
     }
@@ -184,7 +193,8 @@ fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Ve
 }
 
 impl<P: Pair, E: External> Brownian<P, E> {
-    /// A simulation starting at `step` (0 for a fresh run; the checkpoint's step for a restart).
+    /// A simulation of `particles` (in input order) starting at `step`; particles are sorted
+    /// into cell order first.
     pub fn new(
         particles: Particles,
         sbox: SimBox,
@@ -192,6 +202,21 @@ impl<P: Pair, E: External> Brownian<P, E> {
         external: E,
         params: BdParams,
         step: u64,
+    ) -> Result<Self, BdError> {
+        Self::restart(particles, sbox, pair, external, params, step, None)
+    }
+
+    /// Continue from a checkpoint: `particles` in input order at `step`, stored in `order`
+    /// (input indices in storage order, as [`Self::order`] returned) when given, so that the run
+    /// continues bitwise identically.
+    pub fn restart(
+        particles: Particles,
+        sbox: SimBox,
+        pair: P,
+        external: E,
+        params: BdParams,
+        step: u64,
+        order: Option<&[u32]>,
     ) -> Result<Self, BdError> {
         particles.check().map_err(BdError::Invalid)?;
         if let Some(i) = particles
@@ -235,7 +260,30 @@ impl<P: Pair, E: External> Brownian<P, E> {
             perm: Vec::new(),
         };
         s.set_dt(params.dt);
-        s.sort_and_rebuild()?;
+        match order {
+            None => s.sort_and_rebuild()?,
+            Some(order) => {
+                let mut seen = vec![false; n];
+                for &k in order {
+                    if (k as usize) >= n || std::mem::replace(&mut seen[k as usize], true) {
+                        return Err(BdError::Invalid(
+                            "the stored particle order is not a permutation of the particles"
+                                .into(),
+                        ));
+                    }
+                }
+                if order.len() != n {
+                    return Err(BdError::Invalid(format!(
+                        "the stored particle order has {} entries for {n} particles",
+                        order.len()
+                    )));
+                }
+                s.perm.clear();
+                s.perm.extend_from_slice(order);
+                s.apply_perm();
+                s.nlist.build(&s.sbox, &s.particles.pos, &s.tag)?;
+            }
+        }
         Ok(s)
     }
 
@@ -272,8 +320,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         &self.particles
     }
 
-    /// Input index of each internally stored particle.
-    pub fn tags(&self) -> &[u32] {
+    /// Input index of each internally stored particle (the storage order; save it with a
+    /// checkpoint and pass it to [`Self::restart`]).
+    pub fn order(&self) -> &[u32] {
         &self.tag
     }
 
@@ -340,6 +389,16 @@ impl<P: Pair, E: External> Brownian<P, E> {
             let order = self.nlist.bin(&self.sbox, &self.particles.pos);
             self.perm.clear();
             self.perm.extend_from_slice(order);
+            self.apply_perm();
+        }
+        self.nlist
+            .build(&self.sbox, &self.particles.pos, &self.tag)?;
+        Ok(())
+    }
+
+    /// Apply `self.perm` (new slot k takes old slot perm[k]) to every per-particle array.
+    fn apply_perm(&mut self) {
+        {
             let perm = &self.perm;
             let p = &mut self.particles;
             permute(&mut p.pos, perm, &mut self.new_pos);
@@ -353,9 +412,6 @@ impl<P: Pair, E: External> Brownian<P, E> {
             permute(&mut self.noise_amp, perm, &mut self.scratch_f64);
             permute(&mut self.drift_limit2, perm, &mut self.scratch_f64);
         }
-        self.nlist
-            .build(&self.sbox, &self.particles.pos, &self.tag)?;
-        Ok(())
     }
 
     /// Advance `n` steps.
@@ -400,6 +456,8 @@ impl<P: Pair, E: External> Brownian<P, E> {
             .enumerate()
             .map(|(b, (out, images))| {
                 let mut rep = ChunkReport::EMPTY;
+                let block0 = (b * CHUNK / BLOCK) as u64;
+                let mut rng = stream(seed, step, Purpose::Noise, key0 | block0);
                 for (k, (np, img)) in out.iter_mut().zip(images.iter_mut()).enumerate() {
                     let i = b * CHUNK + k;
                     let f = ctx.force_on(i, t);
@@ -416,7 +474,14 @@ impl<P: Pair, E: External> Brownian<P, E> {
                             tag[i],
                         ));
                     }
-                    let mut rng = stream(seed, step, Purpose::Noise, key0 | tag[i] as u64);
+                    if k > 0 && k % BLOCK == 0 {
+                        rng = stream(
+                            seed,
+                            step,
+                            Purpose::Noise,
+                            key0 | (block0 + (k / BLOCK) as u64),
+                        );
+                    }
                     let xi: [f64; 3] = [
                         rng.sample(StandardNormal),
                         rng.sample(StandardNormal),
@@ -455,8 +520,14 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.new_pos = new_pos;
         self.new_image = new_image;
         self.step += 1;
-        if self.nlist.range() > 0.0 && report.max_disp2 > 0.25 * self.nlist.skin * self.nlist.skin {
-            self.sort_and_rebuild()?;
+        if self.nlist.range() > 0.0 {
+            let every = self.params.sort_every;
+            if every > 0 && self.step.is_multiple_of(every) {
+                self.sort_and_rebuild()?;
+            } else if report.max_disp2 > 0.25 * self.nlist.skin * self.nlist.skin {
+                self.nlist
+                    .build(&self.sbox, &self.particles.pos, &self.tag)?;
+            }
         }
         Ok(())
     }

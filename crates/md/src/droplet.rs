@@ -658,6 +658,7 @@ impl DropletParams {
             seed: self.seed,
             replica,
             skin: self.skin,
+            sort_every: 500,
             max_drift: 0.2,
         };
         Ok(Brownian::new(

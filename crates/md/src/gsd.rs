@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 const NAME_LEN: usize = 64;
 const POS64: &str = "log/particles/position_f64";
 const BOX64: &str = "log/configuration/box_f64";
+const ORDER: &str = "log/particles/storage_order";
 
 /// A GSD error with the file involved.
 #[derive(Debug, thiserror::Error)]
@@ -105,7 +106,24 @@ impl GsdWriter {
         exact: bool,
         log: &[(&str, f64)],
     ) -> Result<(), GsdError> {
-        self.write_inner(step, sbox, p, exact, log)
+        self.write_inner(step, sbox, p, exact, None, log)
+            .map_err(|message| GsdError::Write {
+                path: self.path.clone(),
+                message,
+            })
+    }
+
+    /// Append a checkpoint frame: exact positions and box plus the engine's storage order
+    /// (`Brownian::order`), everything `Brownian::restart` needs to continue bitwise.
+    pub fn write_checkpoint(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        order: &[u32],
+        log: &[(&str, f64)],
+    ) -> Result<(), GsdError> {
+        self.write_inner(step, sbox, p, true, Some(order), log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
@@ -118,6 +136,7 @@ impl GsdWriter {
         sbox: &SimBox,
         p: &Particles,
         exact: bool,
+        order: Option<&[u32]>,
         log: &[(&str, f64)],
     ) -> Result<(), String> {
         let f = &mut self.file;
@@ -168,6 +187,9 @@ impl GsdWriter {
             f.write_arrays(POS64, p.pos.iter().copied()).map_err(e)?;
             f.write_scalars(BOX64, sbox.l).map_err(e)?;
         }
+        if let Some(o) = order {
+            f.write_scalars(ORDER, o.iter().copied()).map_err(e)?;
+        }
         for (name, v) in log {
             f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
         }
@@ -195,6 +217,8 @@ pub struct GsdFrame {
     pub particles: Particles,
     /// Whether exact (f64) positions were present.
     pub exact: bool,
+    /// Engine storage order saved by a checkpoint.
+    pub order: Option<Vec<u32>>,
 }
 
 /// Number of frames in a GSD file.
@@ -353,11 +377,16 @@ pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError>
     particles
         .check()
         .map_err(|m| content(format!("frame {k}: {m}")))?;
+    let order = match f.find_chunk(k, ORDER) {
+        Some(_) => Some(f.iter_scalars::<u32>(k, ORDER).map_err(rd)?.collect()),
+        None => None,
+    };
     Ok(GsdFrame {
         step,
         sbox,
         particles,
         exact,
+        order,
     })
 }
 

@@ -21,10 +21,19 @@ final_volume_fraction = 0.45
 
 /// N is constant and no particle gets beyond the interface's soft range: beyond
 /// `s = range` the potential is linear with slope `k range`, so an excursion of 10 kT / (k range)
-/// further has Boltzmann weight e^-10 per sample.
+/// further has Boltzmann weight e^-10 per sample. The bound holds while the suspension is
+/// dilute (here dried to phi = 0.3 with k = 100 kT / d^2); at high compression the osmotic
+/// pressure of the packing pushes the outer layer further into the soft interface (see
+/// docs/droplet.md), which this bound does not cover.
 #[test]
 fn drying_keeps_every_particle_inside_the_interface_range() {
-    let p = DropletScenario::from_toml(&scenario(""))
+    let text = scenario("")
+        .replace(
+            "final_volume_fraction = 0.45",
+            "final_volume_fraction = 0.3",
+        )
+        .replace("[run]", "[interface]\nstiffness = 100.0\n[run]");
+    let p = DropletScenario::from_toml(&text)
         .unwrap()
         .validate()
         .unwrap();

@@ -243,7 +243,7 @@ fn thread_count_and_restart_do_not_change_the_trajectory() {
             .unwrap();
         pool.install(|| {
             let mut sim = wca_system(3000, 0.2, 1e-4, 7);
-            sim.run(300).unwrap();
+            sim.run(700).unwrap(); // includes a re-sort at step 500
             sim.snapshot()
         })
     };
@@ -256,25 +256,26 @@ fn thread_count_and_restart_do_not_change_the_trajectory() {
     let mut sim = wca_system(3000, 0.2, 1e-4, 7);
     sim.run(120).unwrap();
     let mut w = GsdWriter::create_new(&path).unwrap();
-    w.write_frame(sim.step, &sim.sbox, &sim.snapshot(), true, &[])
+    w.write_checkpoint(sim.step, &sim.sbox, &sim.snapshot(), sim.order(), &[])
         .unwrap();
     drop(w);
     let f = read_frame(&path, None).unwrap();
     assert_eq!(f.step, 120);
-    let mut again = Brownian::new(
+    let mut again = Brownian::restart(
         f.particles,
         f.sbox,
         LennardJones::wca(1.0, 1.0),
         NoExternal,
         *sim.params(),
         f.step,
+        f.order.as_deref(),
     )
     .unwrap();
-    again.run(180).unwrap();
+    again.run(580).unwrap();
     assert!(again.snapshot() == one, "restart differs");
     // A different seed does change it (the comparison can fail).
     let mut other = wca_system(3000, 0.2, 1e-4, 8);
-    other.run(300).unwrap();
+    other.run(700).unwrap();
     assert!(other.snapshot().pos != one.pos);
 }
 
