@@ -182,7 +182,8 @@ pub struct RodsProblem {
     pub tolerance: f64,
     /// Iteration limit on the finest grid (default 5000).
     pub max_iterations: usize,
-    /// Anderson memory (default 8); 0 gives damped Picard.
+    /// Anderson memory (default 20); 0 gives damped Picard. If the solve does not converge it
+    /// is repeated once with memory 40 and mixing 0.1.
     pub anderson_memory: usize,
     /// Anderson / Picard mixing parameter in (0, 1] (default 0.5).
     pub mixing: f64,
@@ -203,7 +204,7 @@ impl RodsProblem {
             interaction: RodInteraction::Hard,
             tolerance: 1e-10,
             max_iterations: 5000,
-            anderson_memory: 8,
+            anderson_memory: 20,
             mixing: 0.5,
         }
     }

@@ -39,6 +39,11 @@ impl Anderson {
         }
     }
 
+    /// Changes the mixing parameter.
+    pub fn set_beta(&mut self, beta: f64) {
+        self.beta = beta;
+    }
+
     /// Forget the history (after a rejected step).
     pub fn reset(&mut self) {
         self.have_prev = false;

@@ -132,6 +132,47 @@ impl Equilibrium {
 /// `residual < tolerance`.
 pub fn equilibrium(problem: &RodsProblem) -> Result<Equilibrium, RodsError> {
     problem.validate()?;
+    match solve_levels(problem) {
+        Err(RodsError::NotConverged { iterations, .. })
+            if problem.anderson_memory < ROBUST_MEMORY || problem.mixing > ROBUST_MIXING =>
+        {
+            // Strongly layered or nearly jammed states: once more with a longer history and
+            // smaller mixing (slower per iteration, but converges in more of these states).
+            log::debug!(
+                "rods: retrying with Anderson memory {ROBUST_MEMORY}, mixing {ROBUST_MIXING}"
+            );
+            let mut robust = problem.clone();
+            robust.anderson_memory = problem.anderson_memory.max(ROBUST_MEMORY);
+            robust.mixing = problem.mixing.min(ROBUST_MIXING);
+            match solve_levels(&robust) {
+                Ok(mut eq) => {
+                    eq.total_iterations += iterations;
+                    Ok(eq)
+                }
+                Err(RodsError::NotConverged {
+                    iterations: it2,
+                    residual,
+                    tolerance,
+                    min_vacancy,
+                }) => Err(RodsError::NotConverged {
+                    iterations: iterations + it2,
+                    residual,
+                    tolerance,
+                    min_vacancy,
+                }),
+                Err(e) => Err(e),
+            }
+        }
+        other => other,
+    }
+}
+
+/// Anderson settings of the second attempt.
+const ROBUST_MEMORY: usize = 40;
+const ROBUST_MIXING: f64 = 0.1;
+
+/// Grid sequencing and the solve on every level.
+fn solve_levels(problem: &RodsProblem) -> Result<Equilibrium, RodsError> {
     let gamma = problem.interaction.gamma();
     let fine = problem.grid(problem.dx)?;
     // Grid sequencing: coarser grids by factors of 2 while sigma/dx >= 20 and >= 1024 active points.
@@ -336,6 +377,11 @@ impl Solver {
         let mut have_ok = false;
         let mut tried_peaks = false;
         let mut it = 0;
+        // Mixing adapted to the state: halved after a step that overlaps rods, regrown by 10% per
+        // iteration that lowers the residual.
+        let mut beta = problem.mixing;
+        let mut prev_res = f64::INFINITY;
+        let mut overlaps_in_row = 0;
         loop {
             match self.eval() {
                 Ok((beta_mu, res)) => {
@@ -353,6 +399,12 @@ impl Solver {
                     }
                     self.u_ok.copy_from_slice(&self.u);
                     have_ok = true;
+                    overlaps_in_row = 0;
+                    if res < prev_res && beta < problem.mixing {
+                        beta = (1.1 * beta).min(problem.mixing);
+                        anderson.set_beta(beta);
+                    }
+                    prev_res = res;
                     anderson.step(&mut self.u, &self.r);
                 }
                 Err(Overlap) => {
@@ -383,11 +435,17 @@ impl Solver {
                             min_vacancy: 0.0,
                         });
                     }
-                    // Halve the step back towards the last admissible iterate.
+                    // Halve the step back towards the last admissible iterate and the mixing;
+                    // forget the history only if that keeps failing.
                     for i in 0..self.grid.m {
                         self.u[i] = 0.5 * (self.u[i] + self.u_ok[i]);
                     }
-                    anderson.reset();
+                    beta = (0.5 * beta).max(1e-3);
+                    anderson.set_beta(beta);
+                    overlaps_in_row += 1;
+                    if overlaps_in_row >= 3 {
+                        anderson.reset();
+                    }
                 }
             }
             it += 1;
