@@ -233,6 +233,9 @@ pub struct BenchArgs {
     /// Do not run LAMMPS.
     #[arg(long)]
     pub no_lammps: bool,
+    /// Verlet skin, for both codes (LAMMPS's default in LJ units is 0.3).
+    #[arg(long, default_value_t = 0.3)]
+    pub skin: f64,
 }
 
 fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
@@ -241,12 +244,14 @@ fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
 }
 
 /// `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube (friction 1, kT 1,
-/// dt = 1e-4, skin 0.3), particle-steps per second, beside LAMMPS on the same configuration.
+/// dt = 1e-4, same skin for both), particle-steps per second, beside LAMMPS on the same
+/// configuration in the same run (LAMMPS on one MPI rank, with Gaussian and with its default
+/// uniform noise).
 pub fn bench(a: &BenchArgs) -> Result<()> {
     let dt = 1e-4;
     println!(
-        "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin 0.3; {} steps per run, median (min-max) of {}",
-        a.n, a.phi, a.steps, a.repeats
+        "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin {}; {} steps per run, median (min-max) of {}",
+        a.n, a.phi, a.skin, a.steps, a.repeats
     );
     println!("code\tthreads\tparticle_steps_per_s\tmin\tmax");
     let mut ours = Vec::new();
@@ -258,7 +263,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         let mut rates = Vec::new();
         for _ in 0..a.repeats.max(1) {
             let rate = pool.install(|| -> Result<f64> {
-                let mut sim = colloidsim_md::bench::wca_periodic(a.n, a.phi, dt, 1)?;
+                let mut sim = colloidsim_md::bench::wca_periodic_skin(a.n, a.phi, dt, 1, a.skin)?;
                 sim.run(100)?; // warm-up: buffers and neighbour list reach their size
                 let start = Instant::now();
                 sim.run(a.steps)?;
@@ -298,10 +303,11 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         let input = format!(
             "units lj\natom_style atomic\nboundary p p p\nread_data init.data\n\
              pair_style lj/cut 1.122462048309373\npair_coeff 1 1 1.0 1.0 1.122462048309373\npair_modify shift yes\n\
-             neighbor 0.3 bin\nneigh_modify every 1 delay 0 check yes\n\
+             neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
              fix 1 all brownian 1.0 12345 gamma_t 1.0 rng {rng}\ntimestep {dt}\nthermo 100000\n\
              run 100\nrun {}\n",
-            a.steps
+            a.steps,
+            skin = a.skin
         );
         std::fs::write(dir.join("in.bd"), input)?;
         let mut rates = Vec::new();
