@@ -1,11 +1,12 @@
 //! Validation against exact results, with tolerances from the runs' statistical errors
 //! (fixed seeds). Each test also checks that a deliberately wrong reference would be rejected.
 
-use colloidsim_bcd::forces::{ForceTable, NoField, NoPair};
-use colloidsim_bcd::observe::{ContactDensity, DensityProfile};
+mod common;
+
+use colloidsim_bcd::forces::{NoField, NoPair};
+use colloidsim_bcd::observe::ContactDensity;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
-use colloidsim_core::field1d::{ExternalField, FieldTerm};
-use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
+use common::mean_and_error;
 
 fn cfg(length: f64, sigma: f64, dt: f64, seed: u32) -> BcdConfig {
     BcdConfig {
@@ -18,13 +19,6 @@ fn cfg(length: f64, sigma: f64, dt: f64, seed: u32) -> BcdConfig {
         seed,
         update: Update::Premerge,
     }
-}
-
-fn mean_and_error(samples: &[f64]) -> (f64, f64) {
-    let k = samples.len() as f64;
-    let m = samples.iter().sum::<f64>() / k;
-    let var = samples.iter().map(|s| (s - m).powi(2)).sum::<f64>() / (k - 1.0);
-    (m, (var / k).sqrt())
 }
 
 /// Dilute rods never meet within the run: MSD = 2 D t, error sqrt(2/N) 2 D t.
@@ -136,52 +130,22 @@ fn homogeneous_contact_density_matches_the_tonks_gas() {
 /// (batch means), and the profile for a rod length 10% off is rejected.
 #[test]
 fn density_in_cosine_potential_matches_exact_theory() {
-    let (n, length, sigma, bins) = (50, 100.0, 0.5, 20);
-    let field = ExternalField {
-        terms: vec![FieldTerm::Cosine {
-            amplitude: 6.0,
-            wavelength: 1.0,
-        }],
-        drive: 0.0,
-    };
-    let theory = |s: f64| {
-        let p = RodsProblem::new(s, n as f64 / length, Domain::Periodic { period: 1.0 })
-            .with_dx(1e-3)
-            .with_potential(BetaPotential::from_field(&field, 1.0));
-        rods::equilibrium(&p)
-            .unwrap()
-            .bin_average(bins, 1.0)
-            .unwrap()
-            .rho
-    };
-    let c = cfg(length, sigma, 1e-4, 21);
-    let x0 = init::random(&c, n, 21).unwrap();
-    let table = ForceTable::from_field(&field).unwrap();
-    let mut b = Bcd::new(c, x0, table, NoPair).unwrap();
-    b.run(20_000).unwrap();
-    let mut blocks: Vec<Vec<f64>> = Vec::new();
-    for _ in 0..10 {
-        let mut d = DensityProfile::new(bins, 1.0, length);
-        for _ in 0..20_000 {
-            b.step().unwrap();
-            d.sample(b.positions());
-        }
-        blocks.push(d.profile().1);
-    }
-    let exact = theory(sigma);
-    let wrong = theory(1.1 * sigma);
-    let (mut worst, mut chi2_wrong) = (0.0f64, 0.0);
-    for k in 0..bins {
-        let col: Vec<f64> = blocks.iter().map(|b| b[k]).collect();
-        let (m, err) = mean_and_error(&col);
-        let err = err.max(1e-3 * m.abs()).max(1e-12);
-        worst = worst.max((m - exact[k]).abs() / err);
-        chi2_wrong += ((m - wrong[k]) / err).powi(2);
-    }
-    eprintln!("largest deviation {worst:.2} sigma; chi2 against sigma * 1.1: {chi2_wrong:.0}");
-    assert!(worst < 4.5, "deviation {worst} standard errors");
-    assert!(
-        chi2_wrong > 4.0 * bins as f64,
-        "wrong sigma not caught: chi2 {chi2_wrong}"
+    let o = common::compare(&common::Case {
+        sigma: 0.5,
+        rho: 0.5,
+        gamma: None,
+        length: 100.0,
+        dt: 1e-4,
+        bins: 20,
+        equilibrate_steps: 20_000,
+        blocks: 10,
+        block_steps: 20_000,
+        seed: 21,
+    });
+    eprintln!(
+        "largest deviation {:.2} sigma; chi2 against sigma * 1.1: {:.0}",
+        o.worst, o.chi2_wrong_sigma
     );
+    assert!(o.worst < 4.5, "deviation {} standard errors", o.worst);
+    assert!(o.chi2_wrong_sigma > 4.0 * o.bins as f64);
 }
