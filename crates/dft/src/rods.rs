@@ -4,7 +4,8 @@
 //!   density directly (Picard + Anderson mixing, grid sequencing, O(M) window integrals);
 //!   paper `bcd-hard-rods-sticky.md` Eqs. (21)–(24) (hard) and (35a)–(35c) (sticky).
 //! - [`ddft`]: `d rho / dt = d/dx [D rho d/dx (delta beta F / delta rho + beta U) - D beta f rho]`
-//!   by finite volumes with Scharfetter–Gummel fluxes (particle number conserved to rounding).
+//!   by finite volumes with Scharfetter–Gummel fluxes (particle number conserved to rounding;
+//!   stabilised linearly implicit steps).
 //! - [`bulk`]: exact homogeneous results (Tonks gas, Baxter sticky rods) for checks.
 //!
 //! Units: lengths in the scenario's length unit, energies in kT (the potential is passed as
@@ -35,11 +36,12 @@ pub enum RodsError {
     #[error(
         "rods equilibrium did not converge: residual {residual:.3e} (max-norm of the structure \
          equation in ln rho form) after {iterations} iterations, tolerance {tolerance:.1e}; \
-         raise max_iterations or the tolerance, or refine dx{}",
+         raise max_iterations or the tolerance{}",
         jam_hint(*min_vacancy)
     )]
     NotConverged {
-        /// Iterations done on the finest grid.
+        /// Iterations done on the finest grid (both attempts: the default one and the retry with a
+        /// longer Anderson history).
         iterations: usize,
         /// Residual reached.
         residual: f64,
