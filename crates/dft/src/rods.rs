@@ -1,9 +1,9 @@
 //! Exact 1D equilibrium theory of hard rods (Percus) and sticky rods (Baxter), and 1D DDFT.
 //!
-//! - [`equilibrium`]: solves the structure equation `delta Omega / delta rho = 0` at fixed mean
+//! - [`equilibrium()`]: solves the structure equation `delta Omega / delta rho = 0` at fixed mean
 //!   density directly (Picard + Anderson mixing, grid sequencing, O(M) window integrals);
 //!   paper `bcd-hard-rods-sticky.md` Eqs. (21)–(24) (hard) and (35a)–(35c) (sticky).
-//! - [`ddft`]: `d rho / dt = d/dx [D rho d/dx (delta beta F / delta rho + beta U) - D beta f rho]`
+//! - [`ddft()`]: `d rho / dt = d/dx [D rho d/dx (delta beta F / delta rho + beta U) - D beta f rho]`
 //!   by finite volumes with Scharfetter–Gummel fluxes (particle number conserved to rounding;
 //!   stabilised linearly implicit steps).
 //! - [`bulk`]: exact homogeneous results (Tonks gas, Baxter sticky rods) for checks.

@@ -2,7 +2,7 @@
 //!
 //! `d rho/dt = -dJ/dx`, `J = -D [d rho/dx + rho d psi/dx - beta f rho]`, with
 //! `psi = mu_ex[rho] + beta U` (`mu_ex = delta beta F_ex / delta rho`, the exact functional of
-//! [`super::equilibrium`]) and a constant drive force `f` (`D beta f` is the free drift velocity,
+//! [`super::equilibrium()`]) and a constant drive force `f` (`D beta f` is the free drift velocity,
 //! `mu f` with mobility `mu = D / kT`).
 //!
 //! Finite volumes on the solver grid (control volume `dx` around each point, the same trapezoid
