@@ -253,7 +253,10 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin {}; {} steps per run, median (min-max) of {}",
         a.n, a.phi, a.skin, a.steps, a.repeats
     );
-    println!("code\tthreads\tparticle_steps_per_s\tmin\tmax");
+    println!(
+        "# cpu_rate: particle-steps per second of CPU time (user + system, all threads) — less sensitive to other load on the machine"
+    );
+    println!("code\tthreads\tparticle_steps_per_s\tmin\tmax\tcpu_rate");
     let mut ours = Vec::new();
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -261,19 +264,28 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             .build()
             .context("thread pool")?;
         let mut rates = Vec::new();
+        let mut cpu_rates = Vec::new();
         for _ in 0..a.repeats.max(1) {
-            let rate = pool.install(|| -> Result<f64> {
+            let (rate, cpu_rate) = pool.install(|| -> Result<(f64, f64)> {
                 let mut sim = colloidsim_md::bench::wca_periodic_skin(a.n, a.phi, dt, 1, a.skin)?;
                 sim.run(100)?; // warm-up: buffers and neighbour list reach their size
+                let c0 = cpu_seconds();
                 let start = Instant::now();
                 sim.run(a.steps)?;
-                Ok(a.n as f64 * a.steps as f64 / start.elapsed().as_secs_f64())
+                let work = a.n as f64 * a.steps as f64;
+                let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
+                Ok((
+                    work / start.elapsed().as_secs_f64(),
+                    cpu.map_or(f64::NAN, |c| work / c),
+                ))
             })?;
             rates.push(rate);
+            cpu_rates.push(cpu_rate);
         }
         let (m, lo, hi) = median(rates);
-        println!("colloidsim\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}");
-        ours.push((t, m));
+        let (mc, _, _) = median(cpu_rates);
+        println!("colloidsim\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        ours.push((t, m, mc));
     }
     if a.no_lammps {
         return Ok(());
@@ -311,6 +323,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         );
         std::fs::write(dir.join("in.bd"), input)?;
         let mut rates = Vec::new();
+        let mut cpu_rates = Vec::new();
         for _ in 0..a.repeats.max(1) {
             let out = std::process::Command::new(&a.lammps)
                 .args(["-in", "in.bd", "-log", "none", "-screen", "lammps.out"])
@@ -326,28 +339,47 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
             let text = std::fs::read_to_string(dir.join("lammps.out"))?;
             // The last "Loop time of T on P procs for S steps with N atoms" is the timed run.
-            let line = text
-                .lines()
-                .rfind(|l| l.starts_with("Loop time of"))
+            let lines: Vec<&str> = text.lines().collect();
+            let at = lines
+                .iter()
+                .rposition(|l| l.starts_with("Loop time of"))
                 .context("LAMMPS printed no loop time")?;
-            let w: Vec<&str> = line.split_whitespace().collect();
+            let w: Vec<&str> = lines[at].split_whitespace().collect();
             let secs: f64 = w[3].parse()?;
             let steps: f64 = w[8].parse()?;
             rates.push(a.n as f64 * steps / secs);
+            // "98.7% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.
+            let pct = lines[at..]
+                .iter()
+                .find_map(|l| {
+                    l.split_once("% CPU use")
+                        .and_then(|(p, _)| p.trim().parse::<f64>().ok())
+                })
+                .unwrap_or(f64::NAN);
+            cpu_rates.push(a.n as f64 * steps / (secs * pct / 100.0));
         }
         let (m, lo, hi) = median(rates);
-        println!("{label}\t1\t{m:.4e}\t{lo:.4e}\t{hi:.4e}");
-        if rng == "gaussian" {
-            for (t, r) in &ours {
-                println!(
-                    "# colloidsim on {t} thread(s) / LAMMPS (gaussian noise, 1 core): {:.2}",
-                    r / m
-                );
-            }
+        let (mc, _, _) = median(cpu_rates);
+        println!("{label}\t1\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        for (t, r, rc) in &ours {
+            println!(
+                "# colloidsim on {t} thread(s) / {label} on 1 core: {:.2} (wall), {:.2} (CPU time)",
+                r / m,
+                rc / mc
+            );
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
     Ok(())
+}
+
+/// CPU time (user + system, all threads) of this process in seconds, from /proc (Linux).
+fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
 }
 
 fn tempfile_dir() -> Result<PathBuf> {
