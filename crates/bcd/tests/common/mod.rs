@@ -90,12 +90,28 @@ fn simulate<P: PairForce>(c: &Case, pair: P) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Run the case and compare bin by bin (batch means over `blocks`).
-pub fn compare(c: &Case) -> Outcome {
-    let blocks = match c.gamma {
+fn run(c: &Case) -> Vec<Vec<f64>> {
+    match c.gamma {
         Some(gamma) => simulate(c, Sticky::new(gamma, 0.05, 3.0, c.sigma, 1.0).unwrap()),
         None => simulate(c, NoPair),
-    };
+    }
+}
+
+/// Root-mean-square deviation of the run's profile (all blocks) from the exact one.
+#[allow(dead_code)]
+pub fn rms_deviation(c: &Case) -> f64 {
+    let blocks = run(c);
+    let exact = theory(c, c.sigma);
+    let k = blocks.len() as f64;
+    let ss: f64 = (0..c.bins)
+        .map(|i| (blocks.iter().map(|b| b[i]).sum::<f64>() / k - exact[i]).powi(2))
+        .sum();
+    (ss / c.bins as f64).sqrt()
+}
+
+/// Run the case and compare bin by bin (batch means over `blocks`).
+pub fn compare(c: &Case) -> Outcome {
+    let blocks = run(c);
     let exact = theory(c, c.sigma);
     let wrong = theory(c, 1.1 * c.sigma);
     let (mut worst, mut chi2) = (0.0f64, 0.0);
