@@ -290,13 +290,28 @@ impl DropletScenario {
         let friction = 3.0 * PI * eta * d;
         let d0 = kt / friction;
         let n = particles as f64;
+        // Random insertion packs to MAX_PHI0; a configuration read from a file may be denser.
+        let max_phi0 = if s.initial.is_some() {
+            MAX_PHI_FINAL
+        } else {
+            MAX_PHI0
+        };
         let (phi0, r0) = match (s.phi0, s.radius) {
             (Some(phi), None) => {
-                let phi = in_range("system.phi0", phi, 0.0, MAX_PHI0)?;
-                if phi <= 0.0 {
+                if !(phi.is_finite() && phi > 0.0) {
                     return Err(ParamError::new(
                         "system.phi0",
-                        format!("must lie in (0, {MAX_PHI0}], got {phi}"),
+                        format!("must lie in (0, {max_phi0}], got {phi}"),
+                    ));
+                }
+                if phi > max_phi0 {
+                    return Err(ParamError::new(
+                        "system.phi0",
+                        format!(
+                            "an initial volume fraction of {phi} cannot be packed by random insertion \
+                             of hard spheres (at most {max_phi0}); start from a GSD file (system.initial) \
+                             or lower phi0"
+                        ),
                     ));
                 }
                 (phi, d * (n / (8.0 * phi)).cbrt())
@@ -304,14 +319,14 @@ impl DropletScenario {
             (None, Some(r)) => {
                 let r = positive("system.radius", r)?;
                 let phi = n * d.powi(3) / (8.0 * r.powi(3));
-                if phi > MAX_PHI0 {
+                if phi > max_phi0 {
                     return Err(ParamError::new(
                         "system.radius",
                         format!(
                             "{particles} particles of diameter {d} in radius {r} give phi0 = {phi:.4}, \
-                             which cannot be packed by random insertion (at most {MAX_PHI0}); \
+                             which cannot be packed (at most {max_phi0}); \
                              the radius must be at least {:.4}",
-                            d * (n / (8.0 * MAX_PHI0)).cbrt()
+                            d * (n / (8.0 * max_phi0)).cbrt()
                         ),
                     ));
                 }
