@@ -8,6 +8,11 @@ use colloidsim_bcd::observe::ContactDensity;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use common::mean_and_error;
 
+/// Mean-square displacement of the rods from `x0`.
+fn msd(x: &[f64], x0: &[f64]) -> f64 {
+    x.iter().zip(x0).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / x.len() as f64
+}
+
 fn cfg(length: f64, sigma: f64, dt: f64, seed: u32) -> BcdConfig {
     BcdConfig {
         length,
@@ -31,13 +36,7 @@ fn free_rods_diffuse_with_msd_2dt() {
     let mut b = Bcd::new(c.clone(), x0.clone(), NoField, NoPair).unwrap();
     b.run(1000).unwrap();
     let t = b.time();
-    let msd: f64 = b
-        .positions()
-        .iter()
-        .zip(&x0)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        / n as f64;
+    let msd = msd(b.positions(), &x0);
     let exact = 2.0 * c.diffusion() * t;
     let err = (2.0 / n as f64).sqrt() * exact;
     assert!(
@@ -65,14 +64,7 @@ fn single_file_diffusion_follows_the_exact_law() {
         for (k, &t) in times.iter().enumerate() {
             b.run(((t - done) / dt).round() as u64).unwrap();
             done = t;
-            let m = b
-                .positions()
-                .iter()
-                .zip(&x0)
-                .map(|(x, y)| (x - y).powi(2))
-                .sum::<f64>()
-                / n as f64;
-            per_time[k].push(m);
+            per_time[k].push(msd(b.positions(), &x0));
         }
     }
     for (k, &t) in times.iter().enumerate() {

@@ -219,7 +219,16 @@ fn simulate<P: PairForce + Clone>(
     let pb = progress(total, opts.quiet, "bcd");
     pb.set_position(bcd.steps());
     let start = Instant::now();
-    let save = |bcd: &Bcd<Field, P>, obs: &Observers, wall: f64, frames: u64| -> Result<()> {
+    // Checkpoint: flush the trajectory first, so that the file holds every frame the state knows.
+    let save = |bcd: &Bcd<Field, P>,
+                obs: &Observers,
+                gsd: &mut Option<hoomd_gsd::hoomd::HoomdGsdFile>,
+                wall: f64,
+                frames: u64|
+     -> Result<()> {
+        if let Some(g) = gsd.as_mut() {
+            g.sync_all()?;
+        }
         let ck = Checkpoint {
             version: env!("CARGO_PKG_VERSION").into(),
             scenario: std::fs::read_to_string(out.join("scenario.toml"))?,
@@ -237,15 +246,8 @@ fn simulate<P: PairForce + Clone>(
             INTERRUPTED.store(true, Ordering::SeqCst);
         }
         if INTERRUPTED.load(Ordering::Relaxed) {
-            if let Some(g) = gsd.as_mut() {
-                g.sync_all()?;
-            }
-            save(
-                &bcd,
-                &obs,
-                wall_before + start.elapsed().as_secs_f64(),
-                frames,
-            )?;
+            let wall = wall_before + start.elapsed().as_secs_f64();
+            save(&bcd, &obs, &mut gsd, wall, frames)?;
             pb.abandon();
             bail!(
                 "interrupted at step {}; checkpoint written. Continue with: colloidsim run SCENARIO --restart {}",
@@ -291,26 +293,16 @@ fn simulate<P: PairForce + Clone>(
             frames += 1;
         }
         if s.is_multiple_of(ck_every) && s < total {
-            if let Some(g) = gsd.as_mut() {
-                g.sync_all()?;
-            }
-            save(
-                &bcd,
-                &obs,
-                wall_before + start.elapsed().as_secs_f64(),
-                frames,
-            )?;
+            let wall = wall_before + start.elapsed().as_secs_f64();
+            save(&bcd, &obs, &mut gsd, wall, frames)?;
         }
         if s.is_multiple_of(256) {
             pb.set_position(s);
         }
     }
     pb.finish_and_clear();
-    if let Some(g) = gsd.as_mut() {
-        g.sync_all()?;
-    }
     wall_before += start.elapsed().as_secs_f64();
-    save(&bcd, &obs, wall_before, frames)?;
+    save(&bcd, &obs, &mut gsd, wall_before, frames)?;
     write_outputs(sc, r, out, &bcd, &obs, wall_before, frames)
 }
 
