@@ -25,8 +25,7 @@ pub struct NeighborList {
     cell_start: Vec<u32>,
     cell_members: Vec<u32>,
     cell_pos: Vec<[f64; 3]>,
-    cell_nbrs: Vec<(u32, u32)>,
-    stencil_width: usize,
+    cell_xyz: Vec<[usize; 3]>,
     fill: Vec<u32>,
     n_cells: [usize; 3],
     builds: u64,
@@ -56,8 +55,7 @@ impl NeighborList {
             cell_start: Vec::new(),
             cell_members: Vec::new(),
             cell_pos: Vec::new(),
-            cell_nbrs: Vec::new(),
-            stencil_width: 9,
+            cell_xyz: Vec::new(),
             fill: Vec::new(),
             n_cells: [1; 3],
             builds: 0,
@@ -144,9 +142,8 @@ impl NeighborList {
             let cells = &self.cell_start;
             let members = &self.cell_members;
             let cpos = &self.cell_pos;
-            let cell_of = &self.cell_of;
-            let stencil = &self.cell_nbrs;
-            let width = self.stencil_width;
+            let cell_xyz = &self.cell_xyz;
+            let [nx, ny, nz] = self.n_cells;
             let overflow = self
                 .list
                 .par_chunks_mut(stride)
@@ -155,15 +152,11 @@ impl NeighborList {
                 .with_min_len(256)
                 .map(|(i, (slot, cnt))| {
                     let p = pos[i];
-                    let c = cell_of[i] as usize;
+                    let [cx, cy, cz] = cell_xyz[i];
                     let mut m = 0usize;
-                    for &(lo, hi) in &stencil[c * width..(c + 1) * width] {
-                        if lo == u32::MAX {
-                            break;
-                        }
-                        let (lo, hi) =
-                            (cells[lo as usize] as usize, cells[hi as usize + 1] as usize);
-                        for k in lo..hi {
+                    // Members of cells first..=last (consecutive along x).
+                    let mut scan = |first: usize, last: usize| {
+                        for k in cells[first] as usize..cells[last + 1] as usize {
                             let q = cpos[k];
                             let d = sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
                             let j = members[k];
@@ -172,6 +165,28 @@ impl NeighborList {
                             // Branch-free append; overflow is detected through `m`.
                             slot[m.min(stride - 1)] = j;
                             m += hit as usize;
+                        }
+                    };
+                    let (z_lo, z_n) = if nz >= 3 { (cz + nz - 1, 3) } else { (0, 1) };
+                    let (y_lo, y_n) = if ny >= 3 { (cy + ny - 1, 3) } else { (0, 1) };
+                    for a in 0..z_n {
+                        let z = wrap_index(z_lo + a, nz);
+                        for b in 0..y_n {
+                            let y = wrap_index(y_lo + b, ny);
+                            let row = (z * ny + y) * nx;
+                            // The 3 (or 1) cells along x as runs of consecutive cells; a run
+                            // that would wrap around the boundary is split in two.
+                            if nx < 3 {
+                                scan(row, row + nx - 1);
+                            } else if cx == 0 {
+                                scan(row, row + 1);
+                                scan(row + nx - 1, row + nx - 1);
+                            } else if cx == nx - 1 {
+                                scan(row, row);
+                                scan(row + nx - 2, row + nx - 1);
+                            } else {
+                                scan(row + cx - 1, row + cx + 1);
+                            }
                         }
                     }
                     *cnt = m.min(stride) as u32;
@@ -203,10 +218,7 @@ impl NeighborList {
             let m = (sbox.l[k] / range).floor().min(cap) as usize;
             n_cells[k] = if m >= 3 { m } else { 1 };
         }
-        if n_cells != self.n_cells || self.cell_nbrs.is_empty() {
-            self.n_cells = n_cells;
-            self.make_cell_stencils();
-        }
+        self.n_cells = n_cells;
         let [nx, ny, nz] = self.n_cells;
         let total = nx * ny * nz;
         let scale = [
@@ -215,15 +227,19 @@ impl NeighborList {
             nz as f64 / sbox.l[2],
         ];
         let half = [0.5 * sbox.l[0], 0.5 * sbox.l[1], 0.5 * sbox.l[2]];
-        let cell_index = |p: &[f64; 3]| -> u32 {
+        self.cell_of.resize(n, 0);
+        self.cell_xyz.resize(n, [0; 3]);
+        for ((c, xyz), p) in self
+            .cell_of
+            .iter_mut()
+            .zip(self.cell_xyz.iter_mut())
+            .zip(pos)
+        {
             let cx = (((p[0] + half[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
             let cy = (((p[1] + half[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
             let cz = (((p[2] + half[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
-            ((cz * ny + cy) * nx + cx) as u32
-        };
-        self.cell_of.resize(n, 0);
-        for (c, p) in self.cell_of.iter_mut().zip(pos) {
-            *c = cell_index(p);
+            *xyz = [cx, cy, cz];
+            *c = ((cz * ny + cy) * nx + cx) as u32;
         }
         // Counting sort: members of each cell in increasing particle index, with their
         // positions copied alongside for locality.
@@ -248,59 +264,18 @@ impl NeighborList {
 
         &self.cell_members
     }
+}
 
-    /// For every cell, its 3x3x3 neighbourhood as runs of consecutive cells along x
-    /// (`(first, last)`, inclusive): 9 runs for interior cells, padded with `u32::MAX`. Runs
-    /// that would wrap around the periodic boundary are split, so up to 18 are possible, and
-    /// the table holds 18 slots per cell when that happens.
-    fn make_cell_stencils(&mut self) {
-        let [nx, ny, nz] = self.n_cells;
-        let total = nx * ny * nz;
-        let xs: Vec<usize> = if nx >= 3 { vec![0, 1, 2] } else { vec![1] };
-        let span = |n: usize| if n >= 3 { -1i64..=1 } else { 0..=0 };
-        // Collect runs for every cell first to find the widest.
-        let mut all: Vec<Vec<(u32, u32)>> = Vec::with_capacity(total);
-        for cz in 0..nz {
-            for cy in 0..ny {
-                for cx in 0..nx {
-                    let mut runs = Vec::new();
-                    for dz in span(nz) {
-                        let z = (cz as i64 + dz).rem_euclid(nz as i64) as usize;
-                        for dy in span(ny) {
-                            let y = (cy as i64 + dy).rem_euclid(ny as i64) as usize;
-                            let row = (z * ny + y) * nx;
-                            let mut cols: Vec<usize> = xs
-                                .iter()
-                                .map(|&o| (cx as i64 + o as i64 - 1).rem_euclid(nx as i64) as usize)
-                                .collect();
-                            cols.sort_unstable();
-                            cols.dedup();
-                            let mut start = cols[0];
-                            let mut prev = cols[0];
-                            for &x in &cols[1..] {
-                                if x != prev + 1 {
-                                    runs.push(((row + start) as u32, (row + prev) as u32));
-                                    start = x;
-                                }
-                                prev = x;
-                            }
-                            runs.push(((row + start) as u32, (row + prev) as u32));
-                        }
-                    }
-                    all.push(runs);
-                }
-            }
-        }
-        let width = all.iter().map(Vec::len).max().unwrap_or(0).max(9);
-        self.stencil_width = width;
-        self.cell_nbrs.clear();
-        self.cell_nbrs.resize(total * width, (u32::MAX, u32::MAX));
-        for (c, runs) in all.iter().enumerate() {
-            for (m, r) in runs.iter().enumerate() {
-                self.cell_nbrs[c * width + m] = *r;
-            }
-        }
+/// `i mod n` for `i < 3 n` without a division.
+#[inline(always)]
+fn wrap_index(mut i: usize, n: usize) -> usize {
+    if i >= n {
+        i -= n;
     }
+    if i >= n {
+        i -= n;
+    }
+    i
 }
 
 #[cfg(test)]
