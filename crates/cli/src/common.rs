@@ -31,12 +31,12 @@ pub fn default_out(scenario: &Path, out: Option<PathBuf>, suffix: &str) -> PathB
 }
 
 /// A progress bar over `total` units that appears only on a terminal, only when not quiet, and
-/// only after the run has lasted a second.
+/// only once the run has lasted a second (short runs print nothing but their result).
 pub fn progress(total: u64, quiet: bool, what: &str) -> ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
-    let pb = ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::stderr());
+    let pb = ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::hidden());
     pb.set_style(
         ProgressStyle::with_template(&format!(
             "{what} {{bar:40}} {{percent:>3}}% {{elapsed_precise}} eta {{eta}} {{msg}}"
@@ -44,6 +44,13 @@ pub fn progress(total: u64, quiet: bool, what: &str) -> ProgressBar {
         .expect("static template"),
     );
     pb.enable_steady_tick(Duration::from_millis(500));
+    let reveal = pb.clone();
+    std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_secs(1));
+        if !reveal.is_finished() {
+            reveal.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+    });
     pb
 }
 
