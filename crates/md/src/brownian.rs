@@ -435,15 +435,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         new_pos.resize(n, [0.0; 3]);
         new_image.resize(n, [0; 3]);
         let old_image = &self.particles.image;
-        let ctx = ForceCtx {
-            pos: &self.particles.pos,
-            typeid: &self.particles.typeid,
-            diameter: &self.particles.diameter,
-            nlist: &self.nlist,
-            sbox: self.sbox,
-            pair: &self.pair,
-            external: &self.external,
-        };
+        let ctx = self.ctx();
         let (mobility, noise_amp, drift_limit2, tag) = (
             &self.mobility,
             &self.noise_amp,

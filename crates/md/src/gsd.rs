@@ -333,22 +333,19 @@ pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError>
             .collect(),
         None => vec![0; n],
     };
-    let diameter: Vec<f64> = match at("particles/diameter") {
-        Some(fr) => f
-            .iter_scalars::<f32>(fr, "particles/diameter")
-            .map_err(rd)?
-            .map(|d| d as f64)
-            .collect(),
-        None => vec![1.0; n],
+    // Per-particle float columns (stored as f32 in the HOOMD schema), with their defaults.
+    let column = |name: &str, default: f64| -> Result<Vec<f64>, _> {
+        Ok(match at(name) {
+            Some(fr) => f
+                .iter_scalars::<f32>(fr, name)
+                .map_err(rd)?
+                .map(|d| d as f64)
+                .collect(),
+            None => vec![default; n],
+        })
     };
-    let mass: Vec<f64> = match at("particles/mass") {
-        Some(fr) => f
-            .iter_scalars::<f32>(fr, "particles/mass")
-            .map_err(rd)?
-            .map(|d| d as f64)
-            .collect(),
-        None => vec![1.0; n],
-    };
+    let diameter = column("particles/diameter", 1.0)?;
+    let mass = column("particles/mass", 1.0)?;
     let n_types = typeid.iter().map(|&t| t as usize + 1).max().unwrap_or(1);
     let mut type_names: Vec<String> = match at("particles/types") {
         Some(fr) => match f.iter_arrays::<u8, NAME_LEN>(fr, "particles/types") {
