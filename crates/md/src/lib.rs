@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod brownian;
+pub mod dpd;
 pub mod droplet;
 pub mod gsd;
 pub mod init;
@@ -12,6 +13,7 @@ pub mod potential;
 pub mod state;
 
 pub use brownian::{BdError, BdParams, Brownian};
+pub use dpd::{Dpd, DpdError, DpdParams};
 pub use droplet::{DropletParams, DropletScenario};
 pub use neighbor::NeighborList;
 pub use potential::{

@@ -1,0 +1,234 @@
+//! Validation of the DPD colloid engine (issue 5): thermostat temperature, momentum
+//! conservation, fluctuation–dissipation with lubrication, thread independence, bad input.
+
+use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
+use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise};
+use colloidsim_md::{Particles, SimBox};
+
+/// Mean and standard error from `blocks` block averages of `x`.
+fn mean_and_error(x: &[f64], blocks: usize) -> (f64, f64) {
+    let m = x.len() / blocks;
+    let means: Vec<f64> = (0..blocks)
+        .map(|b| x[b * m..(b + 1) * m].iter().sum::<f64>() / m as f64)
+        .collect();
+    let mean = means.iter().sum::<f64>() / blocks as f64;
+    let var = means.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / (blocks - 1) as f64;
+    (mean, (var / blocks as f64).sqrt())
+}
+
+fn scenario(text: &str) -> DpdSetup {
+    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+}
+
+/// Pure DPD water (a = 25, gamma = 4.5, density 3, kT = 1) in a cube of side `l`.
+fn water(l: f64, dt: f64, seed: u64) -> Dpd {
+    scenario(&format!(
+        "method = \"dpd\"\nseed = {seed}\n[system]\nbox_length = {l}\nkT = 1.0\n[run]\ndt = {dt}\n"
+    ))
+    .build()
+    .unwrap()
+}
+
+/// Kinetic temperatures sampled every `every` steps after `skip` steps.
+fn sample_temperature(sim: &mut Dpd, skip: u64, steps: u64, every: u64) -> Vec<f64> {
+    sim.run(skip).unwrap();
+    let mut t = Vec::new();
+    for s in 0..steps {
+        sim.advance().unwrap();
+        if s.is_multiple_of(every) {
+            t.push(sim.thermo().temperature);
+        }
+    }
+    t
+}
+
+#[test]
+fn water_holds_kt_within_one_percent_at_dt_0_01_and_conserves_momentum() {
+    let mut sim = water(8.0, 0.01, 3);
+    let p0 = sim.momentum();
+    let t = sample_temperature(&mut sim, 500, 6000, 10);
+    let (m, se) = mean_and_error(&t, 20);
+    eprintln!("dt = 0.01: T = {m:.5} +- {se:.5}");
+    // The estimate resolves 1 %, and the temperature is within 1 % of kT.
+    assert!(se < 0.003, "standard error {se} too large to test 1 %");
+    assert!((m - 1.0).abs() < 0.01, "T = {m} +- {se}");
+    // Pair forces are exactly antisymmetric: momentum is conserved to rounding
+    // (thermal momentum per bead ~ 1, 1536 beads).
+    let p1 = sim.momentum();
+    for k in 0..3 {
+        assert!((p1[k] - p0[k]).abs() < 1e-9, "momentum {p0:?} -> {p1:?}");
+    }
+}
+
+#[test]
+fn water_at_dt_0_04_runs_warm_by_the_documented_amount() {
+    // docs/dpd.md: at dt = 0.04 the kinetic temperature of DPD water runs 2-4 % above kT
+    // (velocity Verlet with half-step velocities in the dissipative force).
+    let mut sim = water(8.0, 0.04, 4);
+    let t = sample_temperature(&mut sim, 200, 4000, 5);
+    let (m, se) = mean_and_error(&t, 20);
+    eprintln!("dt = 0.04: T = {m:.5} +- {se:.5}");
+    assert!(se < 0.004);
+    assert!(m > 1.0 + 3.0 * se, "no measurable drift: T = {m} +- {se}");
+    assert!(m < 1.06, "drift larger than documented: T = {m} +- {se}");
+}
+
+/// Dense colloids without solvent on a simple cubic lattice with gaps 0.1: every colloid has
+/// six neighbours in the lubrication range, and the only thermostat is the colloid pair
+/// friction and noise, so the kinetic temperature measures how well the noise matches the
+/// friction.
+fn lubricated_colloids(noise: LubricationNoise) -> Vec<f64> {
+    let n_side = 6;
+    let spacing = 2.1;
+    let l = n_side as f64 * spacing;
+    let mut pos = Vec::new();
+    for i in 0..n_side {
+        for j in 0..n_side {
+            for k in 0..n_side {
+                pos.push([
+                    (i as f64 + 0.5) * spacing - 0.5 * l,
+                    (j as f64 + 0.5) * spacing - 0.5 * l,
+                    (k as f64 + 0.5) * spacing - 0.5 * l,
+                ]);
+            }
+        }
+    }
+    let n = pos.len();
+    let mass = 4.0 / 3.0 * std::f64::consts::PI * 3.0;
+    let kt = 0.1;
+    // Start cold: the thermostat must heat the colloids to kT.
+    let mut p = Particles::monodisperse(pos, 2.0);
+    p.mass = vec![mass; n];
+    p.type_names = vec!["C".into()];
+    let setup = scenario(
+        "method = \"dpd\"\n[system]\nbox_length = 20.0\nphi = 0.1\n[colloids]\neta0 = 0.3\n",
+    );
+    let mut params: DpdParams = setup.params;
+    params.kt = kt;
+    params.lubrication_noise = noise;
+    let mut sim = Dpd::new(p, SimBox::cube(l), params, vec![true], 0).unwrap();
+    sample_temperature(&mut sim, 3000, 24000, 20)
+}
+
+#[test]
+fn colloid_temperature_with_lubrication_is_kt_only_with_the_exact_noise() {
+    let kt = 0.1;
+    let t = lubricated_colloids(LubricationNoise::Exact);
+    let (m, se) = mean_and_error(&t, 12);
+    eprintln!("exact noise: T/kT = {:.4} +- {:.4}", m / kt, se / kt);
+    assert!(se / kt < 0.015, "error {se} too large");
+    assert!(
+        (m / kt - 1.0).abs() < 4.0 * se / kt + 0.01,
+        "T/kT = {} +- {}",
+        m / kt,
+        se / kt
+    );
+    // The authors' noise (weighted by w) is too weak for the lubrication friction away from
+    // contact: the colloids run measurably cold.
+    let t = lubricated_colloids(LubricationNoise::Authors);
+    let (ma, sea) = mean_and_error(&t, 12);
+    eprintln!("authors' noise: T/kT = {:.4} +- {:.4}", ma / kt, sea / kt);
+    assert!(
+        ma < m - 4.0 * (se * se + sea * sea).sqrt(),
+        "exact {m} vs authors {ma}"
+    );
+}
+
+/// A small colloid suspension used for the bitwise checks.
+fn suspension() -> DpdSetup {
+    scenario(
+        "method = \"dpd\"\nseed = 9\n[system]\nbox_length = 8.0\nphi = 0.15\nradius_distribution = \"uniform\"\nradius_spread = 0.2\n[colloids]\nmorse_depth = 12.0\n",
+    )
+}
+
+#[test]
+fn results_do_not_depend_on_the_number_of_threads() {
+    let setup = suspension();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = setup.build().unwrap();
+            sim.run(300).unwrap();
+            let th = sim.advance_with_thermo().unwrap();
+            (sim.snapshot(), th)
+        })
+    };
+    let (a, ta) = run(1);
+    let (b, tb) = run(2);
+    let (c, tc) = run(3);
+    assert_eq!(a, b);
+    assert_eq!(a, c);
+    assert_eq!(ta, tb);
+    assert_eq!(ta, tc);
+    assert!(a.typeid.iter().filter(|&&t| t == 1).count() > 5);
+}
+
+#[test]
+fn bad_input_is_refused_with_the_key() {
+    let base = "method = \"dpd\"\n[system]\nbox_length = 10.0\nphi = 0.1\n";
+    let err = |extra: &str| {
+        DpdScenario::from_toml(&format!("{base}{extra}"))
+            .unwrap()
+            .validate()
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(err("[dpd]\ngamma = 0.0\n").contains("dpd.gamma"));
+    assert!(err("[dpd]\ngamma = 250.0\n").contains("(0, 200]"));
+    assert!(err("[colloids]\ncutoff = 0.0005\n").contains("colloids.cutoff"));
+    assert!(err("[run]\ndt = -1.0\n").contains("run.dt"));
+    let e = DpdScenario::from_toml(&format!("{base}[system2]\n"));
+    assert!(e.is_err());
+    let ok = scenario(&format!("{base}[dpd]\ngamma = 2.0\n"));
+    assert!(ok.warnings.iter().any(|w| w.contains("gamma")));
+    // Overlapping colloids at the start.
+    let setup = scenario(base);
+    let mut p = setup.initial_particles().unwrap();
+    let (a, b) = (0, 1);
+    assert_eq!((p.typeid[a], p.typeid[b]), (1, 1));
+    p.pos[b] = [p.pos[a][0] + 1.9, p.pos[a][1], p.pos[a][2]];
+    let e = setup
+        .build_from(p, 0)
+        .err()
+        .expect("overlap refused")
+        .to_string();
+    assert!(e.contains("overlap"), "{e}");
+}
+
+#[test]
+fn a_heating_time_step_is_detected() {
+    // dt = 0.1 heats DPD water far beyond 10 %.
+    let mut sim = water(8.0, 0.1, 5);
+    let mut mon = TemperatureMonitor::new(1.0, 0.1, 200);
+    let mut stopped = None;
+    for _ in 0..2000 {
+        match sim.advance() {
+            Ok(()) => {}
+            Err(e @ DpdError::Unstable { .. }) | Err(e @ DpdError::NonFinite { .. }) => {
+                stopped = Some(e.to_string());
+                break;
+            }
+            Err(e) => panic!("{e}"),
+        }
+        if sim.step.is_multiple_of(10)
+            && let Err(e) = mon.push(sim.step, sim.thermo().temperature)
+        {
+            stopped = Some(e);
+            break;
+        }
+    }
+    let msg = stopped.expect("no drift detected");
+    assert!(msg.contains("run.dt"), "{msg}");
+    // At dt = 0.01 the same monitor stays quiet.
+    let mut sim = water(8.0, 0.01, 5);
+    let mut mon = TemperatureMonitor::new(1.0, 0.1, 200);
+    for _ in 0..1000 {
+        sim.advance().unwrap();
+        if sim.step.is_multiple_of(10) {
+            mon.push(sim.step, sim.thermo().temperature).unwrap();
+        }
+    }
+}
