@@ -7,11 +7,18 @@ use crate::theory_droplet::profile_name;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::gsd::GsdWriter;
-use colloidsim_md::{DropletParams, DropletScenario};
+use colloidsim_md::droplet::DropletSim;
+use colloidsim_md::gsd::{self, GsdWriter};
+use colloidsim_md::{BdParams, DropletParams, DropletScenario, LennardJones};
+use hoomd_gsd::file_layer::{GsdFile, Mode};
+use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+const CHECKPOINT: &str = "checkpoint.bin";
 
 /// Parse and validate a scenario; `system.initial` is taken relative to the scenario file.
 pub fn resolve(
@@ -45,23 +52,357 @@ pub fn check(path: &Path, text: &str) -> Result<()> {
     Ok(())
 }
 
-/// `colloidsim run`.
-pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
-    if opts.restart.is_some() {
+/// Everything a droplet run accumulates across replicas, saved in every checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Accum {
+    /// Per profile fraction: sum over finished replicas (and the running one, up to its step)
+    /// of the volume-fraction profile.
+    sums: Vec<Vec<f64>>,
+    /// Droplet radius at each profile time.
+    radii: Vec<f64>,
+    /// Shell mid-points of each profile.
+    r_axes: Vec<Vec<f64>>,
+    max_excursion: f64,
+    outside_final: u64,
+    /// Neighbour-list builds of the finished replicas.
+    builds: u64,
+    /// Frames in trajectory.gsd.
+    frames: u64,
+    /// Wall seconds of all earlier sessions.
+    wall_seconds: f64,
+    /// Checkpoints written so far (alternates the GSD file name).
+    checkpoints: u64,
+}
+
+/// The integrator parameters of the running replica (`BdParams`), so that it continues with
+/// exactly the parameters it started with.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct Engine {
+    kt: f64,
+    viscosity: f64,
+    dt: f64,
+    seed: u32,
+    replica: u32,
+    skin: f64,
+    sort_every: u64,
+    max_drift: f64,
+    /// Neighbour-list builds of this replica so far.
+    builds: u64,
+}
+
+impl Engine {
+    fn of(s: &DropletSim, builds: u64) -> Self {
+        let b = s.params();
+        Self {
+            kt: b.kt,
+            viscosity: b.viscosity,
+            dt: b.dt,
+            seed: b.seed,
+            replica: b.replica,
+            skin: b.skin,
+            sort_every: b.sort_every,
+            max_drift: b.max_drift,
+            builds,
+        }
+    }
+
+    fn params(&self) -> BdParams {
+        BdParams {
+            kt: self.kt,
+            viscosity: self.viscosity,
+            dt: self.dt,
+            seed: self.seed,
+            replica: self.replica,
+            skin: self.skin,
+            sort_every: self.sort_every,
+            max_drift: self.max_drift,
+        }
+    }
+}
+
+/// `checkpoint.bin`: where the run stands. The running replica's particles (exact positions,
+/// images, box, storage order) are in the GSD file `gsd` beside it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Checkpoint {
+    version: String,
+    /// The scenario file's text.
+    scenario: String,
+    /// The resolved parameters (JSON), seed and paths included.
+    resolved: String,
+    seed: u64,
+    /// Replica to continue.
+    replica: usize,
+    /// Its step: every event (profile, frame) up to and including this step is in `acc`.
+    step: u64,
+    /// GSD checkpoint of the replica at `step` with its engine parameters; `None`: the replica
+    /// has not started (step 0, built afresh).
+    state: Option<(String, Engine)>,
+    acc: Accum,
+}
+
+/// Read and check the checkpoint of `dir` against the scenario; returns it with the resolved
+/// parameters (the checkpoint's seed unless `--seed` is given).
+fn open_checkpoint(
+    path: &Path,
+    text: &str,
+    dir: &Path,
+    seed: Option<u64>,
+) -> Result<(OutputDir, Checkpoint, DropletParams)> {
+    if !dir.is_dir() {
+        bail!("--restart {}: no such folder", dir.display());
+    }
+    let out = OutputDir::reopen(dir)?;
+    if out.join("summary.json").exists() {
         bail!(
-            "--restart is not supported for droplet-bd runs (replicas are short); run again with --out"
+            "--restart {}: this run is complete (summary.json is written); nothing to continue. Start a new run with --out",
+            dir.display()
         );
     }
-    let (_, p) = resolve(path, text, opts.seed)?;
-    // Set up replica 0 before creating the output folder: bad input leaves nothing behind.
-    let first = p.build_replica(0)?;
-    let out = OutputDir::create(&opts.out, opts.force)?;
-    out.write_bytes("scenario.toml", text.as_bytes())?;
+    let file = out.join(CHECKPOINT);
+    if !file.exists() {
+        bail!(
+            "--restart {}: no {CHECKPOINT} to continue from (checkpoints are written every 10 % of a replica, between replicas and on Ctrl-C)",
+            dir.display()
+        );
+    }
+    let bytes = std::fs::read(&file).with_context(|| format!("{}", file.display()))?;
+    let ck: Checkpoint = bincode::deserialize(&bytes)
+        .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
+    if ck.version != env!("CARGO_PKG_VERSION") {
+        eprintln!(
+            "warning: the checkpoint was written by colloidsim {}, this is {}; the continuation may not be bitwise identical",
+            ck.version,
+            env!("CARGO_PKG_VERSION")
+        );
+    }
+    if ck.scenario != text {
+        bail!(
+            "--restart {}: {} differs from the scenario this run started with (saved as {})",
+            dir.display(),
+            path.display(),
+            out.join("scenario.toml").display()
+        );
+    }
+    let (_, p) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
+    let resolved = serde_json::to_string(&p)?;
+    if resolved != ck.resolved {
+        let now: serde_json::Value = serde_json::from_str(&resolved)?;
+        let then: serde_json::Value = serde_json::from_str(&ck.resolved)?;
+        let keys: Vec<String> = now
+            .as_object()
+            .into_iter()
+            .flatten()
+            .filter(|(k, v)| then.get(k.as_str()) != Some(v))
+            .map(|(k, v)| {
+                format!(
+                    "{k} = {v} (was {})",
+                    then.get(k.as_str()).unwrap_or(&serde_json::Value::Null)
+                )
+            })
+            .collect();
+        bail!(
+            "--restart {}: the resolved scenario differs from the checkpoint's: {}",
+            dir.display(),
+            keys.join(", ")
+        );
+    }
+    Ok((out, ck, p))
+}
+
+/// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
+/// may have written more), so that the continuation appends exactly where the checkpoint stood.
+fn trim_trajectory(path: &Path, frames: u64) -> Result<()> {
+    let have = gsd::frame_count(path)?;
+    if have == frames {
+        return Ok(());
+    }
+    if have < frames {
+        bail!(
+            "{}: holds {have} frames, the checkpoint expects {frames}; the trajectory was damaged",
+            path.display()
+        );
+    }
+    let tmp = path.with_extension("gsd.trim");
+    let _ = std::fs::remove_file(&tmp);
+    {
+        let logs = GsdFile::open(path, Mode::Read)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let mut w = GsdWriter::create_new(&tmp)?;
+        for k in 0..frames {
+            let f = gsd::read_frame(path, Some(k))?;
+            let log = |name: &str| -> Result<f64> {
+                logs.iter_scalars::<f64>(k, name)
+                    .map_err(|e| anyhow::anyhow!("{}: frame {k}: {e}", path.display()))?
+                    .next()
+                    .with_context(|| format!("{}: frame {k}: no {name}", path.display()))
+            };
+            let (r, t) = (log("log/droplet/radius")?, log("log/droplet/time")?);
+            w.write_frame(
+                f.step,
+                &f.sbox,
+                &f.particles,
+                false,
+                &[("droplet/radius", r), ("droplet/time", t)],
+            )?;
+        }
+        w.sync()?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
+    Ok(())
+}
+
+/// Write a checkpoint: the running replica (if any) to the GSD file not named by the current
+/// checkpoint, then `checkpoint.bin` atomically naming it, then remove the older GSD file. A
+/// run killed at any point leaves a consistent checkpoint.
+fn save_checkpoint(
+    out: &OutputDir,
+    base: &Checkpoint,
+    replica: usize,
+    sim: Option<(&DropletSim, u64)>,
+    acc: &mut Accum,
+    wall_seconds: f64,
+) -> Result<()> {
+    acc.checkpoints += 1;
+    let name = format!("checkpoint-{}.gsd", acc.checkpoints % 2);
+    let old = format!("checkpoint-{}.gsd", (acc.checkpoints + 1) % 2);
+    let state = match sim {
+        Some((s, builds)) => {
+            let path = out.join(&name);
+            let _ = std::fs::remove_file(&path);
+            let mut w = GsdWriter::create_new(&path)?;
+            w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), s.order(), &[])?;
+            w.sync()?;
+            Some((name.clone(), Engine::of(s, builds)))
+        }
+        None => None,
+    };
+    let ck = Checkpoint {
+        replica,
+        step: sim.map_or(0, |(s, _)| s.step),
+        state,
+        acc: Accum {
+            wall_seconds,
+            ..acc.clone()
+        },
+        ..base.clone()
+    };
+    out.write_bytes(CHECKPOINT, &bincode::serialize(&ck)?)?;
+    let _ = std::fs::remove_file(out.join(&old));
+    if sim.is_none() {
+        let _ = std::fs::remove_file(out.join(&name));
+    }
+    Ok(())
+}
+
+/// Restore the running replica from a checkpoint.
+fn restore(
+    out: &OutputDir,
+    p: &DropletParams,
+    ck: &Checkpoint,
+) -> Result<Option<(DropletSim, u64)>> {
+    let Some((name, engine)) = &ck.state else {
+        return Ok(None);
+    };
+    let path = out.join(name);
+    let f = gsd::read_frame(&path, None)
+        .with_context(|| format!("--restart {}", out.path().display()))?;
+    if f.step != ck.step || !f.exact || f.order.is_none() || engine.replica as usize != ck.replica {
+        bail!(
+            "{}: not the checkpoint of replica {} at step {} that {CHECKPOINT} names",
+            path.display(),
+            ck.replica,
+            ck.step
+        );
+    }
+    let sim = DropletSim::restart(
+        f.particles,
+        f.sbox,
+        LennardJones::wca(p.kt, p.diameter),
+        p.interface(),
+        engine.params(),
+        f.step,
+        f.order.as_deref(),
+    )
+    .with_context(|| format!("--restart from {}", path.display()))?;
+    // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
+    let builds = engine.builds.saturating_sub(sim.neighbor_builds());
+    Ok(Some((sim, builds)))
+}
+
+/// A test hook read from the environment: a global step (replica * steps + step).
+fn hook(name: &str) -> Option<u64> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+/// Steps per call into the engine between checks for Ctrl-C.
+const CHUNK: u64 = 200;
+
+/// `colloidsim run`: replicas one after the other; checkpoints every 10 % of a replica's steps,
+/// between replicas and on Ctrl-C; `--restart DIR` continues bitwise identically.
+pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
+    // The running replica and the step up to which its events are already in `acc`.
+    let mut resume: Option<(DropletSim, Option<u64>, u64)>;
+    let (out, p, base, mut acc, start_rep) = match &opts.restart {
+        Some(dir) => {
+            let (out, ck, p) = open_checkpoint(path, text, dir, opts.seed)?;
+            resume = restore(&out, &p, &ck)?.map(|(s, builds)| (s, Some(ck.step), builds));
+            let traj = out.join("trajectory.gsd");
+            if ck.replica == 0 && p.trajectory_every > 0 && traj.exists() {
+                trim_trajectory(&traj, ck.acc.frames)?;
+            }
+            let (acc, rep) = (ck.acc.clone(), ck.replica);
+            (out, p, ck, acc, rep)
+        }
+        None => {
+            let (_, p) = resolve(path, text, opts.seed)?;
+            // Set up replica 0 before creating the output folder: bad input leaves nothing behind.
+            resume = Some((p.build_replica(0)?, None, 0));
+            let out = OutputDir::create(&opts.out, opts.force)?;
+            if opts.force {
+                // A new run: no earlier trajectory, summary or checkpoint may mix with it.
+                for f in [
+                    "trajectory.gsd",
+                    "summary.json",
+                    CHECKPOINT,
+                    "checkpoint-0.gsd",
+                    "checkpoint-1.gsd",
+                ] {
+                    let _ = std::fs::remove_file(out.join(f));
+                }
+            }
+            out.write_bytes("scenario.toml", text.as_bytes())?;
+            let n_frac = p.fractions.len();
+            let acc = Accum {
+                sums: vec![vec![0.0; p.bins]; n_frac],
+                radii: vec![0.0; n_frac],
+                r_axes: vec![Vec::new(); n_frac],
+                max_excursion: f64::NEG_INFINITY,
+                outside_final: 0,
+                builds: 0,
+                frames: 0,
+                wall_seconds: 0.0,
+                checkpoints: 0,
+            };
+            let base = Checkpoint {
+                version: env!("CARGO_PKG_VERSION").into(),
+                scenario: text.into(),
+                resolved: serde_json::to_string(&p)?,
+                seed: p.seed as u64,
+                replica: 0,
+                step: 0,
+                state: None,
+                acc: acc.clone(),
+            };
+            (out, p, base, acc, 0)
+        }
+    };
+    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    // Test hooks (global step = replica * steps + step): behave as if Ctrl-C arrived, or as if
+    // the process were killed (no checkpoint; the trajectory reached the disk).
+    let interrupt_at = hook("COLLOIDSIM_INTERRUPT_AT_STEP");
+    let kill_at = hook("COLLOIDSIM_KILL_AT_STEP");
 
     let n_frac = p.fractions.len();
-    let mut sums: Vec<Vec<f64>> = vec![vec![0.0; p.bins]; n_frac];
-    let mut radii = vec![0.0; n_frac];
-    let mut r_axes: Vec<Vec<f64>> = vec![Vec::new(); n_frac];
     // Stops: profile steps and trajectory frames, in order.
     let mut stops: Vec<u64> = p.profile_steps.clone();
     if p.trajectory_every > 0 {
@@ -70,69 +411,137 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
     stops.push(p.steps);
     stops.sort_unstable();
     stops.dedup();
+    // Checkpoints every 10 % of a replica's steps.
+    let ck_every = (p.steps / 10).max(1);
+    let mut events = stops.clone();
+    events.extend((1..10).map(|k| k * ck_every).filter(|&s| s < p.steps));
+    events.sort_unstable();
+    events.dedup();
 
     let total = p.steps * p.replicas as u64;
     let pb = progress(total, opts.quiet, "droplet-bd");
+    pb.set_position(start_rep as u64 * p.steps + resume.as_ref().and_then(|r| r.1).unwrap_or(0));
     let start = Instant::now();
-    let mut max_excursion = f64::NEG_INFINITY;
-    let mut outside_final = 0usize;
-    let mut builds = 0;
-    let mut frames = 0u64;
-    let mut sim = Some(first);
-    for rep in 0..p.replicas {
-        let mut s = match sim.take() {
-            Some(s) => s,
-            None => p.build_replica(rep as u32)?,
+    let wall = |acc: &Accum| acc.wall_seconds + start.elapsed().as_secs_f64();
+    for rep in start_rep..p.replicas {
+        let (mut s, done, builds0) = match resume.take() {
+            Some(r) => r,
+            None => (p.build_replica(rep as u32)?, None, 0),
         };
         let mut gsd = if rep == 0 && p.trajectory_every > 0 {
-            Some(GsdWriter::create_new(&out.join("trajectory.gsd"))?)
+            let traj = out.join("trajectory.gsd");
+            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            Some(if traj.exists() {
+                GsdWriter::append(&traj)?
+            } else {
+                GsdWriter::create_new(&traj)?
+            })
         } else {
             None
         };
-        for &stop in &stops {
-            while s.step < stop {
-                let k = (stop - s.step).min(1000);
+        for &ev in events.iter().filter(|&&e| done.is_none_or(|d| e > d)) {
+            while s.step < ev {
+                let g = rep as u64 * p.steps + s.step;
+                if kill_at == Some(g) {
+                    if let Some(w) = gsd.as_mut() {
+                        w.sync()?;
+                    }
+                    eprintln!("killed at step {g} (test hook)");
+                    std::process::exit(3);
+                }
+                if interrupt_at == Some(g) {
+                    INTERRUPTED.store(true, Ordering::SeqCst);
+                }
+                if INTERRUPTED.load(Ordering::Relaxed) {
+                    if let Some(w) = gsd.as_mut() {
+                        w.sync()?;
+                    }
+                    let w = wall(&acc);
+                    let b = builds0 + s.neighbor_builds();
+                    save_checkpoint(&out, &base, rep, Some((&s, b)), &mut acc, w)?;
+                    pb.abandon();
+                    bail!(
+                        "interrupted at step {g} (replica {rep}, step {}); checkpoint written. Continue with: colloidsim run {} --restart {}",
+                        s.step,
+                        path.display(),
+                        out.path().display()
+                    );
+                }
+                let mut k = (ev - s.step).min(CHUNK);
+                for h in [interrupt_at, kill_at].into_iter().flatten() {
+                    if h > g {
+                        k = k.min(h - g);
+                    }
+                }
                 s.run(k).with_context(|| format!("replica {rep}"))?;
                 pb.inc(k);
             }
-            let t = s.time();
-            let radius = p.radius_at(t);
-            let wall = radius + p.offset;
-            let part = s.particles();
-            for x in &part.pos {
-                let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                max_excursion = max_excursion.max(r - wall);
-            }
-            for (j, &ps) in p.profile_steps.iter().enumerate() {
-                if ps == stop {
-                    let prof = radial_profile(&part.pos, &part.diameter, [0.0; 3], radius, p.bins);
-                    for (a, b) in sums[j].iter_mut().zip(&prof.phi) {
-                        *a += b;
-                    }
-                    radii[j] = radius;
-                    r_axes[j] = prof.r;
-                    if stop == p.steps {
-                        outside_final += prof.outside;
+            if stops.binary_search(&ev).is_ok() {
+                let t = s.time();
+                let radius = p.radius_at(t);
+                let wall_r = radius + p.offset;
+                let part = s.particles();
+                for x in &part.pos {
+                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                    acc.max_excursion = acc.max_excursion.max(r - wall_r);
+                }
+                for (j, &ps) in p.profile_steps.iter().enumerate() {
+                    if ps == ev {
+                        let prof =
+                            radial_profile(&part.pos, &part.diameter, [0.0; 3], radius, p.bins);
+                        for (a, b) in acc.sums[j].iter_mut().zip(&prof.phi) {
+                            *a += b;
+                        }
+                        acc.radii[j] = radius;
+                        acc.r_axes[j] = prof.r;
+                        if ev == p.steps {
+                            acc.outside_final += prof.outside as u64;
+                        }
                     }
                 }
+                if let Some(w) = gsd.as_mut()
+                    && ev % p.trajectory_every == 0
+                {
+                    w.write_frame(
+                        ev,
+                        &s.sbox,
+                        &s.snapshot(),
+                        false,
+                        &[("droplet/radius", radius), ("droplet/time", t)],
+                    )?;
+                    acc.frames += 1;
+                }
             }
-            if let Some(w) = gsd.as_mut()
-                && stop % p.trajectory_every == 0
-            {
-                w.write_frame(
-                    stop,
-                    &s.sbox,
-                    &s.snapshot(),
-                    false,
-                    &[("droplet/radius", radius), ("droplet/time", t)],
-                )?;
-                frames += 1;
+            if ev.is_multiple_of(ck_every) && ev > 0 && ev < p.steps {
+                if let Some(w) = gsd.as_mut() {
+                    w.sync()?;
+                }
+                let w = wall(&acc);
+                let b = builds0 + s.neighbor_builds();
+                save_checkpoint(&out, &base, rep, Some((&s, b)), &mut acc, w)?;
             }
         }
-        builds += s.neighbor_builds();
+        if let Some(mut w) = gsd.take() {
+            w.sync()?;
+        }
+        acc.builds += builds0 + s.neighbor_builds();
+        if rep + 1 < p.replicas {
+            let w = wall(&acc);
+            save_checkpoint(&out, &base, rep + 1, None, &mut acc, w)?;
+        }
     }
     pb.finish_and_clear();
-    let wall_s = start.elapsed().as_secs_f64();
+    let wall_s = wall(&acc);
+    let Accum {
+        sums,
+        radii,
+        r_axes,
+        max_excursion,
+        outside_final,
+        builds,
+        frames,
+        ..
+    } = acc;
 
     let mut files = vec!["scenario.toml".to_string()];
     let reps = p.replicas as f64;
@@ -198,6 +607,10 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
         "files": files,
     });
     out.write_json("summary.json", &summary)?;
+    // The run is complete: its checkpoint is no longer needed (a restart now refuses).
+    for f in [CHECKPOINT, "checkpoint-0.gsd", "checkpoint-1.gsd"] {
+        let _ = std::fs::remove_file(out.join(f));
+    }
     println!(
         "{} replica(s) x {} steps of {} colloids in {wall_s:.1} s ({:.3e} particle-steps/s); outputs in {}",
         p.replicas,
