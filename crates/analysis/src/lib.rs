@@ -1,7 +1,19 @@
 //! colloidsim-analysis: observables of particle configurations and trajectories — radial
 //! volume-fraction profiles, the pair distribution function g(r) and the mean-squared
-//! displacement — working on plain position arrays, so on any GSD trajectory
-//! ([`read_trajectory`]) as well as on a running engine.
+//! displacement, the static structure factor S(q), contacts between spheres and the clusters,
+//! coordination numbers and bond lifetimes of the contact network — working on plain arrays,
+//! so on any GSD trajectory ([`read_trajectory`]) as well as on a running engine.
+
+mod contacts;
+mod network;
+mod structure;
+
+pub use contacts::contacts;
+pub use network::{
+    BondTracker, ClusterStats, cluster_labels, cluster_stats, coordination_histogram,
+    coordination_numbers,
+};
+pub use structure::{Window, default_q_grid, structure_factor, structure_factor_windowed};
 
 use colloidsim_md::gsd::{GsdError, frame_count, read_frame};
 use rayon::prelude::*;
