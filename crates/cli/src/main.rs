@@ -2,6 +2,7 @@
 
 mod bcd_cmd;
 mod common;
+mod dpd_cmd;
 mod droplet;
 mod plot;
 mod theory_droplet;
@@ -97,7 +98,7 @@ fn method_of(doc: &toml::Table, path: &std::path::Path) -> Result<String> {
             other.type_str()
         ),
         None => bail!(
-            "{}: missing key 'method' (one of: bcd, bcd-chronological, droplet-bd)",
+            "{}: missing key 'method' (one of: bcd, bcd-chronological, droplet-bd, dpd)",
             path.display()
         ),
     }
@@ -153,8 +154,9 @@ fn run_cli() -> Result<()> {
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::run(&scenario, &text, &opts),
                 "droplet-bd" => droplet::run(&scenario, &text, &opts),
+                "dpd" => dpd_cmd::run(&scenario, &text, &opts),
                 m => bail!(
-                    "{}: unknown method '{m}' (one of: bcd, bcd-chronological, droplet-bd)",
+                    "{}: unknown method '{m}' (one of: bcd, bcd-chronological, droplet-bd, dpd)",
                     scenario.display()
                 ),
             }
@@ -192,6 +194,7 @@ fn run_cli() -> Result<()> {
             match method.as_str() {
                 "bcd" | "bcd-chronological" => bcd_cmd::check(&scenario, &text),
                 "droplet-bd" => droplet::check(&scenario, &text),
+                "dpd" => dpd_cmd::check(&scenario, &text),
                 m => bail!("{}: unknown method '{m}'", scenario.display()),
             }
         }

@@ -61,6 +61,7 @@ fn chain(e: &dyn std::error::Error) -> String {
 pub struct GsdWriter {
     file: GsdFile,
     path: PathBuf,
+    dynamics: bool,
 }
 
 impl GsdWriter {
@@ -76,6 +77,7 @@ impl GsdWriter {
         Ok(Self {
             file,
             path: path.to_path_buf(),
+            dynamics: false,
         })
     }
 
@@ -88,7 +90,14 @@ impl GsdWriter {
         Ok(Self {
             file,
             path: path.to_path_buf(),
+            dynamics: false,
         })
+    }
+
+    /// Also write `particles/velocity` and `particles/mass` in every frame (inertial methods).
+    pub fn with_velocities(mut self) -> Self {
+        self.dynamics = true;
+        self
     }
 
     /// Number of frames in the file.
@@ -183,6 +192,17 @@ impl GsdWriter {
         .map_err(e)?;
         f.write_arrays("particles/image", p.image.iter().copied())
             .map_err(e)?;
+        if self.dynamics {
+            f.write_arrays(
+                "particles/velocity",
+                p.vel
+                    .iter()
+                    .map(|v| [v[0] as f32, v[1] as f32, v[2] as f32]),
+            )
+            .map_err(e)?;
+            f.write_scalars("particles/mass", p.mass.iter().map(|&m| m as f32))
+                .map_err(e)?;
+        }
         if exact {
             f.write_arrays(POS64, p.pos.iter().copied()).map_err(e)?;
             f.write_scalars(BOX64, sbox.l).map_err(e)?;

@@ -722,30 +722,78 @@ impl DpdSetup {
             diameter.push(2.0 * a);
             mass.push(4.0 / 3.0 * PI * a.powi(3) * self.density * self.solvent_mass);
         }
-        let mut s = 0;
-        while s < self.solvent {
-            let x = [
-                (rng.random::<f64>() - 0.5) * l[0],
-                (rng.random::<f64>() - 0.5) * l[1],
-                (rng.random::<f64>() - 0.5) * l[2],
-            ];
-            let free = radii.is_empty()
-                || near(
-                    &grid,
-                    x,
-                    Box::new(|j| {
-                        let y = cpos[j as usize];
-                        let d = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
-                        d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= radii[j as usize].powi(2)
-                    }),
-                );
-            if free {
-                pos.push(x);
-                typeid.push(0);
-                diameter.push(1.0);
-                mass.push(self.solvent_mass);
-                s += 1;
+        // Solvent on a jittered simple-cubic lattice over the free volume (a random start
+        // overlaps beads strongly, and the energy it releases heats the system for several
+        // DPD times): sites inside a colloid or within half its colloid-solvent cut-off of the
+        // surface are left empty, the lattice is refined until enough sites remain, and a
+        // random subset of them is used.
+        let free_vol = (sbox.volume()
+            - radii
+                .iter()
+                .map(|a| {
+                    4.0 / 3.0 * PI * (a + 0.5 * colloid_solvent_cutoff(self.params.rc, *a)).powi(3)
+                })
+                .sum::<f64>())
+        .max(0.05 * sbox.volume());
+        let mut spacing = (free_vol / self.solvent.max(1) as f64).cbrt();
+        let mut sites: Vec<[f64; 3]> = Vec::new();
+        for _ in 0..200 {
+            sites.clear();
+            let n = l.map(|x| ((x / spacing).ceil() as usize).max(1));
+            let h = [l[0] / n[0] as f64, l[1] / n[1] as f64, l[2] / n[2] as f64];
+            for iz in 0..n[2] {
+                for iy in 0..n[1] {
+                    for ix in 0..n[0] {
+                        let mut x = [
+                            (ix as f64 + 0.5) * h[0] - 0.5 * l[0],
+                            (iy as f64 + 0.5) * h[1] - 0.5 * l[1],
+                            (iz as f64 + 0.5) * h[2] - 0.5 * l[2],
+                        ];
+                        for k in 0..3 {
+                            x[k] += 0.2 * h[k] * (rng.random::<f64>() - 0.5);
+                        }
+                        let free = radii.is_empty()
+                            || near(
+                                &grid,
+                                x,
+                                Box::new(|j| {
+                                    let a = radii[j as usize];
+                                    let y = cpos[j as usize];
+                                    let d = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
+                                    let excl = a + 0.5 * colloid_solvent_cutoff(self.params.rc, a);
+                                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= excl * excl
+                                }),
+                            );
+                        if free {
+                            sites.push(x);
+                        }
+                    }
+                }
             }
+            if sites.len() >= self.solvent {
+                break;
+            }
+            spacing *= 0.98;
+        }
+        if sites.len() < self.solvent {
+            return Err(DpdError::Invalid(format!(
+                "could not fit {} solvent beads between the colloids",
+                self.solvent
+            )));
+        }
+        // Keep a random subset of `solvent` sites (partial Fisher-Yates), in lattice order.
+        let mut keep: Vec<u32> = (0..sites.len() as u32).collect();
+        for k in 0..self.solvent {
+            let r = k + (rng.random::<f64>() * (sites.len() - k) as f64) as usize;
+            keep.swap(k, r.min(sites.len() - 1));
+        }
+        keep.truncate(self.solvent);
+        keep.sort_unstable();
+        for &k in &keep {
+            pos.push(sites[k as usize]);
+            typeid.push(0);
+            diameter.push(1.0);
+            mass.push(self.solvent_mass);
         }
         let n = pos.len();
         let kt = self.params.kt;
