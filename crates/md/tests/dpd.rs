@@ -232,3 +232,191 @@ fn a_heating_time_step_is_detected() {
         }
     }
 }
+
+/// The standard system (phi = 0.2, kT = 0.1, gamma = 4.5, eta0 = 0.3, dt = 0.001) in a box of
+/// side 12: mean colloid kinetic temperature over `steps` after `skip`, with its block error.
+fn colloid_temperature_in_solvent(noise: &str, skip: u64, steps: u64) -> (f64, f64) {
+    let mut sim = scenario(&format!(
+        "method = \"dpd\"\nseed = 21\n[system]\nbox_length = 12.0\nphi = 0.2\n[colloids]\nlubrication_noise = \"{noise}\"\n"
+    ))
+    .build()
+    .unwrap();
+    sim.run(skip).unwrap();
+    let mut t = Vec::new();
+    for s in 0..steps {
+        sim.advance().unwrap();
+        if s.is_multiple_of(50) {
+            t.push(sim.thermo().temperature_by_type[1]);
+        }
+    }
+    mean_and_error(&t, 20)
+}
+
+#[test]
+#[ignore = "long validation (~6 min on 2 cores); results in docs/validation.md"]
+fn colloid_temperature_in_solvent_at_phi_0_2_with_lubrication() {
+    let kt = 0.1;
+    let (m, se) = colloid_temperature_in_solvent("exact", 5000, 40000);
+    eprintln!(
+        "exact noise, in solvent: T_c/kT = {:.4} +- {:.4}",
+        m / kt,
+        se / kt
+    );
+    let (ma, sea) = colloid_temperature_in_solvent("authors", 5000, 40000);
+    eprintln!(
+        "authors' noise, in solvent: T_c/kT = {:.4} +- {:.4}",
+        ma / kt,
+        sea / kt
+    );
+    assert!(
+        (m / kt - 1.0).abs() < 4.0 * se / kt + 0.005,
+        "T_c/kT = {}",
+        m / kt
+    );
+}
+
+#[test]
+#[ignore = "long validation (~4 min on 2 cores); results in docs/validation.md"]
+fn colloid_diffusion_at_phi_0_05_against_stokes_einstein() {
+    let setup = scenario(
+        "method = \"dpd\"\nseed = 5\n[system]\nbox_length = 12.0\nphi = 0.05\n[colloids]\neta0 = 0.3\n",
+    );
+    let mut sim = setup.build().unwrap();
+    sim.run(5000).unwrap();
+    let tags: Vec<u32> = (0..setup.colloids as u32).collect();
+    let every = 200u64;
+    let frames_n = 400usize; // 80,000 steps = 80 DPD times = 1.4 tau_D
+    let mut frames = Vec::new();
+    for f in 0..=frames_n {
+        if f > 0 {
+            sim.run(every).unwrap();
+        }
+        let mut x = Vec::new();
+        sim.unwrapped(&tags, &mut x);
+        frames.push(x);
+    }
+    let msd = |lag: usize| {
+        let mut s = 0.0;
+        let mut c = 0;
+        for t0 in 0..=frames_n - lag {
+            for (a, b) in frames[t0].iter().zip(&frames[t0 + lag]) {
+                s += (0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>();
+                c += 1;
+            }
+        }
+        s / c as f64
+    };
+    let dt_frame = every as f64 * setup.params.dt;
+    // Long-time slopes between 10 and 25 and between 25 and 50 DPD times (m / zeta ~ 1).
+    let slope = |a: usize, b: usize| (msd(b) - msd(a)) / ((b - a) as f64 * dt_frame) / 6.0;
+    let d1 = slope(50, 125);
+    let d2 = slope(125, 250);
+    let d = 0.5 * (d1 + d2);
+    eprintln!(
+        "phi = 0.05, {} colloids: D = {d:.5} (slopes {d1:.5}, {d2:.5}), D0 = {:.5}, D / D0 = {:.3}",
+        setup.colloids,
+        setup.d0,
+        d / setup.d0
+    );
+    assert!(d > 0.0 && d.is_finite());
+    // Diffusive at long times: the two slopes agree within the scatter of 21 colloids.
+    assert!((d1 - d2).abs() < 0.5 * d, "slopes {d1} and {d2}");
+}
+
+/// Every pair force by brute force over all pairs, from the model's definitions (METHODS.md
+/// section 4), for the same positions, velocities and pair noise as the engine.
+fn brute_force(p: &Particles, sbox: &SimBox, prm: &DpdParams, step: u64) -> Vec<[f64; 3]> {
+    use colloidsim_md::dpd::{colloid_solvent_cutoff, pair_noise, step_key};
+    let n = p.len();
+    let key = step_key(prm.seed, step);
+    let a: Vec<f64> = (0..n)
+        .map(|i| {
+            if p.typeid[i] == 1 {
+                0.5 * p.diameter[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut f = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for j in 0..n {
+            if i == j {
+                continue;
+            }
+            let (x, y) = (p.pos[i], p.pos[j]);
+            let d = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let e = [d[0] / r, d[1] / r, d[2] / r];
+            let dv: Vec<f64> = (0..3).map(|k| p.vel[i][k] - p.vel[j][k]).collect();
+            let ev = e[0] * dv[0] + e[1] * dv[1] + e[2] * dv[2];
+            let h = r - a[i] - a[j];
+            let theta = pair_noise(key, i as u32, j as u32);
+            let both = a[i] > 0.0 && a[j] > 0.0;
+            let mag = if both {
+                if h >= prm.colloid_cutoff {
+                    continue;
+                }
+                let w = 1.0 - h / prm.colloid_cutoff;
+                let c = &prm.colloid;
+                let abar = 0.5 * (a[i] + a[j]);
+                let asq = if c.eta0 > 0.0 {
+                    c.squeeze_coefficient(h, abar)
+                } else {
+                    0.0
+                };
+                c.contact_force(h, abar) + c.morse_force(h) - (prm.gamma * w * w + asq) * ev
+                    + (2.0 * prm.kt * (prm.gamma * w * w + asq) / prm.dt).sqrt() * theta
+            } else {
+                let big = a[i].max(a[j]);
+                let (cut, amp) = if big > 0.0 {
+                    let c = colloid_solvent_cutoff(prm.rc, big);
+                    (c, prm.repulsion_cs * prm.kt / c)
+                } else {
+                    (prm.rc, prm.repulsion * prm.kt / prm.rc)
+                };
+                if h >= cut {
+                    continue;
+                }
+                let w = 1.0 - h / cut;
+                amp * w - prm.gamma * w * w * ev
+                    + (2.0 * prm.gamma * prm.kt / prm.dt).sqrt() * w * theta
+            };
+            for k in 0..3 {
+                f[i][k] += mag * e[k];
+            }
+        }
+    }
+    f
+}
+
+#[test]
+fn engine_forces_equal_a_brute_force_sum_over_all_pairs() {
+    let setup = suspension();
+    let p = setup.initial_particles().unwrap();
+    let sim = setup.build().unwrap();
+    let got = sim.forces();
+    let want = brute_force(&p, &setup.sbox, &setup.params, 0);
+    let scale = want
+        .iter()
+        .map(|f| f.iter().map(|x| x.abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+        for k in 0..3 {
+            assert!(
+                (g[k] - w[k]).abs() <= 1e-9 * scale,
+                "particle {i} (type {}): engine {g:?}, brute force {w:?}",
+                p.typeid[i]
+            );
+        }
+    }
+    // A 1 % error in the colloid-solvent repulsion is resolved by the comparison.
+    let mut wrong = setup.params;
+    wrong.repulsion_cs *= 1.01;
+    let bad = brute_force(&p, &setup.sbox, &wrong, 0);
+    assert!(
+        got.iter()
+            .zip(&bad)
+            .any(|(g, b)| (0..3).any(|k| (g[k] - b[k]).abs() > 1e-6 * scale))
+    );
+}

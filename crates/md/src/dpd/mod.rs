@@ -500,6 +500,16 @@ impl Dpd {
         }));
     }
 
+    /// The forces of the last evaluation (positions and half-step velocities of the current
+    /// step, noise of the current step), in tag order.
+    pub fn forces(&self) -> Vec<[f64; 3]> {
+        let mut f = vec![[0.0; 3]; self.len()];
+        for (i, q) in self.props.iter().enumerate() {
+            f[q.tag as usize] = total_force(&self.slabs, &self.slab_of, self.slabs.len(), i);
+        }
+        f
+    }
+
     /// Which types are colloids.
     pub fn colloid_types(&self) -> &[bool] {
         &self.is_colloid_type
@@ -786,7 +796,6 @@ impl Dpd {
         let pos = &self.pos;
         let props = &self.props;
         let cell_start = &self.cell_start;
-        let slab_of = &self.slab_of;
         let sbox = self.sbox;
         let rc_range2 = (self.params.rc + self.params.skin).powi(2);
         let skin = self.params.skin;
@@ -799,42 +808,39 @@ impl Dpd {
                 let pi = props[i];
                 let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
                 let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
-                for dz in [nz - 1, 0, 1] {
-                    let zz = (z + dz) % nz;
-                    for dy in [ny - 1, 0, 1] {
-                        let yy = (cy + dy) % ny;
-                        for dx in [nx - 1, 0, 1] {
-                            let xx = (cx + dx) % nx;
-                            let c = (zz * ny + yy) * nx + xx;
-                            for j in cell_start[c] as usize..cell_start[c + 1] as usize {
-                                let pj = props[j];
-                                if j == i || (pi.colloid && pj.colloid) {
-                                    continue;
-                                }
-                                let q = pos[j];
-                                let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
-                                let owner = if slab_of[j] as usize == z {
-                                    j > i
-                                } else {
-                                    d[2] < 0.0
-                                };
-                                if !owner {
-                                    continue;
-                                }
-                                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                                let lim2 = if pi.colloid {
-                                    (pi.radius + pi.cs_cut + skin).powi(2)
-                                } else if pj.colloid {
-                                    (pj.radius + pj.cs_cut + skin).powi(2)
-                                } else {
-                                    rc_range2
-                                };
-                                if r2 < lim2 {
-                                    slab.nbr.push(j as u32);
-                                }
-                            }
+                let cz = z;
+                let own = (cz * ny + cy) * nx + cx;
+                let mut scan = |c: usize, first: usize| {
+                    for j in first..cell_start[c + 1] as usize {
+                        let pj = props[j];
+                        if pi.colloid && pj.colloid {
+                            continue;
+                        }
+                        let q = pos[j];
+                        let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
+                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        let lim2 = if pi.colloid {
+                            (pi.radius + pi.cs_cut + skin).powi(2)
+                        } else if pj.colloid {
+                            (pj.radius + pj.cs_cut + skin).powi(2)
+                        } else {
+                            rc_range2
+                        };
+                        if r2 < lim2 {
+                            slab.nbr.push(j as u32);
                         }
                     }
+                };
+                // Half stencil: later members of the own cell, then 13 of the 26 neighbour
+                // cells (+x; +y row; the whole +z layer), so each pair is found once, in the
+                // own slab or the next one.
+                scan(own, i + 1);
+                for &[dx, dy, dz] in &HALF_STENCIL {
+                    let xx = (cx + nx + dx - 1) % nx;
+                    let yy = (cy + ny + dy - 1) % ny;
+                    let zz = (cz + nz + dz - 1) % nz;
+                    let c = (zz * ny + yy) * nx + xx;
+                    scan(c, cell_start[c] as usize);
                 }
                 slab.nbr_start.push(slab.nbr.len() as u32);
             }
@@ -892,6 +898,23 @@ impl Dpd {
         });
     }
 }
+
+/// The 13 neighbour cells of the half stencil, as offsets + 1 in x, y, z.
+const HALF_STENCIL: [[usize; 3]; 13] = [
+    [2, 1, 1],
+    [0, 2, 1],
+    [1, 2, 1],
+    [2, 2, 1],
+    [0, 0, 2],
+    [1, 0, 2],
+    [2, 0, 2],
+    [0, 1, 2],
+    [1, 1, 2],
+    [2, 1, 2],
+    [0, 2, 2],
+    [1, 2, 2],
+    [2, 2, 2],
+];
 
 /// Force on particle `i`: its slab's own sum plus the previous slab's halo.
 #[inline(always)]
