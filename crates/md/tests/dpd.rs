@@ -2,7 +2,7 @@
 //! conservation, fluctuation–dissipation with lubrication, thread independence, bad input.
 
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
-use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise};
+use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
 
 /// Mean and standard error from `blocks` block averages of `x`.
@@ -144,6 +144,21 @@ fn suspension() -> DpdSetup {
 #[test]
 fn results_do_not_depend_on_the_number_of_threads() {
     let setup = suspension();
+    let mut cells = suspension();
+    cells.params.neighbors = NeighborMode::Cells;
+    let run_cells = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = cells.build().unwrap();
+            assert!(sim.uses_cells());
+            sim.run(300).unwrap();
+            let th = sim.advance_with_thermo().unwrap();
+            (sim.snapshot(), th)
+        })
+    };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -158,6 +173,10 @@ fn results_do_not_depend_on_the_number_of_threads() {
     };
     let (a, ta) = run(1);
     let (b, tb) = run(2);
+    let (a2, ta2) = run_cells(1);
+    let (b2, tb2) = run_cells(2);
+    assert_eq!(a2, b2);
+    assert_eq!(ta2, tb2);
     let (c, tc) = run(3);
     assert_eq!(a, b);
     assert_eq!(a, c);
@@ -392,7 +411,14 @@ fn brute_force(p: &Particles, sbox: &SimBox, prm: &DpdParams, step: u64) -> Vec<
 
 #[test]
 fn engine_forces_equal_a_brute_force_sum_over_all_pairs() {
-    let setup = suspension();
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let mut setup = suspension();
+        setup.params.neighbors = mode;
+        check_forces_against_brute_force(&setup);
+    }
+}
+
+fn check_forces_against_brute_force(setup: &DpdSetup) {
     let p = setup.initial_particles().unwrap();
     let sim = setup.build().unwrap();
     let got = sim.forces();

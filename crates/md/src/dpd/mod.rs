@@ -54,6 +54,8 @@ pub struct DpdParams {
     pub dt: f64,
     /// Verlet skin of the neighbour lists.
     pub skin: f64,
+    /// Cells or Verlet lists for the solvent pairs.
+    pub neighbors: NeighborMode,
     /// Seed of the pair random numbers.
     pub seed: u32,
 }
@@ -80,6 +82,7 @@ impl DpdParams {
             lubrication_noise: LubricationNoise::Exact,
             dt,
             skin: 0.4,
+            neighbors: NeighborMode::Auto,
             seed,
         }
     }
@@ -106,9 +109,11 @@ pub enum DpdError {
         /// What went non-finite.
         what: &'static str,
     },
-    /// A particle moved further in one step than the neighbour skin allows.
+    /// A particle moved further than half the solvent cut-off in one step: the forces change
+    /// over a step and the integration is meaningless (the neighbour lists stay valid, as they are
+    /// rebuilt after every drift that needs it).
     #[error(
-        "particle {tag} moved {distance:.3} in one step at step {step} (more than the skin {skin}): the time step is too large for these forces; reduce run.dt"
+        "particle {tag} moved {distance:.3} in one step at step {step} (more than half the cut-off, {limit}): the time step is too large for these forces; reduce run.dt"
     )]
     Unstable {
         /// Step.
@@ -117,8 +122,8 @@ pub enum DpdError {
         tag: u32,
         /// Distance moved in the step.
         distance: f64,
-        /// The skin.
-        skin: f64,
+        /// The limit, `rc / 2`.
+        limit: f64,
     },
 }
 
@@ -216,14 +221,12 @@ pub struct Thermo {
     pub momentum: [f64; 3],
 }
 
-/// Per-particle constants, permuted with the particles.
+/// Per-particle constants, stored by tag.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Props {
-    tag: u32,
     typeid: u32,
     colloid: bool,
     mass: f64,
-    inv_mass: f64,
     diameter: f64,
     /// Force radius (0 for solvent).
     radius: f64,
@@ -235,14 +238,34 @@ struct Props {
     cs_amp: f64,
 }
 
+/// Bit of [`Dpd::key`] that marks a colloid (the low bits are the tag).
+const COLLOID_BIT: u32 = 1 << 31;
+
+/// How solvent and colloid–solvent pairs are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NeighborMode {
+    /// Cells when the lists would be rebuilt within about three steps (DPD water at dt ~ 0.04),
+    /// Verlet lists otherwise (colloids at dt ~ 0.001).
+    #[default]
+    Auto,
+    /// Verlet lists with a skin, rebuilt when a particle has moved half the skin.
+    Verlet,
+    /// No lists: particles are re-sorted into cells of the interaction range every step and the
+    /// forces are summed over a half stencil of cells.
+    Cells,
+}
+
 /// One z-layer of cells: its particles, their half neighbour list and force buffers.
 #[derive(Debug, Clone, Default)]
 struct Slab {
     start: usize,
     end: usize,
-    /// `nbr[nbr_start[k]..nbr_start[k+1]]` are the partners of particle `start + k`.
+    /// `nbr[nbr_start[k]..nbr_start[k+1]]` are the partners of particle `start + k`
+    /// (Verlet mode).
     nbr_start: Vec<u32>,
     nbr: Vec<u32>,
+    /// Candidate pairs of one particle (scratch).
+    cand: Vec<(u32, [f64; 3])>,
     /// Forces on this slab's particles from its own pairs.
     force: Vec<[f64; 3]>,
     /// Forces on the next slab's particles from this slab's pairs.
@@ -259,10 +282,18 @@ pub struct Dpd {
     pub step: u64,
     type_names: Vec<String>,
     is_colloid_type: Vec<bool>,
+    // Storage order (sorted by cell, ties by tag).
     pos: Vec<[f64; 3]>,
     vel: Vec<[f64; 3]>,
     image: Vec<[i32; 3]>,
+    /// Tag, with [`COLLOID_BIT`] set for colloids.
+    key: Vec<u32>,
+    inv_mass: Vec<f64>,
+    /// Constants by tag.
     props: Vec<Props>,
+    /// Storage index of each tag.
+    by_tag: Vec<u32>,
+    cells_mode: bool,
     ref_pos: Vec<[f64; 3]>,
     slab_of: Vec<u32>,
     slabs: Vec<Slab>,
@@ -270,20 +301,22 @@ pub struct Dpd {
     n_cells: [usize; 3],
     cell_start: Vec<u32>,
     cell_key: Vec<u32>,
-    by_tag: Vec<u32>,
-    /// Colloid-colloid full list over colloid slots.
+    fill: Vec<u32>,
+    /// Colloid–colloid full list over colloid slots (colloid tags in increasing order).
     cc_list: NeighborList,
     cc_pos: Vec<[f64; 3]>,
     cc_tag: Vec<u32>,
     /// Storage index of each colloid slot.
     cc_index: Vec<u32>,
-    /// Colloid slot of each particle (`u32::MAX` for solvent).
+    /// Colloid slot of each tag (`u32::MAX` for solvent).
     cc_slot: Vec<u32>,
-    fluid_range: f64,
+    /// Range of the cells: interaction range, plus the skin in Verlet mode.
+    cell_range: f64,
     builds: u64,
     scratch3: Vec<[f64; 3]>,
     scratch_img: Vec<[i32; 3]>,
-    scratch_props: Vec<Props>,
+    scratch_u32: Vec<u32>,
+    scratch_f64: Vec<f64>,
     perm: Vec<u32>,
 }
 
@@ -291,15 +324,20 @@ pub struct Dpd {
 struct Ctx<'a> {
     pos: &'a [[f64; 3]],
     vel: &'a [[f64; 3]],
+    key: &'a [u32],
     props: &'a [Props],
     cc_list: &'a NeighborList,
     cc_index: &'a [u32],
     cc_slot: &'a [u32],
+    cell_start: &'a [u32],
+    n_cells: [usize; 3],
+    cells_mode: bool,
+    cell_range: f64,
     sbox: SimBox,
-    key: u64,
-    rc: f64,
+    noise_key: u64,
     rc2: f64,
     inv_rc: f64,
+    rc: f64,
     a_ss: f64,
     gamma: f64,
     /// `sqrt(2 gamma kT / dt)`.
@@ -307,7 +345,6 @@ struct Ctx<'a> {
     two_kt_over_dt: f64,
     cc_cut: f64,
     inv_cc_cut: f64,
-    cc_amp: f64,
     colloid: ColloidForces,
     authors_noise: bool,
 }
@@ -345,20 +382,22 @@ impl Dpd {
             )));
         }
         let n = particles.len();
-        if n < 2 || n > u32::MAX as usize / 2 {
+        if n < 2 || n >= COLLOID_BIT as usize {
             return Err(DpdError::Invalid(format!(
-                "{n} particles (need at least 2)"
+                "{n} particles (need at least 2, fewer than 2^31)"
             )));
         }
         let mut props = Vec::with_capacity(n);
         let mut max_cs_centre: f64 = 0.0;
         let mut max_radius: f64 = 0.0;
+        let mut min_mass = f64::INFINITY;
         for i in 0..n {
             let colloid = is_colloid_type[particles.typeid[i] as usize];
             let m = particles.mass[i];
             if !(m.is_finite() && m > 0.0) {
                 return Err(DpdError::Invalid(format!("particle {i} has mass {m}")));
             }
+            min_mass = min_mass.min(m);
             let d = particles.diameter[i];
             let radius = if colloid { 0.5 * d } else { 0.0 };
             if colloid && !(radius.is_finite() && radius > 0.0) {
@@ -372,11 +411,9 @@ impl Dpd {
             max_cs_centre = max_cs_centre.max(radius + cs_cut);
             max_radius = max_radius.max(radius);
             props.push(Props {
-                tag: i as u32,
                 typeid: particles.typeid[i],
                 colloid,
                 mass: m,
-                inv_mass: 1.0 / m,
                 diameter: d,
                 radius,
                 cs_cut,
@@ -384,7 +421,20 @@ impl Dpd {
                 cs_amp: p.repulsion_cs * p.kt / cs_cut,
             });
         }
-        let fluid_range = p.rc.max(max_cs_centre) + p.skin;
+        // Cells or lists: a Verlet list pays off when it lasts a few steps. The fastest of N
+        // particles moves about 5 thermal velocities sqrt(kT / m) per unit time.
+        let fast_step = 5.0 * p.dt * (p.kt / min_mass).sqrt();
+        let cells_mode = match p.neighbors {
+            NeighborMode::Cells => true,
+            NeighborMode::Verlet => false,
+            NeighborMode::Auto => 0.5 * p.skin < 3.0 * fast_step,
+        };
+        let interaction = p.rc.max(max_cs_centre);
+        let cell_range = if cells_mode {
+            interaction
+        } else {
+            interaction + p.skin
+        };
         let cc_range = if max_radius > 0.0 {
             p.colloid_cutoff + 2.0 * max_radius
         } else {
@@ -395,6 +445,31 @@ impl Dpd {
         for (x, img) in pos.iter_mut().zip(image.iter_mut()) {
             sbox.wrap(x, img);
         }
+        let key = (0..n as u32)
+            .map(|t| {
+                if props[t as usize].colloid {
+                    t | COLLOID_BIT
+                } else {
+                    t
+                }
+            })
+            .collect();
+        let inv_mass = props.iter().map(|q| 1.0 / q.mass).collect();
+        let mut cc_slot = vec![u32::MAX; n];
+        let mut cc_tag = Vec::new();
+        for (t, q) in props.iter().enumerate() {
+            if q.colloid {
+                cc_slot[t] = cc_tag.len() as u32;
+                cc_tag.push(t as u32);
+            }
+        }
+        let edge = sbox.l.iter().cloned().fold(f64::INFINITY, f64::min);
+        if edge < 3.0 * cell_range {
+            return Err(DpdError::BoxTooSmall(BoxTooSmall {
+                edge,
+                range: 1.5 * cell_range,
+            }));
+        }
         let mut s = Self {
             sbox,
             params,
@@ -404,7 +479,11 @@ impl Dpd {
             pos,
             vel: particles.vel,
             image,
+            key,
+            inv_mass,
             props,
+            by_tag: (0..n as u32).collect(),
+            cells_mode,
             ref_pos: Vec::new(),
             slab_of: Vec::new(),
             slabs: Vec::new(),
@@ -412,27 +491,25 @@ impl Dpd {
             n_cells: [0; 3],
             cell_start: Vec::new(),
             cell_key: Vec::new(),
-            by_tag: Vec::new(),
+            fill: Vec::new(),
             cc_list: NeighborList::new(cc_range, p.skin),
             cc_pos: Vec::new(),
-            cc_tag: Vec::new(),
+            cc_tag,
             cc_index: Vec::new(),
-            cc_slot: Vec::new(),
-            fluid_range,
+            cc_slot,
+            cell_range,
             builds: 0,
             scratch3: Vec::new(),
             scratch_img: Vec::new(),
-            scratch_props: Vec::new(),
+            scratch_u32: Vec::new(),
+            scratch_f64: Vec::new(),
             perm: Vec::new(),
         };
-        let edge = sbox.l.iter().cloned().fold(f64::INFINITY, f64::min);
-        if edge < 3.0 * fluid_range {
-            return Err(DpdError::BoxTooSmall(BoxTooSmall {
-                edge,
-                range: 1.5 * fluid_range,
-            }));
+        s.sort_into_cells();
+        if !s.cells_mode {
+            s.build_lists();
         }
-        s.rebuild()?;
+        s.update_colloid_list(true)?;
         s.compute_forces::<false>(s.step);
         Ok(s)
     }
@@ -457,9 +534,15 @@ impl Dpd {
         self.step as f64 * self.params.dt
     }
 
-    /// Number of neighbour-list builds so far.
+    /// Number of Verlet-list builds so far (solvent lists in Verlet mode, colloid lists in
+    /// both modes).
     pub fn neighbor_builds(&self) -> u64 {
         self.builds
+    }
+
+    /// Whether solvent pairs are found from cells every step (instead of Verlet lists).
+    pub fn uses_cells(&self) -> bool {
+        self.cells_mode
     }
 
     /// Number of slabs (z-layers of cells) the force pass is split into.
@@ -473,20 +556,17 @@ impl Dpd {
         let mut p = Particles {
             pos: vec![[0.0; 3]; n],
             image: vec![[0; 3]; n],
-            typeid: vec![0; n],
-            diameter: vec![0.0; n],
+            typeid: self.props.iter().map(|q| q.typeid).collect(),
+            diameter: self.props.iter().map(|q| q.diameter).collect(),
             vel: vec![[0.0; 3]; n],
-            mass: vec![0.0; n],
+            mass: self.props.iter().map(|q| q.mass).collect(),
             type_names: self.type_names.clone(),
         };
-        for (i, q) in self.props.iter().enumerate() {
-            let t = q.tag as usize;
+        for (i, &k) in self.key.iter().enumerate() {
+            let t = (k & !COLLOID_BIT) as usize;
             p.pos[t] = self.pos[i];
             p.image[t] = self.image[i];
-            p.typeid[t] = q.typeid;
-            p.diameter[t] = q.diameter;
             p.vel[t] = self.vel[i];
-            p.mass[t] = q.mass;
         }
         p
     }
@@ -504,8 +584,9 @@ impl Dpd {
     /// step, noise of the current step), in tag order.
     pub fn forces(&self) -> Vec<[f64; 3]> {
         let mut f = vec![[0.0; 3]; self.len()];
-        for (i, q) in self.props.iter().enumerate() {
-            f[q.tag as usize] = total_force(&self.slabs, &self.slab_of, self.slabs.len(), i);
+        for (i, &k) in self.key.iter().enumerate() {
+            f[(k & !COLLOID_BIT) as usize] =
+                total_force(&self.slabs, &self.slab_of, self.slabs.len(), i);
         }
         f
     }
@@ -518,9 +599,9 @@ impl Dpd {
     /// Total momentum.
     pub fn momentum(&self) -> [f64; 3] {
         let mut m = [0.0; 3];
-        for (v, q) in self.vel.iter().zip(&self.props) {
+        for (v, w) in self.vel.iter().zip(&self.inv_mass) {
             for k in 0..3 {
-                m[k] += q.mass * v[k];
+                m[k] += v[k] / w;
             }
         }
         m
@@ -550,12 +631,13 @@ impl Dpd {
         let dt = self.params.dt;
         let half = 0.5 * dt;
         let sbox = self.sbox;
-        let skin = self.params.skin;
-        // First half kick and drift; largest displacement from the list's reference.
+        let verlet = !self.cells_mode;
+        // First half kick and drift; largest step and largest displacement from the list's
+        // reference (Verlet mode).
         let (max_step2, fast, max_disp2) = {
             let slabs = &self.slabs;
             let slab_of = &self.slab_of;
-            let props = &self.props;
+            let inv_mass = &self.inv_mass;
             let ref_pos = &self.ref_pos;
             let n_slabs = slabs.len();
             self.pos
@@ -566,7 +648,7 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(i, ((x, v), img))| {
                     let f = total_force(slabs, slab_of, n_slabs, i);
-                    let im = props[i].inv_mass * half;
+                    let im = inv_mass[i] * half;
                     let mut step2 = 0.0;
                     for k in 0..3 {
                         v[k] += im * f[k];
@@ -575,9 +657,14 @@ impl Dpd {
                         step2 += dx * dx;
                     }
                     sbox.wrap(x, img);
-                    let q = ref_pos[i];
-                    let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
-                    (step2, i, d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                    let disp2 = if verlet {
+                        let q = ref_pos[i];
+                        let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
+                        d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+                    } else {
+                        0.0
+                    };
+                    (step2, i, disp2)
                 })
                 .reduce(
                     || (0.0, usize::MAX, 0.0),
@@ -601,27 +688,36 @@ impl Dpd {
                 .unwrap_or(0);
             return Err(DpdError::NonFinite {
                 step: self.step,
-                tag: self.props[i].tag,
+                tag: self.key[i] & !COLLOID_BIT,
                 what: "position",
             });
         }
-        if max_step2 > skin * skin {
+        let limit = 0.5 * self.params.rc;
+        if max_step2 > limit * limit {
             return Err(DpdError::Unstable {
                 step: self.step,
-                tag: self.props[fast].tag,
+                tag: self.key[fast] & !COLLOID_BIT,
                 distance: max_step2.sqrt(),
-                skin,
+                limit,
             });
         }
-        if max_disp2 > 0.25 * skin * skin {
-            self.rebuild()?;
+        if self.cells_mode {
+            self.sort_into_cells();
+            self.update_colloid_list(false)?;
+        } else if max_disp2 > 0.25 * self.params.skin * self.params.skin {
+            self.sort_into_cells();
+            self.build_lists();
+            self.update_colloid_list(true)?;
+        } else {
+            // Colloid slots keep their storage indices between sorts.
         }
         self.compute_forces::<THERMO>(self.step);
         // Second half kick.
         let bad = {
             let slabs = &self.slabs;
             let slab_of = &self.slab_of;
-            let props = &self.props;
+            let inv_mass = &self.inv_mass;
+            let key = &self.key;
             let n_slabs = slabs.len();
             self.vel
                 .par_iter_mut()
@@ -629,14 +725,14 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(i, v)| {
                     let f = total_force(slabs, slab_of, n_slabs, i);
-                    let im = props[i].inv_mass * half;
+                    let im = inv_mass[i] * half;
                     for k in 0..3 {
                         v[k] += im * f[k];
                     }
                     if v.iter().all(|a| a.is_finite()) {
                         u32::MAX
                     } else {
-                        props[i].tag
+                        key[i] & !COLLOID_BIT
                     }
                 })
                 .min()
@@ -660,7 +756,8 @@ impl Dpd {
         let mut count = vec![0usize; nt];
         let mut kin = [0.0; 6];
         let mut mom = [0.0; 3];
-        for (v, q) in self.vel.iter().zip(&self.props) {
+        for (v, &k) in self.vel.iter().zip(&self.key) {
+            let q = &self.props[(k & !COLLOID_BIT) as usize];
             let m = q.mass;
             ke[q.typeid as usize] += m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
             count[q.typeid as usize] += 1;
@@ -711,34 +808,30 @@ impl Dpd {
         }
     }
 
-    /// Sort particles into cells, split them into slabs and rebuild both neighbour lists.
-    /// The result depends only on the positions (ties broken by tag), so a run that rebuilds at
-    /// the same steps sums its forces in the same order.
-    fn rebuild(&mut self) -> Result<(), DpdError> {
-        self.builds += 1;
+    /// Sort particles into cells (z-major; ties by tag, so the order is a function of the
+    /// positions alone) and split them into slabs (z-layers of cells).
+    fn sort_into_cells(&mut self) {
         let n = self.len();
-        let range = self.fluid_range;
         let l = self.sbox.l;
         let mut nc = [0usize; 3];
         for k in 0..3 {
-            nc[k] = (l[k] / range).floor() as usize;
+            nc[k] = (l[k] / self.cell_range).floor() as usize;
         }
         self.n_cells = nc;
         let [nx, ny, nz] = nc;
         let total = nx * ny * nz;
         let scale = [nx as f64 / l[0], ny as f64 / l[1], nz as f64 / l[2]];
-        // Cell of every particle (z-major), counting sort in tag order.
-        self.by_tag.resize(n, 0);
-        for (i, q) in self.props.iter().enumerate() {
-            self.by_tag[q.tag as usize] = i as u32;
-        }
         self.cell_key.resize(n, 0);
-        for (c, x) in self.cell_key.iter_mut().zip(&self.pos) {
-            let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
-            let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
-            let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
-            *c = ((cz * ny + cy) * nx + cx) as u32;
-        }
+        self.cell_key
+            .par_iter_mut()
+            .zip(self.pos.par_iter())
+            .with_min_len(4096)
+            .for_each(|(c, x)| {
+                let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
+                let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
+                let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
+                *c = ((cz * ny + cy) * nx + cx) as u32;
+            });
         self.cell_start.clear();
         self.cell_start.resize(total + 1, 0);
         for &c in &self.cell_key {
@@ -748,27 +841,36 @@ impl Dpd {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         self.perm.resize(n, 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start[..total]);
+        for (i, &c) in self.cell_key.iter().enumerate() {
+            let c = c as usize;
+            self.perm[self.fill[c] as usize] = i as u32;
+            self.fill[c] += 1;
+        }
+        // Within each cell (a handful of particles), order by tag.
         {
-            // Reuse slab_of as the fill pointer of each cell.
-            let fill = &mut self.slab_of;
-            fill.clear();
-            fill.extend_from_slice(&self.cell_start[..total]);
-            for &i in &self.by_tag {
-                let c = self.cell_key[i as usize] as usize;
-                self.perm[fill[c] as usize] = i;
-                fill[c] += 1;
+            let key = &self.key;
+            let starts = &self.cell_start;
+            for c in 0..total {
+                let cell = &mut self.perm[starts[c] as usize..starts[c + 1] as usize];
+                for a in 1..cell.len() {
+                    let mut b = a;
+                    while b > 0 && key[cell[b - 1] as usize] > key[cell[b] as usize] {
+                        cell.swap(b - 1, b);
+                        b -= 1;
+                    }
+                }
             }
         }
         permute(&mut self.pos, &self.perm, &mut self.scratch3);
         permute(&mut self.vel, &self.perm, &mut self.scratch3);
         permute(&mut self.image, &self.perm, &mut self.scratch_img);
-        permute(&mut self.props, &self.perm, &mut self.scratch_props);
-        for (k, q) in self.props.iter().enumerate() {
-            self.by_tag[q.tag as usize] = k as u32;
+        permute(&mut self.key, &self.perm, &mut self.scratch_u32);
+        permute(&mut self.inv_mass, &self.perm, &mut self.scratch_f64);
+        for (i, &k) in self.key.iter().enumerate() {
+            self.by_tag[(k & !COLLOID_BIT) as usize] = i as u32;
         }
-        self.ref_pos.clear();
-        self.ref_pos.extend_from_slice(&self.pos);
-        // Slabs = z-layers of cells.
         let layer = nx * ny;
         self.slabs.resize_with(nz, Slab::default);
         self.slab_of.clear();
@@ -792,75 +894,93 @@ impl Dpd {
             s.force.resize(own, [0.0; 3]);
             s.halo.resize(m, [0.0; 3]);
         }
-        // Half lists, slab by slab in parallel.
+    }
+
+    /// Verlet mode: half lists of solvent and colloid–solvent pairs within range + skin, slab
+    /// by slab in parallel, over the half stencil of cells.
+    fn build_lists(&mut self) {
+        self.builds += 1;
+        self.ref_pos.clear();
+        self.ref_pos.extend_from_slice(&self.pos);
         let pos = &self.pos;
+        let key = &self.key;
         let props = &self.props;
         let cell_start = &self.cell_start;
+        let n_cells = self.n_cells;
         let sbox = self.sbox;
         let rc_range2 = (self.params.rc + self.params.skin).powi(2);
         let skin = self.params.skin;
+        let cell_range = self.cell_range;
         self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
             slab.nbr_start.clear();
             slab.nbr.clear();
             slab.nbr_start.push(0);
-            for i in slab.start..slab.end {
-                let x = pos[i];
-                let pi = props[i];
-                let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
-                let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
-                let cz = z;
-                let own = (cz * ny + cy) * nx + cx;
-                let mut scan = |c: usize, first: usize| {
-                    for j in first..cell_start[c + 1] as usize {
-                        let pj = props[j];
-                        if pi.colloid && pj.colloid {
+            let Slab {
+                nbr_start,
+                nbr,
+                cand,
+                ..
+            } = slab;
+            scan_layer(
+                z,
+                pos,
+                cell_start,
+                n_cells,
+                &sbox,
+                cell_range,
+                cand,
+                |i, cands| {
+                    let ki = key[i];
+                    let ci = ki & COLLOID_BIT != 0;
+                    let ext_i = if ci {
+                        let q = &props[(ki & !COLLOID_BIT) as usize];
+                        q.radius + q.cs_cut
+                    } else {
+                        0.0
+                    };
+                    for &(j, d) in cands {
+                        let kj = key[j as usize];
+                        let cj = kj & COLLOID_BIT != 0;
+                        if ci & cj {
                             continue;
                         }
-                        let q = pos[j];
-                        let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
                         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        let lim2 = if pi.colloid {
-                            (pi.radius + pi.cs_cut + skin).powi(2)
-                        } else if pj.colloid {
-                            (pj.radius + pj.cs_cut + skin).powi(2)
+                        let lim2 = if ci {
+                            (ext_i + skin) * (ext_i + skin)
+                        } else if cj {
+                            let q = &props[(kj & !COLLOID_BIT) as usize];
+                            (q.radius + q.cs_cut + skin).powi(2)
                         } else {
                             rc_range2
                         };
                         if r2 < lim2 {
-                            slab.nbr.push(j as u32);
+                            nbr.push(j);
                         }
                     }
-                };
-                // Half stencil: later members of the own cell, then 13 of the 26 neighbour
-                // cells (+x; +y row; the whole +z layer), so each pair is found once, in the
-                // own slab or the next one.
-                scan(own, i + 1);
-                for &[dx, dy, dz] in &HALF_STENCIL {
-                    let xx = (cx + nx + dx - 1) % nx;
-                    let yy = (cy + ny + dy - 1) % ny;
-                    let zz = (cz + nz + dz - 1) % nz;
-                    let c = (zz * ny + yy) * nx + xx;
-                    scan(c, cell_start[c] as usize);
-                }
-                slab.nbr_start.push(slab.nbr.len() as u32);
-            }
+                    nbr_start.push(nbr.len() as u32);
+                },
+            );
         });
-        // Colloid-colloid full list.
-        self.cc_pos.clear();
-        self.cc_tag.clear();
-        self.cc_index.clear();
-        self.cc_slot.clear();
-        self.cc_slot.resize(n, u32::MAX);
-        for (i, q) in self.props.iter().enumerate() {
-            if q.colloid {
-                self.cc_slot[i] = self.cc_index.len() as u32;
-                self.cc_index.push(i as u32);
-                self.cc_pos.push(self.pos[i]);
-                self.cc_tag.push(q.tag);
-            }
+    }
+
+    /// Refresh the storage indices of the colloid slots and rebuild the colloid–colloid list
+    /// when `force` or when a colloid has moved half the skin since its last build.
+    fn update_colloid_list(&mut self, force: bool) -> Result<(), DpdError> {
+        if self.cc_tag.len() < 2 {
+            return Ok(());
         }
-        if self.cc_index.len() >= 2 {
+        self.cc_index.clear();
+        self.cc_pos.clear();
+        for &t in &self.cc_tag {
+            let i = self.by_tag[t as usize];
+            self.cc_index.push(i);
+            self.cc_pos.push(self.pos[i as usize]);
+        }
+        if force || self.cc_list.needs_rebuild(&self.sbox, &self.cc_pos) {
             self.cc_list.build(&self.sbox, &self.cc_pos, &self.cc_tag)?;
+            if self.cells_mode {
+                self.builds += 1;
+            }
         }
         Ok(())
     }
@@ -870,36 +990,42 @@ impl Dpd {
         let ctx = Ctx {
             pos: &self.pos,
             vel: &self.vel,
+            key: &self.key,
             props: &self.props,
             cc_list: &self.cc_list,
             cc_index: &self.cc_index,
             cc_slot: &self.cc_slot,
+            cell_start: &self.cell_start,
+            n_cells: self.n_cells,
+            cells_mode: self.cells_mode,
+            cell_range: self.cell_range,
             sbox: self.sbox,
-            key: step_key(p.seed, step),
-            rc: p.rc,
+            noise_key: step_key(p.seed, step),
             rc2: p.rc * p.rc,
             inv_rc: 1.0 / p.rc,
+            rc: p.rc,
             a_ss: p.repulsion * p.kt / p.rc,
             gamma: p.gamma,
             sigma: (2.0 * p.gamma * p.kt / p.dt).sqrt(),
             two_kt_over_dt: 2.0 * p.kt / p.dt,
             cc_cut: p.colloid_cutoff,
             inv_cc_cut: 1.0 / p.colloid_cutoff,
-            cc_amp: 0.0,
             colloid: p.colloid,
             authors_noise: p.lubrication_noise == LubricationNoise::Authors,
         };
-        let has_cc = self.cc_index.len() >= 2;
+        let has_cc = self.cc_tag.len() >= 2;
         let nz = self.slabs.len();
         let starts = &self.slab_start;
         self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
             let next_start = starts[(z + 1) % nz];
-            slab_forces::<THERMO>(&ctx, slab, next_start, has_cc);
+            slab_forces::<THERMO>(&ctx, z, slab, next_start, has_cc);
         });
     }
 }
 
-/// The 13 neighbour cells of the half stencil, as offsets + 1 in x, y, z.
+/// The 13 neighbour cells of the half stencil, as offsets + 1 in x, y, z: +x; the +y row; the
+/// whole +z layer. With the later members of the own cell, every pair is met once, in the own
+/// z-layer (slab) or the next one.
 const HALF_STENCIL: [[usize; 3]; 13] = [
     [2, 1, 1],
     [0, 2, 1],
@@ -915,6 +1041,78 @@ const HALF_STENCIL: [[usize; 3]; 13] = [
     [1, 2, 2],
     [2, 2, 2],
 ];
+
+/// For every particle `i` of z-layer `cz` in storage (cell) order, call `f(i, candidates)` with
+/// the pairs `(j, x_i - x_j)` (minimum image) closer than `range` among the later members of
+/// `i`'s cell and all members of the 13 half-stencil cells. The stencil and its periodic
+/// shifts are worked out once per cell; candidates are gathered branch-free into `buf`.
+#[inline(always)]
+fn scan_layer(
+    cz: usize,
+    pos: &[[f64; 3]],
+    cell_start: &[u32],
+    n_cells: [usize; 3],
+    sbox: &SimBox,
+    range: f64,
+    buf: &mut Vec<(u32, [f64; 3])>,
+    mut f: impl FnMut(usize, &[(u32, [f64; 3])]),
+) {
+    let range2 = range * range;
+    let [nx, ny, nz] = n_cells;
+    let l = sbox.l;
+    let n = [nx, ny, nz];
+    let mut lo = [0usize; 14];
+    let mut hi = [0usize; 14];
+    let mut shift = [[0.0f64; 3]; 14];
+    for cy in 0..ny {
+        for cx in 0..nx {
+            let coords = [cx, cy, cz];
+            let mut total = 0;
+            for (s, off) in std::iter::once(&[1usize, 1, 1])
+                .chain(HALF_STENCIL.iter())
+                .enumerate()
+            {
+                let mut c = [0usize; 3];
+                for k in 0..3 {
+                    let raw = coords[k] + off[k];
+                    // raw in [0, n + 1]: 0 is cell n - 1 seen at -L, n + 1 is cell 0 at +L.
+                    (c[k], shift[s][k]) = if raw == 0 {
+                        (n[k] - 1, -l[k])
+                    } else if raw > n[k] {
+                        (0, l[k])
+                    } else {
+                        (raw - 1, 0.0)
+                    };
+                }
+                let cell = (c[2] * ny + c[1]) * nx + c[0];
+                lo[s] = cell_start[cell] as usize;
+                hi[s] = cell_start[cell + 1] as usize;
+                total += hi[s] - lo[s];
+            }
+            if buf.len() < total {
+                buf.resize(total, (0, [0.0; 3]));
+            }
+            for i in lo[0]..hi[0] {
+                let xi = pos[i];
+                let mut m = 0usize;
+                for s in 0..14 {
+                    let first = if s == 0 { i + 1 } else { lo[s] };
+                    let y = [
+                        xi[0] - shift[s][0],
+                        xi[1] - shift[s][1],
+                        xi[2] - shift[s][2],
+                    ];
+                    for (j, q) in pos[first..hi[s]].iter().enumerate() {
+                        let d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
+                        buf[m] = ((first + j) as u32, d);
+                        m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
+                    }
+                }
+                f(i, &buf[..m]);
+            }
+        }
+    }
+}
 
 /// Force on particle `i`: its slab's own sum plus the previous slab's halo.
 #[inline(always)]
@@ -932,145 +1130,228 @@ fn total_force(slabs: &[Slab], slab_of: &[u32], n_slabs: usize, i: usize) -> [f6
     f
 }
 
-fn permute<T: Copy>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
+fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
     scratch.clear();
-    scratch.extend(perm.iter().map(|&k| v[k as usize]));
+    scratch.resize(v.len(), v[0]);
+    let src = &*v;
+    scratch
+        .par_iter_mut()
+        .zip(perm.par_iter())
+        .with_min_len(4096)
+        .for_each(|(d, &k)| *d = src[k as usize]);
     std::mem::swap(v, scratch);
 }
 
-/// Forces of one slab's pairs: solvent and colloid–solvent pairs from the half list (into the
-/// slab's buffer and the next slab's halo), colloid–colloid pairs from the full list (each
-/// colloid sums its own).
-fn slab_forces<const THERMO: bool>(c: &Ctx, slab: &mut Slab, next_start: usize, has_cc: bool) {
-    slab.force.iter_mut().for_each(|f| *f = [0.0; 3]);
-    slab.halo.iter_mut().for_each(|f| *f = [0.0; 3]);
+/// Forces of one slab's pairs: solvent and colloid–solvent pairs from the half list or the
+/// half stencil of cells (into the slab's buffer and the next slab's halo), colloid–colloid
+/// pairs from the full list (each colloid sums its own).
+fn slab_forces<const THERMO: bool>(
+    c: &Ctx,
+    z: usize,
+    slab: &mut Slab,
+    next_start: usize,
+    has_cc: bool,
+) {
+    let Slab {
+        start,
+        end,
+        nbr_start,
+        nbr,
+        force,
+        halo,
+        virial,
+        cand,
+    } = slab;
+    let (start, end) = (*start, *end);
+    force.iter_mut().for_each(|f| *f = [0.0; 3]);
+    halo.iter_mut().for_each(|f| *f = [0.0; 3]);
     let mut vir = PairVirial::default();
-    let start = slab.start;
-    let end = slab.end;
-    for i in start..end {
-        let xi = c.pos[i];
-        let vi = c.vel[i];
-        let pi = c.props[i];
-        let mut fi = [0.0; 3];
-        let k0 = slab.nbr_start[i - start] as usize;
-        let k1 = slab.nbr_start[i - start + 1] as usize;
-        for &j in &slab.nbr[k0..k1] {
-            let j = j as usize;
-            let pj = c.props[j];
+    let mut out = Out {
+        start,
+        end,
+        next_start,
+        force,
+        halo,
+        vir: &mut vir,
+    };
+    if c.cells_mode {
+        scan_layer(
+            z,
+            c.pos,
+            c.cell_start,
+            c.n_cells,
+            &c.sbox,
+            c.cell_range,
+            cand,
+            |i, cands| {
+                particle_forces::<THERMO>(
+                    c,
+                    i,
+                    cands.iter().map(|&(j, d)| (j as usize, d)),
+                    &mut out,
+                    has_cc,
+                )
+            },
+        );
+    } else {
+        for i in start..end {
+            let xi = c.pos[i];
+            let k0 = nbr_start[i - start] as usize;
+            let k1 = nbr_start[i - start + 1] as usize;
+            let pairs = nbr[k0..k1].iter().map(|&j| {
+                let q = c.pos[j as usize];
+                (
+                    j as usize,
+                    c.sbox.min_image([xi[0] - q[0], xi[1] - q[1], xi[2] - q[2]]),
+                )
+            });
+            particle_forces::<THERMO>(c, i, pairs, &mut out, has_cc);
+        }
+    }
+    *virial = if THERMO { vir } else { PairVirial::default() };
+}
+
+/// Where one slab's forces go.
+struct Out<'a> {
+    start: usize,
+    end: usize,
+    next_start: usize,
+    force: &'a mut [[f64; 3]],
+    halo: &'a mut [[f64; 3]],
+    vir: &'a mut PairVirial,
+}
+
+/// All forces of particle `i`'s pairs: solvent and colloid–solvent pairs `(j, x_i - x_j)` from
+/// `pairs` (each pair once: the reaction goes to `j`), colloid–colloid pairs from the full list.
+#[inline(always)]
+fn particle_forces<const THERMO: bool>(
+    c: &Ctx,
+    i: usize,
+    pairs: impl Iterator<Item = (usize, [f64; 3])>,
+    out: &mut Out,
+    has_cc: bool,
+) {
+    let (start, end, next_start) = (out.start, out.end, out.next_start);
+    let xi = c.pos[i];
+    let vi = c.vel[i];
+    let ki = c.key[i];
+    let mut fi = [0.0; 3];
+    let vir = &mut *out.vir;
+    for (j, d) in pairs {
+        let kj = c.key[j];
+        if ki & kj & COLLOID_BIT != 0 {
+            continue;
+        }
+        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let (h, r, inv_cut, amp, cut) = if (ki | kj) & COLLOID_BIT == 0 {
+            if r2 >= c.rc2 {
+                continue;
+            }
+            let r = r2.sqrt();
+            (r, r, c.inv_rc, c.a_ss, c.rc)
+        } else {
+            let kc = if ki & COLLOID_BIT != 0 { ki } else { kj };
+            let q = &c.props[(kc & !COLLOID_BIT) as usize];
+            let r = r2.sqrt();
+            let h = r - q.radius;
+            if h >= q.cs_cut {
+                continue;
+            }
+            (h, r, q.cs_inv_cut, q.cs_amp, q.cs_cut)
+        };
+        let inv_r = 1.0 / r;
+        let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
+        let vj = c.vel[j];
+        let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
+        let w = 1.0 - h * inv_cut;
+        let theta = pair_noise(c.noise_key, ki & !COLLOID_BIT, kj & !COLLOID_BIT);
+        let fc = amp * w;
+        let fd = -c.gamma * w * w * ev;
+        let fr = c.sigma * w * theta;
+        let f = fc + fd + fr;
+        let fv = [f * e[0], f * e[1], f * e[2]];
+        fi[0] += fv[0];
+        fi[1] += fv[1];
+        fi[2] += fv[2];
+        let fj = if (start..end).contains(&j) {
+            &mut out.force[j - start]
+        } else {
+            &mut out.halo[j - next_start]
+        };
+        fj[0] -= fv[0];
+        fj[1] -= fv[1];
+        fj[2] -= fv[2];
+        if THERMO {
+            outer(&mut vir.conservative, d, fc, e);
+            outer(&mut vir.dissipative, d, fd, e);
+            outer(&mut vir.random, d, fr, e);
+            vir.energy_conservative += 0.5 * amp * cut * w * w;
+        }
+    }
+    if has_cc && ki & COLLOID_BIT != 0 {
+        let ti = (ki & !COLLOID_BIT) as usize;
+        let pi = &c.props[ti];
+        let slot = c.cc_slot[ti] as usize;
+        let cf = &c.colloid;
+        for &k in c.cc_list.neighbors(slot) {
+            let j = c.cc_index[k as usize] as usize;
+            let kj = c.key[j];
+            let pj = &c.props[(kj & !COLLOID_BIT) as usize];
             let xj = c.pos[j];
             let d = c
                 .sbox
                 .min_image([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
-            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let (h, inv_cut, amp, cut) = if !(pi.colloid | pj.colloid) {
-                if r2 >= c.rc2 {
-                    continue;
-                }
-                (r2.sqrt(), c.inv_rc, c.a_ss, c.rc)
-            } else {
-                let q = if pi.colloid { pi } else { pj };
-                let h = r2.sqrt() - q.radius;
-                if h >= q.cs_cut {
-                    continue;
-                }
-                (h, q.cs_inv_cut, q.cs_amp, q.cs_cut)
-            };
-            let r = h + pi.radius + pj.radius;
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let h = r - (pi.radius + pj.radius);
+            if h >= c.cc_cut {
+                continue;
+            }
+            let abar = 0.5 * (pi.radius + pj.radius);
             let inv_r = 1.0 / r;
             let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
             let vj = c.vel[j];
             let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
-            let w = 1.0 - h * inv_cut;
-            let theta = pair_noise(c.key, pi.tag, pj.tag);
-            let fc = amp * w;
-            let fd = -c.gamma * w * w * ev;
-            let fr = c.sigma * w * theta;
-            let f = fc + fd + fr;
-            let fv = [f * e[0], f * e[1], f * e[2]];
-            fi[0] += fv[0];
-            fi[1] += fv[1];
-            fi[2] += fv[2];
-            let fj = if (start..end).contains(&j) {
-                &mut slab.force[j - start]
+            let w = 1.0 - h * c.inv_cc_cut;
+            let f_con = cf.contact_force(h, abar);
+            let f_morse = if cf.morse_depth != 0.0 {
+                cf.morse_force(h)
             } else {
-                // j lies in the next slab (possibly slab 0 across the periodic boundary).
-                &mut slab.halo[j - next_start]
+                0.0
             };
-            fj[0] -= fv[0];
-            fj[1] -= fv[1];
-            fj[2] -= fv[2];
+            let a_sq = if cf.eta0 > 0.0 {
+                cf.squeeze_coefficient(h, abar)
+            } else {
+                0.0
+            };
+            let theta = pair_noise(c.noise_key, ki & !COLLOID_BIT, kj & !COLLOID_BIT);
+            let noise = if c.authors_noise {
+                (c.two_kt_over_dt * (c.gamma + a_sq)).sqrt() * w
+            } else {
+                (c.two_kt_over_dt * (c.gamma * w * w + a_sq)).sqrt()
+            };
+            let fd = -c.gamma * w * w * ev;
+            let flub = -a_sq * ev;
+            let fr = noise * theta;
+            let f = f_con + f_morse + fd + flub + fr;
+            fi[0] += f * e[0];
+            fi[1] += f * e[1];
+            fi[2] += f * e[2];
             if THERMO {
-                outer(&mut vir.conservative, d, fc, e);
-                outer(&mut vir.dissipative, d, fd, e);
-                outer(&mut vir.random, d, fr, e);
-                vir.energy_conservative += 0.5 * amp * cut * w * w;
-            }
-        }
-        if has_cc && pi.colloid {
-            let slot = c.cc_slot[i] as usize;
-            let cf = &c.colloid;
-            for &k in c.cc_list.neighbors(slot) {
-                let j = c.cc_index[k as usize] as usize;
-                let pj = c.props[j];
-                let xj = c.pos[j];
-                let d = c
-                    .sbox
-                    .min_image([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
-                let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                let h = r - (pi.radius + pj.radius);
-                if h >= c.cc_cut {
-                    continue;
-                }
-                let abar = 0.5 * (pi.radius + pj.radius);
-                let inv_r = 1.0 / r;
-                let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
-                let vj = c.vel[j];
-                let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
-                let w = 1.0 - h * c.inv_cc_cut;
-                let f_con = cf.contact_force(h, abar);
-                let f_morse = if cf.morse_depth != 0.0 {
-                    cf.morse_force(h)
-                } else {
-                    0.0
-                };
-                let a_sq = if cf.eta0 > 0.0 {
-                    cf.squeeze_coefficient(h, abar)
-                } else {
-                    0.0
-                };
-                let theta = pair_noise(c.key, pi.tag, pj.tag);
-                let noise = if c.authors_noise {
-                    (c.two_kt_over_dt * (c.gamma + a_sq)).sqrt() * w
-                } else {
-                    (c.two_kt_over_dt * (c.gamma * w * w + a_sq)).sqrt()
-                };
-                let fcons = c.cc_amp * w;
-                let fd = -c.gamma * w * w * ev;
-                let flub = -a_sq * ev;
-                let fr = noise * theta;
-                let f = fcons + f_con + f_morse + fd + flub + fr;
-                fi[0] += f * e[0];
-                fi[1] += f * e[1];
-                fi[2] += f * e[2];
-                if THERMO {
-                    // Each pair is visited from both colloids: count half.
-                    outer(&mut vir.conservative, d, 0.5 * fcons, e);
-                    outer(&mut vir.contact, d, 0.5 * f_con, e);
-                    outer(&mut vir.morse, d, 0.5 * f_morse, e);
-                    outer(&mut vir.dissipative, d, 0.5 * fd, e);
-                    outer(&mut vir.lubrication, d, 0.5 * flub, e);
-                    outer(&mut vir.random, d, 0.5 * fr, e);
-                    vir.energy_contact += 0.5 * cf.contact_energy(h, abar);
-                    if cf.morse_depth != 0.0 {
-                        vir.energy_morse += 0.5 * cf.morse_energy(h);
-                    }
+                // Each pair is visited from both colloids: count half.
+                outer(&mut vir.contact, d, 0.5 * f_con, e);
+                outer(&mut vir.morse, d, 0.5 * f_morse, e);
+                outer(&mut vir.dissipative, d, 0.5 * fd, e);
+                outer(&mut vir.lubrication, d, 0.5 * flub, e);
+                outer(&mut vir.random, d, 0.5 * fr, e);
+                vir.energy_contact += 0.5 * cf.contact_energy(h, abar);
+                if cf.morse_depth != 0.0 {
+                    vir.energy_morse += 0.5 * cf.morse_energy(h);
                 }
             }
         }
-        let f = &mut slab.force[i - start];
-        f[0] += fi[0];
-        f[1] += fi[1];
-        f[2] += fi[2];
     }
-    slab.virial = if THERMO { vir } else { PairVirial::default() };
+    let f = &mut out.force[i - start];
+    f[0] += fi[0];
+    f[1] += fi[1];
+    f[2] += fi[2];
 }

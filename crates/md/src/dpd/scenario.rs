@@ -5,7 +5,9 @@
 //! particle numbers, the colloid diffusion time) or returns a [`ParamError`] naming the key and
 //! the allowed range; [`DpdSetup::build`] places the particles and returns the engine.
 
-use super::{ColloidForces, Dpd, DpdError, DpdParams, LubricationNoise, colloid_solvent_cutoff};
+use super::{
+    ColloidForces, Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode, colloid_solvent_cutoff,
+};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{in_range, non_negative, positive};
@@ -216,6 +218,14 @@ pub struct RunSection {
     /// Steps over which the kinetic temperature is averaged for that check.
     #[serde(default = "d_window")]
     pub temperature_window: u64,
+    /// How solvent pairs are found: `"auto"`, `"verlet"` (lists with a skin) or `"cells"`
+    /// (re-sorted every step, no lists).
+    #[serde(default = "d_auto")]
+    pub neighbors: String,
+}
+
+fn d_auto() -> String {
+    "auto".into()
 }
 
 fn d_dt() -> f64 {
@@ -242,6 +252,7 @@ impl Default for RunSection {
             skin: d_skin(),
             max_temperature_drift: d_drift(),
             temperature_window: d_window(),
+            neighbors: d_auto(),
         }
     }
 }
@@ -480,6 +491,17 @@ impl DpdScenario {
             0.0,
             10.0,
         )?;
+        let neighbors = match r.neighbors.as_str() {
+            "auto" => NeighborMode::Auto,
+            "verlet" => NeighborMode::Verlet,
+            "cells" => NeighborMode::Cells,
+            other => {
+                return Err(ParamError::new(
+                    "run.neighbors",
+                    format!("must be \"auto\", \"verlet\" or \"cells\", got \"{other}\""),
+                ));
+            }
+        };
         if r.temperature_window == 0 {
             return Err(ParamError::new("run.temperature_window", "must be >= 1"));
         }
@@ -552,6 +574,7 @@ impl DpdScenario {
             lubrication_noise: c.lubrication_noise,
             dt,
             skin,
+            neighbors,
             seed,
         };
         Ok(DpdSetup {
