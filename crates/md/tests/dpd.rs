@@ -272,7 +272,7 @@ fn colloid_temperature_in_solvent(noise: &str, skip: u64, steps: u64) -> (f64, f
 }
 
 #[test]
-#[ignore = "long validation (~6 min on 2 cores); results in docs/validation.md"]
+#[ignore = "long validation (~2 min on 2 cores); results in docs/validation.md"]
 fn colloid_temperature_in_solvent_at_phi_0_2_with_lubrication() {
     let kt = 0.1;
     let (m, se) = colloid_temperature_in_solvent("exact", 5000, 40000);
@@ -295,7 +295,7 @@ fn colloid_temperature_in_solvent_at_phi_0_2_with_lubrication() {
 }
 
 #[test]
-#[ignore = "long validation (~4 min on 2 cores); results in docs/validation.md"]
+#[ignore = "long validation (~2.5 min on 2 cores); results in docs/validation.md"]
 fn colloid_diffusion_at_phi_0_05_against_stokes_einstein() {
     let setup = scenario(
         "method = \"dpd\"\nseed = 5\n[system]\nbox_length = 12.0\nphi = 0.05\n[colloids]\neta0 = 0.3\n",
