@@ -446,3 +446,28 @@ fn check_forces_against_brute_force(setup: &DpdSetup) {
             .any(|(g, b)| (0..3).any(|k| (g[k] - b[k]).abs() > 1e-6 * scale))
     );
 }
+
+#[test]
+fn a_restart_at_a_synchronised_step_continues_bitwise() {
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let mut setup = suspension();
+        setup.params.neighbors = mode;
+        let mut a = setup.build().unwrap();
+        a.set_sync_every(50);
+        a.run(100).unwrap();
+        let (snap, forces) = (a.snapshot(), a.forces());
+        a.run(150).unwrap();
+        let mut b = Dpd::restart(
+            snap.clone(),
+            &forces,
+            setup.sbox,
+            setup.params,
+            DpdSetup::colloid_types(),
+            100,
+            50,
+        )
+        .unwrap();
+        b.run(150).unwrap();
+        assert!(a.snapshot() == b.snapshot(), "{mode:?}: restart differs");
+    }
+}

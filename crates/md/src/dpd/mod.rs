@@ -294,6 +294,9 @@ pub struct Dpd {
     /// Storage index of each tag.
     by_tag: Vec<u32>,
     cells_mode: bool,
+    /// Every this many steps all lists are rebuilt whether needed or not (0: never), so that a
+    /// run restarted at such a step sums its forces in the same order.
+    sync_every: u64,
     ref_pos: Vec<[f64; 3]>,
     slab_of: Vec<u32>,
     slabs: Vec<Slab>,
@@ -484,6 +487,7 @@ impl Dpd {
             props,
             by_tag: (0..n as u32).collect(),
             cells_mode,
+            sync_every: 0,
             ref_pos: Vec::new(),
             slab_of: Vec::new(),
             slabs: Vec::new(),
@@ -512,6 +516,47 @@ impl Dpd {
         s.update_colloid_list(true)?;
         s.compute_forces::<false>(s.step);
         Ok(s)
+    }
+
+    /// Continue a run from a checkpoint taken right after step `step`: `particles` (positions,
+    /// velocities, images, in tag order) and the forces of that step ([`Self::forces`]). When
+    /// `step` is a multiple of the synchronisation period ([`Self::set_sync_every`], which the
+    /// interrupted run must have used too), the continuation is bitwise identical to the
+    /// uninterrupted run.
+    pub fn restart(
+        particles: Particles,
+        forces: &[[f64; 3]],
+        sbox: SimBox,
+        params: DpdParams,
+        is_colloid_type: Vec<bool>,
+        step: u64,
+        sync_every: u64,
+    ) -> Result<Self, DpdError> {
+        if forces.len() != particles.len() {
+            return Err(DpdError::Invalid(format!(
+                "{} forces for {} particles",
+                forces.len(),
+                particles.len()
+            )));
+        }
+        let mut s = Self::new(particles, sbox, params, is_colloid_type, step)?;
+        s.sync_every = sync_every;
+        for (i, &k) in s.key.iter().enumerate() {
+            let z = s.slab_of[i] as usize;
+            let start = s.slabs[z].start;
+            s.slabs[z].force[i - start] = forces[(k & !COLLOID_BIT) as usize];
+        }
+        for slab in &mut s.slabs {
+            slab.halo.iter_mut().for_each(|h| *h = [0.0; 3]);
+            slab.virial = PairVirial::default();
+        }
+        Ok(s)
+    }
+
+    /// Rebuild every list at each multiple of `k` steps (0: only when needed), so that runs can
+    /// be restarted bitwise from checkpoints taken at those steps.
+    pub fn set_sync_every(&mut self, k: u64) {
+        self.sync_every = k;
     }
 
     /// Parameters.
@@ -701,10 +746,11 @@ impl Dpd {
                 limit,
             });
         }
+        let sync = self.sync_every > 0 && self.step.is_multiple_of(self.sync_every);
         if self.cells_mode {
             self.sort_into_cells();
-            self.update_colloid_list(false)?;
-        } else if max_disp2 > 0.25 * self.params.skin * self.params.skin {
+            self.update_colloid_list(sync)?;
+        } else if sync || max_disp2 > 0.25 * self.params.skin * self.params.skin {
             self.sort_into_cells();
             self.build_lists();
             self.update_colloid_list(true)?;
