@@ -1,6 +1,7 @@
 //! `colloidsim run|check` for DPD colloids in explicit solvent (`method = "dpd"`).
 
 use crate::common::{RunOptions, progress, seed32};
+use crate::droplet::{changed_keys, checkpoint_bytes, hook, trim_trajectory};
 use crate::plot::{Scale, Series, line_plot};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
@@ -11,12 +12,15 @@ use colloidsim_core::output::OutputDir;
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
 use colloidsim_md::dpd::{Dpd, Thermo};
 use colloidsim_md::gsd::GsdWriter;
+use colloidsim_md::{Particles, SimBox};
+use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+const CHECKPOINT: &str = "checkpoint.bin";
 
 /// Parse and validate a scenario, with the seed from the command line if given.
 pub fn resolve(path: &Path, text: &str, seed: Option<u64>) -> Result<(DpdScenario, DpdSetup)> {
@@ -80,9 +84,10 @@ pub fn check(path: &Path, text: &str) -> Result<()> {
     Ok(())
 }
 
-/// What a run accumulates.
-#[derive(Default)]
+/// What a run accumulates; all of it is saved in every checkpoint.
+#[derive(Default, Serialize, Deserialize)]
 struct Observed {
+    #[serde(with = "thermo_rows")]
     thermo: Vec<(f64, Thermo)>,
     msd_steps: Vec<u64>,
     colloid_frames: Vec<Vec<[f64; 3]>>,
@@ -92,6 +97,262 @@ struct Observed {
     gr_samples: usize,
     coordination: Vec<u64>,
     clusters: Vec<[f64; 5]>,
+    /// Every (step, temperature) fed to the temperature monitor: a restart feeds them again,
+    /// which restores its state exactly.
+    monitor: Vec<(u64, f64)>,
+    /// Frames in trajectory.gsd.
+    frames: u64,
+}
+
+/// `(time, Thermo)` rows through a serialisable mirror of [`Thermo`].
+mod thermo_rows {
+    use colloidsim_md::dpd::{PairVirial, Thermo};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    struct Row {
+        time: f64,
+        step: u64,
+        temperature_by_type: Vec<f64>,
+        temperature: f64,
+        kinetic: [f64; 6],
+        /// Conservative, dissipative, random, contact, Morse, lubrication.
+        virial: [[f64; 6]; 6],
+        /// Conservative, contact, Morse energies.
+        energies: [f64; 3],
+        pressure: [f64; 6],
+        potential_energy: f64,
+        momentum: [f64; 3],
+    }
+
+    pub fn serialize<S: Serializer>(rows: &[(f64, Thermo)], s: S) -> Result<S::Ok, S::Error> {
+        let rows: Vec<Row> = rows
+            .iter()
+            .map(|(time, t)| {
+                let v = &t.virial;
+                Row {
+                    time: *time,
+                    step: t.step,
+                    temperature_by_type: t.temperature_by_type.clone(),
+                    temperature: t.temperature,
+                    kinetic: t.kinetic,
+                    virial: [
+                        v.conservative,
+                        v.dissipative,
+                        v.random,
+                        v.contact,
+                        v.morse,
+                        v.lubrication,
+                    ],
+                    energies: [v.energy_conservative, v.energy_contact, v.energy_morse],
+                    pressure: t.pressure,
+                    potential_energy: t.potential_energy,
+                    momentum: t.momentum,
+                }
+            })
+            .collect();
+        rows.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f64, Thermo)>, D::Error> {
+        let rows = Vec::<Row>::deserialize(d)?;
+        Ok(rows
+            .into_iter()
+            .map(|r| {
+                let [
+                    conservative,
+                    dissipative,
+                    random,
+                    contact,
+                    morse,
+                    lubrication,
+                ] = r.virial;
+                let [energy_conservative, energy_contact, energy_morse] = r.energies;
+                let thermo = Thermo {
+                    step: r.step,
+                    temperature_by_type: r.temperature_by_type,
+                    temperature: r.temperature,
+                    kinetic: r.kinetic,
+                    virial: PairVirial {
+                        conservative,
+                        dissipative,
+                        random,
+                        contact,
+                        morse,
+                        lubrication,
+                        energy_conservative,
+                        energy_contact,
+                        energy_morse,
+                    },
+                    pressure: r.pressure,
+                    potential_energy: r.potential_energy,
+                    momentum: r.momentum,
+                };
+                (r.time, thermo)
+            })
+            .collect())
+    }
+}
+
+/// The particles of a checkpoint: [`Particles`] in tag order, exactly.
+#[derive(Serialize, Deserialize)]
+struct State {
+    pos: Vec<[f64; 3]>,
+    image: Vec<[i32; 3]>,
+    typeid: Vec<u32>,
+    diameter: Vec<f64>,
+    vel: Vec<[f64; 3]>,
+    mass: Vec<f64>,
+    type_names: Vec<String>,
+}
+
+impl From<Particles> for State {
+    fn from(p: Particles) -> Self {
+        Self {
+            pos: p.pos,
+            image: p.image,
+            typeid: p.typeid,
+            diameter: p.diameter,
+            vel: p.vel,
+            mass: p.mass,
+            type_names: p.type_names,
+        }
+    }
+}
+
+impl From<State> for Particles {
+    fn from(p: State) -> Self {
+        Self {
+            pos: p.pos,
+            image: p.image,
+            typeid: p.typeid,
+            diameter: p.diameter,
+            vel: p.vel,
+            mass: p.mass,
+            type_names: p.type_names,
+        }
+    }
+}
+
+/// `checkpoint.bin`: everything a run needs to continue bitwise from step `step`, a multiple
+/// of `sync_every` (`O` is `&Observed` when written, `Observed` when read).
+#[derive(Serialize, Deserialize)]
+struct Checkpoint<O> {
+    version: String,
+    /// The scenario file's text.
+    scenario: String,
+    /// The resolved parameters with the seed (JSON).
+    resolved: String,
+    seed: u64,
+    /// The engine rebuilds every list at multiples of this many steps.
+    sync_every: u64,
+    /// Steps done; every observation up to and including this step is in `obs`.
+    step: u64,
+    box_l: [f64; 3],
+    particles: State,
+    /// Forces of step `step`, tag order.
+    forces: Vec<[f64; 3]>,
+    /// Neighbour-list builds so far.
+    neighbor_builds: u64,
+    /// Wall seconds of all sessions so far.
+    wall_seconds: f64,
+    obs: O,
+}
+
+/// What every checkpoint of a run shares.
+struct Base {
+    scenario: String,
+    resolved: String,
+    seed: u64,
+    sync_every: u64,
+}
+
+impl Base {
+    fn save(
+        &self,
+        out: &OutputDir,
+        sim: &Dpd,
+        neighbor_builds: u64,
+        wall_seconds: f64,
+        obs: &Observed,
+    ) -> Result<()> {
+        let ck = Checkpoint {
+            version: env!("CARGO_PKG_VERSION").into(),
+            scenario: self.scenario.clone(),
+            resolved: self.resolved.clone(),
+            seed: self.seed,
+            sync_every: self.sync_every,
+            step: sim.step,
+            box_l: sim.sbox.l,
+            particles: sim.snapshot().into(),
+            forces: sim.forces(),
+            neighbor_builds,
+            wall_seconds,
+            obs,
+        };
+        out.write_bytes(CHECKPOINT, &bincode::serialize(&ck)?)?;
+        Ok(())
+    }
+}
+
+/// The resolved parameters with the seed, as compared on `--restart`.
+fn resolved(s: &DpdSetup) -> Result<String> {
+    let mut v = describe(s);
+    v["seed"] = json!(s.params.seed);
+    Ok(serde_json::to_string(&v)?)
+}
+
+/// The synchronisation period and the period of the regular checkpoints (a multiple of it,
+/// about 10 % of the run): the engine rebuilds every list at multiples of the first, so that a
+/// run restarted there continues bitwise; Ctrl-C runs on to the next such step.
+fn periods(steps: u64) -> (u64, u64) {
+    let tenth = (steps / 10).max(1);
+    let sync = tenth.min(SYNC_MAX);
+    let every = ((tenth as f64 / sync as f64).round() as u64).max(1) * sync;
+    (sync, every)
+}
+
+/// Longest synchronisation period (steps).
+const SYNC_MAX: u64 = 1000;
+
+/// Read and check the checkpoint of `dir` against the scenario.
+fn open_checkpoint(
+    path: &Path,
+    text: &str,
+    dir: &Path,
+    seed: Option<u64>,
+) -> Result<(OutputDir, Checkpoint<Observed>, DpdSetup)> {
+    let (out, bytes) = checkpoint_bytes(
+        dir,
+        "checkpoints are written every 10 % of the run and on Ctrl-C",
+    )?;
+    let ck: Checkpoint<Observed> = bincode::deserialize(&bytes)
+        .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
+    if ck.version != env!("CARGO_PKG_VERSION") {
+        eprintln!(
+            "warning: the checkpoint was written by colloidsim {}, this is {}; the continuation may not be bitwise identical",
+            ck.version,
+            env!("CARGO_PKG_VERSION")
+        );
+    }
+    if ck.scenario != text {
+        bail!(
+            "--restart {}: {} differs from the scenario this run started with (saved as {})",
+            dir.display(),
+            path.display(),
+            out.join("scenario.toml").display()
+        );
+    }
+    let (_, s) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
+    let now = resolved(&s)?;
+    if now != ck.resolved {
+        bail!(
+            "--restart {}: the resolved scenario differs from the checkpoint's: {}",
+            dir.display(),
+            changed_keys(&now, &ck.resolved)?
+        );
+    }
+    Ok((out, ck, s))
 }
 
 /// MSD at lags of whole frames, averaged over at most ~200 time origins per lag.
@@ -113,21 +374,82 @@ fn msd(frames: &[Vec<[f64; 3]>]) -> Vec<f64> {
         .collect()
 }
 
-/// `colloidsim run` for a `dpd` scenario.
+/// `colloidsim run` for a `dpd` scenario: checkpoints every ~10 % of the run and on Ctrl-C;
+/// `--restart DIR` continues bitwise identically.
 pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
-    if opts.restart.is_some() {
-        bail!(
-            "--restart is not supported for dpd runs yet (their GSD trajectory holds the last configuration with velocities; start a new run from it)"
-        );
-    }
-    let (_, s) = resolve(path, text, opts.seed)?;
-    for w in &s.warnings {
-        eprintln!("warning: {w}");
-    }
-    let out = OutputDir::create(&opts.out, opts.force)?;
-    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    let (out, s, mut sim, mut obs, base, wall0, builds0) = match &opts.restart {
+        Some(dir) => {
+            let (out, ck, s) = open_checkpoint(path, text, dir, opts.seed)?;
+            let sim = Dpd::restart(
+                ck.particles.into(),
+                &ck.forces,
+                SimBox::new(ck.box_l),
+                s.params,
+                DpdSetup::colloid_types(),
+                ck.step,
+                ck.sync_every,
+            )
+            .with_context(|| format!("--restart {}", out.path().display()))?;
+            let traj = out.join("trajectory.gsd");
+            if traj.exists() {
+                trim_trajectory(&traj, ck.obs.frames, &["time_tau"], true)?;
+            } else if ck.obs.frames > 0 {
+                bail!(
+                    "--restart {}: trajectory.gsd is missing (the checkpoint expects {} frames)",
+                    out.path().display(),
+                    ck.obs.frames
+                );
+            }
+            // Restoring builds the lists the interrupted run built at this step: count them once.
+            let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
+            let base = Base {
+                scenario: ck.scenario,
+                resolved: ck.resolved,
+                seed: ck.seed,
+                sync_every: ck.sync_every,
+            };
+            (out, s, sim, ck.obs, base, ck.wall_seconds, builds0)
+        }
+        None => {
+            let (_, s) = resolve(path, text, opts.seed)?;
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
+            let base = Base {
+                scenario: text.into(),
+                resolved: resolved(&s)?,
+                seed: s.params.seed as u64,
+                sync_every: periods(s.steps).0,
+            };
+            let out = OutputDir::create(&opts.out, opts.force)?;
+            if opts.force {
+                // A new run: no earlier trajectory, summary or checkpoint may mix with it.
+                for f in ["trajectory.gsd", "summary.json", CHECKPOINT] {
+                    let _ = std::fs::remove_file(out.join(f));
+                }
+            }
+            out.write_bytes("scenario.toml", text.as_bytes())?;
+            let mut sim = s.build()?;
+            sim.set_sync_every(base.sync_every);
+            (out, s, sim, Observed::default(), base, 0.0, 0)
+        }
+    };
+    let fresh = opts.restart.is_none();
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            eprintln!(
+                "\nsecond Ctrl-C: stopping without a checkpoint (the last regular one remains)"
+            );
+            std::process::exit(130);
+        }
+    });
+    // Test hooks: behave as if Ctrl-C arrived at this step, or as if the process were killed
+    // there (no checkpoint; the trajectory reached the disk).
+    let interrupt_at = hook("COLLOIDSIM_INTERRUPT_AT_STEP");
+    let kill_at = hook("COLLOIDSIM_KILL_AT_STEP");
+    let (sync_every, checkpoint_every) = (base.sync_every, periods(s.steps).1);
     let start = Instant::now();
-    let mut sim = s.build()?;
+    let wall = || wall0 + start.elapsed().as_secs_f64();
     let o = &s.observe;
     let p = sim.snapshot();
     let colloid_tags: Vec<u32> = (0..p.len() as u32)
@@ -143,13 +465,23 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
         .collect();
     drop(p);
     let mut gsd = if o.trajectory_every > 0 {
-        Some(GsdWriter::create_new(&out.join("trajectory.gsd"))?.with_velocities())
+        let traj = out.join("trajectory.gsd");
+        // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+        Some(if traj.exists() {
+            GsdWriter::append(&traj)?.with_velocities()
+        } else {
+            GsdWriter::create_new(&traj)?.with_velocities()
+        })
     } else {
         None
     };
-    let mut obs = Observed::default();
     let mut monitor =
         TemperatureMonitor::new(s.params.kt, s.max_temperature_drift, s.temperature_window);
+    for &(step, t) in &obs.monitor {
+        monitor
+            .push(step, t)
+            .map_err(|e| anyhow::anyhow!("the checkpoint's temperatures: {e}"))?;
+    }
     let dt = s.params.dt;
     let tau = s.tau;
     let record = |sim: &Dpd, obs: &mut Observed, gsd: &mut Option<GsdWriter>| -> Result<()> {
@@ -204,23 +536,64 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
                 false,
                 &[("time_tau", step as f64 * dt / tau)],
             )?;
+            obs.frames += 1;
         }
         Ok(())
     };
-    record(&sim, &mut obs, &mut gsd)?;
+    if fresh {
+        record(&sim, &mut obs, &mut gsd)?;
+    }
     let pb = progress(s.steps, opts.quiet, "dpd");
+    pb.set_position(sim.step);
     let mut failure: Option<String> = None;
     let check_every = if o.thermo_every > 0 {
         o.thermo_every
     } else {
         100
     };
+    // The step at which Ctrl-C arrived.
+    let mut interrupted: Option<u64> = None;
     while sim.step < s.steps {
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            failure = Some(format!("interrupted at step {}", sim.step));
-            break;
+        let step = sim.step;
+        if kill_at == Some(step) {
+            if let Some(w) = gsd.as_mut() {
+                w.sync()?;
+            }
+            eprintln!("killed at step {step} (test hook)");
+            std::process::exit(3);
         }
-        let next = sim.step + 1;
+        if interrupt_at == Some(step) {
+            INTERRUPTED.store(true, Ordering::SeqCst);
+        }
+        if interrupted.is_none() && INTERRUPTED.load(Ordering::Relaxed) {
+            interrupted = Some(step);
+            let to = step.next_multiple_of(sync_every).min(s.steps);
+            if to > step && to < s.steps {
+                pb.suspend(|| {
+                    eprintln!(
+                        "interrupted at step {step}: running on to step {to} to write a checkpoint (Ctrl-C again stops at once)"
+                    )
+                });
+            }
+        }
+        if let Some(at) = interrupted
+            && step.is_multiple_of(sync_every)
+        {
+            if let Some(w) = gsd.as_mut() {
+                w.sync()?;
+            }
+            base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
+            pb.abandon();
+            let (files, _) = write_outputs(&out, &s, &sim, &obs)?;
+            bail!(
+                "interrupted at step {at}; checkpoint written at step {step}, outputs so far in {} ({}; summary.json is written when the run completes). Continue with: colloidsim run {} --restart {}",
+                out.path().display(),
+                files.join(", "),
+                path.display(),
+                out.path().display()
+            );
+        }
+        let next = step + 1;
         let result = if o.thermo_every > 0 && next.is_multiple_of(o.thermo_every) {
             sim.advance_with_thermo().map(|th| {
                 obs.thermo.push((next as f64 * dt, th));
@@ -239,12 +612,19 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
                 .filter(|(_, th)| th.step == next)
                 .map(|(_, th)| th.temperature)
                 .unwrap_or_else(|| sim.thermo().temperature);
+            obs.monitor.push((next, t));
             if let Err(e) = monitor.push(next, t) {
                 failure = Some(e);
                 break;
             }
         }
         record(&sim, &mut obs, &mut gsd)?;
+        if next.is_multiple_of(checkpoint_every) && next < s.steps {
+            if let Some(w) = gsd.as_mut() {
+                w.sync()?;
+            }
+            base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
+        }
         if next.is_multiple_of(100) {
             pb.set_position(next);
         }
@@ -253,8 +633,21 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
     if let Some(w) = gsd.as_mut() {
         w.sync()?;
     }
-    let wall = start.elapsed().as_secs_f64();
-    let files = write_outputs(&out, &s, &sim, &obs, wall, failure.as_deref())?;
+    let wall = wall();
+    let (mut files, diffusion) = write_outputs(&out, &s, &sim, &obs)?;
+    write_summary(
+        &out,
+        &s,
+        &sim,
+        &obs,
+        diffusion,
+        builds0 + sim.neighbor_builds(),
+        wall,
+        failure.as_deref(),
+        &mut files,
+    )?;
+    // The run is over: its checkpoint is no longer needed (a restart now refuses).
+    let _ = std::fs::remove_file(out.join(CHECKPOINT));
     if let Some(f) = failure {
         bail!(
             "{f}\nthe outputs up to step {} are in {} (summary.json says completed = false)",
@@ -277,14 +670,14 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
     Ok(())
 }
 
+/// The tables and pictures of what has been observed so far; returns their names and the
+/// long-time colloid diffusion coefficient.
 fn write_outputs(
     out: &OutputDir,
     s: &DpdSetup,
     sim: &Dpd,
     obs: &Observed,
-    wall: f64,
-    failure: Option<&str>,
-) -> Result<Vec<String>> {
+) -> Result<(Vec<String>, Option<f64>)> {
     let dt = s.params.dt;
     let tau = s.tau;
     let mut files = Vec::new();
@@ -468,6 +861,23 @@ fn write_outputs(
     if s.observe.trajectory_every > 0 {
         files.push("trajectory.gsd".into());
     }
+    Ok((files, diffusion))
+}
+
+/// `summary.json`; `files` are the outputs written beside it (summary.json is added).
+#[allow(clippy::too_many_arguments)]
+fn write_summary(
+    out: &OutputDir,
+    s: &DpdSetup,
+    sim: &Dpd,
+    obs: &Observed,
+    diffusion: Option<f64>,
+    neighbor_builds: u64,
+    wall: f64,
+    failure: Option<&str>,
+    files: &mut Vec<String>,
+) -> Result<()> {
+    let (dt, tau) = (s.params.dt, s.tau);
     let last = obs.thermo.last().map(|(_, t)| t.clone());
     let n = (s.colloids + s.solvent) as f64;
     let summary = json!({
@@ -483,7 +893,7 @@ fn write_outputs(
         "wall_seconds": wall,
         "particle_steps_per_second": n * sim.step as f64 / wall,
         "threads": rayon::current_num_threads(),
-        "neighbor_builds": sim.neighbor_builds(),
+        "neighbor_builds": neighbor_builds,
         "final_temperature": last.as_ref().map(|t| t.temperature),
         "final_temperature_by_type": last.as_ref().map(|t| t.temperature_by_type.clone()),
         "mean_temperature_second_half": mean_second_half(&obs.thermo, |t| t.temperature),
@@ -495,7 +905,7 @@ fn write_outputs(
     });
     out.write_json("summary.json", &summary)?;
     files.push("summary.json".into());
-    Ok(files)
+    Ok(())
 }
 
 fn mean_second_half(rows: &[(f64, Thermo)], f: impl Fn(&Thermo) -> f64) -> Option<f64> {

@@ -140,19 +140,26 @@ struct Checkpoint {
     acc: Accum,
 }
 
-/// Read and check the checkpoint of `dir` against the scenario; returns it with the resolved
-/// parameters (the checkpoint's seed unless `--seed` is given).
-fn open_checkpoint(
-    path: &Path,
-    text: &str,
-    dir: &Path,
-    seed: Option<u64>,
-) -> Result<(OutputDir, Checkpoint, DropletParams)> {
+/// The checks every `--restart DIR` makes before reading its checkpoint: the folder exists, its
+/// run has not finished (no `summary.json`) and it holds a `checkpoint.bin`. Returns the folder
+/// and the checkpoint's bytes; `when` says when the method writes checkpoints.
+pub(crate) fn checkpoint_bytes(dir: &Path, when: &str) -> Result<(OutputDir, Vec<u8>)> {
     if !dir.is_dir() {
         bail!("--restart {}: no such folder", dir.display());
     }
     let out = OutputDir::reopen(dir)?;
-    if out.join("summary.json").exists() {
+    let summary = out.join("summary.json");
+    if summary.exists() {
+        let failed = std::fs::read(&summary)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .is_some_and(|v| v["completed"] == false);
+        if failed {
+            bail!(
+                "--restart {}: this run stopped with an error (summary.json says completed = false) and keeps no checkpoint; start a new run with --out",
+                dir.display()
+            );
+        }
         bail!(
             "--restart {}: this run is complete (summary.json is written); nothing to continue. Start a new run with --out",
             dir.display()
@@ -161,11 +168,46 @@ fn open_checkpoint(
     let file = out.join(CHECKPOINT);
     if !file.exists() {
         bail!(
-            "--restart {}: no {CHECKPOINT} to continue from (checkpoints are written every 10 % of a replica, between replicas and on Ctrl-C)",
+            "--restart {}: no {CHECKPOINT} to continue from ({when})",
             dir.display()
         );
     }
     let bytes = std::fs::read(&file).with_context(|| format!("{}", file.display()))?;
+    Ok((out, bytes))
+}
+
+/// The top-level keys of two resolved-parameter JSON objects that differ, as
+/// `key = now (was then)`; empty when they agree.
+pub(crate) fn changed_keys(now: &str, then: &str) -> Result<String> {
+    let now: serde_json::Value = serde_json::from_str(now)?;
+    let then: serde_json::Value = serde_json::from_str(then)?;
+    let keys: Vec<String> = now
+        .as_object()
+        .into_iter()
+        .flatten()
+        .filter(|(k, v)| then.get(k.as_str()) != Some(v))
+        .map(|(k, v)| {
+            format!(
+                "{k} = {v} (was {})",
+                then.get(k.as_str()).unwrap_or(&serde_json::Value::Null)
+            )
+        })
+        .collect();
+    Ok(keys.join(", "))
+}
+
+/// Read and check the checkpoint of `dir` against the scenario; returns it with the resolved
+/// parameters (the checkpoint's seed unless `--seed` is given).
+fn open_checkpoint(
+    path: &Path,
+    text: &str,
+    dir: &Path,
+    seed: Option<u64>,
+) -> Result<(OutputDir, Checkpoint, DropletParams)> {
+    let (out, bytes) = checkpoint_bytes(
+        dir,
+        "checkpoints are written every 10 % of a replica, between replicas and on Ctrl-C",
+    )?;
     let ck: Checkpoint = bincode::deserialize(&bytes)
         .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
     if ck.version != env!("CARGO_PKG_VERSION") {
@@ -186,24 +228,10 @@ fn open_checkpoint(
     let (_, p) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
     let resolved = serde_json::to_string(&p)?;
     if resolved != ck.resolved {
-        let now: serde_json::Value = serde_json::from_str(&resolved)?;
-        let then: serde_json::Value = serde_json::from_str(&ck.resolved)?;
-        let keys: Vec<String> = now
-            .as_object()
-            .into_iter()
-            .flatten()
-            .filter(|(k, v)| then.get(k.as_str()) != Some(v))
-            .map(|(k, v)| {
-                format!(
-                    "{k} = {v} (was {})",
-                    then.get(k.as_str()).unwrap_or(&serde_json::Value::Null)
-                )
-            })
-            .collect();
         bail!(
             "--restart {}: the resolved scenario differs from the checkpoint's: {}",
             dir.display(),
-            keys.join(", ")
+            changed_keys(&resolved, &ck.resolved)?
         );
     }
     Ok((out, ck, p))
@@ -211,7 +239,14 @@ fn open_checkpoint(
 
 /// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
 /// may have written more), so that the continuation appends exactly where the checkpoint stood.
-fn trim_trajectory(path: &Path, frames: u64) -> Result<()> {
+/// The frames are written again as [`GsdWriter`] wrote them, with the scalars `log/NAME` of
+/// `logs` and, with `velocities`, the velocities and masses: byte for byte the same file.
+pub(crate) fn trim_trajectory(
+    path: &Path,
+    frames: u64,
+    logs: &[&str],
+    velocities: bool,
+) -> Result<()> {
     let have = gsd::frame_count(path)?;
     if have == frames {
         return Ok(());
@@ -225,25 +260,39 @@ fn trim_trajectory(path: &Path, frames: u64) -> Result<()> {
     let tmp = path.with_extension("gsd.trim");
     let _ = std::fs::remove_file(&tmp);
     {
-        let logs = GsdFile::open(path, Mode::Read)
+        let file = GsdFile::open(path, Mode::Read)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         let mut w = GsdWriter::create_new(&tmp)?;
+        if velocities {
+            w = w.with_velocities();
+        }
         for k in 0..frames {
-            let f = gsd::read_frame(path, Some(k))?;
-            let log = |name: &str| -> Result<f64> {
-                logs.iter_scalars::<f64>(k, name)
-                    .map_err(|e| anyhow::anyhow!("{}: frame {k}: {e}", path.display()))?
-                    .next()
-                    .with_context(|| format!("{}: frame {k}: no {name}", path.display()))
+            let mut f = gsd::read_frame(path, Some(k))?;
+            let e = |e: hoomd_gsd::file_layer::ReadError| {
+                anyhow::anyhow!("{}: frame {k}: {e}", path.display())
             };
-            let (r, t) = (log("log/droplet/radius")?, log("log/droplet/time")?);
-            w.write_frame(
-                f.step,
-                &f.sbox,
-                &f.particles,
-                false,
-                &[("droplet/radius", r), ("droplet/time", t)],
-            )?;
+            if velocities {
+                f.particles.vel = file
+                    .iter_arrays::<f32, 3>(k, "particles/velocity")
+                    .map_err(e)?
+                    .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
+                    .collect();
+                if f.particles.vel.len() != f.particles.len() {
+                    bail!("{}: frame {k}: velocities missing", path.display());
+                }
+            }
+            let values = logs
+                .iter()
+                .map(|name| -> Result<(&str, f64)> {
+                    let v = file
+                        .iter_scalars::<f64>(k, &format!("log/{name}"))
+                        .map_err(e)?
+                        .next()
+                        .with_context(|| format!("{}: frame {k}: no log/{name}", path.display()))?;
+                    Ok((*name, v))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            w.write_frame(f.step, &f.sbox, &f.particles, false, &values)?;
         }
         w.sync()?;
     }
@@ -329,8 +378,9 @@ fn restore(
     Ok(Some((sim, builds)))
 }
 
-/// A test hook read from the environment: a global step (replica * steps + step).
-fn hook(name: &str) -> Option<u64> {
+/// A test hook read from the environment: a step number (for droplet runs the global step
+/// replica * steps + step).
+pub(crate) fn hook(name: &str) -> Option<u64> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
 
@@ -348,7 +398,12 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
             resume = restore(&out, &p, &ck)?.map(|(s, builds)| (s, Some(ck.step), builds));
             let traj = out.join("trajectory.gsd");
             if ck.replica == 0 && p.trajectory_every > 0 && traj.exists() {
-                trim_trajectory(&traj, ck.acc.frames)?;
+                trim_trajectory(
+                    &traj,
+                    ck.acc.frames,
+                    &["droplet/radius", "droplet/time"],
+                    false,
+                )?;
             }
             let (acc, rep) = (ck.acc.clone(), ck.replica);
             (out, p, ck, acc, rep)

@@ -1,5 +1,7 @@
-//! End-to-end tests of `colloidsim run|check` on DPD scenarios.
+//! End-to-end tests of `colloidsim run|check` on DPD scenarios, checkpoints and `--restart`
+//! included.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -28,6 +30,16 @@ fn run(dir: &Path, args: &[&str]) -> Output {
         .args(args)
         .output()
         .unwrap()
+}
+
+/// `run` with environment variables (the hidden test hooks).
+fn run_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
+    c.current_dir(dir).args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().unwrap()
 }
 
 fn text(o: &Output) -> String {
@@ -143,4 +155,225 @@ fn a_heating_time_step_stops_the_run_and_says_so() {
         serde_json::from_str(&std::fs::read_to_string(d.join("hot/summary.json")).unwrap())
             .unwrap();
     assert_eq!(s["completed"], false);
+}
+
+/// SMALL with a trajectory frame every 30 steps (frames fall between checkpoints). 400 steps:
+/// lists synchronised, and checkpoints written, every 40 steps.
+fn restart_scenario(d: &Path) -> String {
+    std::fs::write(
+        d.join("r.toml"),
+        SMALL.replace("trajectory_every = 200", "trajectory_every = 30"),
+    )
+    .unwrap();
+    "r.toml".into()
+}
+
+/// Every file of a folder by name.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// summary.json without the fields that depend on the session (timing).
+fn summary(bytes: &[u8]) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
+    let m = v.as_object_mut().unwrap();
+    for k in ["wall_seconds", "particle_steps_per_second"] {
+        assert!(m.remove(k).is_some(), "summary.json has no {k}");
+    }
+    v
+}
+
+/// The same files, byte for byte (summary.json up to timing; neighbor_builds included).
+fn assert_same_outputs(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "different files"
+    );
+    for (name, bytes) in &fa {
+        if name == "summary.json" {
+            assert_eq!(summary(bytes), summary(&fb[name]), "summary.json differs");
+        } else {
+            assert!(bytes == &fb[name], "{name} differs after restart");
+        }
+    }
+}
+
+#[test]
+fn an_interrupted_run_restarts_bitwise() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "a", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let names: Vec<String> = files(&d.join("a")).into_keys().collect();
+    assert!(names.iter().any(|n| n == "scenario.toml"), "{names:?}");
+    assert!(
+        !names.iter().any(|n| n.starts_with("checkpoint")),
+        "{names:?}"
+    );
+    // Ctrl-C at step 123 runs on to step 160 (a multiple of the synchronisation period, 40);
+    // at step 0 and at 200 it stops at once.
+    for (at, ck) in [("123", 160), ("0", 0), ("200", 200)] {
+        let b = format!("b{at}");
+        let o = run_env(
+            d,
+            &["run", &sc, "--out", &b, "--quiet"],
+            &[("COLLOIDSIM_INTERRUPT_AT_STEP", at)],
+        );
+        assert!(!o.status.success());
+        let t = text(&o);
+        assert!(
+            t.contains(&format!(
+                "interrupted at step {at}; checkpoint written at step {ck}"
+            )),
+            "{t}"
+        );
+        assert!(t.contains(&format!("--restart {b}")), "{t}");
+        let bp = d.join(&b);
+        assert!(bp.join("checkpoint.bin").exists());
+        assert!(!bp.join("summary.json").exists());
+        let o = run(d, &["run", &sc, "--restart", &b, "--quiet"]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert_same_outputs(&d.join("a"), &bp);
+    }
+    // Interrupted twice: the second session is itself interrupted (at 250, checkpoint at 280).
+    let o = run_env(
+        d,
+        &["run", &sc, "--out", "c", "--quiet"],
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", "50")],
+    );
+    assert!(!o.status.success());
+    let o = run_env(
+        d,
+        &["run", &sc, "--restart", "c", "--quiet"],
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", "250")],
+    );
+    assert!(
+        text(&o).contains("interrupted at step 250; checkpoint written at step 280"),
+        "{}",
+        text(&o)
+    );
+    let o = run(d, &["run", &sc, "--restart", "c", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_same_outputs(&d.join("a"), &d.join("c"));
+}
+
+#[test]
+fn a_killed_run_restarts_from_the_last_periodic_checkpoint() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "a", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    // Killed without a checkpoint at step 235: the last checkpoint is at step 200, and
+    // trajectory.gsd already holds the frames of steps 210 and 230, which the restart drops
+    // and writes again.
+    let o = run_env(
+        d,
+        &["run", &sc, "--out", "k", "--quiet"],
+        &[("COLLOIDSIM_KILL_AT_STEP", "235")],
+    );
+    assert!(!o.status.success());
+    assert!(d.join("k/checkpoint.bin").exists());
+    let o = run(d, &["run", &sc, "--restart", "k", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_same_outputs(&d.join("a"), &d.join("k"));
+}
+
+#[test]
+fn restart_refuses_without_checkpoint_changed_scenario_or_finished_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "a", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    // A completed run is left alone.
+    let before = files(&d.join("a"));
+    let o = run(d, &["run", &sc, "--restart", "a", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("complete"), "{}", text(&o));
+    assert!(files(&d.join("a")) == before);
+    // No folder; a run killed before its first checkpoint (step 40).
+    let o = run(d, &["run", &sc, "--restart", "none", "--quiet"]);
+    assert!(!o.status.success() && text(&o).contains("no such folder"));
+    let o = run_env(
+        d,
+        &["run", &sc, "--out", "early", "--quiet"],
+        &[("COLLOIDSIM_KILL_AT_STEP", "30")],
+    );
+    assert!(!o.status.success());
+    let o = run(d, &["run", &sc, "--restart", "early", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("no checkpoint.bin"), "{}", text(&o));
+    // An interrupted run continues only with the scenario and seed it started with.
+    let o = run_env(
+        d,
+        &["run", &sc, "--out", "b", "--quiet"],
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", "100")],
+    );
+    assert!(!o.status.success());
+    let other = SMALL
+        .replace("trajectory_every = 200", "trajectory_every = 30")
+        .replace("morse_depth = 12.0", "morse_depth = 11.0");
+    std::fs::write(d.join("other.toml"), other).unwrap();
+    let o = run(d, &["run", "other.toml", "--restart", "b", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("differs from the scenario this run started with"),
+        "{}",
+        text(&o)
+    );
+    let o = run(d, &["run", &sc, "--restart", "b", "--seed", "4", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("seed = 4 (was 3)"), "{}", text(&o));
+    // The refusals left the checkpoint usable.
+    let o = run(d, &["run", &sc, "--restart", "b", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_same_outputs(&d.join("a"), &d.join("b"));
+}
+
+#[test]
+fn a_restarted_run_stops_where_the_uninterrupted_one_does() {
+    // DPD water at dt = 0.08 heats by ~10 %: the temperature monitor (windows of 100 steps, the
+    // first not judged) stops the run at step 210. Interrupted at 150, checkpointed at 200
+    // (1000 steps: synchronisation every 100), the restart must stop at the same step with the
+    // same message: the monitor's state is part of the checkpoint.
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = "method = \"dpd\"\n[system]\nbox_length = 6.0\nkT = 1.0\n[run]\ndt = 0.08\nsteps = 1000\ntemperature_window = 100\n[observe]\nthermo_every = 10\nstructure_every = 0\ntrajectory_every = 0\nmsd_every = 0\n";
+    std::fs::write(d.join("hot.toml"), sc).unwrap();
+    let o = run(d, &["run", "hot.toml", "--out", "a", "--quiet"]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert!(t.contains("before step 210"), "{t}");
+    let o = run_env(
+        d,
+        &["run", "hot.toml", "--out", "b", "--quiet"],
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", "150")],
+    );
+    assert!(
+        text(&o).contains("checkpoint written at step 200"),
+        "{}",
+        text(&o)
+    );
+    let o = run(d, &["run", "hot.toml", "--restart", "b", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("before step 210"), "{}", text(&o));
+    assert_same_outputs(&d.join("a"), &d.join("b"));
+    // A failed run keeps no checkpoint: it cannot be continued.
+    assert!(!d.join("b/checkpoint.bin").exists());
+    let o = run(d, &["run", "hot.toml", "--restart", "b", "--quiet"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("stopped with an error"), "{}", text(&o));
 }
