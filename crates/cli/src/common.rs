@@ -59,3 +59,21 @@ pub fn seed32(seed: u64) -> anyhow::Result<u32> {
     u32::try_from(seed)
         .map_err(|_| anyhow::anyhow!("seed: must lie in [0, 4294967295], got {seed}"))
 }
+
+/// CPU time (user + system, all threads) of this process in seconds, from /proc (Linux; `None`
+/// elsewhere). For benchmarks: a rate per CPU second is less sensitive to other work on the
+/// machine than one per wall second.
+pub fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// The 1-, 5- and 15-minute load averages, from /proc/loadavg (Linux; `None` elsewhere).
+pub fn load_average() -> Option<[f64; 3]> {
+    let s = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let mut w = s.split_whitespace().map(|x| x.parse::<f64>().ok());
+    Some([w.next()??, w.next()??, w.next()??])
+}

