@@ -29,6 +29,7 @@ use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Parameters of a DPD colloid simulation (DPD units: lengths in `rc`, energies in `kT`
 /// multiples as noted, masses in solvent-bead masses).
@@ -304,7 +305,8 @@ pub struct Dpd {
     n_cells: [usize; 3],
     cell_start: Vec<u32>,
     cell_key: Vec<u32>,
-    fill: Vec<u32>,
+    cell_count: Vec<AtomicU32>,
+    slot: Vec<AtomicU32>,
     /// Colloid–colloid full list over colloid slots (colloid tags in increasing order).
     cc_list: NeighborList,
     cc_pos: Vec<[f64; 3]>,
@@ -495,7 +497,8 @@ impl Dpd {
             n_cells: [0; 3],
             cell_start: Vec::new(),
             cell_key: Vec::new(),
-            fill: Vec::new(),
+            cell_count: Vec::new(),
+            slot: Vec::new(),
             cc_list: NeighborList::new(cc_range, p.skin),
             cc_pos: Vec::new(),
             cc_tag,
@@ -878,37 +881,78 @@ impl Dpd {
                 let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
                 *c = ((cz * ny + cy) * nx + cx) as u32;
             });
+        // Parallel counting sort: counts and scatter with atomics (the order inside a cell is
+        // then arbitrary), then every cell ordered by key, so the result does not depend on the
+        // threads.
+        self.cell_count.resize_with(total, || AtomicU32::new(0));
+        self.cell_count
+            .par_iter()
+            .with_min_len(4096)
+            .for_each(|c| c.store(0, Relaxed));
+        {
+            let count = &self.cell_count;
+            self.cell_key.par_iter().with_min_len(4096).for_each(|&c| {
+                count[c as usize].fetch_add(1, Relaxed);
+            });
+        }
         self.cell_start.clear();
         self.cell_start.resize(total + 1, 0);
-        for &c in &self.cell_key {
-            self.cell_start[c as usize + 1] += 1;
-        }
         for c in 0..total {
-            self.cell_start[c + 1] += self.cell_start[c];
+            self.cell_start[c + 1] = self.cell_start[c] + self.cell_count[c].load(Relaxed);
         }
-        self.perm.resize(n, 0);
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.cell_start[..total]);
-        for (i, &c) in self.cell_key.iter().enumerate() {
-            let c = c as usize;
-            self.perm[self.fill[c] as usize] = i as u32;
-            self.fill[c] += 1;
+        {
+            let starts = &self.cell_start;
+            self.cell_count
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(c, f)| f.store(starts[c], Relaxed));
         }
-        // Within each cell (a handful of particles), order by tag.
+        self.slot.resize_with(n, || AtomicU32::new(0));
+        {
+            let fill = &self.cell_count;
+            let slot = &self.slot;
+            self.cell_key
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(i, &c)| {
+                    let k = fill[c as usize].fetch_add(1, Relaxed);
+                    slot[k as usize].store(i as u32, Relaxed);
+                });
+        }
         {
             let key = &self.key;
             let starts = &self.cell_start;
-            for c in 0..total {
-                let cell = &mut self.perm[starts[c] as usize..starts[c + 1] as usize];
-                for a in 1..cell.len() {
-                    let mut b = a;
-                    while b > 0 && key[cell[b - 1] as usize] > key[cell[b] as usize] {
-                        cell.swap(b - 1, b);
-                        b -= 1;
+            let slot = &self.slot;
+            (0..total).into_par_iter().with_min_len(256).for_each(|c| {
+                let (a, b) = (starts[c] as usize, starts[c + 1] as usize);
+                let mut local = [0u32; 32];
+                if b - a <= local.len() {
+                    let cell = &mut local[..b - a];
+                    for (k, x) in cell.iter_mut().enumerate() {
+                        *x = slot[a + k].load(Relaxed);
+                    }
+                    cell.sort_unstable_by_key(|&i| key[i as usize]);
+                    for (k, x) in cell.iter().enumerate() {
+                        slot[a + k].store(*x, Relaxed);
+                    }
+                } else {
+                    // A crowded cell (rare): allocate.
+                    let mut cell: Vec<u32> = slot[a..b].iter().map(|x| x.load(Relaxed)).collect();
+                    cell.sort_unstable_by_key(|&i| key[i as usize]);
+                    for (k, x) in cell.iter().enumerate() {
+                        slot[a + k].store(*x, Relaxed);
                     }
                 }
-            }
+            });
         }
+        self.perm.resize(n, 0);
+        self.perm
+            .par_iter_mut()
+            .zip(self.slot.par_iter())
+            .with_min_len(4096)
+            .for_each(|(p, s)| *p = s.load(Relaxed));
         permute(&mut self.pos, &self.perm, &mut self.scratch3);
         permute(&mut self.vel, &self.perm, &mut self.scratch3);
         permute(&mut self.image, &self.perm, &mut self.scratch_img);
@@ -919,16 +963,28 @@ impl Dpd {
         }
         let layer = nx * ny;
         self.slabs.resize_with(nz, Slab::default);
-        self.slab_of.clear();
         self.slab_of.resize(n, 0);
         for z in 0..nz {
-            let (a, b) = (
-                self.cell_start[z * layer] as usize,
-                self.cell_start[(z + 1) * layer] as usize,
-            );
-            self.slabs[z].start = a;
-            self.slabs[z].end = b;
-            self.slab_of[a..b].iter_mut().for_each(|s| *s = z as u32);
+            self.slabs[z].start = self.cell_start[z * layer] as usize;
+            self.slabs[z].end = self.cell_start[(z + 1) * layer] as usize;
+        }
+        {
+            let starts = &self.cell_start;
+            self.slab_of
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(i, s)| {
+                    // The layer whose particle range holds i.
+                    let mut z = (i * nz / n.max(1)).min(nz - 1);
+                    while starts[z * layer] as usize > i {
+                        z -= 1;
+                    }
+                    while starts[(z + 1) * layer] as usize <= i {
+                        z += 1;
+                    }
+                    *s = z as u32;
+                });
         }
         self.slab_start.clear();
         self.slab_start.extend(self.slabs.iter().map(|s| s.start));
