@@ -51,6 +51,11 @@ pub struct BenchArgs {
     /// Do not run LAMMPS.
     #[arg(long)]
     pub no_lammps: bool,
+    /// Benchmark the standard colloid system of the notes instead of water (phi = 0.2,
+    /// density 3, R_c = 1, kT = 0.1, gamma = 4.5, eta0 = 0.3, contact + lubrication, dt = 0.001,
+    /// box edge --l; LAMMPS has no such model, so colloidsim alone).
+    #[arg(long)]
+    pub colloids: bool,
     /// Keep the LAMMPS data file, inputs and outputs in this folder (default: a temporary
     /// folder, removed at the end).
     #[arg(long)]
@@ -107,8 +112,70 @@ fn load() -> String {
     load_average().map_or("unknown".into(), |[a, b, c]| format!("{a} {b} {c}"))
 }
 
+/// `colloidsim bench dpd --colloids`: the standard colloid system on each thread count, timed
+/// in `repeats` consecutive segments of `steps` after the warm-up.
+fn bench_colloids(a: &BenchArgs) -> Result<()> {
+    let text = format!(
+        "method = \"dpd\"\nseed = {}\n[system]\nbox_length = {}\nphi = 0.2\n[run]\ndt = 0.001\n",
+        a.seed, a.l
+    );
+    let setup = colloidsim_md::dpd::scenario::DpdScenario::from_toml(&text)?.validate()?;
+    let n = setup.colloids + setup.solvent;
+    println!(
+        "# colloidsim bench dpd --colloids: standard system, {} colloids + {} solvent beads (L = {}, phi = 0.2, kT = 0.1, gamma = 4.5, eta0 = 0.3, dt = 0.001, skin {}); {} warm-up steps, then {} segments of {} steps, median (min-max)",
+        setup.colloids,
+        setup.solvent,
+        a.l,
+        setup.params.skin,
+        a.warmup,
+        a.repeats.max(1),
+        a.steps
+    );
+    println!("# load average (1, 5, 15 min) at start: {}", load());
+    println!("threads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbour_builds\tmode");
+    let mut medians = Vec::new();
+    for &t in &a.threads {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+        let (rates, cpu, builds, cells) = pool.install(|| -> Result<_> {
+            let mut sim = setup.build()?;
+            sim.run(a.warmup)?;
+            let b0 = sim.neighbor_builds();
+            let mut rates = Vec::new();
+            let mut cpu = Vec::new();
+            for _ in 0..a.repeats.max(1) {
+                let c0 = cpu_seconds();
+                let start = Instant::now();
+                sim.run(a.steps)?;
+                let work = n as f64 * a.steps as f64;
+                rates.push(work / start.elapsed().as_secs_f64());
+                cpu.push(
+                    cpu_seconds()
+                        .zip(c0)
+                        .map_or(f64::NAN, |(c1, c0)| work / (c1 - c0)),
+                );
+            }
+            Ok((rates, cpu, sim.neighbor_builds() - b0, sim.uses_cells()))
+        })?;
+        let (m, lo, hi) = median(rates);
+        let (mc, _, _) = median(cpu);
+        println!(
+            "{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{builds}\t{}",
+            if cells { "cells" } else { "verlet" }
+        );
+        medians.push((t, m));
+    }
+    if let (Some(&(t1, r1)), Some(&(t2, r2))) = (medians.first(), medians.get(1)) {
+        println!("# {t2} threads / {t1} thread(s): {:.2}", r2 / r1);
+    }
+    println!("# load average (1, 5, 15 min) at end: {}", load());
+    Ok(())
+}
+
 /// `colloidsim bench dpd`.
 pub fn bench(a: &BenchArgs) -> Result<()> {
+    if a.colloids {
+        return bench_colloids(a);
+    }
     if a.skin.is_empty() || a.threads.is_empty() || a.steps == 0 {
         bail!("need at least one --skin, one --threads and --steps > 0");
     }
