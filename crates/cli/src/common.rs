@@ -77,3 +77,24 @@ pub fn load_average() -> Option<[f64; 3]> {
     let mut w = s.split_whitespace().map(|x| x.parse::<f64>().ok());
     Some([w.next()??, w.next()??, w.next()??])
 }
+
+/// Median, min and max of `v` (not empty).
+pub fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[v.len() / 2], v[0], v[v.len() - 1])
+}
+
+/// Seconds and steps of the last "Loop time of T on P procs for S steps with N atoms" line of
+/// a LAMMPS screen output, and that line's index.
+pub fn lammps_loop_time(text: &str) -> anyhow::Result<(f64, f64, usize)> {
+    use anyhow::Context;
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines
+        .iter()
+        .rposition(|l| l.starts_with("Loop time of"))
+        .context("LAMMPS printed no loop time")?;
+    let w: Vec<&str> = lines[at].split_whitespace().collect();
+    let secs: f64 = w.get(3).context("loop time line")?.parse()?;
+    let steps: f64 = w.get(8).context("loop time line")?.parse()?;
+    Ok((secs, steps, at))
+}

@@ -1,7 +1,7 @@
 //! `colloidsim bench dpd`: pure DPD water, colloidsim beside LAMMPS (`pair_style dpd` +
 //! `fix nve`) on the same relaxed configuration in the same invocation.
 
-use crate::common::{cpu_seconds, load_average};
+use crate::common::{cpu_seconds, lammps_loop_time, load_average, median};
 use anyhow::{Context, Result, bail};
 use colloidsim_md::dpd::{Dpd, DpdParams, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
@@ -60,12 +60,6 @@ pub struct BenchArgs {
     /// folder, removed at the end).
     #[arg(long)]
     pub keep: Option<PathBuf>,
-}
-
-/// Median, min and max.
-fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
-    v.sort_by(f64::total_cmp);
-    (v[v.len() / 2], v[0], v[v.len() - 1])
 }
 
 /// One row of the table: the medians of `repeats` runs of one code at one skin.
@@ -449,14 +443,7 @@ fn measure_lammps(
         }
         let text = std::fs::read_to_string(dir.join(&screen))?;
         let lines: Vec<&str> = text.lines().collect();
-        // "Loop time of T on P procs for S steps with N atoms".
-        let at = lines
-            .iter()
-            .rposition(|l| l.starts_with("Loop time of"))
-            .context("LAMMPS printed no loop time")?;
-        let w: Vec<&str> = lines[at].split_whitespace().collect();
-        let secs: f64 = w.get(3).context("loop time line")?.parse()?;
-        let steps: f64 = w.get(8).context("loop time line")?.parse()?;
+        let (secs, steps, at) = lammps_loop_time(&text)?;
         let work = n as f64 * steps;
         rates.push(work / secs);
         // "99.8% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.

@@ -194,46 +194,6 @@ mod thermo_rows {
     }
 }
 
-/// The particles of a checkpoint: [`Particles`] in tag order, exactly.
-#[derive(Serialize, Deserialize)]
-struct State {
-    pos: Vec<[f64; 3]>,
-    image: Vec<[i32; 3]>,
-    typeid: Vec<u32>,
-    diameter: Vec<f64>,
-    vel: Vec<[f64; 3]>,
-    mass: Vec<f64>,
-    type_names: Vec<String>,
-}
-
-impl From<Particles> for State {
-    fn from(p: Particles) -> Self {
-        Self {
-            pos: p.pos,
-            image: p.image,
-            typeid: p.typeid,
-            diameter: p.diameter,
-            vel: p.vel,
-            mass: p.mass,
-            type_names: p.type_names,
-        }
-    }
-}
-
-impl From<State> for Particles {
-    fn from(p: State) -> Self {
-        Self {
-            pos: p.pos,
-            image: p.image,
-            typeid: p.typeid,
-            diameter: p.diameter,
-            vel: p.vel,
-            mass: p.mass,
-            type_names: p.type_names,
-        }
-    }
-}
-
 /// `checkpoint.bin`: everything a run needs to continue bitwise from step `step`, a multiple
 /// of `sync_every` (`O` is `&Observed` when written, `Observed` when read).
 #[derive(Serialize, Deserialize)]
@@ -249,7 +209,8 @@ struct Checkpoint<O> {
     /// Steps done; every observation up to and including this step is in `obs`.
     step: u64,
     box_l: [f64; 3],
-    particles: State,
+    /// The particles in tag order, exactly.
+    particles: Particles,
     /// Forces of step `step`, tag order.
     forces: Vec<[f64; 3]>,
     /// Neighbour-list builds so far.
@@ -284,7 +245,7 @@ impl Base {
             sync_every: self.sync_every,
             step: sim.step,
             box_l: sim.sbox.l,
-            particles: sim.snapshot().into(),
+            particles: sim.snapshot(),
             forces: sim.forces(),
             neighbor_builds,
             wall_seconds,
@@ -381,7 +342,7 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
         Some(dir) => {
             let (out, ck, s) = open_checkpoint(path, text, dir, opts.seed)?;
             let sim = Dpd::restart(
-                ck.particles.into(),
+                ck.particles,
                 &ck.forces,
                 SimBox::new(ck.box_l),
                 s.params,

@@ -1,7 +1,7 @@
 //! `colloidsim run|check|bench` for the drying droplet (`method = "droplet-bd"`) and the WCA
 //! Brownian-dynamics benchmark.
 
-use crate::common::{RunOptions, progress, seed32};
+use crate::common::{RunOptions, cpu_seconds, lammps_loop_time, median, progress, seed32};
 use crate::plot::{Scale, Series, line_plot};
 use crate::theory_droplet::profile_name;
 use anyhow::{Context, Result, bail};
@@ -706,11 +706,6 @@ pub struct BenchArgs {
     pub skin: f64,
 }
 
-fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
-    v.sort_by(f64::total_cmp);
-    (v[v.len() / 2], v[0], v[v.len() - 1])
-}
-
 /// `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube (friction 1, kT 1,
 /// dt = 1e-4, same skin for both), particle-steps per second, beside LAMMPS on the same
 /// configuration in the same run (LAMMPS on one MPI rank, with Gaussian and with its default
@@ -806,15 +801,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 return Ok(());
             }
             let text = std::fs::read_to_string(dir.join("lammps.out"))?;
-            // The last "Loop time of T on P procs for S steps with N atoms" is the timed run.
+            // The last "Loop time of ..." line is the timed run.
+            let (secs, steps, at) = lammps_loop_time(&text)?;
             let lines: Vec<&str> = text.lines().collect();
-            let at = lines
-                .iter()
-                .rposition(|l| l.starts_with("Loop time of"))
-                .context("LAMMPS printed no loop time")?;
-            let w: Vec<&str> = lines[at].split_whitespace().collect();
-            let secs: f64 = w[3].parse()?;
-            let steps: f64 = w[8].parse()?;
             rates.push(a.n as f64 * steps / secs);
             // "98.7% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.
             let pct = lines[at..]
@@ -842,14 +831,6 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
 }
 
 /// CPU time (user + system, all threads) of this process in seconds, from /proc (Linux).
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &s[s.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
-
 fn tempfile_dir() -> Result<PathBuf> {
     let dir = std::env::temp_dir().join(format!("colloidsim-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;

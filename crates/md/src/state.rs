@@ -81,7 +81,7 @@ impl SimBox {
 /// Positions are wrapped into the box; `image` counts box crossings so that
 /// `position + image * L` is the unwrapped trajectory. Velocities and masses are carried for
 /// the inertial methods (DPD, MPCD); Brownian dynamics ignores them.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Particles {
     /// Wrapped positions.
     pub pos: Vec<[f64; 3]>,

@@ -141,48 +141,33 @@ fn suspension() -> DpdSetup {
     )
 }
 
+/// Build `setup` and run 300 steps plus one thermo step on a pool of `threads` threads.
+fn run_on_threads(setup: &DpdSetup, threads: usize) -> (Particles, colloidsim_md::dpd::Thermo) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut sim = setup.build().unwrap();
+        sim.run(300).unwrap();
+        let th = sim.advance_with_thermo().unwrap();
+        (sim.snapshot(), th)
+    })
+}
+
 #[test]
 fn results_do_not_depend_on_the_number_of_threads() {
-    let setup = suspension();
-    let mut cells = suspension();
-    cells.params.neighbors = NeighborMode::Cells;
-    let run_cells = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut sim = cells.build().unwrap();
-            assert!(sim.uses_cells());
-            sim.run(300).unwrap();
-            let th = sim.advance_with_thermo().unwrap();
-            (sim.snapshot(), th)
-        })
-    };
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut sim = setup.build().unwrap();
-            sim.run(300).unwrap();
-            let th = sim.advance_with_thermo().unwrap();
-            (sim.snapshot(), th)
-        })
-    };
-    let (a, ta) = run(1);
-    let (b, tb) = run(2);
-    let (a2, ta2) = run_cells(1);
-    let (b2, tb2) = run_cells(2);
-    assert_eq!(a2, b2);
-    assert_eq!(ta2, tb2);
-    let (c, tc) = run(3);
-    assert_eq!(a, b);
-    assert_eq!(a, c);
-    assert_eq!(ta, tb);
-    assert_eq!(ta, tc);
-    assert!(a.typeid.iter().filter(|&&t| t == 1).count() > 5);
+    let mut setup = suspension();
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        setup.params.neighbors = mode;
+        let (a, ta) = run_on_threads(&setup, 1);
+        for threads in [2, 3] {
+            let (b, tb) = run_on_threads(&setup, threads);
+            assert!(a == b, "{mode:?}: {threads} threads differ from 1");
+            assert_eq!(ta, tb);
+        }
+        assert!(a.typeid.iter().filter(|&&t| t == 1).count() > 5);
+    }
 }
 
 #[test]
