@@ -19,7 +19,7 @@
 //! new positions into a second buffer; the buffers are then swapped. Nothing is allocated per
 //! step.
 
-use crate::neighbor::{BoxTooSmall, NeighborList};
+use crate::neighbor::{BoxTooSmall, NeighborList, near_image};
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::rng::{BLOCK, Purpose, stream};
@@ -173,7 +173,7 @@ impl<P: Pair, E: External> ForceCtx<'_, P, E> {
         for &j in self.nlist.neighbors(i) {
             let j = j as usize;
             let q = self.pos[j];
-            let d = self.sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
+            let d = near_image(&self.sbox, [p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
             let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             let fr = self
                 .pair

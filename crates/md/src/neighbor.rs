@@ -154,38 +154,84 @@ impl NeighborList {
                     let p = pos[i];
                     let [cx, cy, cz] = cell_xyz[i];
                     let mut m = 0usize;
-                    // Members of cells first..=last (consecutive along x).
-                    let mut scan = |first: usize, last: usize| {
-                        for k in cells[first] as usize..cells[last + 1] as usize {
-                            let q = cpos[k];
-                            let d = sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
-                            let j = members[k];
-                            let hit = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2max)
-                                & (j as usize != i);
-                            // Branch-free append; overflow is detected through `m`.
-                            slot[m.min(stride - 1)] = j;
-                            m += hit as usize;
-                        }
-                    };
-                    let (z_lo, z_n) = if nz >= 3 { (cz + nz - 1, 3) } else { (0, 1) };
-                    let (y_lo, y_n) = if ny >= 3 { (cy + ny - 1, 3) } else { (0, 1) };
-                    for a in 0..z_n {
-                        let z = wrap_index(z_lo + a, nz);
-                        for b in 0..y_n {
-                            let y = wrap_index(y_lo + b, ny);
-                            let row = (z * ny + y) * nx;
-                            // The 3 (or 1) cells along x as runs of consecutive cells; a run
-                            // that would wrap around the boundary is split in two.
-                            if nx < 3 {
-                                scan(row, row + nx - 1);
-                            } else if cx == 0 {
-                                scan(row, row + 1);
-                                scan(row + nx - 1, row + nx - 1);
-                            } else if cx == nx - 1 {
-                                scan(row, row);
-                                scan(row + nx - 2, row + nx - 1);
+                    if nx >= 3 && ny >= 3 && nz >= 3 {
+                        // Every neighbour cell is a distinct cell next to particle i's, so the
+                        // periodic image of each run is known in advance: `d = (p - q) + s`
+                        // with the run's shift `s` in {-L, 0, +L} per axis, the value
+                        // `min_image` gives for every pair within range.
+                        let l = sbox.l;
+                        let shift = |u: usize, c: usize, n: usize, l: f64| -> (usize, f64) {
+                            // Neighbour index c + u - 1 (u = 0, 1, 2), wrapped.
+                            if c + u == 0 {
+                                (n - 1, l)
+                            } else if c + u > n {
+                                (0, -l)
                             } else {
-                                scan(row + cx - 1, row + cx + 1);
+                                (c + u - 1, 0.0)
+                            }
+                        };
+                        for a in 0..3 {
+                            let (z, sz) = shift(a, cz, nz, l[2]);
+                            for b in 0..3 {
+                                let (y, sy) = shift(b, cy, ny, l[1]);
+                                let row = (z * ny + y) * nx;
+                                let mut run = |first: usize, last: usize, sx: f64| {
+                                    scan_run(
+                                        p,
+                                        i,
+                                        [sx, sy, sz],
+                                        &cpos[cells[first] as usize..cells[last + 1] as usize],
+                                        &members[cells[first] as usize..cells[last + 1] as usize],
+                                        r2max,
+                                        slot,
+                                        &mut m,
+                                    )
+                                };
+                                if cx == 0 {
+                                    run(row, row + 1, 0.0);
+                                    run(row + nx - 1, row + nx - 1, l[0]);
+                                } else if cx == nx - 1 {
+                                    run(row, row, -l[0]);
+                                    run(row + nx - 2, row + nx - 1, 0.0);
+                                } else {
+                                    run(row + cx - 1, row + cx + 1, 0.0);
+                                }
+                            }
+                        }
+                    } else {
+                        // Members of cells first..=last (consecutive along x).
+                        let mut scan = |first: usize, last: usize| {
+                            for k in cells[first] as usize..cells[last + 1] as usize {
+                                let q = cpos[k];
+                                let d = sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
+                                let j = members[k];
+                                let hit = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2max)
+                                    & (j as usize != i);
+                                // Branch-free append; overflow is detected through `m`.
+                                slot[m.min(stride - 1)] = j;
+                                m += hit as usize;
+                            }
+                        };
+                        let (z_lo, z_n) = if nz >= 3 { (cz + nz - 1, 3) } else { (0, 1) };
+                        let (y_lo, y_n) = if ny >= 3 { (cy + ny - 1, 3) } else { (0, 1) };
+                        for a in 0..z_n {
+                            let z = wrap_index(z_lo + a, nz);
+                            for b in 0..y_n {
+                                let y = wrap_index(y_lo + b, ny);
+                                let row = (z * ny + y) * nx;
+                                // The 3 (or 1) cells along x as runs of consecutive cells; a
+                                // run that would wrap around the boundary is split in two.
+                                if nx < 3 {
+                                    scan(row, row + nx - 1);
+                                } else if cx == 0 {
+                                    scan(row, row + 1);
+                                    scan(row + nx - 1, row + nx - 1);
+                                } else if cx == nx - 1 {
+                                    scan(row, row);
+                                    scan(row + nx - 2, row + nx - 1);
+                                } else {
+                                    scan(row + cx - 1, row + cx + 1);
+                                }
                             }
                         }
                     }
@@ -266,6 +312,54 @@ impl NeighborList {
     }
 }
 
+/// [`SimBox::min_image`] for separations of wrapped positions (`|d| < L` per axis, where one
+/// shift by `L` suffices), as selects rather than branches; equal to it there.
+#[inline(always)]
+pub(crate) fn near_image(sbox: &SimBox, d: [f64; 3]) -> [f64; 3] {
+    let mut out = d;
+    for k in 0..3 {
+        let (l, h) = (sbox.l[k], 0.5 * sbox.l[k]);
+        let x = d[k];
+        out[k] = if x >= h {
+            x - l
+        } else if x < -h {
+            x + l
+        } else {
+            x
+        };
+    }
+    out
+}
+
+/// Append to `slot` (branch-free; overflow shows in `m` exceeding its length) the members of
+/// one run of cells whose shifted separation from `p`, `(p - q) + shift`, is within range.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn scan_run(
+    p: [f64; 3],
+    i: usize,
+    shift: [f64; 3],
+    cpos: &[[f64; 3]],
+    members: &[u32],
+    r2max: f64,
+    slot: &mut [u32],
+    m: &mut usize,
+) {
+    let last = slot.len() - 1;
+    let mut k = *m;
+    for (q, &j) in cpos.iter().zip(members) {
+        let d = [
+            (p[0] - q[0]) + shift[0],
+            (p[1] - q[1]) + shift[1],
+            (p[2] - q[2]) + shift[2],
+        ];
+        let hit = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2max) & (j as usize != i);
+        slot[k.min(last)] = j;
+        k += hit as usize;
+    }
+    *m = k;
+}
+
 /// `i mod n` for `i < 3 n` without a division.
 #[inline(always)]
 fn wrap_index(mut i: usize, n: usize) -> usize {
@@ -286,7 +380,13 @@ mod tests {
 
     #[test]
     fn matches_brute_force_including_periodic_images() {
-        let sbox = SimBox::new([7.0, 9.5, 6.2]);
+        // 3 x 4 x 3 cells (the shifted-run path) and 3 x 1 x 3 (one cell along y).
+        for l in [[7.0, 9.5, 6.2], [7.0, 4.5, 6.2]] {
+            check_against_brute_force(SimBox::new(l));
+        }
+    }
+
+    fn check_against_brute_force(sbox: SimBox) {
         let mut rng = stream(5, 0, Purpose::Initial, 0);
         let pos: Vec<[f64; 3]> = (0..600)
             .map(|_| {

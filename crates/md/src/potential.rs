@@ -114,12 +114,12 @@ impl Pair for LennardJones {
     #[inline(always)]
     fn force_over_r(&self, r2: f64, ti: u32, tj: u32, _: f64, _: f64) -> f64 {
         let [s2, e24, _, rc2, _] = self.table[ti as usize * self.n_types + tj as usize];
-        if r2 >= rc2 {
-            return 0.0;
-        }
+        // Evaluated unconditionally and selected (no branch to mispredict: about half of a
+        // Verlet list's entries lie in the skin, beyond the cut-off).
         let ir2 = 1.0 / r2;
         let sr6 = (s2 * ir2) * (s2 * ir2) * (s2 * ir2);
-        e24 * sr6 * (2.0 * sr6 - 1.0) * ir2
+        let f = e24 * sr6 * (2.0 * sr6 - 1.0) * ir2;
+        if r2 < rc2 { f } else { 0.0 }
     }
 
     fn energy(&self, r2: f64, ti: u32, tj: u32, _: f64, _: f64) -> f64 {
