@@ -84,9 +84,21 @@ pub fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
     (v[v.len() / 2], v[0], v[v.len() - 1])
 }
 
-/// Seconds and steps of the last "Loop time of T on P procs for S steps with N atoms" line of
-/// a LAMMPS screen output, and that line's index.
-pub fn lammps_loop_time(text: &str) -> anyhow::Result<(f64, f64, usize)> {
+/// The timed loop of a LAMMPS screen output: the last "Loop time of T on P procs for S steps
+/// with N atoms" line and the "X% CPU use ..." line after it.
+pub struct LammpsLoop {
+    /// Wall seconds of the loop.
+    pub secs: f64,
+    /// Steps of the loop.
+    pub steps: f64,
+    /// CPU use in percent of wall time (NaN when not printed).
+    pub cpu_percent: f64,
+    /// Index of the "Loop time" line.
+    pub line: usize,
+}
+
+/// Parse the timed loop of a LAMMPS screen output.
+pub fn lammps_loop_time(text: &str) -> anyhow::Result<LammpsLoop> {
     use anyhow::Context;
     let lines: Vec<&str> = text.lines().collect();
     let at = lines
@@ -96,5 +108,17 @@ pub fn lammps_loop_time(text: &str) -> anyhow::Result<(f64, f64, usize)> {
     let w: Vec<&str> = lines[at].split_whitespace().collect();
     let secs: f64 = w.get(3).context("loop time line")?.parse()?;
     let steps: f64 = w.get(8).context("loop time line")?.parse()?;
-    Ok((secs, steps, at))
+    let cpu_percent = lines[at..]
+        .iter()
+        .find_map(|l| {
+            l.split_once("% CPU use")
+                .and_then(|(p, _)| p.trim().parse::<f64>().ok())
+        })
+        .unwrap_or(f64::NAN);
+    Ok(LammpsLoop {
+        secs,
+        steps,
+        cpu_percent,
+        line: at,
+    })
 }

@@ -443,18 +443,11 @@ fn measure_lammps(
         }
         let text = std::fs::read_to_string(dir.join(&screen))?;
         let lines: Vec<&str> = text.lines().collect();
-        let (secs, steps, at) = lammps_loop_time(&text)?;
+        let lp = lammps_loop_time(&text)?;
+        let (secs, steps, at) = (lp.secs, lp.steps, lp.line);
         let work = n as f64 * steps;
         rates.push(work / secs);
-        // "99.8% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.
-        let pct = lines[at..]
-            .iter()
-            .find_map(|l| {
-                l.split_once("% CPU use")
-                    .and_then(|(p, _)| p.trim().parse::<f64>().ok())
-            })
-            .unwrap_or(f64::NAN);
-        cpu_rates.push(work / (secs * pct / 100.0));
+        cpu_rates.push(work / (secs * lp.cpu_percent / 100.0));
         let nb = lines[at..]
             .iter()
             .find_map(|l| {

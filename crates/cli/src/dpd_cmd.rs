@@ -1,7 +1,9 @@
 //! `colloidsim run|check` for DPD colloids in explicit solvent (`method = "dpd"`).
 
 use crate::common::{RunOptions, progress, seed32};
-use crate::droplet::{changed_keys, checkpoint_bytes, hook, trim_trajectory};
+use crate::droplet::{
+    check_resolved, check_version_and_scenario, checkpoint_bytes, hook, trim_trajectory,
+};
 use crate::plot::{Scale, Series, line_plot};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
@@ -289,30 +291,9 @@ fn open_checkpoint(
     )?;
     let ck: Checkpoint<Observed> = bincode::deserialize(&bytes)
         .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
-    if ck.version != env!("CARGO_PKG_VERSION") {
-        eprintln!(
-            "warning: the checkpoint was written by colloidsim {}, this is {}; the continuation may not be bitwise identical",
-            ck.version,
-            env!("CARGO_PKG_VERSION")
-        );
-    }
-    if ck.scenario != text {
-        bail!(
-            "--restart {}: {} differs from the scenario this run started with (saved as {})",
-            dir.display(),
-            path.display(),
-            out.join("scenario.toml").display()
-        );
-    }
+    check_version_and_scenario(dir, path, text, &out, &ck.version, &ck.scenario)?;
     let (_, s) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
-    let now = resolved(&s)?;
-    if now != ck.resolved {
-        bail!(
-            "--restart {}: the resolved scenario differs from the checkpoint's: {}",
-            dir.display(),
-            changed_keys(&now, &ck.resolved)?
-        );
-    }
+    check_resolved(dir, &resolved(&s)?, &ck.resolved)?;
     Ok((out, ck, s))
 }
 

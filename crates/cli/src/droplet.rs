@@ -178,7 +178,7 @@ pub(crate) fn checkpoint_bytes(dir: &Path, when: &str) -> Result<(OutputDir, Vec
 
 /// The top-level keys of two resolved-parameter JSON objects that differ, as
 /// `key = now (was then)`; empty when they agree.
-pub(crate) fn changed_keys(now: &str, then: &str) -> Result<String> {
+fn changed_keys(now: &str, then: &str) -> Result<String> {
     let now: serde_json::Value = serde_json::from_str(now)?;
     let then: serde_json::Value = serde_json::from_str(then)?;
     let keys: Vec<String> = now
@@ -210,14 +210,29 @@ fn open_checkpoint(
     )?;
     let ck: Checkpoint = bincode::deserialize(&bytes)
         .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
-    if ck.version != env!("CARGO_PKG_VERSION") {
+    check_version_and_scenario(dir, path, text, &out, &ck.version, &ck.scenario)?;
+    let (_, p) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
+    check_resolved(dir, &serde_json::to_string(&p)?, &ck.resolved)?;
+    Ok((out, ck, p))
+}
+
+/// Warn when a checkpoint comes from another colloidsim version; refuse a scenario file whose
+/// text differs from the one the run started with.
+pub(crate) fn check_version_and_scenario(
+    dir: &Path,
+    path: &Path,
+    text: &str,
+    out: &OutputDir,
+    version: &str,
+    scenario: &str,
+) -> Result<()> {
+    if version != env!("CARGO_PKG_VERSION") {
         eprintln!(
-            "warning: the checkpoint was written by colloidsim {}, this is {}; the continuation may not be bitwise identical",
-            ck.version,
+            "warning: the checkpoint was written by colloidsim {version}, this is {}; the continuation may not be bitwise identical",
             env!("CARGO_PKG_VERSION")
         );
     }
-    if ck.scenario != text {
+    if scenario != text {
         bail!(
             "--restart {}: {} differs from the scenario this run started with (saved as {})",
             dir.display(),
@@ -225,16 +240,20 @@ fn open_checkpoint(
             out.join("scenario.toml").display()
         );
     }
-    let (_, p) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
-    let resolved = serde_json::to_string(&p)?;
-    if resolved != ck.resolved {
+    Ok(())
+}
+
+/// Refuse a restart whose resolved parameters (JSON) differ from the checkpoint's, naming the
+/// changed keys.
+pub(crate) fn check_resolved(dir: &Path, now: &str, saved: &str) -> Result<()> {
+    if now != saved {
         bail!(
             "--restart {}: the resolved scenario differs from the checkpoint's: {}",
             dir.display(),
-            changed_keys(&resolved, &ck.resolved)?
+            changed_keys(now, saved)?
         );
     }
-    Ok((out, ck, p))
+    Ok(())
 }
 
 /// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
@@ -802,18 +821,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
             let text = std::fs::read_to_string(dir.join("lammps.out"))?;
             // The last "Loop time of ..." line is the timed run.
-            let (secs, steps, at) = lammps_loop_time(&text)?;
-            let lines: Vec<&str> = text.lines().collect();
-            rates.push(a.n as f64 * steps / secs);
-            // "98.7% CPU use with 1 MPI tasks x 1 OpenMP threads" follows.
-            let pct = lines[at..]
-                .iter()
-                .find_map(|l| {
-                    l.split_once("% CPU use")
-                        .and_then(|(p, _)| p.trim().parse::<f64>().ok())
-                })
-                .unwrap_or(f64::NAN);
-            cpu_rates.push(a.n as f64 * steps / (secs * pct / 100.0));
+            let lp = lammps_loop_time(&text)?;
+            rates.push(a.n as f64 * lp.steps / lp.secs);
+            cpu_rates.push(a.n as f64 * lp.steps / (lp.secs * lp.cpu_percent / 100.0));
         }
         let (m, lo, hi) = median(rates);
         let (mc, _, _) = median(cpu_rates);

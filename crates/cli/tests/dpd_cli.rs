@@ -1,9 +1,14 @@
 //! End-to-end tests of `colloidsim run|check` on DPD scenarios, checkpoints and `--restart`
 //! included.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output};
+
+mod common;
+use common::{assert_same_outputs, files, text};
+
+/// summary.json fields that depend on the session (timing); neighbor_builds must match.
+const TIMING: &[&str] = &["wall_seconds", "particle_steps_per_second"];
 
 const SMALL: &str = r#"
 method = "dpd"
@@ -40,14 +45,6 @@ fn run_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
         c.env(k, v);
     }
     c.output().unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 #[test]
@@ -168,47 +165,6 @@ fn restart_scenario(d: &Path) -> String {
     "r.toml".into()
 }
 
-/// Every file of a folder by name.
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect()
-}
-
-/// summary.json without the fields that depend on the session (timing).
-fn summary(bytes: &[u8]) -> serde_json::Value {
-    let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
-    let m = v.as_object_mut().unwrap();
-    for k in ["wall_seconds", "particle_steps_per_second"] {
-        assert!(m.remove(k).is_some(), "summary.json has no {k}");
-    }
-    v
-}
-
-/// The same files, byte for byte (summary.json up to timing; neighbor_builds included).
-fn assert_same_outputs(a: &Path, b: &Path) {
-    let (fa, fb) = (files(a), files(b));
-    assert_eq!(
-        fa.keys().collect::<Vec<_>>(),
-        fb.keys().collect::<Vec<_>>(),
-        "different files"
-    );
-    for (name, bytes) in &fa {
-        if name == "summary.json" {
-            assert_eq!(summary(bytes), summary(&fb[name]), "summary.json differs");
-        } else {
-            assert!(bytes == &fb[name], "{name} differs after restart");
-        }
-    }
-}
-
 #[test]
 fn an_interrupted_run_restarts_bitwise() {
     let tmp = tempfile::tempdir().unwrap();
@@ -245,7 +201,7 @@ fn an_interrupted_run_restarts_bitwise() {
         assert!(!bp.join("summary.json").exists());
         let o = run(d, &["run", &sc, "--restart", &b, "--quiet"]);
         assert!(o.status.success(), "{}", text(&o));
-        assert_same_outputs(&d.join("a"), &bp);
+        assert_same_outputs(&d.join("a"), &bp, TIMING);
     }
     // Interrupted twice: the second session is itself interrupted (at 250, checkpoint at 280).
     let o = run_env(
@@ -266,7 +222,7 @@ fn an_interrupted_run_restarts_bitwise() {
     );
     let o = run(d, &["run", &sc, "--restart", "c", "--quiet"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert_same_outputs(&d.join("a"), &d.join("c"));
+    assert_same_outputs(&d.join("a"), &d.join("c"), TIMING);
 }
 
 #[test]
@@ -288,7 +244,7 @@ fn a_killed_run_restarts_from_the_last_periodic_checkpoint() {
     assert!(d.join("k/checkpoint.bin").exists());
     let o = run(d, &["run", &sc, "--restart", "k", "--quiet"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert_same_outputs(&d.join("a"), &d.join("k"));
+    assert_same_outputs(&d.join("a"), &d.join("k"), TIMING);
 }
 
 #[test]
@@ -340,7 +296,7 @@ fn restart_refuses_without_checkpoint_changed_scenario_or_finished_run() {
     // The refusals left the checkpoint usable.
     let o = run(d, &["run", &sc, "--restart", "b", "--quiet"]);
     assert!(o.status.success(), "{}", text(&o));
-    assert_same_outputs(&d.join("a"), &d.join("b"));
+    assert_same_outputs(&d.join("a"), &d.join("b"), TIMING);
 }
 
 #[test]
@@ -370,7 +326,7 @@ fn a_restarted_run_stops_where_the_uninterrupted_one_does() {
     let o = run(d, &["run", "hot.toml", "--restart", "b", "--quiet"]);
     assert!(!o.status.success());
     assert!(text(&o).contains("before step 210"), "{}", text(&o));
-    assert_same_outputs(&d.join("a"), &d.join("b"));
+    assert_same_outputs(&d.join("a"), &d.join("b"), TIMING);
     // A failed run keeps no checkpoint: it cannot be continued.
     assert!(!d.join("b/checkpoint.bin").exists());
     let o = run(d, &["run", "hot.toml", "--restart", "b", "--quiet"]);

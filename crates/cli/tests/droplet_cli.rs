@@ -1,8 +1,18 @@
 //! End-to-end tests of `colloidsim run` on droplet-bd scenarios: checkpoints and `--restart`.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+mod common;
+use common::{assert_same_outputs, files, text};
+
+/// summary.json fields that depend on the session (timing) or on when the neighbour list was
+/// rebuilt (a restart rebuilds it).
+const VOLATILE: &[&str] = &[
+    "wall_seconds",
+    "particle_steps_per_second",
+    "neighbor_list_builds",
+];
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_colloidsim"))
@@ -27,14 +37,6 @@ profile = { bins = 10, fractions = [0, 0.25, 0.5, 0.75, 1.0] }
 trajectory = { every = 20 }
 "#;
 
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
 /// Run colloidsim with `args` and the environment variables `env`.
 fn run(args: &[&Path], env: &[(&str, &str)]) -> Output {
     let mut c = bin();
@@ -49,52 +51,6 @@ fn run(args: &[&Path], env: &[(&str, &str)]) -> Output {
 
 fn p(s: &str) -> &Path {
     Path::new(s)
-}
-
-/// Every file of a folder by name.
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect()
-}
-
-/// summary.json without the fields that depend on the session (timing) or on when the
-/// neighbour list was rebuilt (a restart rebuilds it).
-fn summary(bytes: &[u8]) -> serde_json::Value {
-    let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
-    let m = v.as_object_mut().unwrap();
-    for k in [
-        "wall_seconds",
-        "particle_steps_per_second",
-        "neighbor_list_builds",
-    ] {
-        assert!(m.remove(k).is_some(), "summary.json has no {k}");
-    }
-    v
-}
-
-/// The same files, byte for byte (summary.json up to timing).
-fn assert_same_outputs(a: &Path, b: &Path) {
-    let (fa, fb) = (files(a), files(b));
-    assert_eq!(
-        fa.keys().collect::<Vec<_>>(),
-        fb.keys().collect::<Vec<_>>(),
-        "different files"
-    );
-    for (name, bytes) in &fa {
-        if name == "summary.json" {
-            assert_eq!(summary(bytes), summary(&fb[name]), "summary.json differs");
-        } else {
-            assert!(bytes == &fb[name], "{name} differs after restart");
-        }
-    }
 }
 
 fn setup() -> (tempfile::TempDir, PathBuf, PathBuf) {
@@ -145,7 +101,7 @@ fn interrupted_run_restarts_bitwise() {
         assert!(!b.join("summary.json").exists());
         let o = run(&[p("run"), &sc, p("--restart"), &b], &[]);
         assert!(o.status.success());
-        assert_same_outputs(&a, &b);
+        assert_same_outputs(&a, &b, VOLATILE);
     }
 }
 
@@ -165,7 +121,7 @@ fn killed_run_restarts_from_the_last_periodic_checkpoint() {
         assert!(c.join("checkpoint.bin").exists());
         let o = run(&[p("run"), &sc, p("--restart"), &c], &[]);
         assert!(o.status.success());
-        assert_same_outputs(&a, &c);
+        assert_same_outputs(&a, &c, VOLATILE);
     }
 }
 
@@ -210,5 +166,5 @@ fn restart_refuses_without_checkpoint_changed_scenario_or_completed_run() {
     // The refusals left the checkpoint usable.
     let o = run(&[p("run"), &sc, p("--restart"), &b], &[]);
     assert!(o.status.success());
-    assert_same_outputs(&a, &b);
+    assert_same_outputs(&a, &b, VOLATILE);
 }
