@@ -121,7 +121,7 @@ impl Engine {
 }
 
 /// `checkpoint.bin`: where the run stands. The running replica's particles (exact positions,
-/// images, box, storage order) are in the GSD file `gsd` beside it.
+/// images, box, storage order, list reference positions) are in the GSD file `gsd` beside it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct Checkpoint {
     version: String,
@@ -338,7 +338,7 @@ fn save_checkpoint(
             let path = out.join(&name);
             let _ = std::fs::remove_file(&path);
             let mut w = GsdWriter::create_new(&path)?;
-            w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), s.order(), &[])?;
+            w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?;
             w.sync()?;
             Some((name.clone(), Engine::of(s, builds)))
         }
@@ -374,7 +374,7 @@ fn restore(
     let path = out.join(name);
     let f = gsd::read_frame(&path, None)
         .with_context(|| format!("--restart {}", out.path().display()))?;
-    if f.step != ck.step || !f.exact || f.order.is_none() || engine.replica as usize != ck.replica {
+    if f.step != ck.step || !f.exact || f.list.is_none() || engine.replica as usize != ck.replica {
         bail!(
             "{}: not the checkpoint of replica {} at step {} that {CHECKPOINT} names",
             path.display(),
@@ -389,7 +389,7 @@ fn restore(
         p.interface(),
         engine.params(),
         f.step,
-        f.order.as_deref(),
+        f.list.as_ref(),
     )
     .with_context(|| format!("--restart from {}", path.display()))?;
     // The rebuild on restoring is not one the uninterrupted run makes: leave it out.

@@ -3,34 +3,37 @@
 //! `x(t + dt) = x + F / gamma_i dt + sqrt(2 kT dt / gamma_i) xi`, with Stokes friction
 //! `gamma_i = 3 pi eta d_i` from each particle's diameter.
 //!
-//! Particles are stored in cell order so that neighbours lie close in memory: they are
-//! re-sorted every [`BdParams::sort_every`] steps (a fixed schedule) and the storage order is
-//! part of the state ([`Brownian::order`], saved in checkpoints). The noise of the particle in
-//! storage slot `k` at step `n` comes from the counter-based stream keyed by
-//! (seed, n, replica, k / BLOCK), one keyed stream per block of [`BLOCK`] slots. A run is
-//! therefore a pure function of its inputs: identical for any number of threads, and a restart
-//! from a checkpoint (positions, images, box and storage order in double precision) continues
-//! bitwise identically. Forces are summed over each particle's neighbours in the order of their
-//! input index, so sums do not depend on when the neighbour list was rebuilt.
+//! **Neighbours.** Particles are kept sorted by cell ([`crate::cells`]; cells at least the
+//! largest cut-off plus the skin wide, z-major) and every pair within that range is stored once,
+//! in a half Verlet list of the particle whose cell has the other in its half stencil. The
+//! lists are rebuilt, with a re-sort, whenever a particle has moved more than half the skin
+//! since the last build, and at every multiple of [`BdParams::sort_every`] steps. Each z-layer of
+//! cells (a *slab*) sums its pairs into its own force buffer, whose tail is a halo for the next
+//! slab; a particle's pair force is its slab's sum plus the previous slab's halo, added in a
+//! fixed order.
+//!
+//! **Determinism.** The noise of the particle in storage slot `k` at step `n` comes from the
+//! counter-based stream keyed by (seed, n, replica, k / BLOCK), one keyed stream per block of
+//! [`BLOCK`] slots. The storage order and the lists are functions of the positions at the last
+//! build (ties in a cell broken by input index), so a run is a pure function of its inputs:
+//! bitwise identical for any number of threads. A checkpoint that keeps the storage order and
+//! the positions of the last build ([`ListState`]) restarts bitwise identically.
 //! [`Brownian::snapshot`] returns the particles in input order.
 //!
-//! One step is a single parallel pass over chunks of particles: each chunk sums its particles'
-//! forces from the neighbour list (reading the old positions), draws its noise and writes the
-//! new positions into a second buffer; the buffers are then swapped. Nothing is allocated per
-//! step.
+//! One step is two parallel passes and nothing is allocated: the pair forces slab by slab, then
+//! chunk by chunk the external force, the noise and the new positions (into a second buffer;
+//! the buffers are then swapped).
 
-use crate::neighbor::{BoxTooSmall, NeighborList, near_image};
+use crate::cells::{CellSort, permute, scan_layer};
+use crate::neighbor::{BoxTooSmall, near_image};
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
-use colloidsim_core::rng::{BLOCK, Purpose, stream};
-use rand::RngExt;
-use rand_distr::StandardNormal;
+use colloidsim_core::rng::{BLOCK, Purpose, Ziggurat, stream};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Particles per parallel work item (a multiple of the noise block).
+/// Particles per parallel work item of the integration pass (a multiple of the noise block).
 const CHUNK: usize = 4 * BLOCK;
-
 /// Parameters of the Brownian integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BdParams {
@@ -47,7 +50,8 @@ pub struct BdParams {
     pub replica: u32,
     /// Verlet skin.
     pub skin: f64,
-    /// Re-sort particles into cell order every this many steps (0: never after the start).
+    /// Also rebuild the neighbour lists (re-sorting the particles into cells) at every
+    /// multiple of this many steps (0: only when a particle has moved half the skin).
     pub sort_every: u64,
     /// A step whose deterministic displacement `|F| dt / gamma` exceeds this fraction of the
     /// particle's diameter stops the run (the time step is too large for the potential).
@@ -55,7 +59,7 @@ pub struct BdParams {
 }
 
 impl BdParams {
-    /// Defaults: kT = 1, eta = 1, skin 0.3, sort every 500 steps, max_drift 0.2.
+    /// Defaults: kT = 1, eta = 1, skin 0.3, lists rebuilt at least every 500 steps, max_drift 0.2.
     pub fn new(dt: f64, seed: u32) -> Self {
         Self {
             kt: 1.0,
@@ -103,6 +107,31 @@ pub enum BdError {
     Invalid(String),
 }
 
+/// What a checkpoint needs besides the particles to continue bitwise: the engine's storage
+/// order and the positions (in storage order) at the last neighbour-list build.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ListState {
+    /// Input index of each stored particle ([`Brownian::order`]).
+    pub order: Vec<u32>,
+    /// Wrapped positions of the stored particles when the lists were last built.
+    pub reference: Vec<[f64; 3]>,
+}
+
+/// One z-layer of cells: its particles, their half neighbour lists and force buffer.
+#[derive(Debug, Clone, Default)]
+struct Slab {
+    start: usize,
+    end: usize,
+    /// Half list of the pairs `(i, j)` found from this slab's particles `i`, in build order
+    /// (one flat loop: no short inner loops whose exits mispredict).
+    pairs: Vec<[u32; 2]>,
+    /// Candidate pairs of one particle (scratch of the list build).
+    cand: Vec<(u32, [f64; 3])>,
+    /// Pair forces on this slab's particles (`end - start` entries), then on the next slab's
+    /// particles (the halo).
+    acc: Vec<[f64; 3]>,
+}
+
 /// A Brownian dynamics simulation with pair potential `P` and external field `E`.
 pub struct Brownian<P: Pair, E: External> {
     particles: Particles,
@@ -116,7 +145,13 @@ pub struct Brownian<P: Pair, E: External> {
     params: BdParams,
     /// Current step (time = step * dt).
     pub step: u64,
-    nlist: NeighborList,
+    /// Neighbour range: largest cut-off plus skin (0 without pair forces).
+    range: f64,
+    grid: CellSort,
+    slabs: Vec<Slab>,
+    slab_of: Vec<u32>,
+    ref_pos: Vec<[f64; 3]>,
+    builds: u64,
     new_pos: Vec<[f64; 3]>,
     new_image: Vec<[i32; 3]>,
     mobility: Vec<f64>,
@@ -124,7 +159,6 @@ pub struct Brownian<P: Pair, E: External> {
     drift_limit2: Vec<f64>,
     scratch_f64: Vec<f64>,
     scratch_u32: Vec<u32>,
-    perm: Vec<u32>,
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
@@ -153,43 +187,139 @@ impl ChunkReport {
     }
 }
 
-/// Borrowed view of everything a force evaluation reads.
-struct ForceCtx<'a, P, E> {
-    pos: &'a [[f64; 3]],
-    typeid: &'a [u32],
-    diameter: &'a [f64],
-    nlist: &'a NeighborList,
-    sbox: SimBox,
-    pair: &'a P,
-    external: &'a E,
-}
+/// Pairs per batch of the pair-force pass.
+const PAIR_BATCH: usize = 64;
 
-impl<P: Pair, E: External> ForceCtx<'_, P, E> {
-    #[inline(always)]
-    fn force_on(&self, i: usize, t: f64) -> [f64; 3] {
-        let p = self.pos[i];
-        let mut f = self.external.force(p, t);
-        let (ti, di) = (self.typeid[i], self.diameter[i]);
-        for &j in self.nlist.neighbors(i) {
-            let j = j as usize;
-            let q = self.pos[j];
-            let d = near_image(&self.sbox, [p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
+/// Pair forces of one slab's half list into `acc` (its own particles first, then the next
+/// slab's, which starts at slot `next_start`). Batch by batch, the separations are computed and
+/// the pairs within the largest cut-off `r_cut` kept (branch-free); only those evaluate the
+/// potential (most list entries lie in the skin). Pairs beyond the cut-off would add exact
+/// zeros, so the sums equal those over the whole list.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn slab_pair_forces<P: Pair>(
+    slab: &Slab,
+    next_start: usize,
+    r_cut: f64,
+    pos: &[[f64; 3]],
+    typeid: &[u32],
+    diameter: &[f64],
+    sbox: &SimBox,
+    pair: &P,
+    acc: &mut [[f64; 3]],
+) {
+    let (start, end) = (slab.start, slab.end);
+    let own = end - start;
+    let rc2 = r_cut * r_cut;
+    acc.iter_mut().for_each(|f| *f = [0.0; 3]);
+    let mut near = [(0u32, 0u32, [0.0f64; 3], 0.0f64); PAIR_BATCH];
+    for batch in slab.pairs.chunks(PAIR_BATCH) {
+        let mut m = 0;
+        for &[i, j] in batch {
+            let (xi, xj) = (pos[i as usize], pos[j as usize]);
+            let d = near_image(sbox, [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
             let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let fr = self
-                .pair
-                .force_over_r(r2, ti, self.typeid[j], di, self.diameter[j]);
-            f[0] += fr * d[0];
-            f[1] += fr * d[1];
-            f[2] += fr * d[2];
+            near[m] = (i, j, d, r2);
+            m += (r2 < rc2) as usize;
         }
-        f
+        for &(i, j, d, r2) in &near[..m] {
+            let (i, j) = (i as usize, j as usize);
+            let fr = pair.force_over_r(r2, typeid[i], typeid[j], diameter[i], diameter[j]);
+            let fv = [fr * d[0], fr * d[1], fr * d[2]];
+            let fi = &mut acc[i - start];
+            fi[0] += fv[0];
+            fi[1] += fv[1];
+            fi[2] += fv[2];
+            // Own slab, or the next one (slab 0 across the periodic seam): a select.
+            let slot = if j.wrapping_sub(start) < own {
+                j - start
+            } else {
+                own + j.wrapping_sub(next_start)
+            };
+            let fj = &mut acc[slot];
+            fj[0] -= fv[0];
+            fj[1] -= fv[1];
+            fj[2] -= fv[2];
+        }
     }
 }
 
-fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
-    scratch.clear();
-    scratch.extend(perm.iter().map(|&k| v[k as usize]));
-    std::mem::swap(v, scratch);
+/// Pair forces of every slab into its buffer, slabs in parallel.
+fn all_pair_forces<P: Pair>(slabs: &mut [Slab], p: &Particles, sbox: &SimBox, pair: &P) {
+    let nz = slabs.len();
+    let r_cut = pair.r_cut_max();
+    // The first slab's start, read before the slabs are borrowed mutably.
+    let first = slabs.first().map_or(0, |s| s.start);
+    slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
+        let next_start = if z + 1 == nz { first } else { slab.end };
+        let mut acc = std::mem::take(&mut slab.acc);
+        slab_pair_forces(
+            slab,
+            next_start,
+            r_cut,
+            &p.pos,
+            &p.typeid,
+            &p.diameter,
+            sbox,
+            pair,
+            &mut acc,
+        );
+        slab.acc = acc;
+    });
+}
+
+/// Walks the slabs along consecutive slots: the pair force on slot `i` is its slab's own sum
+/// plus the previous slab's halo.
+struct PairForceCursor<'a> {
+    slabs: &'a [Slab],
+    /// Current slab, its first slot and end, and its particles' entries in the two buffers.
+    z: usize,
+    start: usize,
+    end: usize,
+    own: &'a [[f64; 3]],
+    halo: &'a [[f64; 3]],
+}
+
+impl<'a> PairForceCursor<'a> {
+    /// A cursor at slot `i` (`slab_of` maps slots to slabs; no slabs: zero forces).
+    fn new(slabs: &'a [Slab], slab_of: &[u32], i: usize) -> Self {
+        let mut c = Self {
+            slabs,
+            z: 0,
+            start: 0,
+            end: usize::MAX,
+            own: &[],
+            halo: &[],
+        };
+        if !slabs.is_empty() {
+            c.seek(slab_of.get(i).map_or(0, |&z| z as usize));
+        }
+        c
+    }
+
+    fn seek(&mut self, z: usize) {
+        let nz = self.slabs.len();
+        let s = &self.slabs[z];
+        let prev = &self.slabs[(z + nz - 1) % nz];
+        self.z = z;
+        self.start = s.start;
+        self.end = s.end;
+        self.own = &s.acc[..s.end - s.start];
+        self.halo = &prev.acc[prev.end - prev.start..];
+    }
+
+    /// Pair force on slot `i` (slots visited in increasing order).
+    #[inline(always)]
+    fn force(&mut self, i: usize) -> [f64; 3] {
+        if self.slabs.is_empty() {
+            return [0.0; 3];
+        }
+        while i >= self.end {
+            self.seek(self.z + 1);
+        }
+        let (a, b) = (self.own[i - self.start], self.halo[i - self.start]);
+        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+    }
 }
 
 impl<P: Pair, E: External> Brownian<P, E> {
@@ -206,9 +336,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         Self::restart(particles, sbox, pair, external, params, step, None)
     }
 
-    /// Continue from a checkpoint: `particles` in input order at `step`, stored in `order`
-    /// (input indices in storage order, as [`Self::order`] returned) when given, so that the run
-    /// continues bitwise identically.
+    /// Continue from a checkpoint: `particles` in input order at `step`, with the storage order
+    /// and list reference positions [`Self::list_state`] returned, so that the run continues
+    /// bitwise identically (without it, the particles are sorted and the lists built afresh).
     pub fn restart(
         particles: Particles,
         sbox: SimBox,
@@ -216,7 +346,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         external: E,
         params: BdParams,
         step: u64,
-        order: Option<&[u32]>,
+        list: Option<&ListState>,
     ) -> Result<Self, BdError> {
         particles.check().map_err(BdError::Invalid)?;
         if let Some(i) = particles
@@ -235,12 +365,35 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 params.dt
             )));
         }
+        if !(params.skin.is_finite() && params.skin >= 0.0) {
+            return Err(BdError::Invalid(format!(
+                "skin {} must be >= 0",
+                params.skin
+            )));
+        }
         let mut particles = particles;
         for (p, img) in particles.pos.iter_mut().zip(particles.image.iter_mut()) {
             sbox.wrap(p, img);
         }
         let n = particles.len();
-        let nlist = NeighborList::new(pair.r_cut_max(), params.skin);
+        let r_cut = pair.r_cut_max();
+        let range = if r_cut > 0.0 {
+            r_cut + params.skin
+        } else {
+            0.0
+        };
+        let edge = sbox.l.iter().cloned().fold(f64::INFINITY, f64::min);
+        // Shorter edges would let two images of a pair lie within range; one or two cells per
+        // axis are fine otherwise (the half stencil then meets other images, which lie beyond
+        // the range).
+        if range > 0.0 && edge <= 2.0 * range {
+            return Err(BoxTooSmall {
+                edge,
+                minimum: 2.0 * range,
+                range,
+            }
+            .into());
+        }
         let mut s = Self {
             particles,
             tag: (0..n as u32).collect(),
@@ -249,7 +402,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
             external,
             params,
             step,
-            nlist,
+            range,
+            grid: CellSort::default(),
+            slabs: Vec::new(),
+            slab_of: Vec::new(),
+            ref_pos: Vec::new(),
+            builds: 0,
             new_pos: vec![[0.0; 3]; n],
             new_image: vec![[0; 3]; n],
             mobility: Vec::new(),
@@ -257,34 +415,73 @@ impl<P: Pair, E: External> Brownian<P, E> {
             drift_limit2: Vec::new(),
             scratch_f64: Vec::new(),
             scratch_u32: Vec::new(),
-            perm: Vec::new(),
         };
         s.set_dt(params.dt);
-        match order {
-            None => s.sort_and_rebuild()?,
-            Some(order) => {
-                let mut seen = vec![false; n];
-                for &k in order {
-                    if (k as usize) >= n || std::mem::replace(&mut seen[k as usize], true) {
-                        return Err(BdError::Invalid(
-                            "the stored particle order is not a permutation of the particles"
-                                .into(),
-                        ));
-                    }
-                }
-                if order.len() != n {
-                    return Err(BdError::Invalid(format!(
-                        "the stored particle order has {} entries for {n} particles",
-                        order.len()
-                    )));
-                }
-                s.perm.clear();
-                s.perm.extend_from_slice(order);
-                s.apply_perm();
-                s.nlist.build(&s.sbox, &s.particles.pos, &s.tag)?;
-            }
+        match list {
+            None => s.sort_and_rebuild(),
+            Some(ls) => s.resume_lists(ls)?,
         }
         Ok(s)
+    }
+
+    /// Re-establish the storage order and the lists of a checkpoint.
+    fn resume_lists(&mut self, ls: &ListState) -> Result<(), BdError> {
+        let n = self.particles.len();
+        let bad = |m: &str| BdError::Invalid(format!("the checkpoint's neighbour-list state: {m}"));
+        if ls.order.len() != n || ls.reference.len() != n {
+            return Err(bad(&format!(
+                "{} stored indices and {} reference positions for {n} particles",
+                ls.order.len(),
+                ls.reference.len()
+            )));
+        }
+        let mut seen = vec![false; n];
+        for &k in &ls.order {
+            if (k as usize) >= n || std::mem::replace(&mut seen[k as usize], true) {
+                return Err(bad(
+                    "the stored order is not a permutation of the particles",
+                ));
+            }
+        }
+        if ls.reference.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(bad("a reference position is not finite"));
+        }
+        self.grid.perm.clear();
+        self.grid.perm.extend_from_slice(&ls.order);
+        self.apply_perm();
+        if self.range > 0.0 {
+            self.ref_pos.clear();
+            self.ref_pos.extend_from_slice(&ls.reference);
+            // The stored order must be the cell order of the reference positions.
+            self.grid
+                .sort(&self.sbox, &self.ref_pos, &self.tag, self.range);
+            if self
+                .grid
+                .perm
+                .iter()
+                .enumerate()
+                .any(|(k, &p)| p as usize != k)
+            {
+                return Err(bad(
+                    "the stored order is not the cell order of the reference positions",
+                ));
+            }
+            self.build_lists();
+        }
+        Ok(())
+    }
+
+    /// The storage order and the positions of the last list build: what a checkpoint needs to
+    /// continue bitwise ([`Self::restart`]).
+    pub fn list_state(&self) -> ListState {
+        ListState {
+            order: self.tag.clone(),
+            reference: if self.range > 0.0 {
+                self.ref_pos.clone()
+            } else {
+                self.particles.pos.clone()
+            },
+        }
     }
 
     /// Change the time step (the time origin stays at `step * dt`).
@@ -315,13 +512,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
         &self.params
     }
 
-    /// Particles in the engine's internal (cell) order; see [`Self::tags`].
+    /// Particles in the engine's internal (cell) order; see [`Self::order`].
     pub fn particles(&self) -> &Particles {
         &self.particles
     }
 
-    /// Input index of each internally stored particle (the storage order; save it with a
-    /// checkpoint and pass it to [`Self::restart`]).
+    /// Input index of each internally stored particle (the storage order).
     pub fn order(&self) -> &[u32] {
         &self.tag
     }
@@ -351,67 +547,96 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.step as f64 * self.params.dt
     }
 
-    /// Number of neighbour-list builds so far.
+    /// Number of neighbour-list builds so far (by this engine object).
     pub fn neighbor_builds(&self) -> u64 {
-        self.nlist.builds()
+        self.builds
     }
 
-    fn ctx(&self) -> ForceCtx<'_, P, E> {
-        ForceCtx {
-            pos: &self.particles.pos,
-            typeid: &self.particles.typeid,
-            diameter: &self.particles.diameter,
-            nlist: &self.nlist,
-            sbox: self.sbox,
-            pair: &self.pair,
-            external: &self.external,
-        }
-    }
-
-    /// Forces on the particles in input order at the current positions and time.
+    /// Forces on the particles in input order at the current positions and time (allocates).
     pub fn forces(&self) -> Vec<[f64; 3]> {
         let t = self.time();
-        let ctx = self.ctx();
-        let internal: Vec<[f64; 3]> = (0..self.particles.len())
-            .into_par_iter()
-            .map(|i| ctx.force_on(i, t))
-            .collect();
-        let mut out = vec![[0.0; 3]; internal.len()];
-        for (k, f) in internal.into_iter().enumerate() {
-            out[self.tag[k] as usize] = f;
+        let n = self.particles.len();
+        let mut slabs = self.slabs.clone();
+        let p = &self.particles;
+        all_pair_forces(&mut slabs, p, &self.sbox, &self.pair);
+        let mut out = vec![[0.0; 3]; n];
+        let mut pair_force = PairForceCursor::new(&slabs, &self.slab_of, 0);
+        for (k, &tag) in self.tag.iter().enumerate() {
+            let mut f = pair_force.force(k);
+            let e = self.external.force(p.pos[k], t);
+            for a in 0..3 {
+                f[a] += e[a];
+            }
+            out[tag as usize] = f;
         }
         out
     }
 
-    /// Reorder the particles by cell (when there is a pair potential) and rebuild the list.
-    fn sort_and_rebuild(&mut self) -> Result<(), BdError> {
-        if self.nlist.range() > 0.0 {
-            let order = self.nlist.bin(&self.sbox, &self.particles.pos);
-            self.perm.clear();
-            self.perm.extend_from_slice(order);
-            self.apply_perm();
+    /// Sort the particles into cells and rebuild the lists (no-op without pair forces).
+    fn sort_and_rebuild(&mut self) {
+        if self.range <= 0.0 {
+            return;
         }
-        self.nlist
-            .build(&self.sbox, &self.particles.pos, &self.tag)?;
-        Ok(())
+        self.grid
+            .sort(&self.sbox, &self.particles.pos, &self.tag, self.range);
+        self.apply_perm();
+        self.ref_pos.clear();
+        self.ref_pos.extend_from_slice(&self.particles.pos);
+        self.build_lists();
     }
 
-    /// Apply `self.perm` (new slot k takes old slot perm[k]) to every per-particle array.
-    fn apply_perm(&mut self) {
-        {
-            let perm = &self.perm;
-            let p = &mut self.particles;
-            permute(&mut p.pos, perm, &mut self.new_pos);
-            permute(&mut p.vel, perm, &mut self.new_pos);
-            permute(&mut p.image, perm, &mut self.new_image);
-            permute(&mut p.typeid, perm, &mut self.scratch_u32);
-            permute(&mut self.tag, perm, &mut self.scratch_u32);
-            permute(&mut p.diameter, perm, &mut self.scratch_f64);
-            permute(&mut p.mass, perm, &mut self.scratch_f64);
-            permute(&mut self.mobility, perm, &mut self.scratch_f64);
-            permute(&mut self.noise_amp, perm, &mut self.scratch_f64);
-            permute(&mut self.drift_limit2, perm, &mut self.scratch_f64);
+    /// Slabs and half lists from the reference positions (which are in cell order).
+    fn build_lists(&mut self) {
+        self.builds += 1;
+        let n = self.particles.len();
+        let nz = self.grid.n_cells[2];
+        self.slabs.resize_with(nz, Slab::default);
+        for z in 0..nz {
+            (self.slabs[z].start, self.slabs[z].end) = self.grid.layer(z);
         }
+        for z in 0..nz {
+            let next = self.slabs[(z + 1) % nz].end - self.slabs[(z + 1) % nz].start;
+            let s = &mut self.slabs[z];
+            s.acc.resize(s.end - s.start + next, [0.0; 3]);
+        }
+        debug_assert_eq!(self.slabs.last().map_or(n, |s| s.end), n);
+        self.grid.layer_of_slots(&mut self.slab_of);
+        let pos = &self.ref_pos;
+        let cell_start = &self.grid.cell_start;
+        let n_cells = self.grid.n_cells;
+        let (sbox, range) = (self.sbox, self.range);
+        self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
+            let Slab { pairs, cand, .. } = slab;
+            pairs.clear();
+            scan_layer(
+                z,
+                pos,
+                cell_start,
+                n_cells,
+                &sbox,
+                range,
+                cand,
+                |i, cands| {
+                    pairs.extend(cands.iter().map(|&(j, _)| [i as u32, j]));
+                },
+            );
+        });
+    }
+
+    /// Apply `self.grid.perm` (new slot k takes old slot perm[k]) to every per-particle array.
+    fn apply_perm(&mut self) {
+        let perm = &self.grid.perm;
+        let p = &mut self.particles;
+        permute(&mut p.pos, perm, &mut self.new_pos);
+        permute(&mut p.vel, perm, &mut self.new_pos);
+        permute(&mut p.image, perm, &mut self.new_image);
+        permute(&mut p.typeid, perm, &mut self.scratch_u32);
+        permute(&mut self.tag, perm, &mut self.scratch_u32);
+        permute(&mut p.diameter, perm, &mut self.scratch_f64);
+        permute(&mut p.mass, perm, &mut self.scratch_f64);
+        permute(&mut self.mobility, perm, &mut self.scratch_f64);
+        permute(&mut self.noise_amp, perm, &mut self.scratch_f64);
+        permute(&mut self.drift_limit2, perm, &mut self.scratch_f64);
     }
 
     /// Advance `n` steps.
@@ -430,18 +655,25 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let key0 = (self.params.replica as u64) << 32;
         let dt = self.params.dt;
         let n = self.particles.len();
+        if self.range > 0.0 {
+            all_pair_forces(&mut self.slabs, &self.particles, &self.sbox, &self.pair);
+        }
         let mut new_pos = std::mem::take(&mut self.new_pos);
         let mut new_image = std::mem::take(&mut self.new_image);
         new_pos.resize(n, [0.0; 3]);
         new_image.resize(n, [0; 3]);
-        let old_image = &self.particles.image;
-        let ctx = self.ctx();
+        let p = &self.particles;
+        let (pos, old_image) = (&p.pos, &p.image);
+        let (slabs, slab_of, ref_pos) = (&self.slabs, &self.slab_of, &self.ref_pos);
+        let track = self.range > 0.0;
+        let (sbox, external) = (self.sbox, &self.external);
         let (mobility, noise_amp, drift_limit2, tag) = (
             &self.mobility,
             &self.noise_amp,
             &self.drift_limit2,
             &self.tag,
         );
+        let zig = Ziggurat::get();
         let report = new_pos
             .par_chunks_mut(CHUNK)
             .zip(new_image.par_chunks_mut(CHUNK))
@@ -450,9 +682,13 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 let mut rep = ChunkReport::EMPTY;
                 let block0 = (b * CHUNK / BLOCK) as u64;
                 let mut rng = stream(seed, step, Purpose::Noise, key0 | block0);
+                let mut pair_force = PairForceCursor::new(slabs, slab_of, b * CHUNK);
                 for (k, (np, img)) in out.iter_mut().zip(images.iter_mut()).enumerate() {
                     let i = b * CHUNK + k;
-                    let f = ctx.force_on(i, t);
+                    let x = pos[i];
+                    let fp = pair_force.force(i);
+                    let fe = external.force(x, t);
+                    let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
                     let m = mobility[i] * dt;
                     let drift = [f[0] * m, f[1] * m, f[2] * m];
                     let drift2 = drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
@@ -474,21 +710,30 @@ impl<P: Pair, E: External> Brownian<P, E> {
                             key0 | (block0 + (k / BLOCK) as u64),
                         );
                     }
-                    let xi: [f64; 3] = [
-                        rng.sample(StandardNormal),
-                        rng.sample(StandardNormal),
-                        rng.sample(StandardNormal),
+                    let xi = [
+                        zig.sample(&mut rng),
+                        zig.sample(&mut rng),
+                        zig.sample(&mut rng),
                     ];
                     let a = noise_amp[i];
-                    let p = ctx.pos[i];
                     let mut q = [
-                        p[0] + drift[0] + a * xi[0],
-                        p[1] + drift[1] + a * xi[1],
-                        p[2] + drift[2] + a * xi[2],
+                        x[0] + drift[0] + a * xi[0],
+                        x[1] + drift[1] + a * xi[1],
+                        x[2] + drift[2] + a * xi[2],
                     ];
-                    rep.max_disp2 = rep.max_disp2.max(ctx.nlist.displacement2(&ctx.sbox, i, q));
+                    if track {
+                        let r = ref_pos[i];
+                        let d = near_image(&sbox, [q[0] - r[0], q[1] - r[1], q[2] - r[2]]);
+                        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        // NaN compares false and is ignored here; the blow-up check reports it.
+                        rep.max_disp2 = if d2 > rep.max_disp2 {
+                            d2
+                        } else {
+                            rep.max_disp2
+                        };
+                    }
                     *img = old_image[i];
-                    ctx.sbox.wrap(&mut q, img);
+                    sbox.wrap(&mut q, img);
                     *np = q;
                 }
                 rep
@@ -512,14 +757,13 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.new_pos = new_pos;
         self.new_image = new_image;
         self.step += 1;
-        if self.nlist.range() > 0.0 {
-            let every = self.params.sort_every;
-            if every > 0 && self.step.is_multiple_of(every) {
-                self.sort_and_rebuild()?;
-            } else if report.max_disp2 > 0.25 * self.nlist.skin * self.nlist.skin {
-                self.nlist
-                    .build(&self.sbox, &self.particles.pos, &self.tag)?;
-            }
+        let every = self.params.sort_every;
+        // NaN displacements (a run gone non-finite without a blow-up) fail every comparison:
+        // the rebuild is skipped and the next step reports the blow-up.
+        if report.max_disp2 > 0.25 * self.params.skin * self.params.skin
+            || (every > 0 && self.step.is_multiple_of(every))
+        {
+            self.sort_and_rebuild();
         }
         Ok(())
     }

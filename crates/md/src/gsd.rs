@@ -4,10 +4,13 @@
 //! `particles/N`, `particles/types`, `particles/typeid`, `particles/diameter`,
 //! `particles/position` (f32, as the schema says) and `particles/image`, which the `gsd`
 //! Python package, freud and OVITO read. Checkpoint frames add the exact double-precision
-//! positions as `log/particles/position_f64` so that a restart continues bitwise identically.
+//! positions as `log/particles/position_f64`, and the Brownian engine's storage order and
+//! neighbour-list reference positions ([`ListState`]), so that a restart continues bitwise
+//! identically.
 //! Readers fall back to frame 0 for chunks a frame lacks, as the schema specifies, and to the
 //! schema's defaults after that.
 
+use crate::brownian::ListState;
 use crate::state::{Particles, SimBox};
 use hoomd_gsd::file_layer::{GsdFile, Mode};
 use std::path::{Path, PathBuf};
@@ -16,6 +19,7 @@ const NAME_LEN: usize = 64;
 const POS64: &str = "log/particles/position_f64";
 const BOX64: &str = "log/configuration/box_f64";
 const ORDER: &str = "log/particles/storage_order";
+const REFERENCE: &str = "log/particles/list_reference_position_f64";
 
 /// A GSD error with the file involved.
 #[derive(Debug, thiserror::Error)]
@@ -122,17 +126,18 @@ impl GsdWriter {
             })
     }
 
-    /// Append a checkpoint frame: exact positions and box plus the engine's storage order
-    /// (`Brownian::order`), everything `Brownian::restart` needs to continue bitwise.
+    /// Append a checkpoint frame: exact positions and box plus the engine's storage order and
+    /// list reference positions (`Brownian::list_state`), everything `Brownian::restart` needs
+    /// to continue bitwise.
     pub fn write_checkpoint(
         &mut self,
         step: u64,
         sbox: &SimBox,
         p: &Particles,
-        order: &[u32],
+        list: &ListState,
         log: &[(&str, f64)],
     ) -> Result<(), GsdError> {
-        self.write_inner(step, sbox, p, true, Some(order), log)
+        self.write_inner(step, sbox, p, true, Some(list), log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
@@ -145,7 +150,7 @@ impl GsdWriter {
         sbox: &SimBox,
         p: &Particles,
         exact: bool,
-        order: Option<&[u32]>,
+        list: Option<&ListState>,
         log: &[(&str, f64)],
     ) -> Result<(), String> {
         let f = &mut self.file;
@@ -207,8 +212,11 @@ impl GsdWriter {
             f.write_arrays(POS64, p.pos.iter().copied()).map_err(e)?;
             f.write_scalars(BOX64, sbox.l).map_err(e)?;
         }
-        if let Some(o) = order {
-            f.write_scalars(ORDER, o.iter().copied()).map_err(e)?;
+        if let Some(ls) = list {
+            f.write_scalars(ORDER, ls.order.iter().copied())
+                .map_err(e)?;
+            f.write_arrays(REFERENCE, ls.reference.iter().copied())
+                .map_err(e)?;
         }
         for (name, v) in log {
             f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
@@ -237,8 +245,8 @@ pub struct GsdFrame {
     pub particles: Particles,
     /// Whether exact (f64) positions were present.
     pub exact: bool,
-    /// Engine storage order saved by a checkpoint.
-    pub order: Option<Vec<u32>>,
+    /// Storage order and list reference positions saved by a checkpoint.
+    pub list: Option<ListState>,
 }
 
 /// Number of frames in a GSD file.
@@ -394,16 +402,19 @@ pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError>
     particles
         .check()
         .map_err(|m| content(format!("frame {k}: {m}")))?;
-    let order = match f.find_chunk(k, ORDER) {
-        Some(_) => Some(f.iter_scalars::<u32>(k, ORDER).map_err(rd)?.collect()),
-        None => None,
+    let list = match (f.find_chunk(k, ORDER), f.find_chunk(k, REFERENCE)) {
+        (Some(_), Some(_)) => Some(ListState {
+            order: f.iter_scalars::<u32>(k, ORDER).map_err(rd)?.collect(),
+            reference: f.iter_arrays::<f64, 3>(k, REFERENCE).map_err(rd)?.collect(),
+        }),
+        _ => None,
     };
     Ok(GsdFrame {
         step,
         sbox,
         particles,
         exact,
-        order,
+        list,
     })
 }
 

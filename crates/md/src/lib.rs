@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod brownian;
+mod cells;
 pub mod dpd;
 pub mod droplet;
 pub mod gsd;

@@ -33,10 +33,14 @@ pub struct NeighborList {
 
 /// The box is too small for the interaction range.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
-#[error("the box edge {edge} is shorter than twice the neighbour range {range} (cut-off + skin)")]
+#[error(
+    "the box edge {edge} is shorter than {minimum}, the least the neighbour range {range} (cut-off + skin) needs"
+)]
 pub struct BoxTooSmall {
     /// The shortest edge.
     pub edge: f64,
+    /// The shortest edge allowed.
+    pub minimum: f64,
     /// Cut-off plus skin.
     pub range: f64,
 }
@@ -122,7 +126,11 @@ impl NeighborList {
         let range = self.range();
         let edge = sbox.l.iter().cloned().fold(f64::INFINITY, f64::min);
         if range > 0.0 && edge < 2.0 * range {
-            return Err(BoxTooSmall { edge, range });
+            return Err(BoxTooSmall {
+                edge,
+                minimum: 2.0 * range,
+                range,
+            });
         }
         self.builds += 1;
         self.ref_pos.clear();
@@ -320,13 +328,10 @@ pub(crate) fn near_image(sbox: &SimBox, d: [f64; 3]) -> [f64; 3] {
     for k in 0..3 {
         let (l, h) = (sbox.l[k], 0.5 * sbox.l[k]);
         let x = d[k];
-        out[k] = if x >= h {
-            x - l
-        } else if x < -h {
-            x + l
-        } else {
-            x
-        };
+        // Two masked constants (compare + and), no branch.
+        let down = if x >= h { l } else { 0.0 };
+        let up = if x < -h { l } else { 0.0 };
+        out[k] = x - down + up;
     }
     out
 }

@@ -25,11 +25,11 @@
 pub mod forces;
 pub mod scenario;
 
+use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
 /// Parameters of a DPD colloid simulation (DPD units: lengths in `rc`, energies in `kT`
 /// multiples as noted, masses in solvent-bead masses).
@@ -302,11 +302,7 @@ pub struct Dpd {
     slab_of: Vec<u32>,
     slabs: Vec<Slab>,
     slab_start: Vec<usize>,
-    n_cells: [usize; 3],
-    cell_start: Vec<u32>,
-    cell_key: Vec<u32>,
-    cell_count: Vec<AtomicU32>,
-    slot: Vec<AtomicU32>,
+    grid: CellSort,
     /// Colloid–colloid full list over colloid slots (colloid tags in increasing order).
     cc_list: NeighborList,
     cc_pos: Vec<[f64; 3]>,
@@ -322,7 +318,6 @@ pub struct Dpd {
     scratch_img: Vec<[i32; 3]>,
     scratch_u32: Vec<u32>,
     scratch_f64: Vec<f64>,
-    perm: Vec<u32>,
 }
 
 /// Everything a force evaluation reads.
@@ -472,7 +467,8 @@ impl Dpd {
         if edge < 3.0 * cell_range {
             return Err(DpdError::BoxTooSmall(BoxTooSmall {
                 edge,
-                range: 1.5 * cell_range,
+                minimum: 3.0 * cell_range,
+                range: cell_range,
             }));
         }
         let mut s = Self {
@@ -494,11 +490,7 @@ impl Dpd {
             slab_of: Vec::new(),
             slabs: Vec::new(),
             slab_start: Vec::new(),
-            n_cells: [0; 3],
-            cell_start: Vec::new(),
-            cell_key: Vec::new(),
-            cell_count: Vec::new(),
-            slot: Vec::new(),
+            grid: CellSort::default(),
             cc_list: NeighborList::new(cc_range, p.skin),
             cc_pos: Vec::new(),
             cc_tag,
@@ -510,7 +502,6 @@ impl Dpd {
             scratch_img: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f64: Vec::new(),
-            perm: Vec::new(),
         };
         s.sort_into_cells();
         if !s.cells_mode {
@@ -860,132 +851,23 @@ impl Dpd {
     /// Sort particles into cells (z-major; ties by tag, so the order is a function of the
     /// positions alone) and split them into slabs (z-layers of cells).
     fn sort_into_cells(&mut self) {
-        let n = self.len();
-        let l = self.sbox.l;
-        let mut nc = [0usize; 3];
-        for k in 0..3 {
-            nc[k] = (l[k] / self.cell_range).floor() as usize;
-        }
-        self.n_cells = nc;
-        let [nx, ny, nz] = nc;
-        let total = nx * ny * nz;
-        let scale = [nx as f64 / l[0], ny as f64 / l[1], nz as f64 / l[2]];
-        self.cell_key.resize(n, 0);
-        self.cell_key
-            .par_iter_mut()
-            .zip(self.pos.par_iter())
-            .with_min_len(4096)
-            .for_each(|(c, x)| {
-                let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
-                let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
-                let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
-                *c = ((cz * ny + cy) * nx + cx) as u32;
-            });
-        // Parallel counting sort: counts and scatter with atomics (the order inside a cell is
-        // then arbitrary), then every cell ordered by key, so the result does not depend on the
-        // threads.
-        self.cell_count.resize_with(total, || AtomicU32::new(0));
-        self.cell_count
-            .par_iter()
-            .with_min_len(4096)
-            .for_each(|c| c.store(0, Relaxed));
-        {
-            let count = &self.cell_count;
-            self.cell_key.par_iter().with_min_len(4096).for_each(|&c| {
-                count[c as usize].fetch_add(1, Relaxed);
-            });
-        }
-        self.cell_start.clear();
-        self.cell_start.resize(total + 1, 0);
-        for c in 0..total {
-            self.cell_start[c + 1] = self.cell_start[c] + self.cell_count[c].load(Relaxed);
-        }
-        {
-            let starts = &self.cell_start;
-            self.cell_count
-                .par_iter()
-                .enumerate()
-                .with_min_len(4096)
-                .for_each(|(c, f)| f.store(starts[c], Relaxed));
-        }
-        self.slot.resize_with(n, || AtomicU32::new(0));
-        {
-            let fill = &self.cell_count;
-            let slot = &self.slot;
-            self.cell_key
-                .par_iter()
-                .enumerate()
-                .with_min_len(4096)
-                .for_each(|(i, &c)| {
-                    let k = fill[c as usize].fetch_add(1, Relaxed);
-                    slot[k as usize].store(i as u32, Relaxed);
-                });
-        }
-        {
-            let key = &self.key;
-            let starts = &self.cell_start;
-            let slot = &self.slot;
-            (0..total).into_par_iter().with_min_len(256).for_each(|c| {
-                let (a, b) = (starts[c] as usize, starts[c + 1] as usize);
-                let mut local = [0u32; 32];
-                if b - a <= local.len() {
-                    let cell = &mut local[..b - a];
-                    for (k, x) in cell.iter_mut().enumerate() {
-                        *x = slot[a + k].load(Relaxed);
-                    }
-                    cell.sort_unstable_by_key(|&i| key[i as usize]);
-                    for (k, x) in cell.iter().enumerate() {
-                        slot[a + k].store(*x, Relaxed);
-                    }
-                } else {
-                    // A crowded cell (rare): allocate.
-                    let mut cell: Vec<u32> = slot[a..b].iter().map(|x| x.load(Relaxed)).collect();
-                    cell.sort_unstable_by_key(|&i| key[i as usize]);
-                    for (k, x) in cell.iter().enumerate() {
-                        slot[a + k].store(*x, Relaxed);
-                    }
-                }
-            });
-        }
-        self.perm.resize(n, 0);
-        self.perm
-            .par_iter_mut()
-            .zip(self.slot.par_iter())
-            .with_min_len(4096)
-            .for_each(|(p, s)| *p = s.load(Relaxed));
-        permute(&mut self.pos, &self.perm, &mut self.scratch3);
-        permute(&mut self.vel, &self.perm, &mut self.scratch3);
-        permute(&mut self.image, &self.perm, &mut self.scratch_img);
-        permute(&mut self.key, &self.perm, &mut self.scratch_u32);
-        permute(&mut self.inv_mass, &self.perm, &mut self.scratch_f64);
+        self.grid
+            .sort(&self.sbox, &self.pos, &self.key, self.cell_range);
+        let [_, _, nz] = self.grid.n_cells;
+        let perm = &self.grid.perm;
+        permute(&mut self.pos, perm, &mut self.scratch3);
+        permute(&mut self.vel, perm, &mut self.scratch3);
+        permute(&mut self.image, perm, &mut self.scratch_img);
+        permute(&mut self.key, perm, &mut self.scratch_u32);
+        permute(&mut self.inv_mass, perm, &mut self.scratch_f64);
         for (i, &k) in self.key.iter().enumerate() {
             self.by_tag[(k & !COLLOID_BIT) as usize] = i as u32;
         }
-        let layer = nx * ny;
         self.slabs.resize_with(nz, Slab::default);
-        self.slab_of.resize(n, 0);
         for z in 0..nz {
-            self.slabs[z].start = self.cell_start[z * layer] as usize;
-            self.slabs[z].end = self.cell_start[(z + 1) * layer] as usize;
+            (self.slabs[z].start, self.slabs[z].end) = self.grid.layer(z);
         }
-        {
-            let starts = &self.cell_start;
-            self.slab_of
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(4096)
-                .for_each(|(i, s)| {
-                    // The layer whose particle range holds i.
-                    let mut z = (i * nz / n.max(1)).min(nz - 1);
-                    while starts[z * layer] as usize > i {
-                        z -= 1;
-                    }
-                    while starts[(z + 1) * layer] as usize <= i {
-                        z += 1;
-                    }
-                    *s = z as u32;
-                });
-        }
+        self.grid.layer_of_slots(&mut self.slab_of);
         self.slab_start.clear();
         self.slab_start.extend(self.slabs.iter().map(|s| s.start));
         for z in 0..nz {
@@ -1007,8 +889,8 @@ impl Dpd {
         let pos = &self.pos;
         let key = &self.key;
         let props = &self.props;
-        let cell_start = &self.cell_start;
-        let n_cells = self.n_cells;
+        let cell_start = &self.grid.cell_start;
+        let n_cells = self.grid.n_cells;
         let sbox = self.sbox;
         let rc_range2 = (self.params.rc + self.params.skin).powi(2);
         let skin = self.params.skin;
@@ -1097,8 +979,8 @@ impl Dpd {
             cc_list: &self.cc_list,
             cc_index: &self.cc_index,
             cc_slot: &self.cc_slot,
-            cell_start: &self.cell_start,
-            n_cells: self.n_cells,
+            cell_start: &self.grid.cell_start,
+            n_cells: self.grid.n_cells,
             cells_mode: self.cells_mode,
             cell_range: self.cell_range,
             sbox: self.sbox,
@@ -1125,97 +1007,6 @@ impl Dpd {
     }
 }
 
-/// The 13 neighbour cells of the half stencil, as offsets + 1 in x, y, z: +x; the +y row; the
-/// whole +z layer. With the later members of the own cell, every pair is met once, in the own
-/// z-layer (slab) or the next one.
-const HALF_STENCIL: [[usize; 3]; 13] = [
-    [2, 1, 1],
-    [0, 2, 1],
-    [1, 2, 1],
-    [2, 2, 1],
-    [0, 0, 2],
-    [1, 0, 2],
-    [2, 0, 2],
-    [0, 1, 2],
-    [1, 1, 2],
-    [2, 1, 2],
-    [0, 2, 2],
-    [1, 2, 2],
-    [2, 2, 2],
-];
-
-/// For every particle `i` of z-layer `cz` in storage (cell) order, call `f(i, candidates)` with
-/// the pairs `(j, x_i - x_j)` (minimum image) closer than `range` among the later members of
-/// `i`'s cell and all members of the 13 half-stencil cells. The stencil and its periodic
-/// shifts are worked out once per cell; candidates are gathered branch-free into `buf`.
-#[inline(always)]
-fn scan_layer(
-    cz: usize,
-    pos: &[[f64; 3]],
-    cell_start: &[u32],
-    n_cells: [usize; 3],
-    sbox: &SimBox,
-    range: f64,
-    buf: &mut Vec<(u32, [f64; 3])>,
-    mut f: impl FnMut(usize, &[(u32, [f64; 3])]),
-) {
-    let range2 = range * range;
-    let [nx, ny, nz] = n_cells;
-    let l = sbox.l;
-    let n = [nx, ny, nz];
-    let mut lo = [0usize; 14];
-    let mut hi = [0usize; 14];
-    let mut shift = [[0.0f64; 3]; 14];
-    for cy in 0..ny {
-        for cx in 0..nx {
-            let coords = [cx, cy, cz];
-            let mut total = 0;
-            for (s, off) in std::iter::once(&[1usize, 1, 1])
-                .chain(HALF_STENCIL.iter())
-                .enumerate()
-            {
-                let mut c = [0usize; 3];
-                for k in 0..3 {
-                    let raw = coords[k] + off[k];
-                    // raw in [0, n + 1]: 0 is cell n - 1 seen at -L, n + 1 is cell 0 at +L.
-                    (c[k], shift[s][k]) = if raw == 0 {
-                        (n[k] - 1, -l[k])
-                    } else if raw > n[k] {
-                        (0, l[k])
-                    } else {
-                        (raw - 1, 0.0)
-                    };
-                }
-                let cell = (c[2] * ny + c[1]) * nx + c[0];
-                lo[s] = cell_start[cell] as usize;
-                hi[s] = cell_start[cell + 1] as usize;
-                total += hi[s] - lo[s];
-            }
-            if buf.len() < total {
-                buf.resize(total, (0, [0.0; 3]));
-            }
-            for i in lo[0]..hi[0] {
-                let xi = pos[i];
-                let mut m = 0usize;
-                for s in 0..14 {
-                    let first = if s == 0 { i + 1 } else { lo[s] };
-                    let y = [
-                        xi[0] - shift[s][0],
-                        xi[1] - shift[s][1],
-                        xi[2] - shift[s][2],
-                    ];
-                    for (j, q) in pos[first..hi[s]].iter().enumerate() {
-                        let d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
-                        buf[m] = ((first + j) as u32, d);
-                        m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
-                    }
-                }
-                f(i, &buf[..m]);
-            }
-        }
-    }
-}
-
 /// Force on particle `i`: its slab's own sum plus the previous slab's halo.
 #[inline(always)]
 fn total_force(slabs: &[Slab], slab_of: &[u32], n_slabs: usize, i: usize) -> [f64; 3] {
@@ -1230,18 +1021,6 @@ fn total_force(slabs: &[Slab], slab_of: &[u32], n_slabs: usize, i: usize) -> [f6
         }
     }
     f
-}
-
-fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
-    scratch.clear();
-    scratch.resize(v.len(), v[0]);
-    let src = &*v;
-    scratch
-        .par_iter_mut()
-        .zip(perm.par_iter())
-        .with_min_len(4096)
-        .for_each(|(d, &k)| *d = src[k as usize]);
-    std::mem::swap(v, scratch);
 }
 
 /// Forces of one slab's pairs: solvent and colloid–solvent pairs from the half list or the

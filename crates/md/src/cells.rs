@@ -1,0 +1,287 @@
+//! Particles sorted into cells, and the half stencil of cells: the neighbour search shared by
+//! the Brownian ([`crate::brownian`]) and DPD ([`crate::dpd`]) engines.
+//!
+//! Cells are at least the neighbour range wide and numbered z-major (`(cz ny + cy) nx + cx`),
+//! so that the particles of one z-layer of cells (a *slab*) are contiguous after sorting. The
+//! half stencil reaches only the own and the next z-layer: every pair is met once, and a slab's
+//! pairs touch only itself and the next slab. Engines exploit that to sum forces per slab into
+//! the slab's own buffer plus a halo for the next slab, bitwise independent of the threads.
+
+use crate::state::SimBox;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+/// Counting sort of particles into cells, with buffers kept between sorts.
+#[derive(Debug, Default)]
+pub(crate) struct CellSort {
+    /// Cells per axis.
+    pub n_cells: [usize; 3],
+    /// Members of cell `c` are slots `cell_start[c]..cell_start[c + 1]` of the sorted order.
+    pub cell_start: Vec<u32>,
+    /// `perm[k]`: the old index of the particle that goes to slot `k`.
+    pub perm: Vec<u32>,
+    cell_key: Vec<u32>,
+    cell_count: Vec<AtomicU32>,
+    slot: Vec<AtomicU32>,
+}
+
+impl CellSort {
+    /// Cells per axis for a neighbour range `range` (`floor(L / range)` per axis).
+    pub fn cells_for(sbox: &SimBox, range: f64) -> [usize; 3] {
+        let mut nc = [1usize; 3];
+        for k in 0..3 {
+            nc[k] = ((sbox.l[k] / range).floor() as usize).max(1);
+        }
+        nc
+    }
+
+    /// Sort wrapped positions `pos` into cells at least `range` wide (z-major; inside a cell by
+    /// increasing `tie`, so that the order is a function of the positions and ties alone, not of
+    /// the threads). Fills [`Self::perm`] and [`Self::cell_start`] (in the new order).
+    pub fn sort(&mut self, sbox: &SimBox, pos: &[[f64; 3]], tie: &[u32], range: f64) {
+        let n = pos.len();
+        let l = sbox.l;
+        let nc = Self::cells_for(sbox, range);
+        self.n_cells = nc;
+        let [nx, ny, nz] = nc;
+        let total = nx * ny * nz;
+        let scale = [nx as f64 / l[0], ny as f64 / l[1], nz as f64 / l[2]];
+        self.cell_key.resize(n, 0);
+        self.cell_key
+            .par_iter_mut()
+            .zip(pos.par_iter())
+            .with_min_len(4096)
+            .for_each(|(c, x)| {
+                let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
+                let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
+                let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
+                *c = ((cz * ny + cy) * nx + cx) as u32;
+            });
+        // Parallel counting sort: counts and scatter with atomics (the order inside a cell is
+        // then arbitrary), then every cell ordered by `tie`.
+        self.cell_count.resize_with(total, || AtomicU32::new(0));
+        self.cell_count
+            .par_iter()
+            .with_min_len(4096)
+            .for_each(|c| c.store(0, Relaxed));
+        {
+            let count = &self.cell_count;
+            self.cell_key.par_iter().with_min_len(4096).for_each(|&c| {
+                count[c as usize].fetch_add(1, Relaxed);
+            });
+        }
+        self.cell_start.clear();
+        self.cell_start.resize(total + 1, 0);
+        for c in 0..total {
+            self.cell_start[c + 1] = self.cell_start[c] + self.cell_count[c].load(Relaxed);
+        }
+        {
+            let starts = &self.cell_start;
+            self.cell_count
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(c, f)| f.store(starts[c], Relaxed));
+        }
+        self.slot.resize_with(n, || AtomicU32::new(0));
+        {
+            let fill = &self.cell_count;
+            let slot = &self.slot;
+            self.cell_key
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(i, &c)| {
+                    let k = fill[c as usize].fetch_add(1, Relaxed);
+                    slot[k as usize].store(i as u32, Relaxed);
+                });
+        }
+        {
+            let starts = &self.cell_start;
+            let slot = &self.slot;
+            (0..total).into_par_iter().with_min_len(256).for_each(|c| {
+                let (a, b) = (starts[c] as usize, starts[c + 1] as usize);
+                let mut local = [0u32; 32];
+                if b - a <= local.len() {
+                    let cell = &mut local[..b - a];
+                    for (k, x) in cell.iter_mut().enumerate() {
+                        *x = slot[a + k].load(Relaxed);
+                    }
+                    cell.sort_unstable_by_key(|&i| tie[i as usize]);
+                    for (k, x) in cell.iter().enumerate() {
+                        slot[a + k].store(*x, Relaxed);
+                    }
+                } else {
+                    // A crowded cell (rare): allocate.
+                    let mut cell: Vec<u32> = slot[a..b].iter().map(|x| x.load(Relaxed)).collect();
+                    cell.sort_unstable_by_key(|&i| tie[i as usize]);
+                    for (k, x) in cell.iter().enumerate() {
+                        slot[a + k].store(*x, Relaxed);
+                    }
+                }
+            });
+        }
+        self.perm.resize(n, 0);
+        self.perm
+            .par_iter_mut()
+            .zip(self.slot.par_iter())
+            .with_min_len(4096)
+            .for_each(|(p, s)| *p = s.load(Relaxed));
+    }
+
+    /// Slot range `start..end` of z-layer `z` (after [`Self::sort`]).
+    pub fn layer(&self, z: usize) -> (usize, usize) {
+        let layer = self.n_cells[0] * self.n_cells[1];
+        (
+            self.cell_start[z * layer] as usize,
+            self.cell_start[(z + 1) * layer] as usize,
+        )
+    }
+
+    /// `slab_of[i]`: the z-layer of slot `i` (after [`Self::sort`]).
+    pub fn layer_of_slots(&self, slab_of: &mut Vec<u32>) {
+        let n = self.perm.len();
+        let nz = self.n_cells[2];
+        let layer = self.n_cells[0] * self.n_cells[1];
+        let starts = &self.cell_start;
+        slab_of.resize(n, 0);
+        slab_of
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, s)| {
+                let mut z = (i * nz / n.max(1)).min(nz - 1);
+                while starts[z * layer] as usize > i {
+                    z -= 1;
+                }
+                while starts[(z + 1) * layer] as usize <= i {
+                    z += 1;
+                }
+                *s = z as u32;
+            });
+    }
+}
+
+/// Apply a permutation (new slot `k` takes old slot `perm[k]`) to `v`, through `scratch`.
+pub(crate) fn permute<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32], scratch: &mut Vec<T>) {
+    if v.is_empty() {
+        return;
+    }
+    scratch.clear();
+    scratch.resize(v.len(), v[0]);
+    let src = &*v;
+    scratch
+        .par_iter_mut()
+        .zip(perm.par_iter())
+        .with_min_len(4096)
+        .for_each(|(d, &k)| *d = src[k as usize]);
+    std::mem::swap(v, scratch);
+}
+
+/// The 13 neighbour cells of the half stencil, as offsets + 1 in x, y, z: +x; the +y row; the
+/// whole +z layer. With the later members of the own cell, every pair is met once, in the own
+/// z-layer (slab) or the next one.
+const HALF_STENCIL: [[usize; 3]; 13] = [
+    [2, 1, 1],
+    [0, 2, 1],
+    [1, 2, 1],
+    [2, 2, 1],
+    [0, 0, 2],
+    [1, 0, 2],
+    [2, 0, 2],
+    [0, 1, 2],
+    [1, 1, 2],
+    [2, 1, 2],
+    [0, 2, 2],
+    [1, 2, 2],
+    [2, 2, 2],
+];
+
+/// For every particle `i` of z-layer `cz` in storage (cell) order, call `f(i, candidates)` with
+/// the pairs `(j, x_i - x_j)` (minimum image) closer than `range` among the later members of
+/// `i`'s cell and all members of the 13 half-stencil cells. The stencil and its periodic
+/// shifts are worked out once per cell; candidates are gathered branch-free into `buf`.
+/// With fewer than 3 cells along an axis the stencil meets some cells twice, at different
+/// periodic shifts; every pair is still met once provided the box edges exceed twice `range`
+/// (then only one image of a pair lies within range).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn scan_layer(
+    cz: usize,
+    pos: &[[f64; 3]],
+    cell_start: &[u32],
+    n_cells: [usize; 3],
+    sbox: &SimBox,
+    range: f64,
+    buf: &mut Vec<(u32, [f64; 3])>,
+    mut f: impl FnMut(usize, &[(u32, [f64; 3])]),
+) {
+    let range2 = range * range;
+    let [nx, ny, nz] = n_cells;
+    let l = sbox.l;
+    let n = [nx, ny, nz];
+    let mut lo = [0usize; 14];
+    let mut hi = [0usize; 14];
+    let mut shift = [[0.0f64; 3]; 14];
+    for cy in 0..ny {
+        for cx in 0..nx {
+            let own = (cz * ny + cy) * nx + cx;
+            if cell_start[own] == cell_start[own + 1] {
+                continue;
+            }
+            let coords = [cx, cy, cz];
+            // Stencil cells in order; neighbours in x that are contiguous in storage and share
+            // a periodic shift merge into one run (same candidates, same order, fewer loops).
+            let mut runs = 0usize;
+            let mut total = 0;
+            for off in std::iter::once(&[1usize, 1, 1]).chain(HALF_STENCIL.iter()) {
+                let mut c = [0usize; 3];
+                let mut sh = [0.0f64; 3];
+                for k in 0..3 {
+                    let raw = coords[k] + off[k];
+                    // raw in [0, n + 1]: 0 is cell n - 1 seen at -L, n + 1 is cell 0 at +L.
+                    (c[k], sh[k]) = if raw == 0 {
+                        (n[k] - 1, -l[k])
+                    } else if raw > n[k] {
+                        (0, l[k])
+                    } else {
+                        (raw - 1, 0.0)
+                    };
+                }
+                let cell = (c[2] * ny + c[1]) * nx + c[0];
+                let (a, b) = (cell_start[cell] as usize, cell_start[cell + 1] as usize);
+                total += b - a;
+                if runs > 0 && hi[runs - 1] == a && shift[runs - 1] == sh {
+                    hi[runs - 1] = b;
+                } else {
+                    lo[runs] = a;
+                    hi[runs] = b;
+                    shift[runs] = sh;
+                    runs += 1;
+                }
+            }
+            if buf.len() < total {
+                buf.resize(total, (0, [0.0; 3]));
+            }
+            for i in cell_start[own] as usize..cell_start[own + 1] as usize {
+                let xi = pos[i];
+                let mut m = 0usize;
+                for s in 0..runs {
+                    // Run 0 starts with the own cell: only its later members.
+                    let first = if s == 0 { i + 1 } else { lo[s] };
+                    let y = [
+                        xi[0] - shift[s][0],
+                        xi[1] - shift[s][1],
+                        xi[2] - shift[s][2],
+                    ];
+                    for (j, q) in pos[first..hi[s]].iter().enumerate() {
+                        let d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
+                        buf[m] = ((first + j) as u32, d);
+                        m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
+                    }
+                }
+                f(i, &buf[..m]);
+            }
+        }
+    }
+}
