@@ -7,7 +7,11 @@
 //! largest cut-off plus the skin wide, z-major) and every pair within that range is stored once,
 //! in a half Verlet list of the particle whose cell has the other in its half stencil. The
 //! lists are rebuilt, with a re-sort, whenever a particle has moved more than half the skin
-//! since the last build, and at every multiple of [`BdParams::sort_every`] steps. Each z-layer of
+//! since the last build, and at every multiple of [`BdParams::sort_every`] steps. Positions are
+//! wrapped into the box only at a build: in between they move continuously (at most half the
+//! skin outside the box), so that a pair's separation is `x_i - x_j` (or `x_i - s - x_j` for
+//! the pairs found across the periodic seam, with the shift `s` stored in the list) without a
+//! minimum-image search per pair and step. Each z-layer of
 //! cells (a *slab*) sums its pairs into its own force buffer, whose tail is a halo for the next
 //! slab; a particle's pair force is its slab's sum plus the previous slab's halo, added in a
 //! fixed order.
@@ -25,7 +29,7 @@
 //! the buffers are then swapped).
 
 use crate::cells::{CellSort, permute, scan_layer};
-use crate::neighbor::{BoxTooSmall, near_image};
+use crate::neighbor::BoxTooSmall;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::rng::{BLOCK, Purpose, Ziggurat, stream};
@@ -108,13 +112,18 @@ pub enum BdError {
 }
 
 /// What a checkpoint needs besides the particles to continue bitwise: the engine's storage
-/// order and the positions (in storage order) at the last neighbour-list build.
+/// order, its positions and image counts exactly as stored (not wrapped since the last list
+/// build), and the positions at that build, all in storage order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ListState {
     /// Input index of each stored particle ([`Brownian::order`]).
     pub order: Vec<u32>,
-    /// Wrapped positions of the stored particles when the lists were last built.
+    /// Positions of the stored particles when the lists were last built (wrapped then).
     pub reference: Vec<[f64; 3]>,
+    /// Current positions as stored.
+    pub positions: Vec<[f64; 3]>,
+    /// Current image counts as stored.
+    pub images: Vec<[i32; 3]>,
 }
 
 /// One z-layer of cells: its particles, their half neighbour lists and force buffer.
@@ -122,9 +131,11 @@ pub struct ListState {
 struct Slab {
     start: usize,
     end: usize,
-    /// Half list of the pairs `(i, j)` found from this slab's particles `i`, in build order
-    /// (one flat loop: no short inner loops whose exits mispredict).
+    /// Half list of the pairs `(i, j)` found from this slab's particles `i` within the box, in
+    /// build order (one flat loop: no short inner loops whose exits mispredict).
     pairs: Vec<[u32; 2]>,
+    /// Pairs found across the periodic seam, with the shift `s` (a box vector) of `x_i`.
+    shifted: Vec<([u32; 2], [f64; 3])>,
     /// Candidate pairs of one particle (scratch of the list build).
     cand: Vec<(u32, [f64; 3])>,
     /// Pair forces on this slab's particles (`end - start` entries), then on the next slab's
@@ -152,13 +163,18 @@ pub struct Brownian<P: Pair, E: External> {
     slab_of: Vec<u32>,
     ref_pos: Vec<[f64; 3]>,
     builds: u64,
+    /// Largest squared displacement from the reference positions before a rebuild: half the
+    /// skin squared, or a quarter of the shortest edge squared without pair forces (then a
+    /// "rebuild" only wraps the positions).
+    rebuild_disp2: f64,
     new_pos: Vec<[f64; 3]>,
-    new_image: Vec<[i32; 3]>,
-    mobility: Vec<f64>,
-    noise_amp: Vec<f64>,
-    drift_limit2: Vec<f64>,
+    scratch_img: Vec<[i32; 3]>,
+    /// Per particle: `dt / gamma` (drift per unit force), `sqrt(2 kT dt / gamma)` (noise
+    /// amplitude) and the largest allowed squared drift `(max_drift d)^2`.
+    kinetics: Vec<[f64; 3]>,
     scratch_f64: Vec<f64>,
     scratch_u32: Vec<u32>,
+    scratch3: Vec<[f64; 3]>,
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
@@ -191,7 +207,8 @@ impl ChunkReport {
 const PAIR_BATCH: usize = 64;
 
 /// Pair forces of one slab's half list into `acc` (its own particles first, then the next
-/// slab's, which starts at slot `next_start`). Batch by batch, the separations are computed and
+/// slab's, which starts at slot `next_start`), from positions not wrapped since the list was
+/// built. Batch by batch, the separations are computed and
 /// the pairs within the largest cut-off `r_cut` kept (branch-free); only those evaluate the
 /// potential (most list entries lie in the skin). Pairs beyond the cut-off would add exact
 /// zeros, so the sums equal those over the whole list.
@@ -204,7 +221,6 @@ fn slab_pair_forces<P: Pair>(
     pos: &[[f64; 3]],
     typeid: &[u32],
     diameter: &[f64],
-    sbox: &SimBox,
     pair: &P,
     acc: &mut [[f64; 3]],
 ) {
@@ -213,16 +229,9 @@ fn slab_pair_forces<P: Pair>(
     let rc2 = r_cut * r_cut;
     acc.iter_mut().for_each(|f| *f = [0.0; 3]);
     let mut near = [(0u32, 0u32, [0.0f64; 3], 0.0f64); PAIR_BATCH];
-    for batch in slab.pairs.chunks(PAIR_BATCH) {
-        let mut m = 0;
-        for &[i, j] in batch {
-            let (xi, xj) = (pos[i as usize], pos[j as usize]);
-            let d = near_image(sbox, [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
-            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            near[m] = (i, j, d, r2);
-            m += (r2 < rc2) as usize;
-        }
-        for &(i, j, d, r2) in &near[..m] {
+    // The forces of the pairs within range of a batch.
+    let mut forces = |near: &[(u32, u32, [f64; 3], f64)]| {
+        for &(i, j, d, r2) in near {
             let (i, j) = (i as usize, j as usize);
             let fr = pair.force_over_r(r2, typeid[i], typeid[j], diameter[i], diameter[j]);
             let fv = [fr * d[0], fr * d[1], fr * d[2]];
@@ -241,11 +250,34 @@ fn slab_pair_forces<P: Pair>(
             fj[1] -= fv[1];
             fj[2] -= fv[2];
         }
+    };
+    for batch in slab.pairs.chunks(PAIR_BATCH) {
+        let mut m = 0;
+        for &[i, j] in batch {
+            let (xi, xj) = (pos[i as usize], pos[j as usize]);
+            let d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            near[m] = (i, j, d, r2);
+            m += (r2 < rc2) as usize;
+        }
+        forces(&near[..m]);
+    }
+    for batch in slab.shifted.chunks(PAIR_BATCH) {
+        let mut m = 0;
+        for &([i, j], sh) in batch {
+            let (xi, xj) = (pos[i as usize], pos[j as usize]);
+            let y = [xi[0] - sh[0], xi[1] - sh[1], xi[2] - sh[2]];
+            let d = [y[0] - xj[0], y[1] - xj[1], y[2] - xj[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            near[m] = (i, j, d, r2);
+            m += (r2 < rc2) as usize;
+        }
+        forces(&near[..m]);
     }
 }
 
 /// Pair forces of every slab into its buffer, slabs in parallel.
-fn all_pair_forces<P: Pair>(slabs: &mut [Slab], p: &Particles, sbox: &SimBox, pair: &P) {
+fn all_pair_forces<P: Pair>(slabs: &mut [Slab], p: &Particles, pair: &P) {
     let nz = slabs.len();
     let r_cut = pair.r_cut_max();
     // The first slab's start, read before the slabs are borrowed mutably.
@@ -260,7 +292,6 @@ fn all_pair_forces<P: Pair>(slabs: &mut [Slab], p: &Particles, sbox: &SimBox, pa
             &p.pos,
             &p.typeid,
             &p.diameter,
-            sbox,
             pair,
             &mut acc,
         );
@@ -408,13 +439,17 @@ impl<P: Pair, E: External> Brownian<P, E> {
             slab_of: Vec::new(),
             ref_pos: Vec::new(),
             builds: 0,
+            rebuild_disp2: if range > 0.0 {
+                0.25 * params.skin * params.skin
+            } else {
+                (0.25 * edge).powi(2)
+            },
             new_pos: vec![[0.0; 3]; n],
-            new_image: vec![[0; 3]; n],
-            mobility: Vec::new(),
-            noise_amp: Vec::new(),
-            drift_limit2: Vec::new(),
+            scratch_img: Vec::new(),
+            kinetics: Vec::new(),
             scratch_f64: Vec::new(),
             scratch_u32: Vec::new(),
+            scratch3: Vec::new(),
         };
         s.set_dt(params.dt);
         match list {
@@ -428,11 +463,17 @@ impl<P: Pair, E: External> Brownian<P, E> {
     fn resume_lists(&mut self, ls: &ListState) -> Result<(), BdError> {
         let n = self.particles.len();
         let bad = |m: &str| BdError::Invalid(format!("the checkpoint's neighbour-list state: {m}"));
-        if ls.order.len() != n || ls.reference.len() != n {
+        if ls.order.len() != n
+            || ls.reference.len() != n
+            || ls.positions.len() != n
+            || ls.images.len() != n
+        {
             return Err(bad(&format!(
-                "{} stored indices and {} reference positions for {n} particles",
+                "{} stored indices, {} reference positions, {} positions and {} images for {n} particles",
                 ls.order.len(),
-                ls.reference.len()
+                ls.reference.len(),
+                ls.positions.len(),
+                ls.images.len()
             )));
         }
         let mut seen = vec![false; n];
@@ -443,15 +484,24 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 ));
             }
         }
-        if ls.reference.iter().flatten().any(|x| !x.is_finite()) {
-            return Err(bad("a reference position is not finite"));
+        if ls
+            .reference
+            .iter()
+            .chain(&ls.positions)
+            .flatten()
+            .any(|x| !x.is_finite())
+        {
+            return Err(bad("a position is not finite"));
         }
         self.grid.perm.clear();
         self.grid.perm.extend_from_slice(&ls.order);
         self.apply_perm();
+        // The particles' own positions are the wrapped snapshot of these.
+        self.particles.pos.clone_from(&ls.positions);
+        self.particles.image.clone_from(&ls.images);
+        self.ref_pos.clear();
+        self.ref_pos.extend_from_slice(&ls.reference);
         if self.range > 0.0 {
-            self.ref_pos.clear();
-            self.ref_pos.extend_from_slice(&ls.reference);
             // The stored order must be the cell order of the reference positions.
             self.grid
                 .sort(&self.sbox, &self.ref_pos, &self.tag, self.range);
@@ -476,11 +526,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
     pub fn list_state(&self) -> ListState {
         ListState {
             order: self.tag.clone(),
-            reference: if self.range > 0.0 {
-                self.ref_pos.clone()
-            } else {
-                self.particles.pos.clone()
-            },
+            reference: self.ref_pos.clone(),
+            positions: self.particles.pos.clone(),
+            images: self.particles.image.clone(),
         }
     }
 
@@ -488,22 +536,18 @@ impl<P: Pair, E: External> Brownian<P, E> {
     pub fn set_dt(&mut self, dt: f64) {
         self.params.dt = dt;
         let p = self.params;
-        self.mobility = self
+        self.kinetics = self
             .particles
             .diameter
             .iter()
-            .map(|d| 1.0 / (3.0 * PI * p.viscosity * d))
-            .collect();
-        self.noise_amp = self
-            .mobility
-            .iter()
-            .map(|m| (2.0 * p.kt * dt * m).sqrt())
-            .collect();
-        self.drift_limit2 = self
-            .particles
-            .diameter
-            .iter()
-            .map(|d| (p.max_drift * d).powi(2))
+            .map(|d| {
+                let mobility = 1.0 / (3.0 * PI * p.viscosity * d);
+                [
+                    mobility * dt,
+                    (2.0 * p.kt * dt * mobility).sqrt(),
+                    (p.max_drift * d).powi(2),
+                ]
+            })
             .collect();
     }
 
@@ -512,7 +556,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         &self.params
     }
 
-    /// Particles in the engine's internal (cell) order; see [`Self::order`].
+    /// Particles in the engine's internal (cell) order ([`Self::order`]), positions as stored:
+    /// wrapped at the last list build, up to half the skin outside the box since (the image
+    /// counts match; [`Self::snapshot`] wraps).
     pub fn particles(&self) -> &Particles {
         &self.particles
     }
@@ -522,7 +568,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         &self.tag
     }
 
-    /// The particles in input order (allocates; for output and analysis).
+    /// The particles in input order, wrapped into the box (allocates; for output and analysis).
     pub fn snapshot(&self) -> Particles {
         let n = self.particles.len();
         let mut inv = vec![0u32; n];
@@ -531,9 +577,14 @@ impl<P: Pair, E: External> Brownian<P, E> {
         }
         let p = &self.particles;
         let pick = |k: &u32| *k as usize;
+        let wrapped = |k: &u32| {
+            let (mut x, mut img) = (p.pos[pick(k)], p.image[pick(k)]);
+            self.sbox.wrap(&mut x, &mut img);
+            (x, img)
+        };
         Particles {
-            pos: inv.iter().map(|k| p.pos[pick(k)]).collect(),
-            image: inv.iter().map(|k| p.image[pick(k)]).collect(),
+            pos: inv.iter().map(|k| wrapped(k).0).collect(),
+            image: inv.iter().map(|k| wrapped(k).1).collect(),
             typeid: inv.iter().map(|k| p.typeid[pick(k)]).collect(),
             diameter: inv.iter().map(|k| p.diameter[pick(k)]).collect(),
             vel: inv.iter().map(|k| p.vel[pick(k)]).collect(),
@@ -558,7 +609,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let n = self.particles.len();
         let mut slabs = self.slabs.clone();
         let p = &self.particles;
-        all_pair_forces(&mut slabs, p, &self.sbox, &self.pair);
+        all_pair_forces(&mut slabs, p, &self.pair);
         let mut out = vec![[0.0; 3]; n];
         let mut pair_force = PairForceCursor::new(&slabs, &self.slab_of, 0);
         for (k, &tag) in self.tag.iter().enumerate() {
@@ -572,17 +623,26 @@ impl<P: Pair, E: External> Brownian<P, E> {
         out
     }
 
-    /// Sort the particles into cells and rebuild the lists (no-op without pair forces).
+    /// Wrap the positions, sort the particles into cells and rebuild the lists (without pair
+    /// forces: only wrap).
     fn sort_and_rebuild(&mut self) {
-        if self.range <= 0.0 {
-            return;
+        let sbox = self.sbox;
+        self.particles
+            .pos
+            .par_iter_mut()
+            .zip(self.particles.image.par_iter_mut())
+            .with_min_len(4096)
+            .for_each(|(x, img)| sbox.wrap(x, img));
+        if self.range > 0.0 {
+            self.grid
+                .sort(&self.sbox, &self.particles.pos, &self.tag, self.range);
+            self.apply_perm();
         }
-        self.grid
-            .sort(&self.sbox, &self.particles.pos, &self.tag, self.range);
-        self.apply_perm();
         self.ref_pos.clear();
         self.ref_pos.extend_from_slice(&self.particles.pos);
-        self.build_lists();
+        if self.range > 0.0 {
+            self.build_lists();
+        }
     }
 
     /// Slabs and half lists from the reference positions (which are in cell order).
@@ -606,8 +666,15 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let n_cells = self.grid.n_cells;
         let (sbox, range) = (self.sbox, self.range);
         self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
-            let Slab { pairs, cand, .. } = slab;
+            let Slab {
+                pairs,
+                shifted,
+                cand,
+                ..
+            } = slab;
             pairs.clear();
+            shifted.clear();
+            let (l, h) = (sbox.l, sbox.l.map(|x| 0.5 * x));
             scan_layer(
                 z,
                 pos,
@@ -617,7 +684,27 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 range,
                 cand,
                 |i, cands| {
-                    pairs.extend(cands.iter().map(|&(j, _)| [i as u32, j]));
+                    let xi = pos[i];
+                    for &(j, d) in cands {
+                        // The periodic shift the scan applied to x_i: 0 or +-L per axis.
+                        let xj = pos[j as usize];
+                        let mut sh = [0.0; 3];
+                        for k in 0..3 {
+                            let gap = (xi[k] - xj[k]) - d[k];
+                            sh[k] = if gap > h[k] {
+                                l[k]
+                            } else if gap < -h[k] {
+                                -l[k]
+                            } else {
+                                0.0
+                            };
+                        }
+                        if sh == [0.0; 3] {
+                            pairs.push([i as u32, j]);
+                        } else {
+                            shifted.push(([i as u32, j], sh));
+                        }
+                    }
                 },
             );
         });
@@ -629,14 +716,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let p = &mut self.particles;
         permute(&mut p.pos, perm, &mut self.new_pos);
         permute(&mut p.vel, perm, &mut self.new_pos);
-        permute(&mut p.image, perm, &mut self.new_image);
+        permute(&mut p.image, perm, &mut self.scratch_img);
         permute(&mut p.typeid, perm, &mut self.scratch_u32);
         permute(&mut self.tag, perm, &mut self.scratch_u32);
         permute(&mut p.diameter, perm, &mut self.scratch_f64);
         permute(&mut p.mass, perm, &mut self.scratch_f64);
-        permute(&mut self.mobility, perm, &mut self.scratch_f64);
-        permute(&mut self.noise_amp, perm, &mut self.scratch_f64);
-        permute(&mut self.drift_limit2, perm, &mut self.scratch_f64);
+        permute(&mut self.kinetics, perm, &mut self.scratch3);
     }
 
     /// Advance `n` steps.
@@ -653,77 +738,71 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let step = self.step;
         let seed = self.params.seed;
         let key0 = (self.params.replica as u64) << 32;
-        let dt = self.params.dt;
         let n = self.particles.len();
         if self.range > 0.0 {
-            all_pair_forces(&mut self.slabs, &self.particles, &self.sbox, &self.pair);
+            all_pair_forces(&mut self.slabs, &self.particles, &self.pair);
         }
         let mut new_pos = std::mem::take(&mut self.new_pos);
-        let mut new_image = std::mem::take(&mut self.new_image);
         new_pos.resize(n, [0.0; 3]);
-        new_image.resize(n, [0; 3]);
         let p = &self.particles;
-        let (pos, old_image) = (&p.pos, &p.image);
+        let pos = &p.pos;
         let (slabs, slab_of, ref_pos) = (&self.slabs, &self.slab_of, &self.ref_pos);
-        let track = self.range > 0.0;
-        let (sbox, external) = (self.sbox, &self.external);
-        let (mobility, noise_amp, drift_limit2, tag) = (
-            &self.mobility,
-            &self.noise_amp,
-            &self.drift_limit2,
-            &self.tag,
-        );
+        let external = &self.external;
+        let (kinetics, tag) = (&self.kinetics, &self.tag);
         let zig = Ziggurat::get();
         let report = new_pos
             .par_chunks_mut(CHUNK)
-            .zip(new_image.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(b, (out, images))| {
+            .map(|(b, out)| {
                 let mut rep = ChunkReport::EMPTY;
-                let block0 = (b * CHUNK / BLOCK) as u64;
-                let mut rng = stream(seed, step, Purpose::Noise, key0 | block0);
-                let mut pair_force = PairForceCursor::new(slabs, slab_of, b * CHUNK);
-                for (k, (np, img)) in out.iter_mut().zip(images.iter_mut()).enumerate() {
-                    let i = b * CHUNK + k;
-                    let x = pos[i];
-                    let fp = pair_force.force(i);
-                    let fe = external.force(x, t);
-                    let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
-                    let m = mobility[i] * dt;
-                    let drift = [f[0] * m, f[1] * m, f[2] * m];
-                    let drift2 = drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
-                    // NaN forces fail the comparison and count as a blow-up too.
-                    let ok = drift2 <= drift_limit2[i];
-                    if !ok && rep.blow_up.is_none_or(|b| tag[i] < b.3) {
-                        rep.blow_up = Some((
-                            i,
-                            (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt(),
-                            drift2.sqrt(),
-                            tag[i],
-                        ));
-                    }
-                    if k > 0 && k % BLOCK == 0 {
-                        rng = stream(
-                            seed,
-                            step,
-                            Purpose::Noise,
-                            key0 | (block0 + (k / BLOCK) as u64),
-                        );
-                    }
-                    let xi = [
-                        zig.sample(&mut rng),
-                        zig.sample(&mut rng),
-                        zig.sample(&mut rng),
-                    ];
-                    let a = noise_amp[i];
-                    let mut q = [
-                        x[0] + drift[0] + a * xi[0],
-                        x[1] + drift[1] + a * xi[1],
-                        x[2] + drift[2] + a * xi[2],
-                    ];
-                    if track {
-                        let r = ref_pos[i];
-                        let d = near_image(&sbox, [q[0] - r[0], q[1] - r[1], q[2] - r[2]]);
+                let lo = b * CHUNK;
+                let mut pair_force = PairForceCursor::new(slabs, slab_of, lo);
+                for (kb, out) in out.chunks_mut(BLOCK).enumerate() {
+                    let lo = lo + kb * BLOCK;
+                    let m = out.len();
+                    let (x, c, r) = (
+                        &pos[lo..lo + m],
+                        &kinetics[lo..lo + m],
+                        &ref_pos[lo..lo + m],
+                    );
+                    let mut rng = stream(seed, step, Purpose::Noise, key0 | (lo / BLOCK) as u64);
+                    for k in 0..m {
+                        let [drift_per_force, amp, limit2] = c[k];
+                        let fp = pair_force.force(lo + k);
+                        let fe = external.force(x[k], t);
+                        let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
+                        let drift = [
+                            f[0] * drift_per_force,
+                            f[1] * drift_per_force,
+                            f[2] * drift_per_force,
+                        ];
+                        let drift2 =
+                            drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
+                        // NaN forces fail the comparison and count as a blow-up too.
+                        let ok = drift2 <= limit2;
+                        if !ok {
+                            let i = lo + k;
+                            if rep.blow_up.is_none_or(|b| tag[i] < b.3) {
+                                rep.blow_up = Some((
+                                    i,
+                                    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt(),
+                                    drift2.sqrt(),
+                                    tag[i],
+                                ));
+                            }
+                        }
+                        let xi = [
+                            zig.sample(&mut rng),
+                            zig.sample(&mut rng),
+                            zig.sample(&mut rng),
+                        ];
+                        let q = [
+                            x[k][0] + drift[0] + amp * xi[0],
+                            x[k][1] + drift[1] + amp * xi[1],
+                            x[k][2] + drift[2] + amp * xi[2],
+                        ];
+                        let rk = r[k];
+                        let d = [q[0] - rk[0], q[1] - rk[1], q[2] - rk[2]];
                         let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                         // NaN compares false and is ignored here; the blow-up check reports it.
                         rep.max_disp2 = if d2 > rep.max_disp2 {
@@ -731,17 +810,14 @@ impl<P: Pair, E: External> Brownian<P, E> {
                         } else {
                             rep.max_disp2
                         };
+                        out[k] = q;
                     }
-                    *img = old_image[i];
-                    sbox.wrap(&mut q, img);
-                    *np = q;
                 }
                 rep
             })
             .reduce(|| ChunkReport::EMPTY, ChunkReport::merge);
         if let Some((i, force, drift, _)) = report.blow_up {
             self.new_pos = new_pos;
-            self.new_image = new_image;
             return Err(BdError::BlowUp {
                 step,
                 time: t,
@@ -753,16 +829,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
             });
         }
         std::mem::swap(&mut self.particles.pos, &mut new_pos);
-        std::mem::swap(&mut self.particles.image, &mut new_image);
         self.new_pos = new_pos;
-        self.new_image = new_image;
         self.step += 1;
         let every = self.params.sort_every;
         // NaN displacements (a run gone non-finite without a blow-up) fail every comparison:
         // the rebuild is skipped and the next step reports the blow-up.
-        if report.max_disp2 > 0.25 * self.params.skin * self.params.skin
-            || (every > 0 && self.step.is_multiple_of(every))
-        {
+        if report.max_disp2 > self.rebuild_disp2 || (every > 0 && self.step.is_multiple_of(every)) {
             self.sort_and_rebuild();
         }
         Ok(())

@@ -20,6 +20,8 @@ const POS64: &str = "log/particles/position_f64";
 const BOX64: &str = "log/configuration/box_f64";
 const ORDER: &str = "log/particles/storage_order";
 const REFERENCE: &str = "log/particles/list_reference_position_f64";
+const STORED_POS: &str = "log/particles/stored_position_f64";
+const STORED_IMAGE: &str = "log/particles/stored_image";
 
 /// A GSD error with the file involved.
 #[derive(Debug, thiserror::Error)]
@@ -217,6 +219,10 @@ impl GsdWriter {
                 .map_err(e)?;
             f.write_arrays(REFERENCE, ls.reference.iter().copied())
                 .map_err(e)?;
+            f.write_arrays(STORED_POS, ls.positions.iter().copied())
+                .map_err(e)?;
+            f.write_arrays(STORED_IMAGE, ls.images.iter().copied())
+                .map_err(e)?;
         }
         for (name, v) in log {
             f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
@@ -402,12 +408,25 @@ pub fn read_frame(path: &Path, frame: Option<u64>) -> Result<GsdFrame, GsdError>
     particles
         .check()
         .map_err(|m| content(format!("frame {k}: {m}")))?;
-    let list = match (f.find_chunk(k, ORDER), f.find_chunk(k, REFERENCE)) {
-        (Some(_), Some(_)) => Some(ListState {
+    let has = |name| f.find_chunk(k, name).is_some();
+    let list = if [ORDER, REFERENCE, STORED_POS, STORED_IMAGE]
+        .into_iter()
+        .all(has)
+    {
+        Some(ListState {
             order: f.iter_scalars::<u32>(k, ORDER).map_err(rd)?.collect(),
             reference: f.iter_arrays::<f64, 3>(k, REFERENCE).map_err(rd)?.collect(),
-        }),
-        _ => None,
+            positions: f
+                .iter_arrays::<f64, 3>(k, STORED_POS)
+                .map_err(rd)?
+                .collect(),
+            images: f
+                .iter_arrays::<i32, 3>(k, STORED_IMAGE)
+                .map_err(rd)?
+                .collect(),
+        })
+    } else {
+        None
     };
     Ok(GsdFrame {
         step,

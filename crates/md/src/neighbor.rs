@@ -320,22 +320,6 @@ impl NeighborList {
     }
 }
 
-/// [`SimBox::min_image`] for separations of wrapped positions (`|d| < L` per axis, where one
-/// shift by `L` suffices), as selects rather than branches; equal to it there.
-#[inline(always)]
-pub(crate) fn near_image(sbox: &SimBox, d: [f64; 3]) -> [f64; 3] {
-    let mut out = d;
-    for k in 0..3 {
-        let (l, h) = (sbox.l[k], 0.5 * sbox.l[k]);
-        let x = d[k];
-        // Two masked constants (compare + and), no branch.
-        let down = if x >= h { l } else { 0.0 };
-        let up = if x < -h { l } else { 0.0 };
-        out[k] = x - down + up;
-    }
-    out
-}
-
 /// Append to `slot` (branch-free; overflow shows in `m` exceeding its length) the members of
 /// one run of cells whose shifted separation from `p`, `(p - q) + shift`, is within range.
 #[allow(clippy::too_many_arguments)]
