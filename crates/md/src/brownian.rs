@@ -725,11 +725,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
     }
 
     /// Advance `n` steps.
+    ///
+    /// The steps run on a worker of the thread pool, so that their parallel passes start
+    /// without a hand-over from a foreign thread each (context switches that cost more than a
+    /// step of a small system).
     pub fn run(&mut self, n: u64) -> Result<(), BdError> {
-        for _ in 0..n {
-            self.advance()?;
-        }
-        Ok(())
+        rayon::scope(|_| (0..n).try_for_each(|_| self.advance()))
     }
 
     /// Advance one step.

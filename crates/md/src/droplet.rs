@@ -130,7 +130,7 @@ pub struct RunSection {
     /// Time step (time units; default 2e-4 d^2 / D0).
     #[serde(default)]
     pub dt: Option<f64>,
-    /// Verlet skin (length; default 0.3 d).
+    /// Verlet skin (length; default 0.6 d).
     #[serde(default)]
     pub skin: Option<f64>,
 }
@@ -445,7 +445,7 @@ impl DropletScenario {
         let steps = (steps as u64).max(1);
         let skin = in_range(
             "run.skin",
-            self.run.skin.unwrap_or(0.3 * d),
+            self.run.skin.unwrap_or(0.6 * d),
             1e-3 * d,
             5.0 * d,
         )?;
