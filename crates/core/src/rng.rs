@@ -12,6 +12,7 @@
 use hoomd_rand::Counter;
 use rand::{Rng, RngExt};
 use rand_distr::StandardNormal;
+use std::sync::LazyLock;
 
 /// Number of consecutive particles that share one keyed stream.
 pub const BLOCK: usize = 64;
@@ -54,6 +55,157 @@ pub fn fill_normals(seed: u32, step: u64, out: &mut [f64]) {
     }
 }
 
+/// Layers of the ziggurat of [`Ziggurat`].
+const LAYERS: usize = 256;
+
+/// Unnormalised standard normal density `f(x) = exp(-x^2/2)`.
+#[inline]
+fn gauss(x: f64) -> f64 {
+    (-0.5 * x * x).exp()
+}
+
+/// `int_r^inf exp(-t^2/2) dt` for `r >= 2`, from the continued fraction of Mills' ratio
+/// `exp(-r^2/2) / (r + 1/(r + 2/(r + 3/(r + ...))))`, evaluated bottom-up.
+fn gauss_tail(r: f64) -> f64 {
+    let mut d = r;
+    for k in (1..=200).rev() {
+        d = r + k as f64 / d;
+    }
+    gauss(r) / d
+}
+
+/// Tables of the Marsaglia–Tsang ziggurat for the standard normal distribution
+/// (J. Stat. Softw. 5(8), 2000), computed at start-up.
+///
+/// [`LAYERS`] strips of equal area `v` cover `f(x) = exp(-x^2/2)` on `x >= 0`: strip 0 is the
+/// rectangle `[0, r] x [0, f(r)]` plus the tail `x > r` (virtual width `x_0 = v / f(r)`), strip
+/// `i >= 1` the rectangle `[0, x_i] x [f(x_i), f(x_{i+1})]` with `x_1 = r > x_2 > ... > x_256 = 0`.
+/// The base `r` is found by bisection so that the recursion
+/// `x_{i+1} = f^{-1}(f(x_i) + v / x_i)` closes at `x_256 = 0`.
+pub struct Ziggurat {
+    /// Per strip `i`: `[x_i, x_{i+1} / x_i]` (the width and the fraction of it that lies under
+    /// the curve for every height in the strip).
+    strips: [[f64; 2]; LAYERS],
+    /// `f(x_i)`, with `f(x_256) = 1`.
+    fx: [f64; LAYERS + 1],
+    r: f64,
+}
+
+static ZIGGURAT: LazyLock<Ziggurat> = LazyLock::new(Ziggurat::build);
+
+impl Ziggurat {
+    /// The shared tables (built on first use).
+    #[inline]
+    pub fn get() -> &'static Ziggurat {
+        &ZIGGURAT
+    }
+
+    /// Widths `x_0..=x_256` for base `r`, or `None` when the strips reach the mode early
+    /// (`r` too small).
+    fn widths(r: f64) -> (Option<[f64; LAYERS + 1]>, f64) {
+        let v = r * gauss(r) + gauss_tail(r);
+        let mut x = [0.0; LAYERS + 1];
+        x[0] = v / gauss(r);
+        x[1] = r;
+        for i in 1..LAYERS {
+            let y = gauss(x[i]) + v / x[i];
+            if i < LAYERS - 1 && y >= 1.0 {
+                return (None, 1.0);
+            }
+            // Residual of the closure condition at the top strip.
+            if i == LAYERS - 1 {
+                return (Some(x), y - 1.0);
+            }
+            x[i + 1] = (-2.0 * y.ln()).sqrt();
+        }
+        unreachable!()
+    }
+
+    fn build() -> Self {
+        let (mut lo, mut hi) = (3.0f64, 4.5f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            match Self::widths(mid) {
+                (Some(_), res) if res <= 0.0 => hi = mid,
+                _ => lo = mid,
+            }
+            if hi - lo <= f64::EPSILON * hi {
+                break;
+            }
+        }
+        let r = hi;
+        let (x, _) = Self::widths(r);
+        let mut x = x.expect("ziggurat closes");
+        x[LAYERS] = 0.0;
+        let mut strips = [[0.0; 2]; LAYERS];
+        let mut fx = [1.0; LAYERS + 1];
+        for i in 0..LAYERS {
+            strips[i] = [x[i], x[i + 1] / x[i]];
+            fx[i] = if i == 0 { gauss(r) } else { gauss(x[i]) };
+        }
+        Self { strips, fx, r }
+    }
+
+    /// One standard normal deviate. The fast path (about 99% of calls) costs one 64-bit draw, a
+    /// table load, a multiply and a compare: bits 0..8 pick the strip, bits 11..64 give a
+    /// signed uniform `u` in [-1, 1), and `x = u x_i` is accepted when `|u| < x_{i+1} / x_i`.
+    #[inline(always)]
+    pub fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> f64 {
+        let bits = rng.next_u64();
+        let i = (bits & (LAYERS as u64 - 1)) as usize;
+        let u = ((bits as i64) >> 11) as f64 * (1.0 / (1u64 << 52) as f64);
+        let [w, k] = self.strips[i];
+        if u.abs() < k {
+            return u * w;
+        }
+        self.sample_slow(rng, i, u)
+    }
+
+    /// The rare paths: the tail beyond `r` (strip 0) and the wedges above the curve.
+    #[cold]
+    #[inline(never)]
+    fn sample_slow<R: Rng + ?Sized>(&self, rng: &mut R, mut i: usize, mut u: f64) -> f64 {
+        let unit = |rng: &mut R| ((rng.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64);
+        loop {
+            if i == 0 {
+                // Marsaglia's tail method: r + a with density proportional to exp(-(r+a)^2/2).
+                loop {
+                    let a = -unit(rng).ln() / self.r;
+                    let b = -unit(rng).ln();
+                    if 2.0 * b > a * a {
+                        return (self.r + a).copysign(u);
+                    }
+                }
+            }
+            let x = u * self.strips[i][0];
+            let y = self.fx[i] + unit(rng) * (self.fx[i + 1] - self.fx[i]);
+            if y < gauss(x) {
+                return x;
+            }
+            let bits = rng.next_u64();
+            i = (bits & (LAYERS as u64 - 1)) as usize;
+            u = ((bits as i64) >> 11) as f64 * (1.0 / (1u64 << 52) as f64);
+            if u.abs() < self.strips[i][1] {
+                return u * self.strips[i][0];
+            }
+        }
+    }
+}
+
+/// Fill `out` with standard normal deviates for the particles of block `block` (particles
+/// `block * BLOCK ..`, `out.len() <= BLOCK`) at `step`, by the ziggurat of [`Ziggurat`] on the
+/// same keyed stream as [`fill_normal_block`] (a different, equally valid, sequence of
+/// deviates; inlined, about 4x cheaper).
+#[inline]
+pub fn fill_normal_block_fast(seed: u32, step: u64, block: u64, out: &mut [f64]) {
+    debug_assert!(out.len() <= BLOCK);
+    let zig = Ziggurat::get();
+    let mut rng = stream(seed, step, Purpose::Noise, block);
+    for x in out.iter_mut() {
+        *x = zig.sample(&mut rng);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,5 +240,172 @@ mod tests {
             (var - 1.0).abs() < 5.0 * (2.0 / n as f64).sqrt(),
             "var {var}"
         );
+    }
+    /// Exact standard normal CDF: Taylor series of the integral below |x| = 3, Mills' ratio
+    /// continued fraction above.
+    fn normal_cdf(x: f64) -> f64 {
+        let a = x.abs();
+        let upper = if a > 3.0 {
+            gauss_tail(a) / (2.0 * std::f64::consts::PI).sqrt()
+        } else {
+            // int_0^a exp(-t^2/2) dt = sum_n (-1)^n a^(2n+1) / (2^n n! (2n+1))
+            let (mut term, mut sum) = (a, 0.0);
+            for n in 0..200 {
+                sum += term / (2 * n + 1) as f64;
+                term *= -a * a / (2.0 * (n + 1) as f64);
+            }
+            0.5 - sum / (2.0 * std::f64::consts::PI).sqrt()
+        };
+        if x >= 0.0 { 1.0 - upper } else { upper }
+    }
+
+    fn ks_statistic(mut x: Vec<f64>) -> f64 {
+        x.sort_by(f64::total_cmp);
+        let n = x.len() as f64;
+        x.iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let c = normal_cdf(v);
+                (c - i as f64 / n).abs().max((c - (i + 1) as f64 / n).abs())
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn fast_normals(n: usize, seed: u32) -> Vec<f64> {
+        let mut x = vec![0.0; n];
+        for (b, chunk) in x.chunks_mut(BLOCK).enumerate() {
+            fill_normal_block_fast(seed, 5, b as u64, chunk);
+        }
+        x
+    }
+
+    #[test]
+    fn ziggurat_tables_close() {
+        let z = Ziggurat::get();
+        // Marsaglia & Tsang (2000) quote r = 3.6541528853610088 for 256 strips.
+        assert!((z.r - 3.654_152_885_361_009).abs() < 1e-12, "r = {}", z.r);
+        assert!(z.strips[LAYERS - 1][1] == 0.0 && z.fx[LAYERS] == 1.0);
+        assert!((normal_cdf(1.0) - 0.841_344_746_068_542_9).abs() < 1e-13);
+        assert!((normal_cdf(-4.0) - 3.167_124_183_311_992e-5).abs() < 1e-17);
+    }
+
+    /// All checks of a standard normal sample: moments 1–4, tail counts (including the
+    /// strip-0 tail beyond r = 3.654), tail symmetry, a chi-square test on 0.25-wide bins over
+    /// [-5, 5] and the Kolmogorov–Smirnov distance to the exact CDF, each at about 5 standard
+    /// errors (or the 1e-4 level).
+    fn check_standard_normal(x: Vec<f64>) -> Result<(), String> {
+        let nf = x.len() as f64;
+        let m = |k: i32| x.iter().map(|v| v.powi(k)).sum::<f64>() / nf;
+        // Standard errors sqrt(Var x^k / n) with Var x^k = 1, 2, 15, 96.
+        for (k, exact, sd) in [
+            (1, 0.0, 1.0),
+            (2, 1.0, 2f64.sqrt()),
+            (3, 0.0, 15f64.sqrt()),
+            (4, 3.0, 96f64.sqrt()),
+        ] {
+            let got = m(k);
+            if (got - exact).abs() > 5.0 * sd / nf.sqrt() {
+                return Err(format!("moment {k}: {got}"));
+            }
+        }
+        let r = 3.654_152_885_361_009;
+        for t in [2.0, 3.0, r, 4.5] {
+            let expect = 2.0 * normal_cdf(-t) * nf;
+            let got = x.iter().filter(|v| v.abs() > t).count() as f64;
+            if (got - expect).abs() > 5.0 * expect.sqrt() + 2.0 {
+                return Err(format!("|x| > {t}: {got} vs {expect}"));
+            }
+        }
+        let pos = x.iter().filter(|&&v| v > r).count() as f64;
+        let neg = x.iter().filter(|&&v| v < -r).count() as f64;
+        if (pos - neg).abs() > 5.0 * (pos + neg).sqrt() {
+            return Err(format!("tail asymmetry {pos} vs {neg}"));
+        }
+        // 40 bins of width 0.25 on [-5, 5] plus the two outer ones: 41 degrees of freedom,
+        // chi2 > 41 + 6 sqrt(82) has p below 1e-4.
+        let mut counts = [0.0f64; 42];
+        for &v in &x {
+            let b = ((v + 5.0) / 0.25).floor() + 1.0;
+            counts[b.clamp(0.0, 41.0) as usize] += 1.0;
+        }
+        let edge = |b: usize| -5.0 + 0.25 * b as f64;
+        let chi2: f64 = (0..42)
+            .map(|b| {
+                let lo = if b == 0 { 0.0 } else { normal_cdf(edge(b - 1)) };
+                let hi = if b == 41 { 1.0 } else { normal_cdf(edge(b)) };
+                let e = (hi - lo) * nf;
+                (counts[b] - e).powi(2) / e
+            })
+            .sum();
+        if chi2 > 41.0 + 6.0 * 82f64.sqrt() {
+            return Err(format!("chi2 {chi2} for 41 degrees of freedom"));
+        }
+        // Kolmogorov–Smirnov: 2/sqrt(n) is about the 0.07% critical value.
+        let d = ks_statistic(x);
+        if d > 2.0 / nf.sqrt() {
+            return Err(format!("KS distance {d}"));
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn fast_normals_are_keyed_and_standard_normal() {
+        let n = 1 << 21;
+        let x = fast_normals(n, 11);
+        assert_eq!(x, fast_normals(n, 11));
+        let mut blk = vec![0.0; BLOCK];
+        fill_normal_block_fast(11, 5, 3, &mut blk);
+        assert_eq!(&x[3 * BLOCK..4 * BLOCK], &blk[..]);
+        check_standard_normal(x).unwrap();
+        check_standard_normal(fast_normals(n, 12)).unwrap();
+        // The checks accept the reference sampler too.
+        let mut reference = vec![0.0; n];
+        fill_normals(11, 5, &mut reference);
+        check_standard_normal(reference).unwrap();
+    }
+
+    #[test]
+    fn normality_checks_reject_broken_ziggurats() {
+        let z = Ziggurat::get();
+        let n = 1 << 21;
+        let mut rng = stream(3, 0, Purpose::Noise, 0);
+        let strip = |rng: &mut dyn Rng| {
+            let bits = rng.next_u64();
+            let i = (bits & 255) as usize;
+            let u = ((bits as i64) >> 11) as f64 * (1.0 / (1u64 << 52) as f64);
+            (i, u)
+        };
+        // Fast path only (wedges and tail dropped, retried).
+        let no_wedges: Vec<f64> = (0..n)
+            .map(|_| {
+                loop {
+                    let (i, u) = strip(&mut rng);
+                    if u.abs() < z.strips[i][1] {
+                        break u * z.strips[i][0];
+                    }
+                }
+            })
+            .collect();
+        let e = check_standard_normal(no_wedges).unwrap_err();
+        // Tail replaced by an exponential of the wrong scale (rate 1 instead of r).
+        let bad_tail: Vec<f64> = (0..n)
+            .map(|_| {
+                let (i, u) = strip(&mut rng);
+                if i == 0 && u.abs() >= z.strips[0][1] {
+                    let a = -(((rng.next_u64() >> 11) + 1) as f64 / (1u64 << 53) as f64).ln();
+                    (z.r + a).copysign(u)
+                } else {
+                    z.sample(&mut rng)
+                }
+            })
+            .collect();
+        let e2 = check_standard_normal(bad_tail).unwrap_err();
+        eprintln!("rejected: {e}; {e2}");
+        // Nor may the fast sampler coincide with the reference one.
+        let mut a = vec![0.0; BLOCK];
+        let mut b = vec![0.0; BLOCK];
+        fill_normal_block(3, 0, 0, &mut a);
+        fill_normal_block_fast(3, 0, 0, &mut b);
+        assert_ne!(a, b);
     }
 }
