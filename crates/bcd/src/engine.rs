@@ -16,7 +16,7 @@ use crate::cluster::{Cluster, Hull, Wall, collide, merge, premerge};
 use crate::forces::{ExternalForce, PairForce};
 use colloidsim_core::ParamError;
 use colloidsim_core::param;
-use colloidsim_core::rng::{BLOCK, fill_normal_block};
+use colloidsim_core::rng::{BLOCK, fill_normal_block_fast};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -145,6 +145,7 @@ struct Chunk {
     ve: usize,
     stack: Vec<Cluster>,
     hull: Hull,
+    pool: Vec<Pool>,
     /// First rod whose velocity went non-finite, with that velocity.
     bad: Option<(usize, f64)>,
 }
@@ -322,6 +323,8 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         let origin = self.origin();
         let periodic = self.cfg.boundary == Boundary::Periodic;
         let chronological = self.cfg.update == Update::Chronological;
+        // Ring with premerging: one pooling pass on end-of-step positions (`chunk_phase_ring`).
+        let fast = periodic && !chronological;
         let (sigma, dt, length) = (self.cfg.sigma, self.cfg.dt, self.cfg.length);
 
         // Chunk boundaries at cluster starts, about CHUNK rods apart.
@@ -373,9 +376,15 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 right_wall: !periodic && self.state.right_contact,
                 premerge: !chronological,
             };
-            self.chunks
-                .par_iter_mut()
-                .for_each(|c| chunk_phase(c, &ctx));
+            if fast {
+                self.chunks
+                    .par_iter_mut()
+                    .for_each(|c| chunk_phase_ring(c, &ctx));
+            } else {
+                self.chunks
+                    .par_iter_mut()
+                    .for_each(|c| chunk_phase(c, &ctx));
+            }
         }
         if let Some((i, u)) = self.chunks.iter().filter_map(|c| c.bad).min_by_key(|b| b.0) {
             return Err(BcdError::NonFinite {
@@ -399,6 +408,12 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             });
         }
         for c in &self.chunks {
+            if fast {
+                for &cl in &c.stack {
+                    pool_final(g, cl, sigma);
+                }
+                continue;
+            }
             for &cl in &c.stack {
                 if cl.wall == Wall::Left {
                     let top = g.last_mut().expect("left wall sentinel");
@@ -428,6 +443,9 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         }
         if chronological {
             head = chronological_events(g, periodic, n, length, sigma, dt);
+            write_dt = 0.0;
+        } else if fast {
+            head = stitch_seam_final(g, n, length, sigma);
             write_dt = 0.0;
         } else if periodic {
             head = stitch_seam(g, n, length, sigma, dt);
@@ -562,25 +580,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
             let xi = ring.x[a] + offset;
             let mut f = ctx.ext.force(xi);
             if has_pair {
-                // Right neighbours push rod a to the left, left neighbours to the right.
-                let mut k = 1;
-                while k < n && (ring.periodic || a + k < n) {
-                    let r = ring.pos(vw + k) - xi;
-                    if r >= range {
-                        break;
-                    }
-                    f -= ctx.pair.force(r);
-                    k += 1;
-                }
-                let mut k = 1;
-                while k < n && (ring.periodic || a >= k) {
-                    let r = xi - (ring.pos(vw + n - k) - ring.length);
-                    if r >= range {
-                        break;
-                    }
-                    f += ctx.pair.force(r);
-                    k += 1;
-                }
+                f += pair_force(ring, ctx.pair, a, vw, xi, range);
             }
             let mut u = ctx.mobility * f;
             if ctx.noise_amp > 0.0 {
@@ -588,7 +588,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
                 if b != noise_block {
                     noise_block = b;
                     let m = BLOCK.min(n - b * BLOCK);
-                    fill_normal_block(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+                    fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
                 }
                 u += ctx.noise_amp * noise[a % BLOCK];
             }
@@ -616,6 +616,212 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
         }
         w = seg_end;
     }
+}
+
+/// A block of rods that end the step together, in the pooling pass of [`chunk_phase_ring`]:
+/// `n` rods from virtual index `start`, end-of-step reduced position `z` (relative to the
+/// chunk's first rod).
+#[derive(Debug, Clone, Copy)]
+struct Pool {
+    z: f64,
+    n: f64,
+    start: u32,
+}
+
+/// The premerged step of the chunk's rods on a ring in one pooling pass.
+///
+/// In reduced coordinates `y_i = x_i - i sigma` hard rods are points that may not pass each
+/// other, and a cluster of rods in contact shares one `y`. Fragmentation (fast-bcd Eqs. 4a/4b:
+/// the lower convex hull of the cumulative free velocities, see [`Hull`]) followed by binary
+/// premerging (Sec. IV, Eq. 20: clusters `a`, `b` merge when `y_a + v_a dt >= y_b + v_b dt`,
+/// into the centre of mass, Eq. 6) is the same pooling of adjacent violators applied to the free
+/// end-of-step positions `z_i = y_i + u_i dt`: inside a cluster (equal `y`) it compares mean
+/// velocities, across clusters it detects the collisions within `dt`, and pooling in any order
+/// reaches the same unique result. So one stack over `z` does both, left to right; each block
+/// keeps its end-of-step position, and rods of one block end in contact.
+fn chunk_phase_ring<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P>) {
+    c.stack.clear();
+    c.bad = None;
+    let (vs, ve) = (c.vs, c.ve);
+    let ring = ctx.ring;
+    let n = ring.n;
+    let range = ctx.pair.range();
+    let has_pair = range > ctx.sigma;
+    let (sigma, dt, mobility, amp) = (ctx.sigma, ctx.dt, ctx.mobility, ctx.noise_amp);
+    let xref = ring.pos(vs);
+    let pool = &mut c.pool;
+    pool.clear();
+    // Sentinel below every block: never pooled into.
+    pool.push(Pool {
+        z: f64::NEG_INFINITY,
+        n: 0.0,
+        start: vs as u32,
+    });
+    let mut noise = [0.0f64; BLOCK];
+    let mut zbuf = [0.0f64; BLOCK];
+    // Reduced start-of-step position of the current cluster; the chunk starts a cluster.
+    let mut y = 0.0;
+    let mut bonded = false;
+    let mut w = vs;
+    while w < ve {
+        // One segment: rods of one noise block, without crossing the ring's end.
+        let wraps = w / n;
+        let base = wraps * n;
+        let a0 = w - base;
+        let b = a0 / BLOCK;
+        let a1 = (ve - base).min(n).min((b + 1) * BLOCK);
+        let offset = wraps as f64 * ring.length;
+        if amp > 0.0 {
+            let m = BLOCK.min(n - b * BLOCK);
+            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+        }
+        let mut finite = true;
+        for a in a0..a1 {
+            let xi = ring.x[a] + offset;
+            let mut f = ctx.ext.force(xi);
+            if has_pair {
+                f += pair_force(ring, ctx.pair, a, a + base, xi, range);
+            }
+            let u = mobility * f + amp * noise[a % BLOCK];
+            finite &= u.is_finite();
+            let fresh = (xi - xref) - (a + base - vs) as f64 * sigma;
+            y = if bonded { y } else { fresh };
+            bonded = ring.bond[a] != 0;
+            zbuf[a - a0] = y + u * dt;
+        }
+        if !finite {
+            let a = (a0..a1).find(|&a| !zbuf[a - a0].is_finite()).unwrap_or(a0);
+            let xi = ring.x[a] + offset;
+            let mut f = ctx.ext.force(xi);
+            if has_pair {
+                f += pair_force(ring, ctx.pair, a, a + base, xi, range);
+            }
+            c.bad = Some((a, mobility * f + amp * noise[a % BLOCK]));
+            return;
+        }
+        for (k, &zk) in zbuf[..a1 - a0].iter().enumerate() {
+            let mut z = zk;
+            let mut cnt = 1.0;
+            let mut start = (w + k) as u32;
+            loop {
+                let top = *pool.last().expect("sentinel");
+                if top.z < z {
+                    break;
+                }
+                let tot = top.n + cnt;
+                z = top.z + (z - top.z) * (cnt / tot);
+                cnt = tot;
+                start = top.start;
+                pool.pop();
+            }
+            pool.push(Pool { z, n: cnt, start });
+        }
+        w = a1 + base;
+    }
+    for p in &pool[1..] {
+        c.stack.push(Cluster {
+            start: p.start,
+            n: p.n as u32,
+            left: xref + p.z + (p.start as usize - vs) as f64 * sigma,
+            v: 0.0,
+            wall: Wall::None,
+        });
+    }
+}
+
+/// Pair force on rod `a` (virtual index `vw`, position `xi`) from its neighbours within `range`.
+#[inline]
+fn pair_force<P: PairForce>(
+    ring: &Ring,
+    pair: &P,
+    a: usize,
+    vw: usize,
+    xi: f64,
+    range: f64,
+) -> f64 {
+    let n = ring.n;
+    let mut f = 0.0;
+    // Right neighbours push rod a to the left, left neighbours to the right.
+    let mut k = 1;
+    while k < n && (ring.periodic || a + k < n) {
+        let r = ring.pos(vw + k) - xi;
+        if r >= range {
+            break;
+        }
+        f -= pair.force(r);
+        k += 1;
+    }
+    let mut k = 1;
+    while k < n && (ring.periodic || a >= k) {
+        let r = xi - (ring.pos(vw + n - k) - ring.length);
+        if r >= range {
+            break;
+        }
+        f += pair.force(r);
+        k += 1;
+    }
+    f
+}
+
+/// Do blocks `a` (left) and `b` (right), given by their end-of-step positions, overlap or touch?
+#[inline]
+fn overlap(a: &Cluster, b: &Cluster, sigma: f64) -> bool {
+    b.left - a.left - a.n as f64 * sigma <= 0.0
+}
+
+/// Pool two blocks given by end-of-step positions at their centre of mass (fast-bcd Eq. 6).
+#[inline]
+fn pool_pair(a: &Cluster, b: &Cluster, sigma: f64) -> Cluster {
+    let n = a.n + b.n;
+    let shift = (b.left - a.n as f64 * sigma - a.left) * (b.n as f64 / n as f64);
+    Cluster {
+        start: a.start,
+        n,
+        left: a.left + shift,
+        v: 0.0,
+        wall: Wall::None,
+    }
+}
+
+/// Push a block (end-of-step position) and pool it with its left neighbours while they overlap.
+#[inline]
+fn pool_final(g: &mut Vec<Cluster>, c: Cluster, sigma: f64) {
+    let mut top = c;
+    while let Some(prev) = g.last() {
+        if overlap(prev, &top, sigma) {
+            top = pool_pair(prev, &top, sigma);
+            g.pop();
+        } else {
+            break;
+        }
+    }
+    g.push(top);
+}
+
+/// [`stitch_seam`] for blocks given by end-of-step positions.
+fn stitch_seam_final(g: &mut Vec<Cluster>, n: usize, length: f64, sigma: f64) -> usize {
+    let mut head = 0;
+    while g.len() - head >= 2 {
+        let last = g.len() - 1;
+        let mut front = g[head];
+        front.start += n as u32;
+        front.left += length;
+        if !overlap(&g[last], &front, sigma) {
+            break;
+        }
+        g[last] = pool_pair(&g[last], &front, sigma);
+        head += 1;
+        while g.len() - head >= 2 {
+            let l = g.len() - 1;
+            if overlap(&g[l - 1], &g[l], sigma) {
+                g[l - 1] = pool_pair(&g[l - 1], &g[l], sigma);
+                g.pop();
+            } else {
+                break;
+            }
+        }
+    }
+    head
 }
 
 /// Premerge across the periodic seam: the last cluster meets the first one a period further
