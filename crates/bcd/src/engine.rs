@@ -145,7 +145,12 @@ struct Chunk {
     ve: usize,
     stack: Vec<Cluster>,
     hull: Hull,
+    /// Blocks of the ring step; `pool[0]` is a sentinel, `pool[head..end]` the live ones.
     pool: Vec<Pool>,
+    head: usize,
+    end: usize,
+    /// The last live block grew in the stitch: its rods must be rewritten.
+    dirty: bool,
     /// First rod whose velocity went non-finite, with that velocity.
     bad: Option<(usize, f64)>,
 }
@@ -196,6 +201,11 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
     chunks: Vec<Chunk>,
     global: Vec<Cluster>,
     noise_amp: f64,
+    /// Positions and bonds being written by the ring step (swapped with the state's).
+    x_next: Vec<f64>,
+    bond_next: Vec<u8>,
+    /// Chunks with live blocks during the ring stitch.
+    live: Vec<usize>,
 }
 
 impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
@@ -245,6 +255,8 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         let n = state.x.len();
         let chunks = vec![Chunk::default(); n.div_ceil(CHUNK)];
         let noise_amp = (2.0 * cfg.diffusion() / cfg.dt).sqrt();
+        let ring = cfg.boundary == Boundary::Periodic && cfg.update == Update::Premerge;
+        let spare = if ring { n } else { 0 };
         Ok(Self {
             cfg,
             ext,
@@ -253,6 +265,9 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             chunks,
             global: Vec::new(),
             noise_amp,
+            x_next: vec![0.0; spare],
+            bond_next: vec![0; spare],
+            live: Vec::new(),
         })
     }
 
@@ -353,6 +368,10 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             self.chunks[k - 1].ve = end;
         }
 
+        if fast {
+            return self.step_ring(origin);
+        }
+
         // Forces, fragmentation and chunk-local premerging, in parallel.
         {
             let ring = Ring {
@@ -376,15 +395,9 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 right_wall: !periodic && self.state.right_contact,
                 premerge: !chronological,
             };
-            if fast {
-                self.chunks
-                    .par_iter_mut()
-                    .for_each(|c| chunk_phase_ring(c, &ctx));
-            } else {
-                self.chunks
-                    .par_iter_mut()
-                    .for_each(|c| chunk_phase(c, &ctx));
-            }
+            self.chunks
+                .par_iter_mut()
+                .for_each(|c| chunk_phase(c, &ctx));
         }
         if let Some((i, u)) = self.chunks.iter().filter_map(|c| c.bad).min_by_key(|b| b.0) {
             return Err(BcdError::NonFinite {
@@ -408,12 +421,6 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             });
         }
         for c in &self.chunks {
-            if fast {
-                for &cl in &c.stack {
-                    pool_final(g, cl, sigma);
-                }
-                continue;
-            }
             for &cl in &c.stack {
                 if cl.wall == Wall::Left {
                     let top = g.last_mut().expect("left wall sentinel");
@@ -443,9 +450,6 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         }
         if chronological {
             head = chronological_events(g, periodic, n, length, sigma, dt);
-            write_dt = 0.0;
-        } else if fast {
-            head = stitch_seam_final(g, n, length, sigma);
             write_dt = 0.0;
         } else if periodic {
             head = stitch_seam(g, n, length, sigma, dt);
@@ -507,6 +511,76 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             // The last rod is never bonded to the right (no ring).
             self.state.bond[n - 1] = 0;
         }
+        self.state.step += 1;
+        Ok(())
+    }
+
+    /// The premerged step on a ring: each chunk pools its rods and writes their end-of-step
+    /// positions and bonds (in parallel); a short sequential pass then pools the blocks that meet
+    /// across chunk boundaries and the periodic seam and rewrites only their rods.
+    fn step_ring(&mut self, origin: usize) -> Result<(), BcdError> {
+        let n = self.len();
+        let (sigma, length) = (self.cfg.sigma, self.cfg.length);
+        {
+            let ring = Ring {
+                x: &self.state.x,
+                bond: &self.state.bond,
+                n,
+                length,
+                periodic: true,
+            };
+            let ctx = StepCtx {
+                ring: &ring,
+                ext: &self.ext,
+                pair: &self.pair,
+                mobility: self.cfg.mobility,
+                noise_amp: self.noise_amp,
+                seed: self.cfg.seed,
+                step: self.state.step,
+                sigma,
+                dt: self.cfg.dt,
+                left_wall: false,
+                right_wall: false,
+                premerge: true,
+            };
+            // Virtual indices [origin, n) are rods origin.., [n, n + origin) rods 0.. one period on.
+            let (xl, xr) = self.x_next.split_at_mut(origin);
+            let (bl, br) = self.bond_next.split_at_mut(origin);
+            let first = Out {
+                x: xr,
+                b: br,
+                v0: origin,
+            };
+            let second = Out {
+                x: xl,
+                b: bl,
+                v0: n,
+            };
+            ring_chunks(&mut self.chunks, first, second, &ctx);
+        }
+        if let Some((i, u)) = self.chunks.iter().filter_map(|c| c.bad).min_by_key(|b| b.0) {
+            return Err(BcdError::NonFinite {
+                step: self.state.step,
+                particle: i,
+                position: self.state.x[i],
+                velocity: u,
+            });
+        }
+        stitch_ring(&mut self.chunks, &mut self.live, n, length, sigma);
+        // Rewrite the rods of the blocks that grew in the stitch (always a chunk's last block).
+        for c in &self.chunks {
+            if c.head < c.end && c.dirty {
+                let p = c.pool[c.end - 1];
+                let (start, cnt) = (p.start as usize, p.n as usize);
+                for w in start..start + cnt {
+                    let a = w % n;
+                    self.x_next[a] = p.pos + (w - start) as f64 * sigma - (w / n) as f64 * length;
+                    self.bond_next[a] = u8::from(w + 1 < start + cnt);
+                }
+            }
+        }
+        std::mem::swap(&mut self.state.x, &mut self.x_next);
+        std::mem::swap(&mut self.state.bond, &mut self.bond_next);
         self.state.step += 1;
         Ok(())
     }
@@ -619,13 +693,65 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
 }
 
 /// A block of rods that end the step together, in the pooling pass of [`chunk_phase_ring`]:
-/// `n` rods from virtual index `start`, end-of-step reduced position `z` (relative to the
-/// chunk's first rod).
-#[derive(Debug, Clone, Copy)]
+/// `n` rods from virtual index `start`. `pos` is the end-of-step reduced position `z` relative
+/// to the chunk's first rod while pooling, then the end-of-step centre of the block's first rod
+/// (unwrapped, in the frame of its virtual index).
+#[derive(Debug, Clone, Copy, Default)]
 struct Pool {
-    z: f64,
-    n: f64,
+    pos: f64,
+    n: u32,
     start: u32,
+}
+
+/// Output rods of virtual indices `[v0, v0 + x.len())`.
+struct Out<'a> {
+    x: &'a mut [f64],
+    b: &'a mut [u8],
+    v0: usize,
+}
+
+impl<'a> Out<'a> {
+    /// Split at virtual index `v`.
+    fn split(self, v: usize) -> (Out<'a>, Out<'a>) {
+        let k = v.saturating_sub(self.v0).min(self.x.len());
+        let (xa, xb) = self.x.split_at_mut(k);
+        let (ba, bb) = self.b.split_at_mut(k);
+        (
+            Out {
+                x: xa,
+                b: ba,
+                v0: self.v0,
+            },
+            Out {
+                x: xb,
+                b: bb,
+                v0: self.v0 + k,
+            },
+        )
+    }
+}
+
+/// Run [`chunk_phase_ring`] on every chunk in parallel, handing each the parts of the output
+/// arrays that hold its rods (`first`: virtual indices below N, `second`: one period on).
+fn ring_chunks<E: ExternalForce, P: PairForce>(
+    chunks: &mut [Chunk],
+    first: Out,
+    second: Out,
+    ctx: &StepCtx<E, P>,
+) {
+    if chunks.len() == 1 {
+        chunk_phase_ring(&mut chunks[0], first, second, ctx);
+        return;
+    }
+    let mid = chunks.len() / 2;
+    let v = chunks[mid].vs;
+    let (f1, f2) = first.split(v);
+    let (s1, s2) = second.split(v);
+    let (c1, c2) = chunks.split_at_mut(mid);
+    rayon::join(
+        || ring_chunks(c1, f1, s1, ctx),
+        || ring_chunks(c2, f2, s2, ctx),
+    );
 }
 
 /// The premerged step of the chunk's rods on a ring in one pooling pass.
@@ -637,10 +763,14 @@ struct Pool {
 /// into the centre of mass, Eq. 6) is the same pooling of adjacent violators applied to the free
 /// end-of-step positions `z_i = y_i + u_i dt`: inside a cluster (equal `y`) it compares mean
 /// velocities, across clusters it detects the collisions within `dt`, and pooling in any order
-/// reaches the same unique result. So one stack over `z` does both, left to right; each block
-/// keeps its end-of-step position, and rods of one block end in contact.
-fn chunk_phase_ring<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P>) {
-    c.stack.clear();
+/// reaches the same unique result. So one stack over `z` does both, left to right; rods of one
+/// block end in contact. The chunk then writes its rods' end-of-step positions and bonds.
+fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
+    c: &mut Chunk,
+    first: Out,
+    second: Out,
+    ctx: &StepCtx<E, P>,
+) {
     c.bad = None;
     let (vs, ve) = (c.vs, c.ve);
     let ring = ctx.ring;
@@ -649,18 +779,21 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx
     let has_pair = range > ctx.sigma;
     let (sigma, dt, mobility, amp) = (ctx.sigma, ctx.dt, ctx.mobility, ctx.noise_amp);
     let xref = ring.pos(vs);
+    // The stack of blocks, pool[0..=top]; pool[0] is a sentinel never pooled into.
     let pool = &mut c.pool;
-    pool.clear();
-    // Sentinel below every block: never pooled into.
-    pool.push(Pool {
-        z: f64::NEG_INFINITY,
-        n: 0.0,
+    if pool.is_empty() {
+        pool.push(Pool::default());
+    }
+    pool[0] = Pool {
+        pos: f64::NEG_INFINITY,
+        n: 0,
         start: vs as u32,
-    });
+    };
+    let mut top = 0;
     let mut noise = [0.0f64; BLOCK];
     let mut zbuf = [0.0f64; BLOCK];
     // Reduced start-of-step position of the current cluster; the chunk starts a cluster.
-    let mut y = 0.0;
+    let mut y = 0.0f64;
     let mut bonded = false;
     let mut w = vs;
     while w < ve {
@@ -670,24 +803,35 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx
         let a0 = w - base;
         let b = a0 / BLOCK;
         let a1 = (ve - base).min(n).min((b + 1) * BLOCK);
+        let len = a1 - a0;
         let offset = wraps as f64 * ring.length;
         if amp > 0.0 {
             let m = BLOCK.min(n - b * BLOCK);
             fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
         }
+        // Free end-of-step reduced positions z (fast-bcd Eq. 3 for the free velocities).
         let mut finite = true;
-        for a in a0..a1 {
-            let xi = ring.x[a] + offset;
+        let mut kf = (w - vs) as f64;
+        let rods = ring.x[a0..a1]
+            .iter()
+            .zip(&ring.bond[a0..a1])
+            .zip(&noise[a0 - b * BLOCK..a1 - b * BLOCK]);
+        for (k, (z, ((&xa, &bd), &g))) in zbuf[..len].iter_mut().zip(rods).enumerate() {
+            let xi = xa + offset;
             let mut f = ctx.ext.force(xi);
             if has_pair {
-                f += pair_force(ring, ctx.pair, a, a + base, xi, range);
+                f += pair_force(ring, ctx.pair, a0 + k, w + k, xi, range);
             }
-            let u = mobility * f + amp * noise[a % BLOCK];
+            let u = mobility * f + amp * g;
             finite &= u.is_finite();
-            let fresh = (xi - xref) - (a + base - vs) as f64 * sigma;
-            y = if bonded { y } else { fresh };
-            bonded = ring.bond[a] != 0;
-            zbuf[a - a0] = y + u * dt;
+            // A rod bonded to its left neighbour keeps the cluster's y bit for bit (select
+            // without a branch: the bonds are data-dependent).
+            let fresh = (xi - xref) - kf * sigma;
+            let keep = u64::from(bonded).wrapping_neg();
+            y = f64::from_bits((y.to_bits() & keep) | (fresh.to_bits() & !keep));
+            bonded = bd != 0;
+            *z = y + u * dt;
+            kf += 1.0;
         }
         if !finite {
             let a = (a0..a1).find(|&a| !zbuf[a - a0].is_finite()).unwrap_or(a0);
@@ -699,33 +843,170 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx
             c.bad = Some((a, mobility * f + amp * noise[a % BLOCK]));
             return;
         }
-        for (k, &zk) in zbuf[..a1 - a0].iter().enumerate() {
+        // Pool adjacent violators.
+        for (k, &zk) in zbuf[..len].iter().enumerate() {
             let mut z = zk;
-            let mut cnt = 1.0;
+            let mut cnt = 1;
             let mut start = (w + k) as u32;
-            loop {
-                let top = *pool.last().expect("sentinel");
-                if top.z < z {
-                    break;
-                }
-                let tot = top.n + cnt;
-                z = top.z + (z - top.z) * (cnt / tot);
+            while pool[top].pos >= z {
+                let p = pool[top];
+                let tot = p.n + cnt;
+                z = p.pos + (z - p.pos) * (cnt as f64 / tot as f64);
                 cnt = tot;
-                start = top.start;
-                pool.pop();
+                start = p.start;
+                top -= 1;
             }
-            pool.push(Pool { z, n: cnt, start });
+            top += 1;
+            // The stack grows to the most blocks a chunk has held (no per-step allocation).
+            if top == pool.len() {
+                pool.push(Pool::default());
+            }
+            pool[top] = Pool {
+                pos: z,
+                n: cnt,
+                start,
+            };
         }
         w = a1 + base;
     }
-    for p in &pool[1..] {
-        c.stack.push(Cluster {
-            start: p.start,
-            n: p.n as u32,
-            left: xref + p.z + (p.start as usize - vs) as f64 * sigma,
-            v: 0.0,
-            wall: Wall::None,
-        });
+    c.end = top + 1;
+    // End-of-step positions and bonds of the chunk's rods.
+    let la = first.x.len();
+    for i in 1..=top {
+        let k0 = pool[i].start as usize - vs;
+        let k1 = if i < top {
+            pool[i + 1].start as usize - vs
+        } else {
+            ve - vs
+        };
+        let p = &mut pool[i];
+        p.pos += xref + k0 as f64 * sigma;
+        let pos = p.pos;
+        if k1 <= la {
+            let xs = &mut first.x[k0..k1];
+            let bs = &mut first.b[k0..k1];
+            let mut jf = 0.0;
+            for (x, b) in xs.iter_mut().zip(bs.iter_mut()) {
+                *x = pos + jf * sigma;
+                *b = 1;
+                jf += 1.0;
+            }
+            bs[k1 - k0 - 1] = 0;
+        } else {
+            for k in k0..k1 {
+                let xk = pos + (k - k0) as f64 * sigma;
+                let bk = u8::from(k + 1 < k1);
+                if k < la {
+                    first.x[k] = xk;
+                    first.b[k] = bk;
+                } else {
+                    second.x[k - la] = xk - ring.length;
+                    second.b[k - la] = bk;
+                }
+            }
+        }
+    }
+}
+
+/// Pool the chunks' blocks across chunk boundaries and the periodic seam (blocks given by
+/// end-of-step positions; pooling at the centre of mass, fast-bcd Eq. 6). Sets each chunk's
+/// live range `pool[head..end]`; grown blocks are marked dirty.
+fn stitch_ring(chunks: &mut [Chunk], live: &mut Vec<usize>, n: usize, length: f64, sigma: f64) {
+    live.clear();
+    for c in chunks.iter_mut() {
+        c.head = 1;
+        c.dirty = false;
+    }
+    for ci in 0..chunks.len() {
+        while chunks[ci].head < chunks[ci].end {
+            let Some(&pi) = live.last() else { break };
+            let first = chunks[ci].pool[chunks[ci].head];
+            let pc = &mut chunks[pi];
+            let top = &mut pc.pool[pc.end - 1];
+            if !overlap(top, &first, sigma) {
+                break;
+            }
+            *top = pool_pair(top, &first, sigma);
+            pc.dirty = true;
+            chunks[ci].head += 1;
+            cascade(chunks, live, 0, sigma);
+        }
+        if chunks[ci].head < chunks[ci].end {
+            live.push(ci);
+        }
+    }
+    // The seam: the last block meets the first one a period further on.
+    let mut lf = 0;
+    while live.len() > lf {
+        let (fi, li) = (live[lf], live[live.len() - 1]);
+        if fi == li && chunks[fi].end - chunks[fi].head < 2 {
+            break;
+        }
+        let mut front = chunks[fi].pool[chunks[fi].head];
+        front.start += n as u32;
+        front.pos += length;
+        let lc = &mut chunks[li];
+        let last = &mut lc.pool[lc.end - 1];
+        if !overlap(last, &front, sigma) {
+            break;
+        }
+        *last = pool_pair(last, &front, sigma);
+        lc.dirty = true;
+        chunks[fi].head += 1;
+        if chunks[fi].head == chunks[fi].end {
+            lf += 1;
+        }
+        cascade(chunks, live, lf, sigma);
+    }
+}
+
+/// Pool the last live block into its left neighbours for as long as they overlap (live chunks
+/// `live[lf..]`).
+fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize, sigma: f64) {
+    loop {
+        let pi = live[live.len() - 1];
+        let c = &mut chunks[pi];
+        let top = c.pool[c.end - 1];
+        if c.end - c.head >= 2 {
+            let prev = c.pool[c.end - 2];
+            if !overlap(&prev, &top, sigma) {
+                return;
+            }
+            c.end -= 1;
+            c.pool[c.end - 1] = pool_pair(&prev, &top, sigma);
+            c.dirty = true;
+        } else {
+            if live.len() - lf < 2 {
+                return;
+            }
+            let qc = &mut chunks[live[live.len() - 2]];
+            let prev = &mut qc.pool[qc.end - 1];
+            if !overlap(prev, &top, sigma) {
+                return;
+            }
+            *prev = pool_pair(prev, &top, sigma);
+            qc.dirty = true;
+            chunks[pi].end -= 1;
+            live.pop();
+        }
+    }
+}
+
+/// Do blocks `a` (left) and `b` (right), given by end-of-step positions, overlap or touch?
+#[inline]
+fn overlap(a: &Pool, b: &Pool, sigma: f64) -> bool {
+    b.pos - a.pos - a.n as f64 * sigma <= 0.0
+}
+
+/// Pool two blocks given by end-of-step positions at their centre of mass (fast-bcd Eq. 6).
+#[inline]
+fn pool_pair(a: &Pool, b: &Pool, sigma: f64) -> Pool {
+    let n = a.n + b.n;
+    let (na, nb) = (a.n as f64, b.n as f64);
+    Pool {
+        pos: a.pos + (b.pos - na * sigma - a.pos) * (nb / (na + nb)),
+        n,
+        start: a.start,
     }
 }
 
@@ -761,67 +1042,6 @@ fn pair_force<P: PairForce>(
         k += 1;
     }
     f
-}
-
-/// Do blocks `a` (left) and `b` (right), given by their end-of-step positions, overlap or touch?
-#[inline]
-fn overlap(a: &Cluster, b: &Cluster, sigma: f64) -> bool {
-    b.left - a.left - a.n as f64 * sigma <= 0.0
-}
-
-/// Pool two blocks given by end-of-step positions at their centre of mass (fast-bcd Eq. 6).
-#[inline]
-fn pool_pair(a: &Cluster, b: &Cluster, sigma: f64) -> Cluster {
-    let n = a.n + b.n;
-    let shift = (b.left - a.n as f64 * sigma - a.left) * (b.n as f64 / n as f64);
-    Cluster {
-        start: a.start,
-        n,
-        left: a.left + shift,
-        v: 0.0,
-        wall: Wall::None,
-    }
-}
-
-/// Push a block (end-of-step position) and pool it with its left neighbours while they overlap.
-#[inline]
-fn pool_final(g: &mut Vec<Cluster>, c: Cluster, sigma: f64) {
-    let mut top = c;
-    while let Some(prev) = g.last() {
-        if overlap(prev, &top, sigma) {
-            top = pool_pair(prev, &top, sigma);
-            g.pop();
-        } else {
-            break;
-        }
-    }
-    g.push(top);
-}
-
-/// [`stitch_seam`] for blocks given by end-of-step positions.
-fn stitch_seam_final(g: &mut Vec<Cluster>, n: usize, length: f64, sigma: f64) -> usize {
-    let mut head = 0;
-    while g.len() - head >= 2 {
-        let last = g.len() - 1;
-        let mut front = g[head];
-        front.start += n as u32;
-        front.left += length;
-        if !overlap(&g[last], &front, sigma) {
-            break;
-        }
-        g[last] = pool_pair(&g[last], &front, sigma);
-        head += 1;
-        while g.len() - head >= 2 {
-            let l = g.len() - 1;
-            if overlap(&g[l - 1], &g[l], sigma) {
-                g[l - 1] = pool_pair(&g[l - 1], &g[l], sigma);
-                g.pop();
-            } else {
-                break;
-            }
-        }
-    }
-    head
 }
 
 /// Premerge across the periodic seam: the last cluster meets the first one a period further
