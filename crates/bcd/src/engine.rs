@@ -151,6 +151,8 @@ struct Chunk {
     end: usize,
     /// The last live block grew in the stitch: its rods must be rewritten.
     dirty: bool,
+    /// Per rod of the ring step, the index of the block it starts (0 inside a block).
+    marks: Vec<u32>,
     /// First rod whose velocity went non-finite, with that velocity.
     bad: Option<(usize, f64)>,
 }
@@ -699,7 +701,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
 #[derive(Debug, Clone, Copy, Default)]
 struct Pool {
     pos: f64,
-    n: u32,
+    n: f64,
     start: u32,
 }
 
@@ -779,17 +781,21 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
     let has_pair = range > ctx.sigma;
     let (sigma, dt, mobility, amp) = (ctx.sigma, ctx.dt, ctx.mobility, ctx.noise_amp);
     let xref = ring.pos(vs);
-    // The stack of blocks, pool[0..=top]; pool[0] is a sentinel never pooled into.
+    let len_c = ve - vs;
+    // Finished blocks pool[1..=top] above a sentinel that never pools (its mean is NaN), each
+    // with the sum `pos` of its z and its size `n` while pooling; the open block (sum `s`,
+    // size `m`, first rod `first_rod`) stays in registers.
     let pool = &mut c.pool;
     if pool.is_empty() {
         pool.push(Pool::default());
     }
     pool[0] = Pool {
-        pos: f64::NEG_INFINITY,
-        n: 0,
+        pos: f64::NAN,
+        n: 1.0,
         start: vs as u32,
     };
     let mut top = 0;
+    let (mut s, mut m, mut first_rod) = (0.0f64, 0.0f64, vs as u32);
     let mut noise = [0.0f64; BLOCK];
     let mut zbuf = [0.0f64; BLOCK];
     // Reduced start-of-step position of the current cluster; the chunk starts a cluster.
@@ -806,11 +812,10 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
         let len = a1 - a0;
         let offset = wraps as f64 * ring.length;
         if amp > 0.0 {
-            let m = BLOCK.min(n - b * BLOCK);
-            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+            let mm = BLOCK.min(n - b * BLOCK);
+            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..mm]);
         }
-        // Free end-of-step reduced positions z (fast-bcd Eq. 3 for the free velocities).
-        let mut finite = true;
+        // Free end-of-step reduced positions z (free velocities: fast-bcd Eq. 3).
         let mut kf = (w - vs) as f64;
         let rods = ring.x[a0..a1]
             .iter()
@@ -823,7 +828,6 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
                 f += pair_force(ring, ctx.pair, a0 + k, w + k, xi, range);
             }
             let u = mobility * f + amp * g;
-            finite &= u.is_finite();
             // A rod bonded to its left neighbour keeps the cluster's y bit for bit (select
             // without a branch: the bonds are data-dependent).
             let fresh = (xi - xref) - kf * sigma;
@@ -833,79 +837,154 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
             *z = y + u * dt;
             kf += 1.0;
         }
-        if !finite {
-            let a = (a0..a1).find(|&a| !zbuf[a - a0].is_finite()).unwrap_or(a0);
-            let xi = ring.x[a] + offset;
-            let mut f = ctx.ext.force(xi);
-            if has_pair {
-                f += pair_force(ring, ctx.pair, a, a + base, xi, range);
-            }
-            c.bad = Some((a, mobility * f + amp * noise[a % BLOCK]));
-            return;
+        // Pool adjacent violators. The common decision (does rod k join the open block, i.e.
+        // is the open block's mean z >= z_k?) is taken without a branch: the open block is
+        // always stored one above the stack top and the top index advances only when it is
+        // closed. Only the rarer cascade into the blocks below branches. Ties pool.
+        // Room for the open block above every block this segment can add.
+        if pool.len() < top + len + 2 {
+            pool.resize(top + len + 2, Pool::default());
         }
-        // Pool adjacent violators.
-        for (k, &zk) in zbuf[..len].iter().enumerate() {
-            let mut z = zk;
-            let mut cnt = 1;
-            let mut start = (w + k) as u32;
-            while pool[top].pos >= z {
-                let p = pool[top];
-                let tot = p.n + cnt;
-                z = p.pos + (z - p.pos) * (cnt as f64 / tot as f64);
-                cnt = tot;
-                start = p.start;
-                top -= 1;
-            }
-            top += 1;
-            // The stack grows to the most blocks a chunk has held (no per-step allocation).
-            if top == pool.len() {
-                pool.push(Pool::default());
-            }
-            pool[top] = Pool {
-                pos: z,
-                n: cnt,
-                start,
+        for (k, &z) in zbuf[..len].iter().enumerate() {
+            let join = s >= z * m;
+            pool[top + 1] = Pool {
+                pos: s,
+                n: m,
+                start: first_rod,
             };
-        }
-        w = a1 + base;
-    }
-    c.end = top + 1;
-    // End-of-step positions and bonds of the chunk's rods.
-    let la = first.x.len();
-    for i in 1..=top {
-        let k0 = pool[i].start as usize - vs;
-        let k1 = if i < top {
-            pool[i + 1].start as usize - vs
-        } else {
-            ve - vs
-        };
-        let p = &mut pool[i];
-        p.pos += xref + k0 as f64 * sigma;
-        let pos = p.pos;
-        if k1 <= la {
-            let xs = &mut first.x[k0..k1];
-            let bs = &mut first.b[k0..k1];
-            let mut jf = 0.0;
-            for (x, b) in xs.iter_mut().zip(bs.iter_mut()) {
-                *x = pos + jf * sigma;
-                *b = 1;
-                jf += 1.0;
-            }
-            bs[k1 - k0 - 1] = 0;
-        } else {
-            for k in k0..k1 {
-                let xk = pos + (k - k0) as f64 * sigma;
-                let bk = u8::from(k + 1 < k1);
-                if k < la {
-                    first.x[k] = xk;
-                    first.b[k] = bk;
+            let jf = f64::from(u8::from(join));
+            top += usize::from(!join);
+            s = z + jf * s;
+            m = 1.0 + jf * m;
+            let keep = u32::from(join).wrapping_neg();
+            first_rod = (first_rod & keep) | ((w + k) as u32 & !keep);
+            loop {
+                let below = pool[top];
+                if below.pos * m >= s * below.n {
+                    s += below.pos;
+                    m += below.n;
+                    first_rod = below.start;
+                    top -= 1;
                 } else {
-                    second.x[k - la] = xk - ring.length;
-                    second.b[k - la] = bk;
+                    break;
                 }
             }
         }
+        w = a1 + base;
     }
+    if m > 0.0 {
+        top += 1;
+        if top == pool.len() {
+            pool.push(Pool::default());
+        }
+        pool[top] = Pool {
+            pos: s,
+            n: m,
+            start: first_rod,
+        };
+    }
+    c.end = top + 1;
+    // Each block's rods end at x_k = base + k sigma (k counted from the chunk's first rod);
+    // rods are marked with the index of the block they start.
+    let marks = &mut c.marks;
+    if marks.len() < len_c + 1 {
+        marks.resize(len_c + 1, 0);
+    }
+    marks[..len_c].fill(0);
+    marks[len_c] = 1;
+    let mut finite = true;
+    for (i, p) in pool[1..=top].iter_mut().enumerate() {
+        marks[p.start as usize - vs] = i as u32 + 1;
+        p.pos = xref + p.pos / p.n;
+        finite &= p.pos.is_finite();
+    }
+    if !finite {
+        c.bad = first_non_finite(vs, ve, ctx);
+        return;
+    }
+    let la = first.x.len();
+    let mut cur = 0;
+    write_rods(
+        first.x,
+        first.b,
+        &marks[..=la],
+        pool,
+        &mut cur,
+        0.0,
+        sigma,
+        0.0,
+    );
+    write_rods(
+        second.x,
+        second.b,
+        &marks[la..=len_c],
+        pool,
+        &mut cur,
+        la as f64,
+        sigma,
+        ring.length,
+    );
+    // For the stitch: the end-of-step centre of each block's first rod.
+    for p in &mut pool[1..=top] {
+        p.pos += (p.start as usize - vs) as f64 * sigma;
+    }
+}
+
+/// Positions `base + k sigma - wrap` and bonds of consecutive rods (`k` from `k0`), where
+/// `base` is that of the last block started at or before the rod (`marks`, one longer than
+/// `xs`, holds the block index at each block's first rod and 0 elsewhere). Branch-free.
+#[inline]
+fn write_rods(
+    xs: &mut [f64],
+    bs: &mut [u8],
+    marks: &[u32],
+    pool: &[Pool],
+    cur: &mut usize,
+    k0: f64,
+    sigma: f64,
+    wrap: f64,
+) {
+    let mut kf = k0;
+    let ends = marks.iter().zip(&marks[1..]);
+    for ((x, b), (&mk, &next)) in xs.iter_mut().zip(bs.iter_mut()).zip(ends) {
+        *cur = (*cur).max(mk as usize);
+        *x = pool[*cur].pos + kf * sigma - wrap;
+        *b = u8::from(next == 0);
+        kf += 1.0;
+    }
+}
+
+/// The first rod of virtual range `[vs, ve)` with a non-finite free velocity, and that
+/// velocity (the slow path behind the ring step's finiteness check).
+fn first_non_finite<E: ExternalForce, P: PairForce>(
+    vs: usize,
+    ve: usize,
+    ctx: &StepCtx<E, P>,
+) -> Option<(usize, f64)> {
+    let ring = ctx.ring;
+    let n = ring.n;
+    let range = ctx.pair.range();
+    let mut noise = [0.0f64; BLOCK];
+    for w in vs..ve {
+        let a = w % n;
+        let xi = ring.x[a] + (w / n) as f64 * ring.length;
+        let mut f = ctx.ext.force(xi);
+        if range > ctx.sigma {
+            f += pair_force(ring, ctx.pair, a, w, xi, range);
+        }
+        let mut g = 0.0;
+        if ctx.noise_amp > 0.0 {
+            let b = a / BLOCK;
+            let mm = BLOCK.min(n - b * BLOCK);
+            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..mm]);
+            g = noise[a % BLOCK];
+        }
+        let u = ctx.mobility * f + ctx.noise_amp * g;
+        if !(u * ctx.dt).is_finite() {
+            return Some((a, u));
+        }
+    }
+    Some((ring.actual(vs), f64::NAN))
 }
 
 /// Pool the chunks' blocks across chunk boundaries and the periodic seam (blocks given by
@@ -995,16 +1074,15 @@ fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize, sigma: f64) {
 /// Do blocks `a` (left) and `b` (right), given by end-of-step positions, overlap or touch?
 #[inline]
 fn overlap(a: &Pool, b: &Pool, sigma: f64) -> bool {
-    b.pos - a.pos - a.n as f64 * sigma <= 0.0
+    b.pos - a.pos - a.n * sigma <= 0.0
 }
 
 /// Pool two blocks given by end-of-step positions at their centre of mass (fast-bcd Eq. 6).
 #[inline]
 fn pool_pair(a: &Pool, b: &Pool, sigma: f64) -> Pool {
     let n = a.n + b.n;
-    let (na, nb) = (a.n as f64, b.n as f64);
     Pool {
-        pos: a.pos + (b.pos - na * sigma - a.pos) * (nb / (na + nb)),
+        pos: a.pos + (b.pos - a.n * sigma - a.pos) * (b.n / n),
         n,
         start: a.start,
     }
