@@ -816,21 +816,24 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
             fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..mm]);
         }
         // Free end-of-step reduced positions z (free velocities: fast-bcd Eq. 3).
+        let xs = &ring.x[a0..a1];
+        let fbuf = &mut zbuf[..len];
+        ctx.ext.force_block(xs, offset, fbuf);
+        if has_pair {
+            for (k, f) in fbuf.iter_mut().enumerate() {
+                *f += pair_force(ring, ctx.pair, a0 + k, w + k, xs[k] + offset, range);
+            }
+        }
         let mut kf = (w - vs) as f64;
-        let rods = ring.x[a0..a1]
+        let rods = xs
             .iter()
             .zip(&ring.bond[a0..a1])
             .zip(&noise[a0 - b * BLOCK..a1 - b * BLOCK]);
-        for (k, (z, ((&xa, &bd), &g))) in zbuf[..len].iter_mut().zip(rods).enumerate() {
-            let xi = xa + offset;
-            let mut f = ctx.ext.force(xi);
-            if has_pair {
-                f += pair_force(ring, ctx.pair, a0 + k, w + k, xi, range);
-            }
-            let u = mobility * f + amp * g;
+        for (z, ((&xa, &bd), &g)) in fbuf.iter_mut().zip(rods) {
+            let u = mobility * *z + amp * g;
             // A rod bonded to its left neighbour keeps the cluster's y bit for bit (select
             // without a branch: the bonds are data-dependent).
-            let fresh = (xi - xref) - kf * sigma;
+            let fresh = (xa + offset - xref) - kf * sigma;
             let keep = u64::from(bonded).wrapping_neg();
             y = f64::from_bits((y.to_bits() & keep) | (fresh.to_bits() & !keep));
             bonded = bd != 0;
@@ -845,9 +848,10 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
         if pool.len() < top + len + 2 {
             pool.resize(top + len + 2, Pool::default());
         }
+        let st = pool.as_mut_slice();
         for (k, &z) in zbuf[..len].iter().enumerate() {
             let join = s >= z * m;
-            pool[top + 1] = Pool {
+            st[top + 1] = Pool {
                 pos: s,
                 n: m,
                 start: first_rod,
@@ -859,7 +863,7 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
             let keep = u32::from(join).wrapping_neg();
             first_rod = (first_rod & keep) | ((w + k) as u32 & !keep);
             loop {
-                let below = pool[top];
+                let below = st[top];
                 if below.pos * m >= s * below.n {
                     s += below.pos;
                     m += below.n;
@@ -926,7 +930,7 @@ fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
     );
     // For the stitch: the end-of-step centre of each block's first rod.
     for p in &mut pool[1..=top] {
-        p.pos += (p.start as usize - vs) as f64 * sigma;
+        p.pos += f64::from(p.start - vs as u32) * sigma;
     }
 }
 

@@ -11,6 +11,15 @@ use colloidsim_core::field1d::ExternalField;
 pub trait ExternalForce: Sync {
     /// Force at position `x` (unwrapped coordinates).
     fn force(&self, x: f64) -> f64;
+
+    /// `out[k] = force(x[k] + offset)` for a run of rods (the engine's inner loop; fields with
+    /// a cheaper batched form override it).
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        for (o, &xk) in out.iter_mut().zip(x) {
+            *o = self.force(xk + offset);
+        }
+    }
 }
 
 impl<F: Fn(f64) -> f64 + Sync> ExternalForce for F {
@@ -143,6 +152,30 @@ impl ForceTable {
 }
 
 impl ExternalForce for ForceTable {
+    /// The batched look-up: table fields held in registers and no branch per rod (one check
+    /// per run that every |x / h| is below 2^50, else the per-rod path).
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        let (inv_h, mask, cubic) = (self.inv_h, self.cells - 1, &self.cubic[..]);
+        let near = x
+            .iter()
+            .fold(0.0f64, |m, &xk| m.max(((xk + offset) * inv_h).abs()))
+            < (1u64 << 50) as f64;
+        if !near {
+            for (o, &xk) in out.iter_mut().zip(x) {
+                *o = self.force(xk + offset);
+            }
+            return;
+        }
+        for (o, &xk) in out.iter_mut().zip(x) {
+            let s = (xk + offset) * inv_h;
+            let big = s + ROUND;
+            let t = s - (big - ROUND);
+            let [c0, c1, c2, c3] = cubic[(big.to_bits() as usize) & mask];
+            *o = c0 + t * (c1 + t * (c2 + t * c3));
+        }
+    }
+
     #[inline]
     fn force(&self, x: f64) -> f64 {
         let s = x * self.inv_h;
