@@ -11,6 +11,15 @@ use colloidsim_core::field1d::ExternalField;
 pub trait ExternalForce: Sync {
     /// Force at position `x` (unwrapped coordinates).
     fn force(&self, x: f64) -> f64;
+
+    /// `out[k] = force(x[k] + offset)` for a run of rods (the engine's inner loop; fields with
+    /// a cheaper batched form override it).
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        for (o, &xk) in out.iter_mut().zip(x) {
+            *o = self.force(xk + offset);
+        }
+    }
 }
 
 impl<F: Fn(f64) -> f64 + Sync> ExternalForce for F {
@@ -35,18 +44,24 @@ impl ExternalForce for NoField {
 /// slopes on `cells` cells per period: one table look-up instead of transcendental functions.
 /// The interpolation error is O(h^4); [`ForceTable::from_field`] chooses `cells` so that the
 /// largest error (checked at every cell midpoint) stays below `1e-9` of the largest force.
+///
+/// Cell `i` covers `[(i - 1/2) h, (i + 1/2) h)`, so the look-up is a rounding to the nearest
+/// knot, done branch-free by adding `1.5 * 2^52` (the sum's low bits are the rounded integer).
 #[derive(Debug, Clone)]
 pub struct ForceTable {
     inv_h: f64,
     h: f64,
     /// Cells per period (a power of two, so the periodic wrap is a bit mask).
     cells: usize,
-    /// Per cell, the cubic `c0 + c1 t + c2 t^2 + c3 t^3` in the cell coordinate t in [0, 1).
+    /// Per cell, the cubic `c0 + c1 t + c2 t^2 + c3 t^3` in the centred cell coordinate
+    /// `t = x / h - i` in [-1/2, 1/2], with the drive included in `c0`.
     cubic: Vec<[f64; 4]>,
-    drive: f64,
     /// Largest interpolation error found at the cell midpoints.
     pub max_error: f64,
 }
+
+/// `1.5 * 2^52`: for |s| < 2^51, `s + ROUND` rounds `s` to an integer held in the low bits.
+const ROUND: f64 = 6_755_399_441_055_744.0;
 
 impl ForceTable {
     /// Tabulate a periodic `field` (its drive is added exactly). Returns `None` when the field
@@ -71,25 +86,33 @@ impl ForceTable {
     fn build(period: f64, cells: usize, f: &dyn Fn(f64) -> f64, drive: f64) -> Self {
         let h = period / cells as f64;
         let d = 1e-4 * h;
+        // Knots at the cell edges (i - 1/2) h, i = 0..=cells.
         let knots: Vec<[f64; 2]> = (0..=cells)
             .map(|i| {
-                let x = i as f64 * h;
+                let x = (i as f64 - 0.5) * h;
                 // Slope by a fourth-order central difference: exact to ~1e-12 relative.
                 let slope = (-f(x + 2.0 * d) + 8.0 * f(x + d) - 8.0 * f(x - d) + f(x - 2.0 * d))
                     / (12.0 * d);
                 [f(x), slope * h]
             })
             .collect();
-        // Hermite data (f, h f') at the two ends of each cell, as polynomial coefficients.
+        // Hermite data (f, h f') at the two ends of each cell as a cubic in tau = t + 1/2 in
+        // [0, 1], re-expanded about the cell centre (tau = 1/2).
         let cubic = knots
             .windows(2)
             .map(|k| {
                 let ([f0, m0], [f1, m1]) = (k[0], k[1]);
-                [
+                let (a0, a1, a2, a3) = (
                     f0,
                     m0,
                     3.0 * (f1 - f0) - 2.0 * m0 - m1,
                     2.0 * (f0 - f1) + m0 + m1,
+                );
+                [
+                    drive + a0 + 0.5 * a1 + 0.25 * a2 + 0.125 * a3,
+                    a1 + a2 + 0.75 * a3,
+                    a2 + 1.5 * a3,
+                    a3,
                 ]
             })
             .collect();
@@ -98,12 +121,11 @@ impl ForceTable {
             h,
             cells,
             cubic,
-            drive,
             max_error: 0.0,
         };
         t.max_error = (0..cells)
             .map(|i| {
-                let x = (i as f64 + 0.5) * h;
+                let x = i as f64 * h;
                 (t.force(x) - drive - f(x)).abs()
             })
             .fold(0.0, f64::max);
@@ -114,19 +136,59 @@ impl ForceTable {
     pub fn spacing(&self) -> f64 {
         self.h
     }
+
+    /// The look-up for |x / h| >= 2^50 (and non-finite x), with an explicit floor.
+    #[cold]
+    fn force_far(&self, s: f64) -> f64 {
+        if !s.is_finite() {
+            return f64::NAN;
+        }
+        let r = s.round();
+        let t = s - r;
+        let i = (r.rem_euclid(self.cells as f64)) as usize;
+        let [c0, c1, c2, c3] = self.cubic[i];
+        c0 + t * (c1 + t * (c2 + t * c3))
+    }
 }
 
 impl ExternalForce for ForceTable {
+    /// The batched look-up: table fields held in registers and no branch per rod (one check
+    /// per run that every |x / h| is below 2^50, else the per-rod path).
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        let (inv_h, mask, cubic) = (self.inv_h, self.cells - 1, &self.cubic[..]);
+        let near = x
+            .iter()
+            .fold(0.0f64, |m, &xk| m.max(((xk + offset) * inv_h).abs()))
+            < (1u64 << 50) as f64;
+        if !near {
+            for (o, &xk) in out.iter_mut().zip(x) {
+                *o = self.force(xk + offset);
+            }
+            return;
+        }
+        for (o, &xk) in out.iter_mut().zip(x) {
+            let s = (xk + offset) * inv_h;
+            let big = s + ROUND;
+            let t = s - (big - ROUND);
+            let [c0, c1, c2, c3] = cubic[(big.to_bits() as usize) & mask];
+            *o = c0 + t * (c1 + t * (c2 + t * c3));
+        }
+    }
+
     #[inline]
     fn force(&self, x: f64) -> f64 {
         let s = x * self.inv_h;
-        // floor without a libm call: truncate, then step down for negative non-integers.
-        let tr = s as i64;
-        let fl = if (tr as f64) > s { tr - 1 } else { tr };
-        let t = s - fl as f64;
-        let i = (fl & (self.cells as i64 - 1)) as usize;
+        // NaN fails the comparison and takes the far path too.
+        let near = s.abs() < (1u64 << 50) as f64;
+        if !near {
+            return self.force_far(s);
+        }
+        let big = s + ROUND;
+        let t = s - (big - ROUND);
+        let i = (big.to_bits() as usize) & (self.cells - 1);
         let [c0, c1, c2, c3] = self.cubic[i];
-        self.drive + c0 + t * (c1 + t * (c2 + t * c3))
+        c0 + t * (c1 + t * (c2 + t * c3))
     }
 }
 
@@ -379,6 +441,16 @@ mod tests {
             let x = -7.3 + 0.001_37 * i as f64;
             assert!((t.force(x) - field.force(x)).abs() < 1e-8 * 18.85, "x={x}");
         }
+        // Far from the origin (beyond the rounding trick) and non-finite positions.
+        // (Whole periods: the table must give the force at 0.3 and 0.)
+        for (x, x0) in [
+            (2f64.powi(60), 0.0),
+            (-13.0 * 2f64.powi(53), 0.0),
+            (1e6 + 0.3, 0.3),
+        ] {
+            assert!((t.force(x) - field.force(x0)).abs() < 1e-6 * 18.85, "x={x}");
+        }
+        assert!(t.force(f64::NAN).is_nan() && t.force(f64::INFINITY).is_nan());
     }
 
     #[test]

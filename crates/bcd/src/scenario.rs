@@ -287,6 +287,16 @@ impl crate::forces::ExternalForce for Field {
             Field::Exact(f) => f.force(x),
         }
     }
+
+    /// One dispatch per run of rods, then the field's own batched loop.
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        match self {
+            Field::None => out.fill(0.0),
+            Field::Table(t) => t.force_block(x, offset, out),
+            Field::Exact(f) => f.force_block(x, offset, out),
+        }
+    }
 }
 
 /// Pair force as the engine sees it: any combination of the specified terms.

@@ -161,9 +161,10 @@ impl Ziggurat {
         self.sample_slow(rng, i, u)
     }
 
-    /// The rare paths: the tail beyond `r` (strip 0) and the wedges above the curve.
+    /// The rare paths: the tail beyond `r` (strip 0) and the wedges above the curve. Inlined
+    /// (but cold) so that the caller's generator state can stay in registers.
     #[cold]
-    #[inline(never)]
+    #[inline(always)]
     fn sample_slow<R: Rng + ?Sized>(&self, rng: &mut R, mut i: usize, mut u: f64) -> f64 {
         let unit = |rng: &mut R| ((rng.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64);
         loop {
