@@ -383,20 +383,18 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 length,
                 periodic,
             };
-            let ctx = StepCtx {
-                ring: &ring,
-                ext: &self.ext,
-                pair: &self.pair,
-                mobility: self.cfg.mobility,
-                noise_amp: self.noise_amp,
-                seed: self.cfg.seed,
-                step: self.state.step,
-                sigma,
-                dt,
-                left_wall: !periodic && self.state.left_contact,
-                right_wall: !periodic && self.state.right_contact,
-                premerge: !chronological,
-            };
+            let ctx = StepCtx::new(
+                &ring,
+                (&self.ext, &self.pair),
+                &self.cfg,
+                self.noise_amp,
+                self.state.step,
+                [
+                    !periodic && self.state.left_contact,
+                    !periodic && self.state.right_contact,
+                ],
+                !chronological,
+            );
             self.chunks
                 .par_iter_mut()
                 .for_each(|c| chunk_phase(c, &ctx));
@@ -531,20 +529,15 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 length,
                 periodic: true,
             };
-            let ctx = StepCtx {
-                ring: &ring,
-                ext: &self.ext,
-                pair: &self.pair,
-                mobility: self.cfg.mobility,
-                noise_amp: self.noise_amp,
-                seed: self.cfg.seed,
-                step: self.state.step,
-                sigma,
-                dt: self.cfg.dt,
-                left_wall: false,
-                right_wall: false,
-                premerge: true,
-            };
+            let ctx = StepCtx::new(
+                &ring,
+                (&self.ext, &self.pair),
+                &self.cfg,
+                self.noise_amp,
+                self.state.step,
+                [false; 2],
+                true,
+            );
             // Virtual indices [origin, n) are rods origin.., [n, n + origin) rods 0.. one period on.
             let (xl, xr) = self.x_next.split_at_mut(origin);
             let (bl, br) = self.bond_next.split_at_mut(origin);
@@ -627,6 +620,35 @@ struct StepCtx<'a, E, P> {
     left_wall: bool,
     right_wall: bool,
     premerge: bool,
+}
+
+impl<'a, E, P> StepCtx<'a, E, P> {
+    /// What every chunk of a step reads: the configuration `ring`, the forces, the step's noise
+    /// key, whether each end touches its wall, and whether fragments are premerged.
+    fn new(
+        ring: &'a Ring<'a>,
+        (ext, pair): (&'a E, &'a P),
+        cfg: &BcdConfig,
+        noise_amp: f64,
+        step: u64,
+        walls: [bool; 2],
+        premerge: bool,
+    ) -> Self {
+        Self {
+            ring,
+            ext,
+            pair,
+            mobility: cfg.mobility,
+            noise_amp,
+            seed: cfg.seed,
+            step,
+            sigma: cfg.sigma,
+            dt: cfg.dt,
+            left_wall: walls[0],
+            right_wall: walls[1],
+            premerge,
+        }
+    }
 }
 
 /// Free velocities `u_i = mu F_i` (fast-bcd Eq. 3; hard-rods paper Eq. 12) of the chunk's rods,
