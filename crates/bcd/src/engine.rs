@@ -1026,13 +1026,9 @@ fn stitch_ring(chunks: &mut [Chunk], live: &mut Vec<usize>, n: usize, length: f6
         while chunks[ci].head < chunks[ci].end {
             let Some(&pi) = live.last() else { break };
             let first = chunks[ci].pool[chunks[ci].head];
-            let pc = &mut chunks[pi];
-            let top = &mut pc.pool[pc.end - 1];
-            if !overlap(top, &first, sigma) {
+            if !absorb(&mut chunks[pi], &first, sigma) {
                 break;
             }
-            *top = pool_pair(top, &first, sigma);
-            pc.dirty = true;
             chunks[ci].head += 1;
             cascade(chunks, live, 0, sigma);
         }
@@ -1050,19 +1046,27 @@ fn stitch_ring(chunks: &mut [Chunk], live: &mut Vec<usize>, n: usize, length: f6
         let mut front = chunks[fi].pool[chunks[fi].head];
         front.start += n as u32;
         front.pos += length;
-        let lc = &mut chunks[li];
-        let last = &mut lc.pool[lc.end - 1];
-        if !overlap(last, &front, sigma) {
+        if !absorb(&mut chunks[li], &front, sigma) {
             break;
         }
-        *last = pool_pair(last, &front, sigma);
-        lc.dirty = true;
         chunks[fi].head += 1;
         if chunks[fi].head == chunks[fi].end {
             lf += 1;
         }
         cascade(chunks, live, lf, sigma);
     }
+}
+
+/// Pool `block` into chunk `c`'s last block when they overlap (marking the chunk dirty); false
+/// when they do not.
+fn absorb(c: &mut Chunk, block: &Pool, sigma: f64) -> bool {
+    let last = &mut c.pool[c.end - 1];
+    if !overlap(last, block, sigma) {
+        return false;
+    }
+    *last = pool_pair(last, block, sigma);
+    c.dirty = true;
+    true
 }
 
 /// Pool the last live block into its left neighbours for as long as they overlap (live chunks
