@@ -122,3 +122,40 @@ pub fn lammps_loop_time(text: &str) -> anyhow::Result<LammpsLoop> {
         line: at,
     })
 }
+
+/// A LAMMPS data file (`atom_style atomic`, one atom type of mass 1) of `p` in input order
+/// (LAMMPS id = index + 1), box centred on the origin like colloidsim's; with `velocities`, a
+/// Velocities section too. Positions are written with `f64`'s shortest exact representation.
+pub fn write_lammps_data(
+    path: &Path,
+    title: &str,
+    p: &colloidsim_md::Particles,
+    sbox: &colloidsim_md::SimBox,
+    velocities: bool,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    use std::fmt::Write as _;
+    let l = sbox.l;
+    let mut s = String::with_capacity(p.len() * 120);
+    writeln!(
+        s,
+        "{title}\n\n{} atoms\n1 atom types\n\n{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\nMasses\n\n1 1.0\n\nAtoms # atomic\n",
+        p.len(),
+        -0.5 * l[0],
+        0.5 * l[0],
+        -0.5 * l[1],
+        0.5 * l[1],
+        -0.5 * l[2],
+        0.5 * l[2]
+    )?;
+    for (i, x) in p.pos.iter().enumerate() {
+        writeln!(s, "{} 1 {} {} {}", i + 1, x[0], x[1], x[2])?;
+    }
+    if velocities {
+        writeln!(s, "\nVelocities\n")?;
+        for (i, v) in p.vel.iter().enumerate() {
+            writeln!(s, "{} {} {} {}", i + 1, v[0], v[1], v[2])?;
+        }
+    }
+    std::fs::write(path, s).with_context(|| format!("{}", path.display()))
+}

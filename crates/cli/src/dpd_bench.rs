@@ -1,11 +1,10 @@
 //! `colloidsim bench dpd`: pure DPD water, colloidsim beside LAMMPS (`pair_style dpd` +
 //! `fix nve`) on the same relaxed configuration in the same invocation.
 
-use crate::common::{cpu_seconds, lammps_loop_time, load_average, median};
+use crate::common::{cpu_seconds, lammps_loop_time, load_average, median, write_lammps_data};
 use anyhow::{Context, Result, bail};
 use colloidsim_md::dpd::{Dpd, DpdParams, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -225,7 +224,13 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     };
     let mut lammps_ok = !a.no_lammps;
     if lammps_ok {
-        write_lammps_data(&dir.join("relaxed.data"), &relaxed, &sbox)?;
+        write_lammps_data(
+            &dir.join("relaxed.data"),
+            "colloidsim bench dpd: relaxed DPD water",
+            &relaxed,
+            &sbox,
+            true,
+        )?;
     }
 
     println!(
@@ -380,33 +385,6 @@ fn measure_ours(
         builds: median(builds).0,
         t_end,
     })
-}
-
-/// A LAMMPS data file (`atom_style atomic`) of the relaxed state, velocities included, in tag
-/// order (LAMMPS id = tag + 1), box centred on the origin like colloidsim's.
-fn write_lammps_data(path: &Path, p: &Particles, sbox: &SimBox) -> Result<()> {
-    let l = sbox.l;
-    let mut s = String::with_capacity(p.len() * 120);
-    writeln!(
-        s,
-        "colloidsim bench dpd: relaxed DPD water\n\n{} atoms\n1 atom types\n\n{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\nMasses\n\n1 1.0\n\nAtoms # atomic\n",
-        p.len(),
-        -0.5 * l[0],
-        0.5 * l[0],
-        -0.5 * l[1],
-        0.5 * l[1],
-        -0.5 * l[2],
-        0.5 * l[2]
-    )?;
-    for (i, x) in p.pos.iter().enumerate() {
-        // Display of f64 is the shortest representation that reads back exactly.
-        writeln!(s, "{} 1 {} {} {}", i + 1, x[0], x[1], x[2])?;
-    }
-    writeln!(s, "\nVelocities\n")?;
-    for (i, v) in p.vel.iter().enumerate() {
-        writeln!(s, "{} {} {} {}", i + 1, v[0], v[1], v[2])?;
-    }
-    std::fs::write(path, s).with_context(|| format!("{}", path.display()))
 }
 
 /// `repeats` LAMMPS runs (one MPI rank) from the relaxed state; `None` if LAMMPS cannot be run.

@@ -1,7 +1,9 @@
 //! `colloidsim run|check|bench` for the drying droplet (`method = "droplet-bd"`) and the WCA
 //! Brownian-dynamics benchmark.
 
-use crate::common::{RunOptions, cpu_seconds, lammps_loop_time, median, progress, seed32};
+use crate::common::{
+    RunOptions, cpu_seconds, lammps_loop_time, median, progress, seed32, write_lammps_data,
+};
 use crate::plot::{Scale, Series, line_plot};
 use crate::theory_droplet::profile_name;
 use anyhow::{Context, Result, bail};
@@ -775,21 +777,13 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     let dir = tempfile_dir()?;
     let sim = colloidsim_md::bench::wca_periodic(a.n, a.phi, dt, 1)?;
     let snap = sim.snapshot();
-    let l = sim.sbox.l;
-    let mut data = format!(
-        "colloidsim bench bd configuration\n\n{} atoms\n1 atom types\n\n{} {} xlo xhi\n{} {} ylo yhi\n{} {} zlo zhi\n\nMasses\n\n1 1.0\n\nAtoms # atomic\n\n",
-        a.n,
-        -0.5 * l[0],
-        0.5 * l[0],
-        -0.5 * l[1],
-        0.5 * l[1],
-        -0.5 * l[2],
-        0.5 * l[2]
-    );
-    for (i, x) in snap.pos.iter().enumerate() {
-        data.push_str(&format!("{} 1 {} {} {}\n", i + 1, x[0], x[1], x[2]));
-    }
-    std::fs::write(dir.join("init.data"), data)?;
+    write_lammps_data(
+        &dir.join("init.data"),
+        "colloidsim bench bd configuration",
+        &snap,
+        &sim.sbox,
+        false,
+    )?;
     for (rng, label) in [
         ("gaussian", "lammps-gaussian"),
         ("uniform", "lammps-uniform"),
