@@ -6,23 +6,25 @@
 //! A *virtual index* `w` counts around the ring from the first cluster start (`origin`);
 //! `w >= N` denotes rod `w - N` seen one period further on (position `+ L`).
 //!
-//! The ring is cut into chunks of about [`CHUNK`] rods at cluster boundaries; each chunk computes
-//! its forces, fragments its clusters and premerges them independently (in parallel), then one
-//! short sequential pass premerges across chunk boundaries and the periodic seam. Chunking
-//! depends only on N and the configuration, never on the thread count, so results are
-//! bitwise identical for any number of threads.
+//! The premerged update on a ring runs in reduced coordinates ([`crate::ring`]). The other
+//! updates (walls, the chronological oracle) cut the line into chunks of about [`CHUNK`] rods at
+//! cluster boundaries; each chunk computes its forces, fragments its clusters and premerges them
+//! independently (in parallel), then one short sequential pass premerges across chunk
+//! boundaries and the walls or the periodic seam. Chunking depends only on N and the
+//! configuration, never on the thread count, so results are bitwise identical for any number
+//! of threads.
 
 use crate::cluster::{Cluster, Hull, Wall, collide, merge, premerge};
 use crate::forces::{ExternalForce, PairForce};
+use crate::ring::{RingStep, SEG, noise_segment};
 use colloidsim_core::ParamError;
 use colloidsim_core::param;
-use colloidsim_core::rng::{BLOCK, fill_normal_block_fast};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 use thiserror::Error;
 
-/// Rods per chunk of the parallel step.
-pub const CHUNK: usize = 4096;
+pub use crate::ring::CHUNK;
 
 /// What bounds the line of rods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -137,6 +139,11 @@ pub struct BcdState {
     pub right_contact: bool,
     /// Steps done.
     pub step: u64,
+    /// The premerged ring update's own coordinates, `y_i = x_i - i sigma` with the rods of a
+    /// cluster sharing one value bit for bit (empty for the other updates). A restart uses them
+    /// so that it continues bitwise; `x` is derived from them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reduced: Vec<f64>,
 }
 
 #[derive(Debug, Default, Clone)]
@@ -145,14 +152,6 @@ struct Chunk {
     ve: usize,
     stack: Vec<Cluster>,
     hull: Hull,
-    /// Blocks of the ring step; `pool[0]` is a sentinel, `pool[head..end]` the live ones.
-    pool: Vec<Pool>,
-    head: usize,
-    end: usize,
-    /// The last live block grew in the stitch: its rods must be rewritten.
-    dirty: bool,
-    /// Per rod of the ring step, the index of the block it starts (0 inside a block).
-    marks: Vec<u32>,
     /// First rod whose velocity went non-finite, with that velocity.
     bad: Option<(usize, f64)>,
 }
@@ -203,11 +202,10 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
     chunks: Vec<Chunk>,
     global: Vec<Cluster>,
     noise_amp: f64,
-    /// Positions and bonds being written by the ring step (swapped with the state's).
-    x_next: Vec<f64>,
-    bond_next: Vec<u8>,
-    /// Chunks with live blocks during the ring stitch.
-    live: Vec<usize>,
+    /// The premerged ring update (periodic boundary): it keeps the configuration in reduced
+    /// coordinates, and `state.x`/`state.bond` are then derived on demand into `view`.
+    ring: Option<RingStep>,
+    view: OnceLock<BcdState>,
 }
 
 impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
@@ -241,6 +239,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             left_contact,
             right_contact,
             step: 0,
+            reduced: Vec::new(),
         };
         Self::from_state(cfg, state, ext, pair)
     }
@@ -255,10 +254,21 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         }
         check_positions(&cfg, &state.x)?;
         let n = state.x.len();
-        let chunks = vec![Chunk::default(); n.div_ceil(CHUNK)];
         let noise_amp = (2.0 * cfg.diffusion() / cfg.dt).sqrt();
-        let ring = cfg.boundary == Boundary::Periodic && cfg.update == Update::Premerge;
-        let spare = if ring { n } else { 0 };
+        let mut state = state;
+        let ring = if cfg.boundary == Boundary::Periodic && cfg.update == Update::Premerge {
+            let y = reduced_positions(&cfg, &state)?;
+            state.reduced = Vec::new();
+            Some(RingStep::new(y, n > 1 && state.bond[n - 1] != 0))
+        } else {
+            state.reduced = Vec::new();
+            None
+        };
+        let chunks = if ring.is_some() {
+            Vec::new()
+        } else {
+            vec![Chunk::default(); n.div_ceil(CHUNK)]
+        };
         Ok(Self {
             cfg,
             ext,
@@ -267,9 +277,8 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             chunks,
             global: Vec::new(),
             noise_amp,
-            x_next: vec![0.0; spare],
-            bond_next: vec![0; spare],
-            live: Vec::new(),
+            ring,
+            view: OnceLock::new(),
         })
     }
 
@@ -287,11 +296,33 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     }
     /// Unwrapped rod centres in ring order.
     pub fn positions(&self) -> &[f64] {
-        &self.state.x
+        &self.state().x
     }
     /// The dynamic state (for checkpoints).
     pub fn state(&self) -> &BcdState {
-        &self.state
+        match &self.ring {
+            None => &self.state,
+            Some(r) => self.view.get_or_init(|| {
+                let sigma = self.cfg.sigma;
+                let y = &r.y;
+                let n = y.len();
+                let x = y
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &yi)| yi + i as f64 * sigma)
+                    .collect();
+                let mut bond: Vec<u8> = y.windows(2).map(|w| u8::from(w[0] == w[1])).collect();
+                bond.push(u8::from(r.seam));
+                BcdState {
+                    x,
+                    bond,
+                    left_contact: false,
+                    right_contact: false,
+                    step: self.state.step,
+                    reduced: if n > 0 { y.clone() } else { Vec::new() },
+                }
+            }),
+        }
     }
     /// Steps done.
     pub fn steps(&self) -> u64 {
@@ -310,11 +341,12 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     /// together), in ring order starting from the first cluster start.
     pub fn cluster_sizes(&self, mut visit: impl FnMut(usize)) {
         let n = self.len();
-        let origin = self.origin();
+        let bond = &self.state().bond;
+        let origin = self.origin(bond);
         let mut size = 0;
         for w in origin..origin + n {
             size += 1;
-            if self.state.bond[w % n] == 0 {
+            if bond[w % n] == 0 {
                 visit(size);
                 size = 0;
             }
@@ -324,24 +356,35 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         }
     }
 
-    fn origin(&self) -> usize {
+    /// The first cluster start in ring order, given the bonds.
+    fn origin(&self, bond: &[u8]) -> usize {
         let n = self.len();
         match self.cfg.boundary {
             Boundary::Walls => 0,
-            Boundary::Periodic => (0..n)
-                .find(|&i| self.state.bond[(i + n - 1) % n] == 0)
-                .unwrap_or(0),
+            Boundary::Periodic => (0..n).find(|&i| bond[(i + n - 1) % n] == 0).unwrap_or(0),
         }
     }
 
     /// Advance by one time step.
     pub fn step(&mut self) -> Result<(), BcdError> {
+        if let Some(r) = &mut self.ring {
+            let step = self.state.step;
+            if let Err((i, u)) = r.step(&self.ext, &self.pair, &self.cfg, self.noise_amp, step) {
+                return Err(BcdError::NonFinite {
+                    step,
+                    particle: i,
+                    position: r.y[i] + i as f64 * self.cfg.sigma,
+                    velocity: u,
+                });
+            }
+            self.view = OnceLock::new();
+            self.state.step += 1;
+            return Ok(());
+        }
         let n = self.len();
-        let origin = self.origin();
+        let origin = self.origin(&self.state.bond);
         let periodic = self.cfg.boundary == Boundary::Periodic;
         let chronological = self.cfg.update == Update::Chronological;
-        // Ring with premerging: one pooling pass on end-of-step positions (`chunk_phase_ring`).
-        let fast = periodic && !chronological;
         let (sigma, dt, length) = (self.cfg.sigma, self.cfg.dt, self.cfg.length);
 
         // Chunk boundaries at cluster starts, about CHUNK rods apart.
@@ -368,10 +411,6 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 prev = self.chunks[c].vs;
             }
             self.chunks[k - 1].ve = end;
-        }
-
-        if fast {
-            return self.step_ring(origin);
         }
 
         // Forces, fragmentation and chunk-local premerging, in parallel.
@@ -515,71 +554,6 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         Ok(())
     }
 
-    /// The premerged step on a ring: each chunk pools its rods and writes their end-of-step
-    /// positions and bonds (in parallel); a short sequential pass then pools the blocks that meet
-    /// across chunk boundaries and the periodic seam and rewrites only their rods.
-    fn step_ring(&mut self, origin: usize) -> Result<(), BcdError> {
-        let n = self.len();
-        let (sigma, length) = (self.cfg.sigma, self.cfg.length);
-        {
-            let ring = Ring {
-                x: &self.state.x,
-                bond: &self.state.bond,
-                n,
-                length,
-                periodic: true,
-            };
-            let ctx = StepCtx::new(
-                &ring,
-                (&self.ext, &self.pair),
-                &self.cfg,
-                self.noise_amp,
-                self.state.step,
-                [false; 2],
-                true,
-            );
-            // Virtual indices [origin, n) are rods origin.., [n, n + origin) rods 0.. one period on.
-            let (xl, xr) = self.x_next.split_at_mut(origin);
-            let (bl, br) = self.bond_next.split_at_mut(origin);
-            let first = Out {
-                x: xr,
-                b: br,
-                v0: origin,
-            };
-            let second = Out {
-                x: xl,
-                b: bl,
-                v0: n,
-            };
-            ring_chunks(&mut self.chunks, first, second, &ctx);
-        }
-        if let Some((i, u)) = self.chunks.iter().filter_map(|c| c.bad).min_by_key(|b| b.0) {
-            return Err(BcdError::NonFinite {
-                step: self.state.step,
-                particle: i,
-                position: self.state.x[i],
-                velocity: u,
-            });
-        }
-        stitch_ring(&mut self.chunks, &mut self.live, n, length, sigma);
-        // Rewrite the rods of the blocks that grew in the stitch (always a chunk's last block).
-        for c in &self.chunks {
-            if c.head < c.end && c.dirty {
-                let p = c.pool[c.end - 1];
-                let (start, cnt) = (p.start as usize, p.n as usize);
-                for w in start..start + cnt {
-                    let a = w % n;
-                    self.x_next[a] = p.pos + (w - start) as f64 * sigma - (w / n) as f64 * length;
-                    self.bond_next[a] = u8::from(w + 1 < start + cnt);
-                }
-            }
-        }
-        std::mem::swap(&mut self.state.x, &mut self.x_next);
-        std::mem::swap(&mut self.state.bond, &mut self.bond_next);
-        self.state.step += 1;
-        Ok(())
-    }
-
     /// Run `steps` steps.
     pub fn run(&mut self, steps: u64) -> Result<(), BcdError> {
         for _ in 0..steps {
@@ -590,7 +564,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
 
     /// Check the hard core and the walls (for tests): returns the smallest gap minus sigma.
     pub fn min_clearance(&self) -> f64 {
-        let x = &self.state.x;
+        let x = self.positions();
         let n = x.len();
         let s = self.cfg.sigma;
         let mut m = f64::INFINITY;
@@ -663,7 +637,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
     let range = ctx.pair.range();
     let has_pair = range > ctx.sigma;
     let mut noise_block = usize::MAX;
-    let mut noise = [0.0f64; BLOCK];
+    let mut noise = [0.0f64; SEG];
     let (stack, hull) = (&mut c.stack, &mut c.hull);
     let mut open = false;
     let mut w = vs;
@@ -676,19 +650,21 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
         for a in w - base..seg_end - base {
             let vw = a + base;
             let xi = ring.x[a] + offset;
-            let mut f = ctx.ext.force(xi);
+            // The external force acts at the rod's own (unwrapped) position, whatever frame
+            // the cluster is seen in.
+            let mut f = ctx.ext.force(ring.x[a]);
             if has_pair {
                 f += pair_force(ring, ctx.pair, a, vw, xi, range);
             }
             let mut u = ctx.mobility * f;
             if ctx.noise_amp > 0.0 {
-                let b = a / BLOCK;
+                let b = a / SEG;
                 if b != noise_block {
                     noise_block = b;
-                    let m = BLOCK.min(n - b * BLOCK);
-                    fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..m]);
+                    let m = SEG.min(n - b * SEG);
+                    noise_segment(ctx.seed, ctx.step, b, &mut noise[..m]);
                 }
-                u += ctx.noise_amp * noise[a % BLOCK];
+                u += ctx.noise_amp * noise[a % SEG];
             }
             if !u.is_finite() {
                 c.bad = Some((a, u));
@@ -713,408 +689,6 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
             }
         }
         w = seg_end;
-    }
-}
-
-/// A block of rods that end the step together, in the pooling pass of [`chunk_phase_ring`]:
-/// `n` rods from virtual index `start`. `pos` is the end-of-step reduced position `z` relative
-/// to the chunk's first rod while pooling, then the end-of-step centre of the block's first rod
-/// (unwrapped, in the frame of its virtual index).
-#[derive(Debug, Clone, Copy, Default)]
-struct Pool {
-    pos: f64,
-    n: f64,
-    start: u32,
-}
-
-/// Output rods of virtual indices `[v0, v0 + x.len())`.
-struct Out<'a> {
-    x: &'a mut [f64],
-    b: &'a mut [u8],
-    v0: usize,
-}
-
-impl<'a> Out<'a> {
-    /// Split at virtual index `v`.
-    fn split(self, v: usize) -> (Out<'a>, Out<'a>) {
-        let k = v.saturating_sub(self.v0).min(self.x.len());
-        let (xa, xb) = self.x.split_at_mut(k);
-        let (ba, bb) = self.b.split_at_mut(k);
-        (
-            Out {
-                x: xa,
-                b: ba,
-                v0: self.v0,
-            },
-            Out {
-                x: xb,
-                b: bb,
-                v0: self.v0 + k,
-            },
-        )
-    }
-}
-
-/// Run [`chunk_phase_ring`] on every chunk in parallel, handing each the parts of the output
-/// arrays that hold its rods (`first`: virtual indices below N, `second`: one period on).
-fn ring_chunks<E: ExternalForce, P: PairForce>(
-    chunks: &mut [Chunk],
-    first: Out,
-    second: Out,
-    ctx: &StepCtx<E, P>,
-) {
-    if chunks.len() == 1 {
-        chunk_phase_ring(&mut chunks[0], first, second, ctx);
-        return;
-    }
-    let mid = chunks.len() / 2;
-    let v = chunks[mid].vs;
-    let (f1, f2) = first.split(v);
-    let (s1, s2) = second.split(v);
-    let (c1, c2) = chunks.split_at_mut(mid);
-    rayon::join(
-        || ring_chunks(c1, f1, s1, ctx),
-        || ring_chunks(c2, f2, s2, ctx),
-    );
-}
-
-/// The premerged step of the chunk's rods on a ring in one pooling pass.
-///
-/// In reduced coordinates `y_i = x_i - i sigma` hard rods are points that may not pass each
-/// other, and a cluster of rods in contact shares one `y`. Fragmentation (fast-bcd Eqs. 4a/4b:
-/// the lower convex hull of the cumulative free velocities, see [`Hull`]) followed by binary
-/// premerging (Sec. IV, Eq. 20: clusters `a`, `b` merge when `y_a + v_a dt >= y_b + v_b dt`,
-/// into the centre of mass, Eq. 6) is the same pooling of adjacent violators applied to the free
-/// end-of-step positions `z_i = y_i + u_i dt`: inside a cluster (equal `y`) it compares mean
-/// velocities, across clusters it detects the collisions within `dt`, and pooling in any order
-/// reaches the same unique result. So one stack over `z` does both, left to right; rods of one
-/// block end in contact. The chunk then writes its rods' end-of-step positions and bonds.
-fn chunk_phase_ring<E: ExternalForce, P: PairForce>(
-    c: &mut Chunk,
-    first: Out,
-    second: Out,
-    ctx: &StepCtx<E, P>,
-) {
-    c.bad = None;
-    let (vs, ve) = (c.vs, c.ve);
-    let ring = ctx.ring;
-    let n = ring.n;
-    let range = ctx.pair.range();
-    let has_pair = range > ctx.sigma;
-    let (sigma, dt, mobility, amp) = (ctx.sigma, ctx.dt, ctx.mobility, ctx.noise_amp);
-    let xref = ring.pos(vs);
-    let len_c = ve - vs;
-    // Finished blocks pool[1..=top] above a sentinel that never pools (its mean is NaN), each
-    // with the sum `pos` of its z and its size `n` while pooling; the open block (sum `s`,
-    // size `m`, first rod `first_rod`) stays in registers.
-    let pool = &mut c.pool;
-    if pool.is_empty() {
-        pool.push(Pool::default());
-    }
-    pool[0] = Pool {
-        pos: f64::NAN,
-        n: 1.0,
-        start: vs as u32,
-    };
-    let mut top = 0;
-    let (mut s, mut m, mut first_rod) = (0.0f64, 0.0f64, vs as u32);
-    let mut noise = [0.0f64; BLOCK];
-    let mut zbuf = [0.0f64; BLOCK];
-    // Reduced start-of-step position of the current cluster; the chunk starts a cluster.
-    let mut y = 0.0f64;
-    let mut bonded = false;
-    let mut w = vs;
-    while w < ve {
-        // One segment: rods of one noise block, without crossing the ring's end.
-        let wraps = w / n;
-        let base = wraps * n;
-        let a0 = w - base;
-        let b = a0 / BLOCK;
-        let a1 = (ve - base).min(n).min((b + 1) * BLOCK);
-        let len = a1 - a0;
-        let offset = wraps as f64 * ring.length;
-        if amp > 0.0 {
-            let mm = BLOCK.min(n - b * BLOCK);
-            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..mm]);
-        }
-        // Free end-of-step reduced positions z (free velocities: fast-bcd Eq. 3).
-        let xs = &ring.x[a0..a1];
-        let fbuf = &mut zbuf[..len];
-        ctx.ext.force_block(xs, offset, fbuf);
-        if has_pair {
-            for (k, f) in fbuf.iter_mut().enumerate() {
-                *f += pair_force(ring, ctx.pair, a0 + k, w + k, xs[k] + offset, range);
-            }
-        }
-        let mut kf = (w - vs) as f64;
-        let rods = xs
-            .iter()
-            .zip(&ring.bond[a0..a1])
-            .zip(&noise[a0 - b * BLOCK..a1 - b * BLOCK]);
-        for (z, ((&xa, &bd), &g)) in fbuf.iter_mut().zip(rods) {
-            let u = mobility * *z + amp * g;
-            // A rod bonded to its left neighbour keeps the cluster's y bit for bit (select
-            // without a branch: the bonds are data-dependent).
-            let fresh = (xa + offset - xref) - kf * sigma;
-            let keep = u64::from(bonded).wrapping_neg();
-            y = f64::from_bits((y.to_bits() & keep) | (fresh.to_bits() & !keep));
-            bonded = bd != 0;
-            *z = y + u * dt;
-            kf += 1.0;
-        }
-        // Pool adjacent violators. The common decision (does rod k join the open block, i.e.
-        // is the open block's mean z >= z_k?) is taken without a branch: the open block is
-        // always stored one above the stack top and the top index advances only when it is
-        // closed. Only the rarer cascade into the blocks below branches. Ties pool.
-        // Room for the open block above every block this segment can add.
-        if pool.len() < top + len + 2 {
-            pool.resize(top + len + 2, Pool::default());
-        }
-        let st = pool.as_mut_slice();
-        for (k, &z) in zbuf[..len].iter().enumerate() {
-            let join = s >= z * m;
-            st[top + 1] = Pool {
-                pos: s,
-                n: m,
-                start: first_rod,
-            };
-            let jf = f64::from(u8::from(join));
-            top += usize::from(!join);
-            s = z + jf * s;
-            m = 1.0 + jf * m;
-            let keep = u32::from(join).wrapping_neg();
-            first_rod = (first_rod & keep) | ((w + k) as u32 & !keep);
-            loop {
-                let below = st[top];
-                if below.pos * m >= s * below.n {
-                    s += below.pos;
-                    m += below.n;
-                    first_rod = below.start;
-                    top -= 1;
-                } else {
-                    break;
-                }
-            }
-        }
-        w = a1 + base;
-    }
-    if m > 0.0 {
-        top += 1;
-        if top == pool.len() {
-            pool.push(Pool::default());
-        }
-        pool[top] = Pool {
-            pos: s,
-            n: m,
-            start: first_rod,
-        };
-    }
-    c.end = top + 1;
-    // Each block's rods end at x_k = base + k sigma (k counted from the chunk's first rod);
-    // rods are marked with the index of the block they start.
-    let marks = &mut c.marks;
-    if marks.len() < len_c + 1 {
-        marks.resize(len_c + 1, 0);
-    }
-    marks[..len_c].fill(0);
-    marks[len_c] = 1;
-    let mut finite = true;
-    for (i, p) in pool[1..=top].iter_mut().enumerate() {
-        marks[p.start as usize - vs] = i as u32 + 1;
-        p.pos = xref + p.pos / p.n;
-        finite &= p.pos.is_finite();
-    }
-    if !finite {
-        c.bad = first_non_finite(vs, ve, ctx);
-        return;
-    }
-    let la = first.x.len();
-    let mut cur = 0;
-    write_rods(
-        first.x,
-        first.b,
-        &marks[..=la],
-        pool,
-        &mut cur,
-        0.0,
-        sigma,
-        0.0,
-    );
-    write_rods(
-        second.x,
-        second.b,
-        &marks[la..=len_c],
-        pool,
-        &mut cur,
-        la as f64,
-        sigma,
-        ring.length,
-    );
-    // For the stitch: the end-of-step centre of each block's first rod.
-    for p in &mut pool[1..=top] {
-        p.pos += f64::from(p.start - vs as u32) * sigma;
-    }
-}
-
-/// Positions `base + k sigma - wrap` and bonds of consecutive rods (`k` from `k0`), where
-/// `base` is that of the last block started at or before the rod (`marks`, one longer than
-/// `xs`, holds the block index at each block's first rod and 0 elsewhere). Branch-free.
-#[inline]
-fn write_rods(
-    xs: &mut [f64],
-    bs: &mut [u8],
-    marks: &[u32],
-    pool: &[Pool],
-    cur: &mut usize,
-    k0: f64,
-    sigma: f64,
-    wrap: f64,
-) {
-    let mut kf = k0;
-    let ends = marks.iter().zip(&marks[1..]);
-    for ((x, b), (&mk, &next)) in xs.iter_mut().zip(bs.iter_mut()).zip(ends) {
-        *cur = (*cur).max(mk as usize);
-        *x = pool[*cur].pos + kf * sigma - wrap;
-        *b = u8::from(next == 0);
-        kf += 1.0;
-    }
-}
-
-/// The first rod of virtual range `[vs, ve)` with a non-finite free velocity, and that
-/// velocity (the slow path behind the ring step's finiteness check).
-fn first_non_finite<E: ExternalForce, P: PairForce>(
-    vs: usize,
-    ve: usize,
-    ctx: &StepCtx<E, P>,
-) -> Option<(usize, f64)> {
-    let ring = ctx.ring;
-    let n = ring.n;
-    let range = ctx.pair.range();
-    let mut noise = [0.0f64; BLOCK];
-    for w in vs..ve {
-        let a = w % n;
-        let xi = ring.x[a] + (w / n) as f64 * ring.length;
-        let mut f = ctx.ext.force(xi);
-        if range > ctx.sigma {
-            f += pair_force(ring, ctx.pair, a, w, xi, range);
-        }
-        let mut g = 0.0;
-        if ctx.noise_amp > 0.0 {
-            let b = a / BLOCK;
-            let mm = BLOCK.min(n - b * BLOCK);
-            fill_normal_block_fast(ctx.seed, ctx.step, b as u64, &mut noise[..mm]);
-            g = noise[a % BLOCK];
-        }
-        let u = ctx.mobility * f + ctx.noise_amp * g;
-        if !(u * ctx.dt).is_finite() {
-            return Some((a, u));
-        }
-    }
-    Some((ring.actual(vs), f64::NAN))
-}
-
-/// Pool the chunks' blocks across chunk boundaries and the periodic seam (blocks given by
-/// end-of-step positions; pooling at the centre of mass, fast-bcd Eq. 6). Sets each chunk's
-/// live range `pool[head..end]`; grown blocks are marked dirty.
-fn stitch_ring(chunks: &mut [Chunk], live: &mut Vec<usize>, n: usize, length: f64, sigma: f64) {
-    live.clear();
-    for c in chunks.iter_mut() {
-        c.head = 1;
-        c.dirty = false;
-    }
-    for ci in 0..chunks.len() {
-        while chunks[ci].head < chunks[ci].end {
-            let Some(&pi) = live.last() else { break };
-            let first = chunks[ci].pool[chunks[ci].head];
-            if !absorb(&mut chunks[pi], &first, sigma) {
-                break;
-            }
-            chunks[ci].head += 1;
-            cascade(chunks, live, 0, sigma);
-        }
-        if chunks[ci].head < chunks[ci].end {
-            live.push(ci);
-        }
-    }
-    // The seam: the last block meets the first one a period further on.
-    let mut lf = 0;
-    while live.len() > lf {
-        let (fi, li) = (live[lf], live[live.len() - 1]);
-        if fi == li && chunks[fi].end - chunks[fi].head < 2 {
-            break;
-        }
-        let mut front = chunks[fi].pool[chunks[fi].head];
-        front.start += n as u32;
-        front.pos += length;
-        if !absorb(&mut chunks[li], &front, sigma) {
-            break;
-        }
-        chunks[fi].head += 1;
-        if chunks[fi].head == chunks[fi].end {
-            lf += 1;
-        }
-        cascade(chunks, live, lf, sigma);
-    }
-}
-
-/// Pool `block` into chunk `c`'s last block when they overlap (marking the chunk dirty); false
-/// when they do not.
-fn absorb(c: &mut Chunk, block: &Pool, sigma: f64) -> bool {
-    let last = &mut c.pool[c.end - 1];
-    if !overlap(last, block, sigma) {
-        return false;
-    }
-    *last = pool_pair(last, block, sigma);
-    c.dirty = true;
-    true
-}
-
-/// Pool the last live block into its left neighbours for as long as they overlap (live chunks
-/// `live[lf..]`).
-fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize, sigma: f64) {
-    loop {
-        let pi = live[live.len() - 1];
-        let c = &mut chunks[pi];
-        let top = c.pool[c.end - 1];
-        if c.end - c.head >= 2 {
-            let prev = c.pool[c.end - 2];
-            if !overlap(&prev, &top, sigma) {
-                return;
-            }
-            c.end -= 1;
-            c.pool[c.end - 1] = pool_pair(&prev, &top, sigma);
-            c.dirty = true;
-        } else {
-            if live.len() - lf < 2 {
-                return;
-            }
-            let qc = &mut chunks[live[live.len() - 2]];
-            let prev = &mut qc.pool[qc.end - 1];
-            if !overlap(prev, &top, sigma) {
-                return;
-            }
-            *prev = pool_pair(prev, &top, sigma);
-            qc.dirty = true;
-            chunks[pi].end -= 1;
-            live.pop();
-        }
-    }
-}
-
-/// Do blocks `a` (left) and `b` (right), given by end-of-step positions, overlap or touch?
-#[inline]
-fn overlap(a: &Pool, b: &Pool, sigma: f64) -> bool {
-    b.pos - a.pos - a.n * sigma <= 0.0
-}
-
-/// Pool two blocks given by end-of-step positions at their centre of mass (fast-bcd Eq. 6).
-#[inline]
-fn pool_pair(a: &Pool, b: &Pool, sigma: f64) -> Pool {
-    let n = a.n + b.n;
-    Pool {
-        pos: a.pos + (b.pos - a.n * sigma - a.pos) * (b.n / n),
-        n,
-        start: a.start,
     }
 }
 
@@ -1302,6 +876,43 @@ fn write_range(
         w = end;
         idx += 1;
     }
+}
+
+/// The ring update's reduced coordinates `y_i = x_i - i sigma` of a state: its own `reduced`
+/// when present (a checkpoint of the ring update; checked against `x`), else derived from `x`
+/// with the rods of each cluster (`bond`) set to their first rod's value.
+fn reduced_positions(cfg: &BcdConfig, state: &BcdState) -> Result<Vec<f64>, BcdError> {
+    let (x, n, sigma) = (&state.x, state.x.len(), cfg.sigma);
+    if state.reduced.is_empty() {
+        let mut y: Vec<f64> = Vec::with_capacity(n);
+        for i in 0..n {
+            let fresh = x[i] - i as f64 * sigma;
+            y.push(if i > 0 && state.bond[i - 1] != 0 {
+                y[i - 1]
+            } else {
+                fresh
+            });
+        }
+        return Ok(y);
+    }
+    let y = &state.reduced;
+    if y.len() != n {
+        return Err(BcdError::Positions(format!(
+            "reduced has {} entries for {n} rods",
+            y.len()
+        )));
+    }
+    let tol = 1e-9 * cfg.length.max(sigma);
+    for i in 0..n {
+        let xi = y[i] + i as f64 * sigma;
+        if !(xi - x[i]).abs().le(&tol) || (i > 0 && y[i] < y[i - 1]) {
+            return Err(BcdError::Positions(format!(
+                "reduced position {i} ({}) does not match x = {} (x_i = reduced_i + i sigma, non-decreasing)",
+                y[i], x[i]
+            )));
+        }
+    }
+    Ok(y.clone())
 }
 
 fn check_positions(cfg: &BcdConfig, x: &[f64]) -> Result<(), BcdError> {

@@ -15,6 +15,7 @@ pub mod engine;
 pub mod forces;
 pub mod init;
 pub mod observe;
+mod ring;
 pub mod scenario;
 
 pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Update};

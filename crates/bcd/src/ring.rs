@@ -1,0 +1,538 @@
+//! The premerged BCD step on a ring, in reduced coordinates (the fast path of [`crate::engine`]).
+//!
+//! In reduced coordinates `y_i = x_i - i sigma` hard rods are points that may not pass each
+//! other, and the rods of a cluster share one `y`: here bit for bit, because a cluster is stored
+//! as one value written to all its rods. Fragmentation (fast-bcd Eqs. 4a/4b: the lower convex
+//! hull of the cumulative free velocities) followed by binary premerging (Sec. IV, Eq. 20:
+//! clusters `a`, `b` merge when `y_a + v_a dt >= y_b + v_b dt`, at the centre of mass, Eq. 6)
+//! is the pooling of adjacent violators of the free end-of-step positions `z_i = y_i + u_i dt`
+//! (free velocities `u_i`, Eq. 3): inside a cluster (equal `y`) it compares mean velocities,
+//! across clusters it detects the collisions within `dt`, and pooling in any order reaches the
+//! same unique result. Each block of pooled rods ends the step in contact at the mean `z` of
+//! its rods.
+//!
+//! The ring is cut into chunks of [`CHUNK`] rods at fixed indices. Each chunk (in parallel)
+//! computes its `z`, pools them in [`LANES`] interleaved streams (independent dependency chains
+//! that the out-of-order core runs side by side), joins the streams' blocks and writes its rods;
+//! a short sequential stitch then pools across chunk boundaries and the periodic seam and
+//! rewrites the rods of the blocks that grew. Chunks and streams depend only on N, never on the
+//! thread count, so results are bitwise identical for any number of threads.
+
+use crate::forces::{ExternalForce, PairForce};
+use colloidsim_core::rng::{BLOCK, fill_normal_block_fast};
+use rayon::prelude::*;
+use std::sync::Mutex;
+
+/// Rods per chunk of the parallel step (a multiple of [`SEG`]).
+pub const CHUNK: usize = 4096;
+/// Rods per noise and force segment.
+pub const SEG: usize = 256;
+/// Interleaved pooling streams per chunk.
+const LANES: usize = 4;
+/// Capacity of one stream's stack: a power of two above `CHUNK / LANES + LANES + 2`, so that a
+/// masked index needs no bounds check.
+const STACK: usize = 2048;
+const _: () = assert!(STACK > CHUNK / LANES + LANES + 2 && STACK.is_power_of_two());
+const _: () = assert!(CHUNK.is_multiple_of(SEG) && SEG.is_multiple_of(BLOCK));
+
+/// Standard normal deviates of rods `[seg * SEG, seg * SEG + out.len())` at `step` (the noise
+/// of every BCD update, so that all of them see the same numbers).
+#[inline]
+pub(crate) fn noise_segment(seed: u32, step: u64, seg: usize, out: &mut [f64]) {
+    debug_assert!(out.len() <= SEG);
+    for (b, part) in out.chunks_mut(BLOCK).enumerate() {
+        fill_normal_block_fast(seed, step, (seg * (SEG / BLOCK) + b) as u64, part);
+    }
+}
+
+/// A block of rods that end the step together: `[pos, n]`, `n` rods (an integer) at the
+/// end-of-step reduced position `pos`. While pooling, `pos` is instead the sum of the rods' `z`
+/// relative to the chunk's first rod.
+type Block = [f64; 2];
+
+/// `n` as an index, for an integer `0 <= n < 2^52` (branch-free: the integer is read off the
+/// mantissa of `n + 2^52`).
+#[inline(always)]
+fn count(n: f64) -> usize {
+    const TWO52: f64 = (1u64 << 52) as f64;
+    ((n + TWO52).to_bits() & ((1u64 << 52) - 1)) as usize
+}
+
+/// What every chunk of a step reads.
+pub(crate) struct RingCtx<'a, E, P> {
+    /// Reduced positions at the start of the step.
+    pub y: &'a [f64],
+    pub ext: &'a E,
+    pub pair: &'a P,
+    pub mobility: f64,
+    /// Noise amplitude `sqrt(2 D / dt)`.
+    pub noise_amp: f64,
+    pub seed: u32,
+    pub step: u64,
+    pub sigma: f64,
+    pub dt: f64,
+    /// Ring length L.
+    pub length: f64,
+}
+
+impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
+    /// Reduced period `L - N sigma`: rod `a` one period on sits at `y_a + L - N sigma`.
+    fn reduced_period(&self) -> f64 {
+        self.length - self.y.len() as f64 * self.sigma
+    }
+
+    /// Free velocities `u = mu F + sqrt(2D/dt) xi` (fast-bcd Eq. 3) of rods `[a0, a0 + u.len())`
+    /// within one segment; `noise` and `x` are scratch of the same length.
+    fn free_velocities(&self, a0: usize, u: &mut [f64], noise: &mut [f64], x: &mut [f64]) {
+        let len = u.len();
+        let (sigma, ys) = (self.sigma, &self.y[a0..a0 + len]);
+        for (k, (xk, &yk)) in x.iter_mut().zip(ys).enumerate() {
+            *xk = yk + (a0 + k) as f64 * sigma;
+        }
+        self.ext.force_block(x, 0.0, u);
+        let range = self.pair.range();
+        if range > sigma {
+            for (k, f) in u.iter_mut().enumerate() {
+                *f += self.pair_force(a0 + k, range);
+            }
+        }
+        if self.noise_amp > 0.0 {
+            noise_segment(self.seed, self.step, a0 / SEG, noise);
+        } else {
+            noise.fill(0.0);
+        }
+        let (mu, amp) = (self.mobility, self.noise_amp);
+        for (f, &g) in u.iter_mut().zip(noise.iter()) {
+            *f = mu * *f + amp * g;
+        }
+    }
+
+    /// Pair force on rod `a` from its neighbours within `range` (centre distances
+    /// `r = y_b - y_a + (b - a) sigma`, across the seam with the reduced period).
+    fn pair_force(&self, a: usize, range: f64) -> f64 {
+        let (y, n, sigma) = (self.y, self.y.len(), self.sigma);
+        let lred = self.reduced_period();
+        let mut f = 0.0;
+        // Right neighbours push rod a to the left, left neighbours to the right.
+        for k in 1..n {
+            let b = a + k;
+            let yb = if b < n { y[b] } else { y[b - n] + lred };
+            let r = (yb - y[a]) + k as f64 * sigma;
+            if r >= range {
+                break;
+            }
+            f -= self.pair.force(r);
+        }
+        for k in 1..n {
+            let yb = if a >= k {
+                y[a - k]
+            } else {
+                y[a + n - k] - lred
+            };
+            let r = (y[a] - yb) + k as f64 * sigma;
+            if r >= range {
+                break;
+            }
+            f += self.pair.force(r);
+        }
+        f
+    }
+}
+
+/// Per-thread scratch of the chunk pass.
+struct Scratch {
+    /// Free end-of-step reduced positions of the chunk's rods, relative to its first rod.
+    z: Vec<f64>,
+    /// One stack of `[sum of z, rods]` per stream; entry 0 is a sentinel that never pools.
+    stacks: Box<[[[f64; 2]; STACK]]>,
+}
+
+impl Scratch {
+    fn new() -> Self {
+        Self {
+            z: vec![0.0; CHUNK],
+            stacks: vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice(),
+        }
+    }
+}
+
+#[derive(Debug, Default, Clone)]
+struct Chunk {
+    /// Rods `[a0, a1)`.
+    a0: usize,
+    a1: usize,
+    /// The chunk's blocks in ring order; `pool[head..end]` are live during the stitch.
+    pool: Vec<Block>,
+    head: usize,
+    end: usize,
+    /// First rods of `pool[head]` and of `pool[end - 1]` (virtual indices: the last block may
+    /// reach past N after the seam is stitched).
+    head_start: usize,
+    last_start: usize,
+    /// The last live block grew in the stitch: its rods must be rewritten.
+    dirty: bool,
+    /// First rod whose free velocity went non-finite, with that velocity.
+    bad: Option<(usize, f64)>,
+}
+
+/// State and buffers of the ring step.
+pub(crate) struct RingStep {
+    /// Reduced positions `y_i = x_i - i sigma` (unwrapped); rods of one cluster share `y`.
+    pub y: Vec<f64>,
+    y_next: Vec<f64>,
+    /// Rods N-1 and 0 belong to one cluster (across the seam).
+    pub seam: bool,
+    chunks: Vec<Chunk>,
+    live: Vec<usize>,
+    scratch: Vec<Mutex<Option<Scratch>>>,
+}
+
+impl RingStep {
+    /// Start from reduced positions `y` (rods of a cluster with equal values).
+    pub fn new(y: Vec<f64>, seam: bool) -> Self {
+        let n = y.len();
+        let chunks = (0..n.div_ceil(CHUNK))
+            .map(|c| Chunk {
+                a0: c * CHUNK,
+                a1: ((c + 1) * CHUNK).min(n),
+                ..Chunk::default()
+            })
+            .collect();
+        Self {
+            y_next: vec![0.0; n],
+            y,
+            seam,
+            chunks,
+            live: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// One premerged step; on a non-finite free velocity, returns the first such rod and its
+    /// velocity and leaves the state unchanged.
+    pub fn step<E: ExternalForce, P: PairForce>(
+        &mut self,
+        ext: &E,
+        pair: &P,
+        cfg: &crate::engine::BcdConfig,
+        noise_amp: f64,
+        step: u64,
+    ) -> Result<(), (usize, f64)> {
+        let threads = rayon::current_num_threads().max(1);
+        if self.scratch.len() < threads {
+            self.scratch.resize_with(threads, || Mutex::new(None));
+        }
+        let ctx = RingCtx {
+            y: &self.y,
+            ext,
+            pair,
+            mobility: cfg.mobility,
+            noise_amp,
+            seed: cfg.seed,
+            step,
+            sigma: cfg.sigma,
+            dt: cfg.dt,
+            length: cfg.length,
+        };
+        let scratch = &self.scratch;
+        self.chunks
+            .par_iter_mut()
+            .zip(self.y_next.par_chunks_mut(CHUNK))
+            .for_each(|(c, out)| {
+                let slot = rayon::current_thread_index().unwrap_or(0) % scratch.len();
+                let mut guard = scratch[slot].lock().unwrap_or_else(|e| e.into_inner());
+                let s = guard.get_or_insert_with(Scratch::new);
+                chunk_pass(c, out, s, &ctx);
+            });
+        if let Some(bad) = self.chunks.iter().find_map(|c| c.bad) {
+            return Err(bad);
+        }
+        let n = self.y.len();
+        let lred = cfg.length - n as f64 * cfg.sigma;
+        stitch(&mut self.chunks, &mut self.live, lred);
+        // Rewrite the rods of the blocks that grew in the stitch (always a chunk's last block).
+        let mut seam = false;
+        for c in &self.chunks {
+            if c.head < c.end {
+                let [pos, cnt] = c.pool[c.end - 1];
+                let (start, cnt) = (c.last_start, count(cnt));
+                seam |= start + cnt > n;
+                if c.dirty {
+                    for w in start..start + cnt {
+                        let wraps = w / n;
+                        self.y_next[w - wraps * n] = pos - wraps as f64 * lred;
+                    }
+                }
+            }
+        }
+        std::mem::swap(&mut self.y, &mut self.y_next);
+        self.seam = seam && n > 1;
+        Ok(())
+    }
+}
+
+/// Add one rod's `z` to a pooling stream (pool adjacent violators, ties pool): the open block
+/// `open = [sum, rods]` stays in registers and is stored one above the stack top on every
+/// call, so the common decision (does the rod join the open block?) needs no branch; only a
+/// cascade into the blocks below does.
+#[inline(always)]
+fn push_rod(st: &mut [[f64; 2]; STACK], top: &mut usize, open: &mut [f64; 2], z: f64) {
+    let join = open[0] >= z * open[1];
+    st[(*top + 1) & (STACK - 1)] = *open;
+    *top += usize::from(!join);
+    let jf = f64::from(u8::from(join));
+    *open = [z + jf * open[0], 1.0 + jf * open[1]];
+    loop {
+        let below = st[*top & (STACK - 1)];
+        if below[0] * open[1] >= open[0] * below[1] {
+            open[0] += below[0];
+            open[1] += below[1];
+            *top -= 1;
+        } else {
+            break;
+        }
+    }
+}
+
+/// Append block `b` (`[sum, n]`) to `pool`, pooling it with the blocks it violates; true when
+/// it pooled.
+#[inline]
+fn push_block(pool: &mut Vec<Block>, mut b: Block) -> bool {
+    let mut pooled = false;
+    while let Some(&top) = pool.last() {
+        if top[0] * b[1] >= b[0] * top[1] {
+            b = [top[0] + b[0], top[1] + b[1]];
+            pool.pop();
+            pooled = true;
+        } else {
+            break;
+        }
+    }
+    pool.push(b);
+    pooled
+}
+
+/// The chunk's step: free end-of-step positions, pooling in [`LANES`] streams, joining the
+/// streams, writing the rods' end-of-step reduced positions into `out`.
+fn chunk_pass<E: ExternalForce, P: PairForce>(
+    c: &mut Chunk,
+    out: &mut [f64],
+    s: &mut Scratch,
+    ctx: &RingCtx<E, P>,
+) {
+    c.bad = None;
+    let (a0, a1) = (c.a0, c.a1);
+    let len = a1 - a0;
+    let yref = ctx.y[a0];
+    let dt = ctx.dt;
+    // Free end-of-step reduced positions relative to the chunk's first rod.
+    let z = &mut s.z[..len];
+    let mut noise = [0.0f64; SEG];
+    let mut x = [0.0f64; SEG];
+    for (k, zs) in z.chunks_mut(SEG).enumerate() {
+        let a = a0 + k * SEG;
+        let m = zs.len();
+        ctx.free_velocities(a, zs, &mut noise[..m], &mut x[..m]);
+        for (zk, &yk) in zs.iter_mut().zip(&ctx.y[a..a + m]) {
+            *zk = (yk - yref) + *zk * dt;
+        }
+    }
+    // Pool in LANES streams over consecutive quarters, interleaved rod by rod.
+    let q = len / LANES;
+    let mut top = [0usize; LANES];
+    let mut open = [[0.0f64; 2]; LANES];
+    let stacks = &mut s.stacks[..LANES];
+    for st in stacks.iter_mut() {
+        st[0] = [f64::NAN, 1.0];
+    }
+    let zq: [&[f64]; LANES] = std::array::from_fn(|j| &z[j * q..(j + 1) * q]);
+    for k in 0..q {
+        for j in 0..LANES {
+            push_rod(&mut stacks[j], &mut top[j], &mut open[j], zq[j][k]);
+        }
+    }
+    // The last stream takes the rods left over.
+    for &zk in &z[LANES * q..] {
+        push_rod(
+            &mut stacks[LANES - 1],
+            &mut top[LANES - 1],
+            &mut open[LANES - 1],
+            zk,
+        );
+    }
+    // Join the streams: each stream's blocks pool with the ones before only until one of them
+    // stands alone (the stream's means increase from there on); the rest is copied.
+    let pool = &mut c.pool;
+    pool.clear();
+    for j in 0..LANES {
+        stacks[j][(top[j] + 1) & (STACK - 1)] = open[j];
+        let mut blocks = &stacks[j][1..top[j] + 2];
+        if open[j][1] == 0.0 {
+            // An empty stream (fewer rods than streams).
+            blocks = &blocks[..blocks.len() - 1];
+        }
+        if j > 0 {
+            while let Some((&b, rest)) = blocks.split_first() {
+                blocks = rest;
+                if !push_block(pool, b) {
+                    break;
+                }
+            }
+        }
+        pool.extend_from_slice(blocks);
+    }
+    // End-of-step reduced positions: every rod of a block at the block's mean z. Short blocks
+    // are written as a fixed run of FILL values (no data-dependent loop exit); the next block
+    // overwrites the excess.
+    const FILL: usize = 8;
+    let mut finite = true;
+    let mut at = 0;
+    for b in pool.iter_mut() {
+        b[0] = yref + b[0] / b[1];
+        finite &= b[0].is_finite();
+        let m = count(b[1]);
+        if m <= FILL && at + FILL <= len {
+            out[at..at + FILL].copy_from_slice(&[b[0]; FILL]);
+        } else {
+            out[at..at + m].fill(b[0]);
+        }
+        at += m;
+    }
+    c.head = 0;
+    c.end = pool.len();
+    c.head_start = a0;
+    c.last_start = a1 - pool.last().map_or(0, |b| count(b[1]));
+    if !finite || at != len {
+        c.bad = first_non_finite(a0, a1, ctx);
+    }
+}
+
+/// The first rod of `[a0, a1)` with a non-finite free velocity, and that velocity (the slow
+/// path behind the chunk's finiteness check).
+fn first_non_finite<E: ExternalForce, P: PairForce>(
+    a0: usize,
+    a1: usize,
+    ctx: &RingCtx<E, P>,
+) -> Option<(usize, f64)> {
+    let mut u = [0.0f64; SEG];
+    let mut noise = [0.0f64; SEG];
+    let mut x = [0.0f64; SEG];
+    let mut a = a0;
+    while a < a1 {
+        let m = (a1 - a).min(SEG);
+        ctx.free_velocities(a, &mut u[..m], &mut noise[..m], &mut x[..m]);
+        if let Some(k) = u[..m].iter().position(|v| !v.is_finite()) {
+            return Some((a + k, u[k]));
+        }
+        a += m;
+    }
+    // Finite velocities can still overflow the position.
+    Some((a0, f64::NAN))
+}
+
+/// Pool the chunks' blocks across chunk boundaries and the periodic seam (pooling at the
+/// centre of mass, fast-bcd Eq. 6). Sets each chunk's live range `pool[head..end]`; grown
+/// blocks are marked dirty. `lred = L - N sigma` is the reduced period.
+fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
+    live.clear();
+    for c in chunks.iter_mut() {
+        c.dirty = false;
+    }
+    for ci in 0..chunks.len() {
+        while chunks[ci].head < chunks[ci].end {
+            let Some(&pi) = live.last() else { break };
+            let first = chunks[ci].pool[chunks[ci].head];
+            if !absorb(&mut chunks[pi], &first) {
+                break;
+            }
+            chunks[ci].pop_head();
+            cascade(chunks, live, 0);
+        }
+        if chunks[ci].head < chunks[ci].end {
+            live.push(ci);
+        }
+    }
+    // The seam: the last block meets the first one a period further on.
+    let mut lf = 0;
+    while live.len() > lf {
+        let (fi, li) = (live[lf], live[live.len() - 1]);
+        if fi == li && chunks[fi].end - chunks[fi].head < 2 {
+            break;
+        }
+        let [pos, cnt] = chunks[fi].pool[chunks[fi].head];
+        if !absorb(&mut chunks[li], &[pos + lred, cnt]) {
+            break;
+        }
+        chunks[fi].pop_head();
+        if chunks[fi].head == chunks[fi].end {
+            lf += 1;
+        }
+        cascade(chunks, live, lf);
+    }
+}
+
+impl Chunk {
+    /// Drop the first live block (it was pooled into the previous chunk's last one).
+    fn pop_head(&mut self) {
+        self.head_start += count(self.pool[self.head][1]);
+        self.head += 1;
+    }
+}
+
+/// Pool `block` into chunk `c`'s last block when they meet (marking the chunk dirty); false
+/// when they do not.
+fn absorb(c: &mut Chunk, block: &Block) -> bool {
+    let last = &mut c.pool[c.end - 1];
+    if !meet(last, block) {
+        return false;
+    }
+    *last = pool_pair(last, block);
+    c.dirty = true;
+    true
+}
+
+/// Pool the last live block into its left neighbours for as long as they meet (live chunks
+/// `live[lf..]`).
+fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize) {
+    loop {
+        let pi = live[live.len() - 1];
+        let c = &mut chunks[pi];
+        let top = c.pool[c.end - 1];
+        if c.end - c.head >= 2 {
+            let prev = c.pool[c.end - 2];
+            if !meet(&prev, &top) {
+                return;
+            }
+            c.end -= 1;
+            c.pool[c.end - 1] = pool_pair(&prev, &top);
+            c.last_start -= count(prev[1]);
+            c.dirty = true;
+        } else {
+            if live.len() - lf < 2 {
+                return;
+            }
+            let qc = &mut chunks[live[live.len() - 2]];
+            let prev = &mut qc.pool[qc.end - 1];
+            if !meet(prev, &top) {
+                return;
+            }
+            *prev = pool_pair(prev, &top);
+            qc.dirty = true;
+            chunks[pi].end -= 1;
+            live.pop();
+        }
+    }
+}
+
+/// Do blocks `a` (left) and `b` (right), given by end-of-step reduced positions, meet?
+#[inline]
+fn meet(a: &Block, b: &Block) -> bool {
+    b[0] <= a[0]
+}
+
+/// Pool two blocks at their centre of mass (fast-bcd Eq. 6).
+#[inline]
+fn pool_pair(a: &Block, b: &Block) -> Block {
+    let n = a[1] + b[1];
+    [a[0] + (b[0] - a[0]) * (b[1] / n), n]
+}
