@@ -81,29 +81,26 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
         self.length - self.y.len() as f64 * self.sigma
     }
 
-    /// Free velocities `u = mu F + sqrt(2D/dt) xi` (fast-bcd Eq. 3) of rods `[a0, a0 + u.len())`
-    /// within one segment; `noise` and `x` are scratch of the same length.
-    fn free_velocities(&self, a0: usize, u: &mut [f64], noise: &mut [f64], x: &mut [f64]) {
-        let len = u.len();
+    /// Forces `f` on rods `[a0, a0 + f.len())` (external and pair) and their noise deviates
+    /// `xi`, within one segment; `x` is scratch of the same length. The free velocities are
+    /// `u = mu f + sqrt(2D/dt) xi` (fast-bcd Eq. 3).
+    fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64], x: &mut [f64]) {
+        let len = f.len();
         let (sigma, ys) = (self.sigma, &self.y[a0..a0 + len]);
         for (k, (xk, &yk)) in x.iter_mut().zip(ys).enumerate() {
             *xk = yk + (a0 + k) as f64 * sigma;
         }
-        self.ext.force_block(x, 0.0, u);
+        self.ext.force_block(x, 0.0, f);
         let range = self.pair.range();
         if range > sigma {
-            for (k, f) in u.iter_mut().enumerate() {
-                *f += self.pair_force(a0 + k, range);
+            for (k, fk) in f.iter_mut().enumerate() {
+                *fk += self.pair_force(a0 + k, range);
             }
         }
         if self.noise_amp > 0.0 {
-            noise_segment(self.seed, self.step, a0 / SEG, noise);
+            noise_segment(self.seed, self.step, a0 / SEG, xi);
         } else {
-            noise.fill(0.0);
-        }
-        let (mu, amp) = (self.mobility, self.noise_amp);
-        for (f, &g) in u.iter_mut().zip(noise.iter()) {
-            *f = mu * *f + amp * g;
+            xi.fill(0.0);
         }
     }
 
@@ -329,12 +326,14 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     let z = &mut s.z[..len];
     let mut noise = [0.0f64; SEG];
     let mut x = [0.0f64; SEG];
+    let (mu, amp) = (ctx.mobility, ctx.noise_amp);
     for (k, zs) in z.chunks_mut(SEG).enumerate() {
         let a = a0 + k * SEG;
         let m = zs.len();
-        ctx.free_velocities(a, zs, &mut noise[..m], &mut x[..m]);
-        for (zk, &yk) in zs.iter_mut().zip(&ctx.y[a..a + m]) {
-            *zk = (yk - yref) + *zk * dt;
+        ctx.forces(a, zs, &mut noise[..m], &mut x[..m]);
+        let rods = ctx.y[a..a + m].iter().zip(&noise[..m]);
+        for (zk, (&yk, &g)) in zs.iter_mut().zip(rods) {
+            *zk = (yk - yref) + (mu * *zk + amp * g) * dt;
         }
     }
     // Pool in LANES streams over consecutive quarters, interleaved rod by rod.
@@ -420,7 +419,10 @@ fn first_non_finite<E: ExternalForce, P: PairForce>(
     let mut a = a0;
     while a < a1 {
         let m = (a1 - a).min(SEG);
-        ctx.free_velocities(a, &mut u[..m], &mut noise[..m], &mut x[..m]);
+        ctx.forces(a, &mut u[..m], &mut noise[..m], &mut x[..m]);
+        for (uk, &g) in u[..m].iter_mut().zip(&noise[..m]) {
+            *uk = ctx.mobility * *uk + ctx.noise_amp * g;
+        }
         if let Some(k) = u[..m].iter().position(|v| !v.is_finite()) {
             return Some((a + k, u[k]));
         }
