@@ -27,6 +27,10 @@ pub enum Purpose {
     Initial = 1,
     /// Monte Carlo moves and other method-specific draws.
     Moves = 2,
+    /// Thermal noise drawn by [`fill_normal_wide`]: four lock-step lane streams per block.
+    WideNoise = 3,
+    /// The per-particle streams that finish a ziggurat rejection in [`fill_normal_wide`].
+    WideNoiseTail = 4,
 }
 
 /// A keyed random stream: `seed` fixes the run, `step` the time step, `index` the particle
@@ -204,6 +208,140 @@ pub fn fill_normal_block_fast(seed: u32, step: u64, block: u64, out: &mut [f64])
     let mut rng = stream(seed, step, Purpose::Noise, block);
     for x in out.iter_mut() {
         *x = zig.sample(&mut rng);
+    }
+}
+
+/// Particles per wide noise block (see [`fill_normal_wide`]).
+pub const WIDE: usize = 256;
+
+/// Lock-step SFC64 lanes of [`fill_normal_wide`].
+const LANES: usize = 4;
+
+/// [`LANES`] keyed SFC64 streams advanced in lock-step, lane `l` being exactly
+/// `stream(seed, step, purpose, first + l)` (hoomd-rand's SFC64: state
+/// `[step, (purpose << 32) | seed, index]`, counter 0, 12 outputs discarded). The lanes are plain
+/// `[u64; 4]` arithmetic so that LLVM keeps them in vector registers.
+#[derive(Clone)]
+struct Sfc64x4 {
+    a: [u64; LANES],
+    b: [u64; LANES],
+    c: [u64; LANES],
+    /// The Weyl counter, equal in all lanes.
+    counter: u64,
+}
+
+impl Sfc64x4 {
+    #[inline(always)]
+    fn new(seed: u32, step: u64, purpose: Purpose, first: u64) -> Self {
+        let key = (u64::from(purpose as u32) << 32) | u64::from(seed);
+        let mut rng = Self {
+            a: [step; LANES],
+            b: [key; LANES],
+            c: std::array::from_fn(|l| first.wrapping_add(l as u64)),
+            counter: 0,
+        };
+        for _ in 0..12 {
+            rng.next();
+        }
+        rng
+    }
+
+    /// The next output of every lane.
+    #[inline(always)]
+    fn next(&mut self) -> [u64; LANES] {
+        let mut out = [0u64; LANES];
+        for l in 0..LANES {
+            let (a, b, c) = (self.a[l], self.b[l], self.c[l]);
+            out[l] = a.wrapping_add(b).wrapping_add(self.counter);
+            self.a[l] = b ^ (b >> 11);
+            self.b[l] = c.wrapping_add(c << 3);
+            self.c[l] = c.rotate_left(24).wrapping_add(out[l]);
+        }
+        self.counter = self.counter.wrapping_add(1);
+        out
+    }
+}
+
+/// The fast-path uniform of [`fill_normal_wide`]: `u` in [-1, 1) on a 2^-51 grid from bits
+/// 12..64, exactly (the bits become the mantissa of a number in [2, 4); no integer-to-float
+/// conversion, which AVX2 lacks for 64-bit integers).
+#[inline(always)]
+fn wide_uniform(bits: u64) -> f64 {
+    f64::from_bits((bits >> 12) | 0x4000_0000_0000_0000) - 3.0
+}
+
+impl Ziggurat {
+    /// Finish the ziggurat for a fast-path rejection of [`fill_normal_wide`] (strip from bits
+    /// 0..8, `u` from [`wide_uniform`]): the wedge or tail test with the same `u`, further
+    /// uniforms from particle `p`'s own stream `stream(seed, step, WideNoiseTail, p)`.
+    #[cold]
+    #[inline(never)]
+    fn wide_reject(&self, seed: u32, step: u64, p: u64, bits: u64) -> f64 {
+        let mut rng = stream(seed, step, Purpose::WideNoiseTail, p);
+        let i = (bits & (LAYERS as u64 - 1)) as usize;
+        self.sample_slow(&mut rng, i, wide_uniform(bits))
+    }
+}
+
+/// Fill `out[k]` with the standard normal deviate of particle `block * WIDE + k` at `step`
+/// (`out.len() <= WIDE`), by the ziggurat of [`Ziggurat`] on four lock-step streams.
+///
+/// Particle `p = WIDE * b + k` takes draw `k / 4` of lane `l = k % 4`, the stream
+/// `stream(seed, step, Purpose::WideNoise, 4 * b + l)`: each draw of the four lanes gives the
+/// 64 bits of four consecutive particles, bits 0..8 picking the strip and bits 12..64 the
+/// uniform `u` in [-1, 1) of [`wide_uniform`]. About 1.2% of particles fail the fast-path test
+/// `|u| < x_{i+1} / x_i`; they continue the exact ziggurat (wedge, tail, retries) on their own
+/// stream `stream(seed, step, Purpose::WideNoiseTail, p)`, which keeps the lanes in lock-step.
+/// The result is a pure function of `(seed, step, p)`: a block may be filled whole or in
+/// pieces (each piece a prefix of its block) and gives the same numbers.
+#[inline]
+pub fn fill_normal_wide(seed: u32, step: u64, block: u64, out: &mut [f64]) {
+    let zig = Ziggurat::get();
+    fill_wide_with(seed, step, block, out, |p, bits| {
+        zig.wide_reject(seed, step, p, bits)
+    });
+}
+
+/// [`fill_normal_wide`] with the fast-path rejections of particle `p` (64 bits `bits`) finished
+/// by `reject(p, bits)` (the tests swap in broken variants).
+#[inline(always)]
+fn fill_wide_with(
+    seed: u32,
+    step: u64,
+    block: u64,
+    out: &mut [f64],
+    mut reject: impl FnMut(u64, u64) -> f64,
+) {
+    assert!(
+        out.len() <= WIDE,
+        "fill_normal_wide: at most {WIDE} particles"
+    );
+    let zig = Ziggurat::get();
+    let n = out.len();
+    let mut bits = [0u64; WIDE];
+    let mut rng = Sfc64x4::new(
+        seed,
+        step,
+        Purpose::WideNoise,
+        block.wrapping_mul(LANES as u64),
+    );
+    for chunk in bits[..n.div_ceil(LANES) * LANES].chunks_exact_mut(LANES) {
+        chunk.copy_from_slice(&rng.next());
+    }
+    // Fast path for every particle, branch-free.
+    let mut rejected = [false; WIDE];
+    for ((o, r), &b) in out.iter_mut().zip(&mut rejected).zip(&bits) {
+        let [w, k] = zig.strips[(b & (LAYERS as u64 - 1)) as usize];
+        let u = wide_uniform(b);
+        *o = u * w;
+        *r = u.abs() >= k;
+    }
+    // The rare rejections.
+    let first = block.wrapping_mul(WIDE as u64);
+    for (k, o) in out.iter_mut().enumerate() {
+        if rejected[k] {
+            *o = reject(first.wrapping_add(k as u64), bits[k]);
+        }
     }
 }
 
@@ -408,5 +546,139 @@ mod tests {
         fill_normal_block(3, 0, 0, &mut a);
         fill_normal_block_fast(3, 0, 0, &mut b);
         assert_ne!(a, b);
+    }
+
+    /// Raw draws `0..draws` of the four lanes of wide block `block`.
+    fn wide_lane_draws(seed: u32, step: u64, block: u64, draws: usize) -> Vec<[u64; LANES]> {
+        let mut rng = Sfc64x4::new(seed, step, Purpose::WideNoise, block.wrapping_mul(4));
+        (0..draws).map(|_| rng.next()).collect()
+    }
+
+    #[test]
+    fn wide_lanes_are_the_scalar_streams() {
+        for (seed, step, block) in [
+            (0, 0, 0),
+            (7, 3, 1),
+            (u32::MAX, u64::MAX, 12345),
+            (9, 1 << 40, 1 << 61),
+        ] {
+            let lanes = wide_lane_draws(seed, step, block, 100);
+            for l in 0..LANES {
+                let mut rng = stream(seed, step, Purpose::WideNoise, 4 * block + l as u64);
+                for (d, draw) in lanes.iter().enumerate() {
+                    assert_eq!(
+                        draw[l],
+                        rng.next_u64(),
+                        "seed {seed} step {step} block {block} lane {l} draw {d}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Particle `p`'s wide deviate recomputed alone, straight from the definition.
+    fn wide_reference(seed: u32, step: u64, p: u64) -> (f64, bool) {
+        let (b, k) = (p / WIDE as u64, p % WIDE as u64);
+        let mut rng = stream(seed, step, Purpose::WideNoise, 4 * b + k % 4);
+        for _ in 0..k / 4 {
+            rng.next_u64();
+        }
+        let bits = rng.next_u64();
+        let i = (bits & 255) as usize;
+        let u = (bits >> 12) as f64 / (1u64 << 51) as f64 - 1.0;
+        let z = Ziggurat::get();
+        if u.abs() < z.strips[i][1] {
+            (u * z.strips[i][0], false)
+        } else {
+            let mut tail = stream(seed, step, Purpose::WideNoiseTail, p);
+            (z.sample_slow(&mut tail, i, u), true)
+        }
+    }
+
+    #[test]
+    fn wide_blocks_are_pure_functions_of_the_particle() {
+        let (seed, step) = (21, 1_000_003);
+        let (mut slow, mut tail) = (0, 0);
+        for block in (0..48).chain([1 << 20, (1 << 56) - 1]) {
+            let mut whole = [0.0; WIDE];
+            fill_normal_wide(seed, step, block, &mut whole);
+            for (k, &v) in whole.iter().enumerate() {
+                let p = block * WIDE as u64 + k as u64;
+                let (r, rejected) = wide_reference(seed, step, p);
+                assert_eq!(v.to_bits(), r.to_bits(), "block {block} particle {k}");
+                slow += rejected as usize;
+                tail += (rejected && v.abs() > Ziggurat::get().r) as usize;
+            }
+            // Partial fills are prefixes of the block.
+            for m in [0, 1, 3, 4, 5, 63, 128, 255] {
+                let mut part = vec![f64::NAN; m];
+                fill_normal_wide(seed, step, block, &mut part);
+                assert!(
+                    part.iter()
+                        .zip(&whole)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "block {block} prefix {m}"
+                );
+            }
+        }
+        // Both rare paths were exercised (about 1.2% wedges and 0.03% tails expected).
+        assert!(slow > 60 && tail > 0, "{slow} rejections, {tail} tails");
+        // Keys matter.
+        let (mut a, mut b) = ([0.0; WIDE], [0.0; WIDE]);
+        fill_normal_wide(seed, step, 3, &mut a);
+        fill_normal_wide(seed, step + 1, 3, &mut b);
+        assert_ne!(a, b);
+        fill_normal_wide(seed + 1, step, 3, &mut b);
+        assert_ne!(a, b);
+        fill_normal_wide(seed, step, 4, &mut b);
+        assert_ne!(a, b);
+    }
+
+    fn wide_normals(n: usize, seed: u32, reject: &mut dyn FnMut(u64, u64) -> f64) -> Vec<f64> {
+        let mut x = vec![0.0; n];
+        for (b, chunk) in x.chunks_mut(WIDE).enumerate() {
+            fill_wide_with(seed, 5, b as u64, chunk, &mut *reject);
+        }
+        x
+    }
+
+    #[test]
+    fn wide_normals_are_standard_normal() {
+        let z = Ziggurat::get();
+        let n = 1 << 20;
+        for seed in [11, 12] {
+            let exact = wide_normals(n, seed, &mut |p, bits| z.wide_reject(seed, 5, p, bits));
+            let mut public = vec![0.0; n];
+            for (b, chunk) in public.chunks_mut(WIDE).enumerate() {
+                fill_normal_wide(seed, 5, b as u64, chunk);
+            }
+            assert_eq!(exact, public);
+            check_standard_normal(exact).unwrap();
+        }
+    }
+
+    #[test]
+    fn normality_checks_reject_broken_wide_ziggurats() {
+        let z = Ziggurat::get();
+        let n = 1 << 20;
+        let seed = 11;
+        // Fast path only: a rejection retries the fast path on the particle's tail stream.
+        let no_wedges = wide_normals(n, seed, &mut |p, _| {
+            let mut rng = stream(seed, 5, Purpose::WideNoiseTail, p);
+            loop {
+                let bits = rng.next_u64();
+                let (i, u) = ((bits & 255) as usize, wide_uniform(bits));
+                if u.abs() < z.strips[i][1] {
+                    break u * z.strips[i][0];
+                }
+            }
+        });
+        let e = check_standard_normal(no_wedges).unwrap_err();
+        // Rejections kept as fast-path values (no slow path at all).
+        let no_slow = wide_normals(n, seed, &mut |_, bits| {
+            wide_uniform(bits) * z.strips[(bits & 255) as usize][0]
+        });
+        let e2 = check_standard_normal(no_slow).unwrap_err();
+        eprintln!("rejected: {e}; {e2}");
     }
 }
