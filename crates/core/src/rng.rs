@@ -226,6 +226,9 @@ struct Sfc64x4 {
     a: [u64; LANES],
     b: [u64; LANES],
     c: [u64; LANES],
+    /// `c >> 40`, carried along so that `c.rotate_left(24)` is `(c << 24) + h`: LLVM keeps a
+    /// plain 64-bit rotate scalar (AVX2 has no vector rotate), this form it vectorises.
+    h: [u64; LANES],
     /// The Weyl counter, equal in all lanes.
     counter: u64,
 }
@@ -234,10 +237,12 @@ impl Sfc64x4 {
     #[inline(always)]
     fn new(seed: u32, step: u64, purpose: Purpose, first: u64) -> Self {
         let key = (u64::from(purpose as u32) << 32) | u64::from(seed);
+        let c: [u64; LANES] = std::array::from_fn(|l| first.wrapping_add(l as u64));
         let mut rng = Self {
             a: [step; LANES],
             b: [key; LANES],
-            c: std::array::from_fn(|l| first.wrapping_add(l as u64)),
+            c,
+            h: c.map(|c| c >> 40),
             counter: 0,
         };
         for _ in 0..12 {
@@ -255,7 +260,15 @@ impl Sfc64x4 {
             out[l] = a.wrapping_add(b).wrapping_add(self.counter);
             self.a[l] = b ^ (b >> 11);
             self.b[l] = c.wrapping_add(c << 3);
-            self.c[l] = c.rotate_left(24).wrapping_add(out[l]);
+            // c.rotate_left(24) + out: with the high bits carried in `h` when AVX2 can keep
+            // the lanes in vector registers, as a scalar rotate otherwise.
+            let c = if cfg!(target_feature = "avx2") {
+                (c << 24).wrapping_add(self.h[l]).wrapping_add(out[l])
+            } else {
+                c.rotate_left(24).wrapping_add(out[l])
+            };
+            self.c[l] = c;
+            self.h[l] = c >> 40;
         }
         self.counter = self.counter.wrapping_add(1);
         out
@@ -302,6 +315,23 @@ pub fn fill_normal_wide(seed: u32, step: u64, block: u64, out: &mut [f64]) {
     });
 }
 
+/// One draw of the lanes of [`fill_normal_wide`]: the fast-path values of four particles, their
+/// bits, and a mask with bit `l` set where the fast path rejects particle `l`.
+#[inline(always)]
+fn wide_draw(zig: &Ziggurat, rng: &mut Sfc64x4) -> ([f64; LANES], [u64; LANES], u8) {
+    let r = rng.next();
+    let strips: [[f64; 2]; LANES] =
+        std::array::from_fn(|l| zig.strips[(r[l] & (LAYERS as u64 - 1)) as usize]);
+    let mut v = [0.0; LANES];
+    let mut rejected = 0u8;
+    for l in 0..LANES {
+        let u = wide_uniform(r[l]);
+        v[l] = u * strips[l][0];
+        rejected |= u8::from(u.abs() >= strips[l][1]) << l;
+    }
+    (v, r, rejected)
+}
+
 /// [`fill_normal_wide`] with the fast-path rejections of particle `p` (64 bits `bits`) finished
 /// by `reject(p, bits)` (the tests swap in broken variants).
 #[inline(always)]
@@ -318,29 +348,48 @@ fn fill_wide_with(
     );
     let zig = Ziggurat::get();
     let n = out.len();
-    let mut bits = [0u64; WIDE];
     let mut rng = Sfc64x4::new(
         seed,
         step,
         Purpose::WideNoise,
         block.wrapping_mul(LANES as u64),
     );
-    for chunk in bits[..n.div_ceil(LANES) * LANES].chunks_exact_mut(LANES) {
-        chunk.copy_from_slice(&rng.next());
+    // One draw of the lanes gives four particles: the fast path for each, branch-free, and in
+    // `rejected[d]` bit `l` for particle `4 d + l` failing it (bits past `n` stay 0).
+    let mut bits = [0u64; WIDE];
+    let mut rejected = [0u8; WIDE / LANES];
+    let whole = n / LANES;
+    let (head, tail) = out.split_at_mut(whole * LANES);
+    for ((o, b), r) in head
+        .chunks_exact_mut(LANES)
+        .zip(bits.chunks_exact_mut(LANES))
+        .zip(&mut rejected)
+    {
+        let (v, bb, rr) = wide_draw(zig, &mut rng);
+        o.copy_from_slice(&v);
+        b.copy_from_slice(&bb);
+        *r = rr;
     }
-    // Fast path for every particle, branch-free.
-    let mut rejected = [false; WIDE];
-    for ((o, r), &b) in out.iter_mut().zip(&mut rejected).zip(&bits) {
-        let [w, k] = zig.strips[(b & (LAYERS as u64 - 1)) as usize];
-        let u = wide_uniform(b);
-        *o = u * w;
-        *r = u.abs() >= k;
+    if !tail.is_empty() {
+        let (v, bb, rr) = wide_draw(zig, &mut rng);
+        tail.copy_from_slice(&v[..tail.len()]);
+        bits[whole * LANES..(whole + 1) * LANES].copy_from_slice(&bb);
+        rejected[whole] = rr & ((1 << tail.len()) - 1);
     }
-    // The rare rejections.
+    // The rare rejections, found eight draws (32 particles) at a time: bit `t` of word `j`
+    // is particle `4 (8 j + t / 8) + t % 8`.
     let first = block.wrapping_mul(WIDE as u64);
-    for (k, o) in out.iter_mut().enumerate() {
-        if rejected[k] {
-            *o = reject(first.wrapping_add(k as u64), bits[k]);
+    for (j, flags) in rejected
+        .chunks_exact(8)
+        .take(n.div_ceil(8 * LANES))
+        .enumerate()
+    {
+        let mut m = u64::from_le_bytes(flags.try_into().expect("8 draws"));
+        while m != 0 {
+            let t = m.trailing_zeros() as usize;
+            let k = LANES * (8 * j + t / 8) + t % 8;
+            m &= m - 1;
+            out[k] = reject(first.wrapping_add(k as u64), bits[k]);
         }
     }
 }
