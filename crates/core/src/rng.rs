@@ -217,30 +217,33 @@ pub const WIDE: usize = 256;
 /// Lock-step SFC64 lanes of [`fill_normal_wide`].
 const LANES: usize = 4;
 
-/// [`LANES`] keyed SFC64 streams advanced in lock-step, lane `l` being exactly
+/// `N` keyed SFC64 streams advanced in lock-step, lane `l` being exactly
 /// `stream(seed, step, purpose, first + l)` (hoomd-rand's SFC64: state
 /// `[step, (purpose << 32) | seed, index]`, counter 0, 12 outputs discarded). The lanes are plain
-/// `[u64; 4]` arithmetic so that LLVM keeps them in vector registers.
+/// `[u64; N]` arithmetic so that LLVM keeps them in vector registers.
 #[derive(Clone)]
-struct Sfc64x4 {
-    a: [u64; LANES],
-    b: [u64; LANES],
-    c: [u64; LANES],
-    /// `c >> 40`, carried along so that `c.rotate_left(24)` is `(c << 24) + h`: LLVM keeps a
-    /// plain 64-bit rotate scalar (AVX2 has no vector rotate), this form it vectorises.
-    h: [u64; LANES],
+struct SfcLanes<const N: usize> {
+    a: [u64; N],
+    b: [u64; N],
+    c: [u64; N],
+    /// `c >> 40`, carried along so that `c.rotate_left(24)` is `(c << 24) + h` (see
+    /// [`SfcLanes::step`]).
+    h: [u64; N],
     /// The Weyl counter, equal in all lanes.
     counter: u64,
 }
 
-impl Sfc64x4 {
+/// The four lanes of a block of [`fill_normal_wide`].
+type Sfc64x4 = SfcLanes<LANES>;
+
+impl<const N: usize> SfcLanes<N> {
     #[inline(always)]
     fn new(seed: u32, step: u64, purpose: Purpose, first: u64) -> Self {
         let key = (u64::from(purpose as u32) << 32) | u64::from(seed);
-        let c: [u64; LANES] = std::array::from_fn(|l| first.wrapping_add(l as u64));
+        let c: [u64; N] = std::array::from_fn(|l| first.wrapping_add(l as u64));
         let mut rng = Self {
-            a: [step; LANES],
-            b: [key; LANES],
+            a: [step; N],
+            b: [key; N],
             c,
             h: c.map(|c| c >> 40),
             counter: 0,
@@ -251,18 +254,37 @@ impl Sfc64x4 {
         rng
     }
 
+    /// Lanes `M * part ..M * (part + 1)` alone, in their current state.
+    #[inline(always)]
+    fn part<const M: usize>(&self, part: usize) -> SfcLanes<M> {
+        let pick = |x: &[u64; N]| std::array::from_fn(|l| x[M * part + l]);
+        SfcLanes {
+            a: pick(&self.a),
+            b: pick(&self.b),
+            c: pick(&self.c),
+            h: pick(&self.h),
+            counter: self.counter,
+        }
+    }
+
     /// The next output of every lane.
     #[inline(always)]
-    fn next(&mut self) -> [u64; LANES] {
-        let mut out = [0u64; LANES];
-        for l in 0..LANES {
+    fn next(&mut self) -> [u64; N] {
+        self.step::<{ cfg!(target_feature = "avx2") }>()
+    }
+
+    /// The next output of every lane, with `c.rotate_left(24)` computed as `(c << 24) + h` from
+    /// the carried `h = c >> 40` (`CARRY`: LLVM keeps the lanes in AVX2 registers, where a plain
+    /// rotate stays scalar) or as a scalar rotate (without AVX2 the lanes are scalar anyway).
+    #[inline(always)]
+    fn step<const CARRY: bool>(&mut self) -> [u64; N] {
+        let mut out = [0u64; N];
+        for l in 0..N {
             let (a, b, c) = (self.a[l], self.b[l], self.c[l]);
             out[l] = a.wrapping_add(b).wrapping_add(self.counter);
             self.a[l] = b ^ (b >> 11);
             self.b[l] = c.wrapping_add(c << 3);
-            // c.rotate_left(24) + out: with the high bits carried in `h` when AVX2 can keep
-            // the lanes in vector registers, as a scalar rotate otherwise.
-            let c = if cfg!(target_feature = "avx2") {
+            let c = if CARRY {
                 (c << 24).wrapping_add(self.h[l]).wrapping_add(out[l])
             } else {
                 c.rotate_left(24).wrapping_add(out[l])
@@ -310,16 +332,15 @@ impl Ziggurat {
 #[inline]
 pub fn fill_normal_wide(seed: u32, step: u64, block: u64, out: &mut [f64]) {
     let zig = Ziggurat::get();
-    fill_wide_with(seed, step, block, out, |p, bits| {
+    fill_wide_with::<FUSED>(seed, step, block, out, |p, bits| {
         zig.wide_reject(seed, step, p, bits)
     });
 }
 
-/// One draw of the lanes of [`fill_normal_wide`]: the fast-path values of four particles, their
-/// bits, and a mask with bit `l` set where the fast path rejects particle `l`.
+/// The fast path of [`fill_normal_wide`] for the four particles of one draw `r` of the lanes:
+/// their values, and a mask with bit `l` set where particle `l` is rejected.
 #[inline(always)]
-fn wide_draw(zig: &Ziggurat, rng: &mut Sfc64x4) -> ([f64; LANES], [u64; LANES], u8) {
-    let r = rng.next();
+fn wide_fast(zig: &Ziggurat, r: &[u64; LANES]) -> ([f64; LANES], u8) {
     let strips: [[f64; 2]; LANES] =
         std::array::from_fn(|l| zig.strips[(r[l] & (LAYERS as u64 - 1)) as usize]);
     let mut v = [0.0; LANES];
@@ -329,13 +350,17 @@ fn wide_draw(zig: &Ziggurat, rng: &mut Sfc64x4) -> ([f64; LANES], [u64; LANES], 
         v[l] = u * strips[l][0];
         rejected |= u8::from(u.abs() >= strips[l][1]) << l;
     }
-    (v, r, rejected)
+    (v, rejected)
 }
+
+/// Whether [`fill_normal_wide`] draws and transforms in one pass (best where the lanes live in
+/// vector registers) or draws all bits first (fewer live registers for scalar code).
+const FUSED: bool = cfg!(target_feature = "avx2");
 
 /// [`fill_normal_wide`] with the fast-path rejections of particle `p` (64 bits `bits`) finished
 /// by `reject(p, bits)` (the tests swap in broken variants).
 #[inline(always)]
-fn fill_wide_with(
+fn fill_wide_with<const FUSED_PASS: bool>(
     seed: u32,
     step: u64,
     block: u64,
@@ -354,10 +379,21 @@ fn fill_wide_with(
         Purpose::WideNoise,
         block.wrapping_mul(LANES as u64),
     );
-    // One draw of the lanes gives four particles: the fast path for each, branch-free, and in
-    // `rejected[d]` bit `l` for particle `4 d + l` failing it (bits past `n` stay 0).
+    // One draw of the lanes gives the bits of four particles; the fast path for each,
+    // branch-free, sets bit `l` of `rejected[d]` where particle `4 d + l` fails it (bits past
+    // `n` stay 0).
     let mut bits = [0u64; WIDE];
     let mut rejected = [0u8; WIDE / LANES];
+    let draws = n.div_ceil(LANES);
+    if !FUSED_PASS {
+        // Two lanes at a time, so that scalar code keeps the state in registers.
+        for part in 0..LANES / 2 {
+            let mut pair = rng.part::<2>(part);
+            for b in bits[..draws * LANES].chunks_exact_mut(LANES) {
+                b[2 * part..2 * part + 2].copy_from_slice(&pair.next());
+            }
+        }
+    }
     let whole = n / LANES;
     let (head, tail) = out.split_at_mut(whole * LANES);
     for ((o, b), r) in head
@@ -365,15 +401,23 @@ fn fill_wide_with(
         .zip(bits.chunks_exact_mut(LANES))
         .zip(&mut rejected)
     {
-        let (v, bb, rr) = wide_draw(zig, &mut rng);
+        let b: &mut [u64; LANES] = b.try_into().expect("4 lanes");
+        if FUSED_PASS {
+            *b = rng.next();
+        }
+        let (v, rr) = wide_fast(zig, b);
         o.copy_from_slice(&v);
-        b.copy_from_slice(&bb);
         *r = rr;
     }
     if !tail.is_empty() {
-        let (v, bb, rr) = wide_draw(zig, &mut rng);
+        let b: &mut [u64; LANES] = (&mut bits[whole * LANES..draws * LANES])
+            .try_into()
+            .expect("4 lanes");
+        if FUSED_PASS {
+            *b = rng.next();
+        }
+        let (v, rr) = wide_fast(zig, b);
         tail.copy_from_slice(&v[..tail.len()]);
-        bits[whole * LANES..(whole + 1) * LANES].copy_from_slice(&bb);
         rejected[whole] = rr & ((1 << tail.len()) - 1);
     }
     // The rare rejections, found eight draws (32 particles) at a time: bit `t` of word `j`
@@ -597,10 +641,19 @@ mod tests {
         assert_ne!(a, b);
     }
 
-    /// Raw draws `0..draws` of the four lanes of wide block `block`.
+    /// Raw draws `0..draws` of the four lanes of wide block `block`, by both forms of the
+    /// rotate.
     fn wide_lane_draws(seed: u32, step: u64, block: u64, draws: usize) -> Vec<[u64; LANES]> {
         let mut rng = Sfc64x4::new(seed, step, Purpose::WideNoise, block.wrapping_mul(4));
-        (0..draws).map(|_| rng.next()).collect()
+        let mut carry = rng.clone();
+        let mut plain = rng.clone();
+        (0..draws)
+            .map(|_| {
+                let (a, b, c) = (rng.next(), carry.step::<true>(), plain.step::<false>());
+                assert!(a == b && b == c, "the rotate forms differ");
+                a
+            })
+            .collect()
     }
 
     #[test]
@@ -658,8 +711,23 @@ mod tests {
                 slow += rejected as usize;
                 tail += (rejected && v.abs() > Ziggurat::get().r) as usize;
             }
-            // Partial fills are prefixes of the block.
-            for m in [0, 1, 3, 4, 5, 63, 128, 255] {
+            // Partial fills are prefixes of the block, in both loop shapes.
+            for m in [0, 1, 3, 4, 5, 63, 128, 255, 256] {
+                for fused in [false, true] {
+                    let mut part = vec![f64::NAN; m];
+                    let reject = |p, bits| Ziggurat::get().wide_reject(seed, step, p, bits);
+                    if fused {
+                        fill_wide_with::<true>(seed, step, block, &mut part, reject);
+                    } else {
+                        fill_wide_with::<false>(seed, step, block, &mut part, reject);
+                    }
+                    assert!(
+                        part.iter()
+                            .zip(&whole)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "block {block} prefix {m}, fused {fused}"
+                    );
+                }
                 let mut part = vec![f64::NAN; m];
                 fill_normal_wide(seed, step, block, &mut part);
                 assert!(
@@ -686,7 +754,7 @@ mod tests {
     fn wide_normals(n: usize, seed: u32, reject: &mut dyn FnMut(u64, u64) -> f64) -> Vec<f64> {
         let mut x = vec![0.0; n];
         for (b, chunk) in x.chunks_mut(WIDE).enumerate() {
-            fill_wide_with(seed, 5, b as u64, chunk, &mut *reject);
+            fill_wide_with::<FUSED>(seed, 5, b as u64, chunk, &mut *reject);
         }
         x
     }
