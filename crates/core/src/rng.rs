@@ -329,7 +329,11 @@ impl Ziggurat {
 /// stream `stream(seed, step, Purpose::WideNoiseTail, p)`, which keeps the lanes in lock-step.
 /// The result is a pure function of `(seed, step, p)`: a block may be filled whole or in
 /// pieces (each piece a prefix of its block) and gives the same numbers.
-#[inline]
+///
+/// Never inlined: the vectorisation of the lanes depends on LLVM's cost model, and a
+/// stand-alone copy keeps the code measured in `examples/noise_bench.rs` whatever the caller
+/// (the call costs nothing next to 256 deviates).
+#[inline(never)]
 pub fn fill_normal_wide(seed: u32, step: u64, block: u64, out: &mut [f64]) {
     let zig = Ziggurat::get();
     fill_wide_with::<FUSED>(seed, step, block, out, |p, bits| {
