@@ -1,9 +1,9 @@
-//! Time the batched external-force look-up `ForceTable::force_block`: `cargo run --release -p
+//! Time the batched external forces `ForceTable::force_block` and `CosineForce::force_block`: `cargo run --release -p
 //! colloidsim-bcd --example force_bench -- [RODS] [STEPS] [REPEATS]` (default 1e6 rods in
 //! blocks of 256, 20 sweeps, median and minimum of 7 repeats of thread CPU time). The rods sit in order on a ring of 1e6 rod
 //! lengths under a cosine field of period 1 (the table has 1024 cells); the result goes to a
 //! small buffer kept alive by `black_box`, as in the engine.
-use colloidsim_bcd::forces::{ExternalForce, ForceTable};
+use colloidsim_bcd::forces::{CosineForce, ExternalForce, ForceTable};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use std::hint::black_box;
 
@@ -30,6 +30,13 @@ fn main() {
             i as f64 + 0.5 * (state >> 11) as f64 / (1u64 << 53) as f64
         })
         .collect();
+    let cosine = CosineForce::from_field(&field).unwrap();
+    time("ForceTable", &table, &x, steps, repeats);
+    time("CosineForce", &cosine, &x, steps, repeats);
+}
+
+fn time<F: ExternalForce>(name: &str, force: &F, x: &[f64], steps: usize, repeats: usize) {
+    let n = x.len();
     let mut buf = [0.0f64; 256];
     let mut ns: Vec<f64> = (0..repeats + 1)
         .map(|_| {
@@ -38,7 +45,7 @@ fn main() {
                 let offset = if step % 2 == 1 { -(n as f64) } else { 0.0 };
                 for xs in x.chunks(256) {
                     let out = &mut buf[..xs.len()];
-                    table.force_block(black_box(xs), offset, out);
+                    force.force_block(black_box(xs), offset, out);
                     black_box(&mut *out);
                 }
             }
@@ -48,7 +55,7 @@ fn main() {
         .collect();
     ns.sort_by(f64::total_cmp);
     println!(
-        "{n} rods x {steps} sweeps, median (min) of {repeats}: ForceTable::force_block {:.3} ({:.3}) ns/rod (thread CPU time)",
+        "{n} rods x {steps} sweeps, median (min) of {repeats}: {name}::force_block {:.3} ({:.3}) ns/rod (thread CPU time)",
         ns[repeats / 2],
         ns[0]
     );

@@ -19,7 +19,7 @@
 //! thread count, so results are bitwise identical for any number of threads.
 
 use crate::forces::{ExternalForce, PairForce};
-use colloidsim_core::rng::{BLOCK, fill_normal_block_fast};
+use colloidsim_core::rng::{WIDE, fill_normal_wide};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
@@ -33,16 +33,13 @@ const LANES: usize = 4;
 /// masked index needs no bounds check.
 const STACK: usize = 2048;
 const _: () = assert!(STACK > CHUNK / LANES + LANES + 2 && STACK.is_power_of_two());
-const _: () = assert!(CHUNK.is_multiple_of(SEG) && SEG.is_multiple_of(BLOCK));
+const _: () = assert!(CHUNK.is_multiple_of(SEG) && SEG == WIDE);
 
 /// Standard normal deviates of rods `[seg * SEG, seg * SEG + out.len())` at `step` (the noise
 /// of every BCD update, so that all of them see the same numbers).
 #[inline]
 pub(crate) fn noise_segment(seed: u32, step: u64, seg: usize, out: &mut [f64]) {
-    debug_assert!(out.len() <= SEG);
-    for (b, part) in out.chunks_mut(BLOCK).enumerate() {
-        fill_normal_block_fast(seed, step, (seg * (SEG / BLOCK) + b) as u64, part);
-    }
+    fill_normal_wide(seed, step, seg as u64, out);
 }
 
 /// A block of rods that end the step together: `[pos, n]`, `n` rods (an integer) at the

@@ -5,7 +5,7 @@
 //! potential (kT = 1 by default), time in (length unit)^2 / D when mobility = kT = 1.
 
 use crate::engine::{BcdConfig, Boundary, Update};
-use crate::forces::{ForceTable, PairForce, Sticky, TabulatedPair, Yukawa};
+use crate::forces::{CosineForce, ForceTable, PairForce, Sticky, TabulatedPair, Yukawa};
 use crate::init;
 use colloidsim_core::ParamError;
 use colloidsim_core::field1d::{ExternalField, FieldTerm, PeriodicSpline};
@@ -272,10 +272,28 @@ pub struct Trajectory {
 pub enum Field {
     /// No field.
     None,
+    /// Cosine potentials (and a drive), evaluated exactly.
+    Cosine(CosineForce),
     /// Periodic field from a table (exact to 1e-9).
     Table(ForceTable),
     /// Non-periodic field evaluated exactly.
     Exact(ExternalField),
+}
+
+impl Field {
+    /// The fastest exact form of `field`: none, cosines evaluated directly, other periodic
+    /// fields from a table, the rest evaluated term by term.
+    pub fn new(field: &ExternalField) -> Self {
+        if field.is_zero() {
+            Field::None
+        } else if let Some(c) = CosineForce::from_field(field) {
+            Field::Cosine(c)
+        } else if let Some(t) = ForceTable::from_field(field) {
+            Field::Table(t)
+        } else {
+            Field::Exact(field.clone())
+        }
+    }
 }
 
 impl crate::forces::ExternalForce for Field {
@@ -283,6 +301,7 @@ impl crate::forces::ExternalForce for Field {
     fn force(&self, x: f64) -> f64 {
         match self {
             Field::None => 0.0,
+            Field::Cosine(c) => c.force(x),
             Field::Table(t) => t.force(x),
             Field::Exact(f) => f.force(x),
         }
@@ -293,6 +312,7 @@ impl crate::forces::ExternalForce for Field {
     fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
         match self {
             Field::None => out.fill(0.0),
+            Field::Cosine(c) => c.force_block(x, offset, out),
             Field::Table(t) => t.force_block(x, offset, out),
             Field::Exact(f) => f.force_block(x, offset, out),
         }
@@ -399,13 +419,7 @@ impl Scenario {
                 ));
             }
         }
-        let engine_field = if field.is_zero() {
-            Field::None
-        } else if let Some(t) = ForceTable::from_field(&field) {
-            Field::Table(t)
-        } else {
-            Field::Exact(field.clone())
-        };
+        let engine_field = Field::new(&field);
 
         let pair = self.pair(base, s.diameter, s.kt)?;
         if let Some(st) = &pair.sticky {

@@ -126,7 +126,7 @@ fn density_in_cosine_potential_matches_exact_theory() {
         sigma: 0.5,
         rho: 0.5,
         gamma: None,
-        length: 100.0,
+        length: 400.0,
         dt: 1e-4,
         bins: 20,
         equilibrate_steps: 20_000,

@@ -3,7 +3,7 @@
 use crate::common::{RunOptions, progress};
 use crate::plot::{Scale, Series, line_plot};
 use anyhow::{Context, Result, bail};
-use colloidsim_bcd::forces::{ForceTable, NoField, NoPair};
+use colloidsim_bcd::forces::{NoField, NoPair};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
 use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
 use colloidsim_bcd::{Bcd, BcdConfig, BcdState, Boundary, Update, init};
@@ -695,7 +695,8 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         }],
         drive: 0.0,
     };
-    let table = ForceTable::from_field(&field).expect("periodic");
+    // The force as `colloidsim run` evaluates this field.
+    let force = Field::new(&field);
     println!(
         "# colloidsim bench bcd: sigma = 0.99, U0 = 6 kT, rho = 1, dt = 1e-3, periodic; {} threads, median of {}",
         rayon::current_num_threads(),
@@ -719,7 +720,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         let x0 = init::lattice(&cfg, n)?;
         for rep in 0..a.repeats.max(1) {
             let before = rss_bytes();
-            let mut b = Bcd::new(cfg.clone(), x0.clone(), table.clone(), NoPair)?;
+            let mut b = Bcd::new(cfg.clone(), x0.clone(), force.clone(), NoPair)?;
             b.run(steps.min(50))?; // warm-up: clusters form, buffers reach their size
             let t = Instant::now();
             b.run(steps)?;
