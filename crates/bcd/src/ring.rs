@@ -382,10 +382,12 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     // overwrites the excess.
     const FILL: usize = 8;
     let mut finite = true;
-    let mut at = 0;
     for b in pool.iter_mut() {
         b[0] = yref + b[0] / b[1];
         finite &= b[0].is_finite();
+    }
+    let mut at = 0;
+    for b in pool.iter() {
         let m = count(b[1]);
         if m <= FILL && at + FILL <= len {
             out[at..at + FILL].copy_from_slice(&[b[0]; FILL]);
