@@ -7,6 +7,18 @@
 use colloidsim_core::ParamError;
 use colloidsim_core::field1d::ExternalField;
 
+/// 0, 1, ..., 63 as floats: rod indices `i0 + IOTA[k]` without a per-rod integer conversion
+/// (exact below 2^53).
+const IOTA: [f64; 64] = {
+    let mut a = [0.0; 64];
+    let mut k = 0;
+    while k < 64 {
+        a[k] = k as f64;
+        k += 1;
+    }
+    a
+};
+
 /// A one-body force f(x) (energy/length). Implemented for closures `Fn(f64) -> f64`.
 pub trait ExternalForce: Sync {
     /// Force at position `x` (unwrapped coordinates).
@@ -18,6 +30,22 @@ pub trait ExternalForce: Sync {
     fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
         for (o, &xk) in out.iter_mut().zip(x) {
             *o = self.force(xk + offset);
+        }
+    }
+
+    /// `out[k] = force(y[k] + (first + k) sigma)`: the forces on rods `first, first + 1, ...`
+    /// from their reduced positions `y_i = x_i - i sigma` (the ring update's inner loop). The
+    /// default forms the positions and calls [`force_block`](Self::force_block).
+    #[inline]
+    fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
+        let mut x = [0.0f64; 64];
+        for (c, (ys, os)) in y.chunks(64).zip(out.chunks_mut(64)).enumerate() {
+            let x = &mut x[..ys.len()];
+            let i0 = (first + 64 * c) as f64;
+            for ((xk, &yk), &i) in x.iter_mut().zip(ys).zip(&IOTA) {
+                *xk = yk + (i0 + i) * sigma;
+            }
+            self.force_block(x, 0.0, os);
         }
     }
 }
@@ -268,10 +296,14 @@ fn sin_reduced(w: f64) -> f64 {
     let w4 = w2 * w2;
     let w8 = w4 * w4;
     let w16 = w8 * w8;
-    let a = [0, 2, 4, 6, 8].map(|i| c[i + 1].mul_add(w2, c[i]));
-    let b0 = a[1].mul_add(w4, a[0]);
-    let b1 = a[3].mul_add(w4, a[2]);
-    w * a[4].mul_add(w16, b1.mul_add(w8, b0))
+    let a0 = c[1].mul_add(w2, c[0]);
+    let a1 = c[3].mul_add(w2, c[2]);
+    let a2 = c[5].mul_add(w2, c[4]);
+    let a3 = c[7].mul_add(w2, c[6]);
+    let a4 = c[9].mul_add(w2, c[8]);
+    let b0 = a1.mul_add(w4, a0);
+    let b1 = a3.mul_add(w4, a2);
+    w * a4.mul_add(w16, b1.mul_add(w8, b0))
 }
 
 impl CosineForce {
@@ -332,16 +364,14 @@ impl ExternalForce for CosineForce {
         let mut far = false;
         for (xs, os) in x.chunks(64).zip(out.chunks_mut(64)) {
             os.fill(self.drive);
-            let w = &mut w[..xs.len()];
+            let w = &mut w[..os.len()];
             for &[k, a] in &self.terms {
                 for (wk, &xk) in w.iter_mut().zip(xs) {
                     let u = (xk + offset) * k;
                     far |= !reducible(u);
                     *wk = sin_turns_arg(u);
                 }
-                for (o, &wk) in os.iter_mut().zip(w.iter()) {
-                    *o += a * sin_reduced(wk);
-                }
+                add_sines(os, w, a);
             }
         }
         if far {
@@ -349,6 +379,38 @@ impl ExternalForce for CosineForce {
                 *o = self.force(xk + offset);
             }
         }
+    }
+
+    fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
+        let mut w = [0.0f64; 64];
+        let mut far = false;
+        for (c, (ys, os)) in y.chunks(64).zip(out.chunks_mut(64)).enumerate() {
+            os.fill(self.drive);
+            let w = &mut w[..os.len()];
+            let i0 = (first + 64 * c) as f64;
+            for &[k, a] in &self.terms {
+                for ((wk, &yk), &i) in w.iter_mut().zip(ys).zip(&IOTA) {
+                    // (i0 + i) is exact: the same index as (first + 64 c + i) as f64.
+                    let u = (yk + (i0 + i) * sigma) * k;
+                    far |= !reducible(u);
+                    *wk = sin_turns_arg(u);
+                }
+                add_sines(os, w, a);
+            }
+        }
+        if far {
+            for (i, (o, &yk)) in out.iter_mut().zip(y).enumerate() {
+                *o = self.force(yk + (first + i) as f64 * sigma);
+            }
+        }
+    }
+}
+
+/// `out[k] += a sin(w[k])` for reduced arguments `w` (see [`sin_reduced`]).
+#[inline(always)]
+fn add_sines(out: &mut [f64], w: &[f64], a: f64) {
+    for (o, &wk) in out.iter_mut().zip(w) {
+        *o += a * sin_reduced(wk);
     }
 }
 
@@ -772,6 +834,23 @@ mod tests {
                 c.force(x).to_bits(),
                 "block and single differ at {x}"
             );
+        }
+        // From reduced positions: the force at y_k + (first + k) sigma, bit for bit, for the
+        // cosine field and for the default implementation (the table).
+        let (first, sigma) = (999_937, 0.99);
+        let y: Vec<f64> = (0..300).map(|k| -9.9e3 + 0.37 * (k as f64).sin()).collect();
+        let one = ExternalField {
+            terms: field.terms[..1].to_vec(),
+            drive: 0.3,
+        };
+        let table = ForceTable::from_field(&one).unwrap();
+        let mut tout = vec![0.0; y.len()];
+        c.force_block_reduced(&y, first, sigma, &mut out[..y.len()]);
+        table.force_block_reduced(&y, first, sigma, &mut tout);
+        for (k, &yk) in y.iter().enumerate() {
+            let x = yk + (first + k) as f64 * sigma;
+            assert_eq!(out[k].to_bits(), c.force(x).to_bits(), "cosine, rod {k}");
+            assert_eq!(tout[k].to_bits(), table.force(x).to_bits(), "table, rod {k}");
         }
         // A field with other terms is not a cosine field.
         let mut other = field.clone();

@@ -79,15 +79,12 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
     }
 
     /// Forces `f` on rods `[a0, a0 + f.len())` (external and pair) and their noise deviates
-    /// `xi`, within one segment; `x` is scratch of the same length. The free velocities are
+    /// `xi`, within one segment. The free velocities are
     /// `u = mu f + sqrt(2D/dt) xi` (fast-bcd Eq. 3).
-    fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64], x: &mut [f64]) {
-        let len = f.len();
-        let (sigma, ys) = (self.sigma, &self.y[a0..a0 + len]);
-        for (k, (xk, &yk)) in x.iter_mut().zip(ys).enumerate() {
-            *xk = yk + (a0 + k) as f64 * sigma;
-        }
-        self.ext.force_block(x, 0.0, f);
+    fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64]) {
+        let (sigma, len) = (self.sigma, f.len());
+        self.ext
+            .force_block_reduced(&self.y[a0..a0 + len], a0, sigma, f);
         let range = self.pair.range();
         if range > sigma {
             for (k, fk) in f.iter_mut().enumerate() {
@@ -322,12 +319,11 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     // Free end-of-step reduced positions relative to the chunk's first rod.
     let z = &mut s.z[..len];
     let mut noise = [0.0f64; SEG];
-    let mut x = [0.0f64; SEG];
     let (mu, amp) = (ctx.mobility, ctx.noise_amp);
     for (k, zs) in z.chunks_mut(SEG).enumerate() {
         let a = a0 + k * SEG;
         let m = zs.len();
-        ctx.forces(a, zs, &mut noise[..m], &mut x[..m]);
+        ctx.forces(a, zs, &mut noise[..m]);
         let rods = ctx.y[a..a + m].iter().zip(&noise[..m]);
         for (zk, (&yk, &g)) in zs.iter_mut().zip(rods) {
             *zk = (yk - yref) + (mu * *zk + amp * g) * dt;
@@ -414,11 +410,10 @@ fn first_non_finite<E: ExternalForce, P: PairForce>(
 ) -> Option<(usize, f64)> {
     let mut u = [0.0f64; SEG];
     let mut noise = [0.0f64; SEG];
-    let mut x = [0.0f64; SEG];
     let mut a = a0;
     while a < a1 {
         let m = (a1 - a).min(SEG);
-        ctx.forces(a, &mut u[..m], &mut noise[..m], &mut x[..m]);
+        ctx.forces(a, &mut u[..m], &mut noise[..m]);
         for (uk, &g) in u[..m].iter_mut().zip(&noise[..m]) {
             *uk = ctx.mobility * *uk + ctx.noise_amp * g;
         }

@@ -317,6 +317,16 @@ impl crate::forces::ExternalForce for Field {
             Field::Exact(f) => f.force_block(x, offset, out),
         }
     }
+
+    #[inline]
+    fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
+        match self {
+            Field::None => out.fill(0.0),
+            Field::Cosine(c) => c.force_block_reduced(y, first, sigma, out),
+            Field::Table(t) => t.force_block_reduced(y, first, sigma, out),
+            Field::Exact(f) => f.force_block_reduced(y, first, sigma, out),
+        }
+    }
 }
 
 /// Pair force as the engine sees it: any combination of the specified terms.
