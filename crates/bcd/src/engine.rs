@@ -142,7 +142,7 @@ pub struct BcdState {
     /// The premerged ring update's own coordinates, `y_i = x_i - i sigma` with the rods of a
     /// cluster sharing one value bit for bit (empty for the other updates). A restart uses them
     /// so that it continues bitwise; `x` is derived from them.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[serde(default)]
     pub reduced: Vec<f64>,
 }
 
@@ -206,6 +206,7 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
     /// coordinates, and `state.x`/`state.bond` are then derived on demand into `view`.
     ring: Option<RingStep>,
     view: OnceLock<BcdState>,
+    positions: OnceLock<Vec<f64>>,
 }
 
 impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
@@ -279,6 +280,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             noise_amp,
             ring,
             view: OnceLock::new(),
+            positions: OnceLock::new(),
         })
     }
 
@@ -296,21 +298,25 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     }
     /// Unwrapped rod centres in ring order.
     pub fn positions(&self) -> &[f64] {
-        &self.state().x
+        match &self.ring {
+            None => &self.state.x,
+            Some(r) => self.positions.get_or_init(|| {
+                let sigma = self.cfg.sigma;
+                r.y.iter()
+                    .enumerate()
+                    .map(|(i, &yi)| yi + i as f64 * sigma)
+                    .collect()
+            }),
+        }
     }
     /// The dynamic state (for checkpoints).
     pub fn state(&self) -> &BcdState {
         match &self.ring {
             None => &self.state,
             Some(r) => self.view.get_or_init(|| {
-                let sigma = self.cfg.sigma;
                 let y = &r.y;
                 let n = y.len();
-                let x = y
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &yi)| yi + i as f64 * sigma)
-                    .collect();
+                let x = self.positions().to_vec();
                 let mut bond: Vec<u8> = y.windows(2).map(|w| u8::from(w[0] == w[1])).collect();
                 bond.push(u8::from(r.seam));
                 BcdState {
@@ -378,6 +384,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 });
             }
             self.view = OnceLock::new();
+            self.positions = OnceLock::new();
             self.state.step += 1;
             return Ok(());
         }

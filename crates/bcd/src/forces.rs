@@ -850,7 +850,11 @@ mod tests {
         for (k, &yk) in y.iter().enumerate() {
             let x = yk + (first + k) as f64 * sigma;
             assert_eq!(out[k].to_bits(), c.force(x).to_bits(), "cosine, rod {k}");
-            assert_eq!(tout[k].to_bits(), table.force(x).to_bits(), "table, rod {k}");
+            assert_eq!(
+                tout[k].to_bits(),
+                table.force(x).to_bits(),
+                "table, rod {k}"
+            );
         }
         // A field with other terms is not a cosine field.
         let mut other = field.clone();
