@@ -5,6 +5,7 @@
 //! small buffer kept alive by `black_box`, as in the engine.
 use colloidsim_bcd::forces::{CosineForce, ExternalForce, ForceTable};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
+use colloidsim_core::timing::thread_cpu_seconds;
 use std::hint::black_box;
 
 fn main() {
@@ -40,7 +41,7 @@ fn time<F: ExternalForce>(name: &str, force: &F, x: &[f64], steps: usize, repeat
     let mut buf = [0.0f64; 256];
     let mut ns: Vec<f64> = (0..repeats + 1)
         .map(|_| {
-            let t = cpu_seconds();
+            let t = thread_cpu_seconds();
             for step in 0..steps {
                 let offset = if step % 2 == 1 { -(n as f64) } else { 0.0 };
                 for xs in x.chunks(256) {
@@ -49,7 +50,7 @@ fn time<F: ExternalForce>(name: &str, force: &F, x: &[f64], steps: usize, repeat
                     black_box(&mut *out);
                 }
             }
-            (cpu_seconds() - t) * 1e9 / (n * steps) as f64
+            (thread_cpu_seconds() - t) * 1e9 / (n * steps) as f64
         })
         .skip(1)
         .collect();
@@ -59,13 +60,4 @@ fn time<F: ExternalForce>(name: &str, force: &F, x: &[f64], steps: usize, repeat
         ns[repeats / 2],
         ns[0]
     );
-}
-
-/// CPU time of this thread in seconds (`/proc/thread-self/schedstat`, Linux), so that time the
-/// scheduler gives to other processes on a shared machine does not count; falls back to 0.
-fn cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(0.0, |ns| ns * 1e-9)
 }

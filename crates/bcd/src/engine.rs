@@ -16,7 +16,7 @@
 
 use crate::cluster::{Cluster, Hull, Wall, collide, merge, premerge};
 use crate::forces::{ExternalForce, PairForce};
-use crate::ring::{RingStep, SEG, noise_segment};
+use crate::ring::{Motion, RingStep, SEG, noise_segment};
 use colloidsim_core::ParamError;
 use colloidsim_core::param;
 use rayon::prelude::*;
@@ -592,12 +592,7 @@ struct StepCtx<'a, E, P> {
     ring: &'a Ring<'a>,
     ext: &'a E,
     pair: &'a P,
-    mobility: f64,
-    noise_amp: f64,
-    seed: u32,
-    step: u64,
-    sigma: f64,
-    dt: f64,
+    m: Motion,
     left_wall: bool,
     right_wall: bool,
     premerge: bool,
@@ -619,12 +614,7 @@ impl<'a, E, P> StepCtx<'a, E, P> {
             ring,
             ext,
             pair,
-            mobility: cfg.mobility,
-            noise_amp,
-            seed: cfg.seed,
-            step,
-            sigma: cfg.sigma,
-            dt: cfg.dt,
+            m: Motion::new(cfg, noise_amp, step),
             left_wall: walls[0],
             right_wall: walls[1],
             premerge,
@@ -642,7 +632,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
     let ring = ctx.ring;
     let n = ring.n;
     let range = ctx.pair.range();
-    let has_pair = range > ctx.sigma;
+    let has_pair = range > ctx.m.sigma;
     let mut noise_block = usize::MAX;
     let mut noise = [0.0f64; SEG];
     let (stack, hull) = (&mut c.stack, &mut c.hull);
@@ -663,15 +653,15 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
             if has_pair {
                 f += pair_force(ring, ctx.pair, a, vw, xi, range);
             }
-            let mut u = ctx.mobility * f;
-            if ctx.noise_amp > 0.0 {
+            let mut u = ctx.m.mobility * f;
+            if ctx.m.noise_amp > 0.0 {
                 let b = a / SEG;
                 if b != noise_block {
                     noise_block = b;
                     let m = SEG.min(n - b * SEG);
-                    noise_segment(ctx.seed, ctx.step, b, &mut noise[..m]);
+                    noise_segment(ctx.m.seed, ctx.m.step, b, &mut noise[..m]);
                 }
-                u += ctx.noise_amp * noise[a % SEG];
+                u += ctx.m.noise_amp * noise[a % SEG];
             }
             if !u.is_finite() {
                 c.bad = Some((a, u));
@@ -687,7 +677,7 @@ fn chunk_phase<E: ExternalForce, P: PairForce>(c: &mut Chunk, ctx: &StepCtx<E, P
                 hull.finish(rw, |cl| {
                     // A fragment stuck to the left wall joins the wall in the sequential pass.
                     if ctx.premerge && cl.wall != Wall::Left {
-                        premerge(stack, cl, ctx.sigma, ctx.dt);
+                        premerge(stack, cl, ctx.m.sigma, ctx.m.dt);
                     } else {
                         stack.push(cl);
                     }

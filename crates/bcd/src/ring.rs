@@ -55,12 +55,9 @@ fn count(n: f64) -> usize {
     ((n + TWO52).to_bits() & ((1u64 << 52) - 1)) as usize
 }
 
-/// What every chunk of a step reads.
-pub(crate) struct RingCtx<'a, E, P> {
-    /// Reduced positions at the start of the step.
-    pub y: &'a [f64],
-    pub ext: &'a E,
-    pub pair: &'a P,
+/// What a step of any update reads from the configuration besides the forces.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Motion {
     pub mobility: f64,
     /// Noise amplitude `sqrt(2 D / dt)`.
     pub noise_amp: f64,
@@ -68,21 +65,44 @@ pub(crate) struct RingCtx<'a, E, P> {
     pub step: u64,
     pub sigma: f64,
     pub dt: f64,
-    /// Ring length L.
+    /// Ring length (or wall distance) L.
     pub length: f64,
+}
+
+impl Motion {
+    pub fn new(cfg: &crate::engine::BcdConfig, noise_amp: f64, step: u64) -> Self {
+        Self {
+            mobility: cfg.mobility,
+            noise_amp,
+            seed: cfg.seed,
+            step,
+            sigma: cfg.sigma,
+            dt: cfg.dt,
+            length: cfg.length,
+        }
+    }
+}
+
+/// What every chunk of a ring step reads.
+pub(crate) struct RingCtx<'a, E, P> {
+    /// Reduced positions at the start of the step.
+    pub y: &'a [f64],
+    pub ext: &'a E,
+    pub pair: &'a P,
+    pub m: Motion,
 }
 
 impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
     /// Reduced period `L - N sigma`: rod `a` one period on sits at `y_a + L - N sigma`.
     fn reduced_period(&self) -> f64 {
-        self.length - self.y.len() as f64 * self.sigma
+        self.m.length - self.y.len() as f64 * self.m.sigma
     }
 
     /// Forces `f` on rods `[a0, a0 + f.len())` (external and pair) and their noise deviates
     /// `xi`, within one segment. The free velocities are
     /// `u = mu f + sqrt(2D/dt) xi` (fast-bcd Eq. 3).
     fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64]) {
-        let (sigma, len) = (self.sigma, f.len());
+        let (sigma, len) = (self.m.sigma, f.len());
         self.ext
             .force_block_reduced(&self.y[a0..a0 + len], a0, sigma, f);
         let range = self.pair.range();
@@ -91,8 +111,8 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
                 *fk += self.pair_force(a0 + k, range);
             }
         }
-        if self.noise_amp > 0.0 {
-            noise_segment(self.seed, self.step, a0 / SEG, xi);
+        if self.m.noise_amp > 0.0 {
+            noise_segment(self.m.seed, self.m.step, a0 / SEG, xi);
         } else {
             xi.fill(0.0);
         }
@@ -101,7 +121,7 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
     /// Pair force on rod `a` from its neighbours within `range` (centre distances
     /// `r = y_b - y_a + (b - a) sigma`, across the seam with the reduced period).
     fn pair_force(&self, a: usize, range: f64) -> f64 {
-        let (y, n, sigma) = (self.y, self.y.len(), self.sigma);
+        let (y, n, sigma) = (self.y, self.y.len(), self.m.sigma);
         let lred = self.reduced_period();
         let mut f = 0.0;
         // Right neighbours push rod a to the left, left neighbours to the right.
@@ -217,13 +237,7 @@ impl RingStep {
             y: &self.y,
             ext,
             pair,
-            mobility: cfg.mobility,
-            noise_amp,
-            seed: cfg.seed,
-            step,
-            sigma: cfg.sigma,
-            dt: cfg.dt,
-            length: cfg.length,
+            m: Motion::new(cfg, noise_amp, step),
         };
         let scratch = &self.scratch;
         self.chunks
@@ -315,11 +329,11 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     let (a0, a1) = (c.a0, c.a1);
     let len = a1 - a0;
     let yref = ctx.y[a0];
-    let dt = ctx.dt;
+    let dt = ctx.m.dt;
     // Free end-of-step reduced positions relative to the chunk's first rod.
     let z = &mut s.z[..len];
     let mut noise = [0.0f64; SEG];
-    let (mu, amp) = (ctx.mobility, ctx.noise_amp);
+    let (mu, amp) = (ctx.m.mobility, ctx.m.noise_amp);
     for (k, zs) in z.chunks_mut(SEG).enumerate() {
         let a = a0 + k * SEG;
         let m = zs.len();
@@ -415,7 +429,7 @@ fn first_non_finite<E: ExternalForce, P: PairForce>(
         let m = (a1 - a).min(SEG);
         ctx.forces(a, &mut u[..m], &mut noise[..m]);
         for (uk, &g) in u[..m].iter_mut().zip(&noise[..m]) {
-            *uk = ctx.mobility * *uk + ctx.noise_amp * g;
+            *uk = ctx.m.mobility * *uk + ctx.m.noise_amp * g;
         }
         if let Some(k) = u[..m].iter().position(|v| !v.is_finite()) {
             return Some((a + k, u[k]));

@@ -3,6 +3,7 @@
 //! 11 repeats of thread CPU time; the kernels alternate so that both see the same machine load). Each block is
 //! drawn into a small buffer that stays in L1, as in the engines; `black_box` keeps it alive.
 use colloidsim_core::rng::{BLOCK, WIDE, fill_normal_block_fast, fill_normal_wide};
+use colloidsim_core::timing::thread_cpu_seconds;
 use std::hint::black_box;
 
 type Fill = fn(u32, u64, u64, &mut [f64]);
@@ -11,7 +12,7 @@ type Fill = fn(u32, u64, u64, &mut [f64]);
 /// of `block` by `fill`.
 fn time(n: usize, steps: u64, block: usize, fill: Fill) -> f64 {
     let mut buf = vec![0.0f64; block];
-    let t = cpu_seconds();
+    let t = thread_cpu_seconds();
     for step in 0..steps {
         for (b, lo) in (0..n).step_by(block).enumerate() {
             let m = block.min(n - lo);
@@ -19,7 +20,7 @@ fn time(n: usize, steps: u64, block: usize, fill: Fill) -> f64 {
             black_box(&mut buf);
         }
     }
-    (cpu_seconds() - t) * 1e9 / (n as f64 * steps as f64)
+    (thread_cpu_seconds() - t) * 1e9 / (n as f64 * steps as f64)
 }
 
 fn main() {
@@ -48,13 +49,4 @@ fn main() {
             t[0]
         );
     }
-}
-
-/// CPU time of this thread in seconds (`/proc/thread-self/schedstat`, Linux), so that time the
-/// scheduler gives to other processes on a shared machine does not count; falls back to 0.
-fn cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(0.0, |ns| ns * 1e-9)
 }

@@ -9,6 +9,7 @@ pub mod field1d;
 pub mod output;
 pub mod param;
 pub mod rng;
+pub mod timing;
 pub mod trigger;
 
 pub use param::ParamError;
