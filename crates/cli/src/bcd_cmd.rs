@@ -64,6 +64,12 @@ fn resolved_json(sc: &Scenario, r: &Resolved) -> serde_json::Value {
         },
         "observe": sc.observe,
         "profile_period": r.period,
+        "external_force": match &r.engine_field {
+            Field::None => "none",
+            Field::Cosine(_) => "exact cosine (vectorised sine)",
+            Field::Table(_) => "cubic Hermite table (error < 1e-9 of the largest force)",
+            Field::Exact(_) => "exact, term by term",
+        },
         "external_force_table_spacing": match &r.engine_field {
             Field::Table(t) => Some(t.spacing()),
             _ => None,
