@@ -176,9 +176,8 @@ struct Chunk {
     pool: Vec<Block>,
     head: usize,
     end: usize,
-    /// First rods of `pool[head]` and of `pool[end - 1]` (virtual indices: the last block may
-    /// reach past N after the seam is stitched).
-    head_start: usize,
+    /// First rod of `pool[end - 1]` (its rods may reach past N, i.e. round the seam, after the
+    /// stitch).
     last_start: usize,
     /// The last live block grew in the stitch: its rods must be rewritten.
     dirty: bool,
@@ -408,7 +407,6 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     }
     c.head = 0;
     c.end = pool.len();
-    c.head_start = a0;
     c.last_start = a1 - pool.last().map_or(0, |b| count(b[1]));
     if !finite || at != len {
         c.bad = first_non_finite(a0, a1, ctx);
@@ -455,7 +453,7 @@ fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
             if !absorb(&mut chunks[pi], &first) {
                 break;
             }
-            chunks[ci].pop_head();
+            chunks[ci].head += 1;
             cascade(chunks, live, 0);
         }
         if chunks[ci].head < chunks[ci].end {
@@ -473,19 +471,11 @@ fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
         if !absorb(&mut chunks[li], &[pos + lred, cnt]) {
             break;
         }
-        chunks[fi].pop_head();
+        chunks[fi].head += 1;
         if chunks[fi].head == chunks[fi].end {
             lf += 1;
         }
         cascade(chunks, live, lf);
-    }
-}
-
-impl Chunk {
-    /// Drop the first live block (it was pooled into the previous chunk's last one).
-    fn pop_head(&mut self) {
-        self.head_start += count(self.pool[self.head][1]);
-        self.head += 1;
     }
 }
 
