@@ -263,3 +263,29 @@ fn clusters_longer_than_a_chunk_equal_chronological() {
     }
     assert!(biggest > CHUNK + CHUNK / 2, "largest cluster {biggest}");
 }
+
+/// A checkpointed ring state whose reduced coordinates do not match its positions is refused,
+/// naming the rod; one without them (an older or hand-made state) is accepted.
+#[test]
+fn inconsistent_reduced_positions_are_refused() {
+    let cfg = config(60.0, 1.0, 1e-3, Boundary::Periodic, Update::Premerge);
+    let x = init::random(&cfg, 40, 9).unwrap();
+    let mut a = Bcd::new(cfg.clone(), x, NoField, NoPair).unwrap();
+    a.run(20).unwrap();
+    let good = a.state().clone();
+    assert_eq!(good.reduced.len(), 40);
+    let mut bad = good.clone();
+    bad.reduced[17] += 0.3;
+    match Bcd::from_state(cfg.clone(), bad, NoField, NoPair) {
+        Err(BcdError::Positions(m)) => assert!(m.contains("17"), "{m}"),
+        Err(e) => panic!("wrong error {e}"),
+        Ok(_) => panic!("inconsistent reduced positions accepted"),
+    }
+    let mut plain = good.clone();
+    plain.reduced.clear();
+    let b = Bcd::from_state(cfg, plain, NoField, NoPair).unwrap();
+    for (p, q) in a.positions().iter().zip(b.positions()) {
+        assert!((p - q).abs() < 1e-12 * 60.0, "{p} vs {q}");
+    }
+    assert_eq!(a.state().bond, b.state().bond);
+}
