@@ -259,12 +259,12 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         let mut state = state;
         let ring = if cfg.boundary == Boundary::Periodic && cfg.update == Update::Premerge {
             let y = reduced_positions(&cfg, &state)?;
-            state.reduced = Vec::new();
             Some(RingStep::new(y, n > 1 && state.bond[n - 1] != 0))
         } else {
-            state.reduced = Vec::new();
             None
         };
+        // The engine's own copy lives in the ring step; the stored state never holds it.
+        state.reduced = Vec::new();
         let chunks = if ring.is_some() {
             Vec::new()
         } else {
@@ -315,7 +315,6 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             None => &self.state,
             Some(r) => self.view.get_or_init(|| {
                 let y = &r.y;
-                let n = y.len();
                 let x = self.positions().to_vec();
                 let mut bond: Vec<u8> = y.windows(2).map(|w| u8::from(w[0] == w[1])).collect();
                 bond.push(u8::from(r.seam));
@@ -325,7 +324,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                     left_contact: false,
                     right_contact: false,
                     step: self.state.step,
-                    reduced: if n > 0 { y.clone() } else { Vec::new() },
+                    reduced: y.clone(),
                 }
             }),
         }
