@@ -15,6 +15,9 @@ pub mod engine;
 pub mod forces;
 pub mod init;
 pub mod observe;
+mod pava;
+#[doc(hidden)]
+pub use pava::PoolBench;
 mod ring;
 pub mod scenario;
 

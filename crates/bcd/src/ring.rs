@@ -19,6 +19,7 @@
 //! thread count, so results are bitwise identical for any number of threads.
 
 use crate::forces::{ExternalForce, PairForce};
+use crate::pava::{self, Block, LANES, STACK};
 use colloidsim_core::rng::{WIDE, fill_normal_wide};
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -27,12 +28,7 @@ use std::sync::Mutex;
 pub const CHUNK: usize = 4096;
 /// Rods per noise and force segment.
 pub const SEG: usize = 256;
-/// Interleaved pooling streams per chunk.
-const LANES: usize = 4;
-/// Capacity of one stream's stack: a power of two above `CHUNK / LANES + LANES + 2`, so that a
-/// masked index needs no bounds check.
-const STACK: usize = 2048;
-const _: () = assert!(STACK > CHUNK / LANES + LANES + 2 && STACK.is_power_of_two());
+const _: () = assert!(STACK >= CHUNK / LANES + LANES + 3);
 const _: () = assert!(CHUNK.is_multiple_of(SEG) && SEG == WIDE);
 
 /// Standard normal deviates of rods `[seg * SEG, seg * SEG + out.len())` at `step` (the noise
@@ -41,11 +37,6 @@ const _: () = assert!(CHUNK.is_multiple_of(SEG) && SEG == WIDE);
 pub(crate) fn noise_segment(seed: u32, step: u64, seg: usize, out: &mut [f64]) {
     fill_normal_wide(seed, step, seg as u64, out);
 }
-
-/// A block of rods that end the step together: `[pos, n]`, `n` rods (an integer) at the
-/// end-of-step reduced position `pos`. While pooling, `pos` is instead the sum of the rods' `z`
-/// relative to the chunk's first rod.
-type Block = [f64; 2];
 
 /// `n` as an index, for an integer `0 <= n < 2^52` (branch-free: the integer is read off the
 /// mantissa of `n + 2^52`).
@@ -156,6 +147,8 @@ struct Scratch {
     z: Vec<f64>,
     /// One stack of `[sum of z, rods]` per stream; entry 0 is a sentinel that never pools.
     stacks: Box<[[[f64; 2]; STACK]]>,
+    /// The chunk's pooled blocks `[sum of z, rods]`.
+    blocks: Vec<Block>,
 }
 
 impl Scratch {
@@ -163,6 +156,7 @@ impl Scratch {
         Self {
             z: vec![0.0; CHUNK],
             stacks: vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice(),
+            blocks: vec![[0.0; 2]; CHUNK],
         }
     }
 }
@@ -275,47 +269,6 @@ impl RingStep {
     }
 }
 
-/// Add one rod's `z` to a pooling stream (pool adjacent violators, ties pool): the open block
-/// `open = [sum, rods]` stays in registers and is stored one above the stack top on every
-/// call, so the common decision (does the rod join the open block?) needs no branch; only a
-/// cascade into the blocks below does.
-#[inline(always)]
-fn push_rod(st: &mut [[f64; 2]; STACK], top: &mut usize, open: &mut [f64; 2], z: f64) {
-    let join = open[0] >= z * open[1];
-    st[(*top + 1) & (STACK - 1)] = *open;
-    *top += usize::from(!join);
-    let jf = f64::from(u8::from(join));
-    *open = [z + jf * open[0], 1.0 + jf * open[1]];
-    loop {
-        let below = st[*top & (STACK - 1)];
-        if below[0] * open[1] >= open[0] * below[1] {
-            open[0] += below[0];
-            open[1] += below[1];
-            *top -= 1;
-        } else {
-            break;
-        }
-    }
-}
-
-/// Append block `b` (`[sum, n]`) to `pool`, pooling it with the blocks it violates; true when
-/// it pooled.
-#[inline]
-fn push_block(pool: &mut Vec<Block>, mut b: Block) -> bool {
-    let mut pooled = false;
-    while let Some(&top) = pool.last() {
-        if top[0] * b[1] >= b[0] * top[1] {
-            b = [top[0] + b[0], top[1] + b[1]];
-            pool.pop();
-            pooled = true;
-        } else {
-            break;
-        }
-    }
-    pool.push(b);
-    pooled
-}
-
 /// The chunk's step: free end-of-step positions, pooling in [`LANES`] streams, joining the
 /// streams, writing the rods' end-of-step reduced positions into `out`.
 fn chunk_pass<E: ExternalForce, P: PairForce>(
@@ -342,59 +295,19 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
             *zk = (yk - yref) + (mu * *zk + amp * g) * dt;
         }
     }
-    // Pool in LANES streams over consecutive quarters, interleaved rod by rod.
-    let q = len / LANES;
-    let mut top = [0usize; LANES];
-    let mut open = [[0.0f64; 2]; LANES];
-    let stacks = &mut s.stacks[..LANES];
-    for st in stacks.iter_mut() {
-        st[0] = [f64::NAN, 1.0];
-    }
-    let zq: [&[f64]; LANES] = std::array::from_fn(|j| &z[j * q..(j + 1) * q]);
-    for k in 0..q {
-        for j in 0..LANES {
-            push_rod(&mut stacks[j], &mut top[j], &mut open[j], zq[j][k]);
-        }
-    }
-    // The last stream takes the rods left over.
-    for &zk in &z[LANES * q..] {
-        push_rod(
-            &mut stacks[LANES - 1],
-            &mut top[LANES - 1],
-            &mut open[LANES - 1],
-            zk,
-        );
-    }
-    // Join the streams: each stream's blocks pool with the ones before only until one of them
-    // stands alone (the stream's means increase from there on); the rest is copied.
-    let pool = &mut c.pool;
-    pool.clear();
-    for j in 0..LANES {
-        stacks[j][(top[j] + 1) & (STACK - 1)] = open[j];
-        let mut blocks = &stacks[j][1..top[j] + 2];
-        if open[j][1] == 0.0 {
-            // An empty stream (fewer rods than streams).
-            blocks = &blocks[..blocks.len() - 1];
-        }
-        if j > 0 {
-            while let Some((&b, rest)) = blocks.split_first() {
-                blocks = rest;
-                if !push_block(pool, b) {
-                    break;
-                }
-            }
-        }
-        pool.extend_from_slice(blocks);
-    }
+    let blocks = pava::pool_chunk(&mut s.stacks, z, &mut s.blocks);
     // End-of-step reduced positions: every rod of a block at the block's mean z. Short blocks
     // are written as a fixed run of FILL values (no data-dependent loop exit); the next block
     // overwrites the excess.
     const FILL: usize = 8;
-    let mut finite = true;
-    for b in pool.iter_mut() {
-        b[0] = yref + b[0] / b[1];
-        finite &= b[0].is_finite();
-    }
+    let pool = &mut c.pool;
+    pool.clear();
+    pool.extend(
+        s.blocks[..blocks]
+            .iter()
+            .map(|b| [yref + b[0] / b[1], b[1]]),
+    );
+    let finite = pool.iter().all(|b| b[0].is_finite());
     let mut at = 0;
     for b in pool.iter() {
         let m = count(b[1]);
@@ -406,7 +319,7 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
         at += m;
     }
     c.head = 0;
-    c.end = pool.len();
+    c.end = blocks;
     c.last_start = a1 - pool.last().map_or(0, |b| count(b[1]));
     if !finite || at != len {
         c.bad = first_non_finite(a0, a1, ctx);
