@@ -284,7 +284,11 @@ fn reducible(u: f64) -> bool {
 fn sin_turns_arg(u: f64) -> f64 {
     let r = u - ((u + ROUND) - ROUND);
     let v = 2.0 * r;
-    std::f64::consts::PI * v.min(1.0 - v).max(-1.0 - v)
+    // min(v, 1 - v) then max(., -1 - v), written as selects: `f64::min`/`max` would also
+    // handle NaN, which costs two more instructions per vector and cannot occur here.
+    let (a, b) = (1.0 - v, -1.0 - v);
+    let m = if v < a { v } else { a };
+    std::f64::consts::PI * if m > b { m } else { b }
 }
 
 /// `sin(w)` for `|w| <= pi/2`: the series summed by Estrin's scheme with fused multiply-adds
