@@ -8,7 +8,7 @@ mod common;
 use common::{Case, compare};
 
 fn case(sigma: f64, rho: f64, gamma: Option<f64>, seed: u32) -> Case {
-    // Euler-Maruyama has an O(dt U'') bias in the steep wells (about 1% at dt = 1e-4, see
+    // Euler-Maruyama has an O(dt U'') bias in the steep wells (rms 1e-2 at dt = 1e-3, see
     // `dt_refinement_reduces_the_euler_bias`), and denser systems collide more often: smaller
     // steps for them, as in the paper.
     let dt = if rho * sigma > 0.5 || gamma.is_some_and(|g| g > 1.0) {
@@ -71,20 +71,26 @@ fn paper_density_profiles_match_exact_theory() {
 
 /// The remaining deviation at large dt is the Euler-Maruyama bias of the one-body density, not
 /// a collision error: in the dilute case (sigma = 0.5, rho = 0.2, few collisions) the rms
-/// deviation from the exact profile falls when the step shrinks.
+/// deviation from the exact profile falls when the step shrinks. The steps are 1e-3 and 1e-4,
+/// and the rms is pooled over four seeds: at 1e-4 and 1e-5 the bias is below the statistical
+/// error of these runs (about 2.5e-3 rms), and a single seed passed or failed by chance.
 #[test]
-#[ignore = "long: about a minute"]
 fn dt_refinement_reduces_the_euler_bias() {
     let rms = |dt: f64| {
-        let mut c = case(0.5, 0.2, None, 40);
-        c.dt = dt;
-        c.block_steps = (2.0 / dt) as u64;
-        c.equilibrate_steps = c.block_steps;
-        common::rms_deviation(&c)
+        let ms: f64 = (40..44)
+            .map(|seed| {
+                let mut c = case(0.5, 0.2, None, seed);
+                c.dt = dt;
+                c.block_steps = (2.0 / dt) as u64;
+                c.equilibrate_steps = c.block_steps;
+                common::rms_deviation(&c).powi(2)
+            })
+            .sum();
+        (ms / 4.0).sqrt()
     };
-    let (coarse, fine) = (rms(1e-4), rms(1e-5));
+    let (coarse, fine) = (rms(1e-3), rms(1e-4));
     println!(
-        "rms deviation from the exact profile: dt = 1e-4: {coarse:.3e}, dt = 1e-5: {fine:.3e}"
+        "rms deviation from the exact profile (4 seeds): dt = 1e-3: {coarse:.3e}, dt = 1e-4: {fine:.3e}"
     );
-    assert!(fine < 0.7 * coarse, "{fine} vs {coarse}");
+    assert!(fine < 0.5 * coarse, "{fine} vs {coarse}");
 }
