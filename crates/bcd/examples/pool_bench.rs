@@ -1,6 +1,6 @@
 //! Time the pooling kernel of the premerged ring step on its own: `cargo run --release -p
 //! colloidsim-bcd --example pool_bench -- [SAMPLES] [REPEATS]` (default 64 chunks of 4096
-//! rods, median and minimum of 9 repeats of 40 passes, thread CPU time, in ns per rod).
+//! rods, median and minimum of 9 repeats of 200 passes, thread CPU time, in ns per rod).
 //!
 //! The free end-of-step positions come from a small stand-alone BCD of one chunk between
 //! walls in the benchmark case (sigma = 0.99, density 1, U0 = 6 kT, wavelength 1, dt = 1e-3,
@@ -14,7 +14,7 @@ use std::hint::black_box;
 
 const RODS: usize = 4096;
 /// Passes over the samples per timing (the thread clock ticks in milliseconds).
-const SWEEPS: usize = 40;
+const SWEEPS: usize = 200;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();

@@ -307,7 +307,8 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
             .iter()
             .map(|b| [yref + b[0] / b[1], b[1]]),
     );
-    let finite = pool.iter().all(|b| b[0].is_finite());
+    // Without short-circuit, so that it vectorises.
+    let finite = pool.iter().fold(true, |ok, b| ok & b[0].is_finite());
     let mut at = 0;
     for b in pool.iter() {
         let m = count(b[1]);
