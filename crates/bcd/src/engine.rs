@@ -561,11 +561,12 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     }
 
     /// Run `steps` steps.
+    ///
+    /// The steps run on a worker of the thread pool, so that the chunks of each step start
+    /// without a hand-over from a foreign thread (two context switches per step, about 1 ns per
+    /// particle-step at 10^4 rods).
     pub fn run(&mut self, steps: u64) -> Result<(), BcdError> {
-        for _ in 0..steps {
-            self.step()?;
-        }
-        Ok(())
+        rayon::scope(|_| (0..steps).try_for_each(|_| self.step()))
     }
 
     /// Check the hard core and the walls (for tests): returns the smallest gap minus sigma.

@@ -20,7 +20,7 @@ const IOTA: [f64; 64] = {
 };
 
 /// A one-body force f(x) (energy/length). Implemented for closures `Fn(f64) -> f64`.
-pub trait ExternalForce: Sync {
+pub trait ExternalForce: Send + Sync {
     /// Force at position `x` (unwrapped coordinates).
     fn force(&self, x: f64) -> f64;
 
@@ -50,7 +50,7 @@ pub trait ExternalForce: Sync {
     }
 }
 
-impl<F: Fn(f64) -> f64 + Sync> ExternalForce for F {
+impl<F: Fn(f64) -> f64 + Send + Sync> ExternalForce for F {
     #[inline]
     fn force(&self, x: f64) -> f64 {
         self(x)
@@ -427,7 +427,7 @@ impl ExternalForce for ExternalField {
 }
 
 /// A central pair force between rods at centre distance `r >= sigma`, positive when repulsive.
-pub trait PairForce: Sync {
+pub trait PairForce: Send + Sync {
     /// Distance beyond which the force vanishes (0 for none).
     fn range(&self) -> f64;
     /// Force magnitude at distance `r` (positive pushes the rods apart).
