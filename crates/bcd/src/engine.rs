@@ -21,7 +21,7 @@ use colloidsim_core::ParamError;
 use colloidsim_core::param;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 use thiserror::Error;
 
 pub use crate::ring::CHUNK;
@@ -207,6 +207,8 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
     ring: Option<RingStep>,
     view: OnceLock<BcdState>,
     positions: OnceLock<Vec<f64>>,
+    /// The buffer of the last step's `positions`, reused by the next (no allocation per step).
+    spare: Mutex<Vec<f64>>,
 }
 
 impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
@@ -281,6 +283,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             ring,
             view: OnceLock::new(),
             positions: OnceLock::new(),
+            spare: Mutex::new(Vec::new()),
         })
     }
 
@@ -302,10 +305,11 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             None => &self.state.x,
             Some(r) => self.positions.get_or_init(|| {
                 let sigma = self.cfg.sigma;
-                r.y.iter()
-                    .enumerate()
-                    .map(|(i, &yi)| yi + i as f64 * sigma)
-                    .collect()
+                let mut x =
+                    std::mem::take(&mut *self.spare.lock().unwrap_or_else(|e| e.into_inner()));
+                x.clear();
+                x.extend(r.y.iter().enumerate().map(|(i, &yi)| yi + i as f64 * sigma));
+                x
             }),
         }
     }
@@ -344,20 +348,27 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
 
     /// Sizes of the clusters present at the end of the last step (rods in contact that moved
     /// together), in ring order starting from the first cluster start.
-    pub fn cluster_sizes(&self, mut visit: impl FnMut(usize)) {
+    pub fn cluster_sizes(&self, visit: impl FnMut(usize)) {
         let n = self.len();
-        let bond = &self.state().bond;
-        let origin = self.origin(bond);
-        let mut size = 0;
-        for w in origin..origin + n {
-            size += 1;
-            if bond[w % n] == 0 {
-                visit(size);
-                size = 0;
+        match &self.ring {
+            // Bonds read off equal reduced positions (no derived state, no allocation).
+            Some(r) => cluster_walk(
+                n,
+                true,
+                |i| {
+                    if i + 1 < n {
+                        r.y[i] == r.y[i + 1]
+                    } else {
+                        r.seam
+                    }
+                },
+                visit,
+            ),
+            None => {
+                let bond = &self.state.bond;
+                let periodic = self.cfg.boundary == Boundary::Periodic;
+                cluster_walk(n, periodic, |i| bond[i] != 0, visit)
             }
-        }
-        if size > 0 {
-            visit(size);
         }
     }
 
@@ -383,7 +394,9 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 });
             }
             self.view = OnceLock::new();
-            self.positions = OnceLock::new();
+            if let Some(x) = self.positions.take() {
+                *self.spare.get_mut().unwrap_or_else(|e| e.into_inner()) = x;
+            }
             self.state.step += 1;
             return Ok(());
         }
@@ -956,4 +969,31 @@ fn check_positions(cfg: &BcdConfig, x: &[f64]) -> Result<(), BcdError> {
         }
     }
     Ok(())
+}
+
+/// Visit the sizes of the clusters of `n` rods in ring order, rod `i` bonded to its right
+/// neighbour when `bonded(i)` (on a ring, rod `n - 1` to rod 0), starting at the first cluster
+/// start.
+fn cluster_walk(
+    n: usize,
+    periodic: bool,
+    bonded: impl Fn(usize) -> bool,
+    mut visit: impl FnMut(usize),
+) {
+    let origin = if periodic {
+        (0..n).find(|&i| !bonded((i + n - 1) % n)).unwrap_or(0)
+    } else {
+        0
+    };
+    let mut size = 0;
+    for w in origin..origin + n {
+        size += 1;
+        if !bonded(w % n) {
+            visit(size);
+            size = 0;
+        }
+    }
+    if size > 0 {
+        visit(size);
+    }
 }

@@ -6,6 +6,13 @@ use crate::engine::{Bcd, Boundary};
 use crate::forces::{ExternalForce, PairForce};
 use serde::{Deserialize, Serialize};
 
+/// `x` folded into one `period`, `[0, period]` up to rounding (callers clamp the bin). Not
+/// `rem_euclid`, which calls `fmod` and took a sixth of the time of a small run.
+#[inline]
+fn fold(x: f64, period: f64) -> f64 {
+    x - (x / period).floor() * period
+}
+
 /// Histogram of rod centres over `[0, period)`, folded when the system is longer.
 /// `rho(x_a + dx/2) = p_a / (M dx (L / period))`, so its mean is the mean density N/L.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -32,7 +39,7 @@ impl DensityProfile {
         let m = self.counts.len();
         let scale = m as f64 / self.period;
         for &xi in x {
-            let b = ((xi.rem_euclid(self.period)) * scale) as usize;
+            let b = (fold(xi, self.period) * scale) as usize;
             self.counts[b.min(m - 1)] += 1;
         }
         self.samples += 1;
@@ -101,7 +108,7 @@ impl ContactDensity {
                 continue;
             };
             if right - x[i] < reach {
-                let b = ((x[i].rem_euclid(self.inner.period)) * scale) as usize;
+                let b = (fold(x[i], self.inner.period) * scale) as usize;
                 self.inner.counts[b.min(m - 1)] += 1;
             }
         }

@@ -149,6 +149,9 @@ struct Scratch {
     stacks: Box<[[[f64; 2]; STACK]]>,
     /// The chunk's pooled blocks `[sum of z, rods]`.
     blocks: Vec<Block>,
+    /// Noise deviates of one segment (kept here: zeroing a fresh array per chunk showed in
+    /// small runs).
+    noise: [f64; SEG],
 }
 
 impl Scratch {
@@ -157,6 +160,7 @@ impl Scratch {
             z: vec![0.0; CHUNK],
             stacks: vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice(),
             blocks: vec![[0.0; 2]; CHUNK],
+            noise: [0.0; SEG],
         }
     }
 }
@@ -284,7 +288,7 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     let dt = ctx.m.dt;
     // Free end-of-step reduced positions relative to the chunk's first rod.
     let z = &mut s.z[..len];
-    let mut noise = [0.0f64; SEG];
+    let noise = &mut s.noise;
     let (mu, amp) = (ctx.m.mobility, ctx.m.noise_amp);
     for (k, zs) in z.chunks_mut(SEG).enumerate() {
         let a = a0 + k * SEG;

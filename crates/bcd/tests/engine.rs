@@ -289,3 +289,36 @@ fn inconsistent_reduced_positions_are_refused() {
     }
     assert_eq!(a.state().bond, b.state().bond);
 }
+
+#[test]
+fn ring_cluster_sizes_follow_the_bonds_of_the_state() {
+    // The ring update reads clusters off equal reduced positions and the seam flag; they must
+    // be the clusters of the derived state's bonds, including one across the seam.
+    let cfg = config(105.0, 0.99, 1e-3, Boundary::Periodic, Update::Premerge);
+    let x = init::random(&cfg, 100, 3).unwrap();
+    let mut a = Bcd::new(cfg, x, NoField, NoPair).unwrap();
+    let mut across_seam = 0;
+    for _ in 0..200 {
+        a.run(1).unwrap();
+        let mut sizes = vec![];
+        a.cluster_sizes(|s| sizes.push(s));
+        let bond = &a.state().bond;
+        let n = bond.len();
+        let start = (0..n).find(|&i| bond[(i + n - 1) % n] == 0).unwrap_or(0);
+        let (mut want, mut size) = (vec![], 0);
+        for w in start..start + n {
+            size += 1;
+            if bond[w % n] == 0 {
+                want.push(size);
+                size = 0;
+            }
+        }
+        if size > 0 {
+            want.push(size);
+        }
+        across_seam += usize::from(bond[n - 1] != 0);
+        assert_eq!(sizes, want);
+        assert_eq!(sizes.iter().sum::<usize>(), n);
+    }
+    assert!(across_seam > 0, "no cluster crossed the seam");
+}
