@@ -203,7 +203,7 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
     global: Vec<Cluster>,
     noise_amp: f64,
     /// The premerged ring update (periodic boundary): it keeps the configuration in reduced
-    /// coordinates, and `state.x`/`state.bond` are then derived on demand into `view`.
+    /// coordinates, and `state.x`/`state.bond` are then empty and derived on demand into `view`.
     ring: Option<RingStep>,
     view: OnceLock<BcdState>,
     positions: OnceLock<Vec<f64>>,
@@ -265,8 +265,13 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         } else {
             None
         };
-        // The engine's own copy lives in the ring step; the stored state never holds it.
+        // The engine's own copy lives in the ring step; the stored state never holds it, nor,
+        // on a ring, the positions and bonds (derived from the ring step when asked for).
         state.reduced = Vec::new();
+        if ring.is_some() {
+            state.x = Vec::new();
+            state.bond = Vec::new();
+        }
         let chunks = if ring.is_some() {
             Vec::new()
         } else {
@@ -293,11 +298,14 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     }
     /// Number of rods.
     pub fn len(&self) -> usize {
-        self.state.x.len()
+        match &self.ring {
+            Some(r) => r.y.len(),
+            None => self.state.x.len(),
+        }
     }
     /// Always false (a run has at least one rod).
     pub fn is_empty(&self) -> bool {
-        self.state.x.is_empty()
+        self.len() == 0
     }
     /// Unwrapped rod centres in ring order.
     pub fn positions(&self) -> &[f64] {
