@@ -150,6 +150,7 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
                     dir.display()
                 )
             })?;
+            crate::common::check_checkpoint_version(&bytes, &out.join(CHECKPOINT))?;
             let ck: Checkpoint = bincode::deserialize(&bytes)
                 .with_context(|| format!("{}: unreadable checkpoint", dir.display()))?;
             if ck.scenario != text {
@@ -236,7 +237,7 @@ fn simulate<P: PairForce + Clone>(
             g.sync_all()?;
         }
         let ck = Checkpoint {
-            version: env!("CARGO_PKG_VERSION").into(),
+            version: crate::common::checkpoint_version(),
             scenario: std::fs::read_to_string(out.join("scenario.toml"))?,
             seed: cfg.seed as u64,
             state: bcd.state().clone(),

@@ -1,9 +1,7 @@
 //! `colloidsim run|check` for DPD colloids in explicit solvent (`method = "dpd"`).
 
 use crate::common::{RunOptions, progress, seed32};
-use crate::droplet::{
-    check_resolved, check_version_and_scenario, checkpoint_bytes, hook, trim_trajectory,
-};
+use crate::droplet::{check_resolved, check_scenario, checkpoint_bytes, hook, trim_trajectory};
 use crate::plot::{Scale, Series, line_plot};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
@@ -240,7 +238,7 @@ impl Base {
         obs: &Observed,
     ) -> Result<()> {
         let ck = Checkpoint {
-            version: env!("CARGO_PKG_VERSION").into(),
+            version: crate::common::checkpoint_version(),
             scenario: self.scenario.clone(),
             resolved: self.resolved.clone(),
             seed: self.seed,
@@ -289,9 +287,10 @@ fn open_checkpoint(
         dir,
         "checkpoints are written every 10 % of the run and on Ctrl-C",
     )?;
+    crate::common::check_checkpoint_version(&bytes, &out.join(CHECKPOINT))?;
     let ck: Checkpoint<Observed> = bincode::deserialize(&bytes)
         .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
-    check_version_and_scenario(dir, path, text, &out, &ck.version, &ck.scenario)?;
+    check_scenario(dir, path, text, &out, &ck.scenario)?;
     let (_, s) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
     check_resolved(dir, &resolved(&s)?, &ck.resolved)?;
     Ok((out, ck, s))

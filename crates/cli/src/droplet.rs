@@ -210,30 +210,24 @@ fn open_checkpoint(
         dir,
         "checkpoints are written every 10 % of a replica, between replicas and on Ctrl-C",
     )?;
+    crate::common::check_checkpoint_version(&bytes, &out.join(CHECKPOINT))?;
     let ck: Checkpoint = bincode::deserialize(&bytes)
         .with_context(|| format!("{}: unreadable checkpoint", out.join(CHECKPOINT).display()))?;
-    check_version_and_scenario(dir, path, text, &out, &ck.version, &ck.scenario)?;
+    check_scenario(dir, path, text, &out, &ck.scenario)?;
     let (_, p) = resolve(path, text, Some(seed.unwrap_or(ck.seed)))?;
     check_resolved(dir, &serde_json::to_string(&p)?, &ck.resolved)?;
     Ok((out, ck, p))
 }
 
-/// Warn when a checkpoint comes from another colloidsim version; refuse a scenario file whose
-/// text differs from the one the run started with.
-pub(crate) fn check_version_and_scenario(
+/// Refuse a scenario file whose text differs from the one the run started with (the
+/// checkpoint's version was checked by `check_checkpoint_version`).
+pub(crate) fn check_scenario(
     dir: &Path,
     path: &Path,
     text: &str,
     out: &OutputDir,
-    version: &str,
     scenario: &str,
 ) -> Result<()> {
-    if version != env!("CARGO_PKG_VERSION") {
-        eprintln!(
-            "warning: the checkpoint was written by colloidsim {version}, this is {}; the continuation may not be bitwise identical",
-            env!("CARGO_PKG_VERSION")
-        );
-    }
     if scenario != text {
         bail!(
             "--restart {}: {} differs from the scenario this run started with (saved as {})",
@@ -460,7 +454,7 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
                 checkpoints: 0,
             };
             let base = Checkpoint {
-                version: env!("CARGO_PKG_VERSION").into(),
+                version: crate::common::checkpoint_version(),
                 scenario: text.into(),
                 resolved: serde_json::to_string(&p)?,
                 seed: p.seed as u64,
