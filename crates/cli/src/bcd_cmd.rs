@@ -248,65 +248,70 @@ fn simulate<P: PairForce + Clone>(
         out.write_bytes(CHECKPOINT, &bincode::serialize(&ck)?)?;
         Ok(())
     };
-    while bcd.steps() < total {
-        if stop_at == Some(bcd.steps()) {
-            INTERRUPTED.store(true, Ordering::SeqCst);
-        }
-        if INTERRUPTED.load(Ordering::Relaxed) {
-            let wall = wall_before + start.elapsed().as_secs_f64();
-            save(&bcd, &obs, &mut gsd, wall, frames)?;
-            pb.abandon();
-            bail!(
-                "interrupted at step {}; checkpoint written. Continue with: colloidsim run SCENARIO --restart {}",
-                bcd.steps(),
-                out.path().display()
-            );
-        }
-        bcd.step()?;
-        let s = bcd.steps();
-        if s > r.equilibrate_steps {
-            let k = s - r.equilibrate_steps;
-            let x = bcd.positions();
-            if k.is_multiple_of(every) {
-                if let Some(d) = obs.density.as_mut() {
-                    d.sample(x);
-                }
-                if let Some(c) = obs.contact.as_mut() {
-                    c.sample(x);
-                }
-                if let Some(c) = obs.clusters.as_mut() {
-                    c.sample(&bcd);
-                }
+    // The steps run on a worker of the thread pool, so that each step's chunks start without a
+    // hand-over from this thread (see `Bcd::run`).
+    rayon::scope(|_| -> Result<()> {
+        while bcd.steps() < total {
+            if stop_at == Some(bcd.steps()) {
+                INTERRUPTED.store(true, Ordering::SeqCst);
             }
-            if let Some(m) = obs.msd.as_mut() {
-                m.sample(k - 1, x);
+            if INTERRUPTED.load(Ordering::Relaxed) {
+                let wall = wall_before + start.elapsed().as_secs_f64();
+                save(&bcd, &obs, &mut gsd, wall, frames)?;
+                pb.abandon();
+                bail!(
+                    "interrupted at step {}; checkpoint written. Continue with: colloidsim run SCENARIO --restart {}",
+                    bcd.steps(),
+                    out.path().display()
+                );
             }
-            if let Some(c) = obs.current.as_mut()
-                && k.is_multiple_of(current_every)
+            bcd.step()?;
+            let s = bcd.steps();
+            if s > r.equilibrate_steps {
+                let k = s - r.equilibrate_steps;
+                let x = bcd.positions();
+                if k.is_multiple_of(every) {
+                    if let Some(d) = obs.density.as_mut() {
+                        d.sample(x);
+                    }
+                    if let Some(c) = obs.contact.as_mut() {
+                        c.sample(x);
+                    }
+                    if let Some(c) = obs.clusters.as_mut() {
+                        c.sample(&bcd);
+                    }
+                }
+                if let Some(m) = obs.msd.as_mut() {
+                    m.sample(k - 1, x);
+                }
+                if let Some(c) = obs.current.as_mut()
+                    && k.is_multiple_of(current_every)
+                {
+                    c.t.push(k as f64 * cfg.dt);
+                    c.displacement
+                        .push(x.iter().sum::<f64>() / n as f64 - c.x0_sum);
+                }
+            } else if s == r.equilibrate_steps
+                && let Some(c) = obs.current.as_mut()
             {
-                c.t.push(k as f64 * cfg.dt);
-                c.displacement
-                    .push(x.iter().sum::<f64>() / n as f64 - c.x0_sum);
+                c.x0_sum = bcd.positions().iter().sum::<f64>() / n as f64;
             }
-        } else if s == r.equilibrate_steps
-            && let Some(c) = obs.current.as_mut()
-        {
-            c.x0_sum = bcd.positions().iter().sum::<f64>() / n as f64;
+            if let (Some(g), Some(e)) = (gsd.as_mut(), traj_every)
+                && s.is_multiple_of(e)
+            {
+                write_frame(g, &bcd)?;
+                frames += 1;
+            }
+            if s.is_multiple_of(ck_every) && s < total {
+                let wall = wall_before + start.elapsed().as_secs_f64();
+                save(&bcd, &obs, &mut gsd, wall, frames)?;
+            }
+            if s.is_multiple_of(256) {
+                pb.set_position(s);
+            }
         }
-        if let (Some(g), Some(e)) = (gsd.as_mut(), traj_every)
-            && s.is_multiple_of(e)
-        {
-            write_frame(g, &bcd)?;
-            frames += 1;
-        }
-        if s.is_multiple_of(ck_every) && s < total {
-            let wall = wall_before + start.elapsed().as_secs_f64();
-            save(&bcd, &obs, &mut gsd, wall, frames)?;
-        }
-        if s.is_multiple_of(256) {
-            pb.set_position(s);
-        }
-    }
+        Ok(())
+    })?;
     pb.finish_and_clear();
     wall_before += start.elapsed().as_secs_f64();
     save(&bcd, &obs, &mut gsd, wall_before, frames)?;
