@@ -494,82 +494,87 @@ pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
     };
     // The step at which Ctrl-C arrived.
     let mut interrupted: Option<u64> = None;
-    while sim.step < s.steps {
-        let step = sim.step;
-        if kill_at == Some(step) {
-            if let Some(w) = gsd.as_mut() {
-                w.sync()?;
+    // The steps run on a worker of the thread pool, so that each step's parallel passes start
+    // without a hand-over from this thread.
+    rayon::scope(|_| -> Result<()> {
+        while sim.step < s.steps {
+            let step = sim.step;
+            if kill_at == Some(step) {
+                if let Some(w) = gsd.as_mut() {
+                    w.sync()?;
+                }
+                eprintln!("killed at step {step} (test hook)");
+                std::process::exit(3);
             }
-            eprintln!("killed at step {step} (test hook)");
-            std::process::exit(3);
-        }
-        if interrupt_at == Some(step) {
-            INTERRUPTED.store(true, Ordering::SeqCst);
-        }
-        if interrupted.is_none() && INTERRUPTED.load(Ordering::Relaxed) {
-            interrupted = Some(step);
-            let to = step.next_multiple_of(sync_every).min(s.steps);
-            if to > step && to < s.steps {
-                pb.suspend(|| {
-                    eprintln!(
-                        "interrupted at step {step}: running on to step {to} to write a checkpoint (Ctrl-C again stops at once)"
-                    )
-                });
+            if interrupt_at == Some(step) {
+                INTERRUPTED.store(true, Ordering::SeqCst);
             }
-        }
-        if let Some(at) = interrupted
-            && step.is_multiple_of(sync_every)
-        {
-            if let Some(w) = gsd.as_mut() {
-                w.sync()?;
+            if interrupted.is_none() && INTERRUPTED.load(Ordering::Relaxed) {
+                interrupted = Some(step);
+                let to = step.next_multiple_of(sync_every).min(s.steps);
+                if to > step && to < s.steps {
+                    pb.suspend(|| {
+                        eprintln!(
+                            "interrupted at step {step}: running on to step {to} to write a checkpoint (Ctrl-C again stops at once)"
+                        )
+                    });
+                }
             }
-            base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
-            pb.abandon();
-            let (files, _) = write_outputs(&out, &s, &sim, &obs)?;
-            bail!(
-                "interrupted at step {at}; checkpoint written at step {step}, outputs so far in {} ({}; summary.json is written when the run completes). Continue with: colloidsim run {} --restart {}",
-                out.path().display(),
-                files.join(", "),
-                path.display(),
-                out.path().display()
-            );
-        }
-        let next = step + 1;
-        let result = if o.thermo_every > 0 && next.is_multiple_of(o.thermo_every) {
-            sim.advance_with_thermo().map(|th| {
-                obs.thermo.push((next as f64 * dt, th));
-            })
-        } else {
-            sim.advance()
-        };
-        if let Err(e) = result {
-            failure = Some(e.to_string());
-            break;
-        }
-        if next.is_multiple_of(check_every) {
-            let t = obs
-                .thermo
-                .last()
-                .filter(|(_, th)| th.step == next)
-                .map(|(_, th)| th.temperature)
-                .unwrap_or_else(|| sim.thermo().temperature);
-            obs.monitor.push((next, t));
-            if let Err(e) = monitor.push(next, t) {
-                failure = Some(e);
+            if let Some(at) = interrupted
+                && step.is_multiple_of(sync_every)
+            {
+                if let Some(w) = gsd.as_mut() {
+                    w.sync()?;
+                }
+                base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
+                pb.abandon();
+                let (files, _) = write_outputs(&out, &s, &sim, &obs)?;
+                bail!(
+                    "interrupted at step {at}; checkpoint written at step {step}, outputs so far in {} ({}; summary.json is written when the run completes). Continue with: colloidsim run {} --restart {}",
+                    out.path().display(),
+                    files.join(", "),
+                    path.display(),
+                    out.path().display()
+                );
+            }
+            let next = step + 1;
+            let result = if o.thermo_every > 0 && next.is_multiple_of(o.thermo_every) {
+                sim.advance_with_thermo().map(|th| {
+                    obs.thermo.push((next as f64 * dt, th));
+                })
+            } else {
+                sim.advance()
+            };
+            if let Err(e) = result {
+                failure = Some(e.to_string());
                 break;
             }
-        }
-        record(&sim, &mut obs, &mut gsd)?;
-        if next.is_multiple_of(checkpoint_every) && next < s.steps {
-            if let Some(w) = gsd.as_mut() {
-                w.sync()?;
+            if next.is_multiple_of(check_every) {
+                let t = obs
+                    .thermo
+                    .last()
+                    .filter(|(_, th)| th.step == next)
+                    .map(|(_, th)| th.temperature)
+                    .unwrap_or_else(|| sim.thermo().temperature);
+                obs.monitor.push((next, t));
+                if let Err(e) = monitor.push(next, t) {
+                    failure = Some(e);
+                    break;
+                }
             }
-            base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
+            record(&sim, &mut obs, &mut gsd)?;
+            if next.is_multiple_of(checkpoint_every) && next < s.steps {
+                if let Some(w) = gsd.as_mut() {
+                    w.sync()?;
+                }
+                base.save(&out, &sim, builds0 + sim.neighbor_builds(), wall(), &obs)?;
+            }
+            if next.is_multiple_of(100) {
+                pb.set_position(next);
+            }
         }
-        if next.is_multiple_of(100) {
-            pb.set_position(next);
-        }
-    }
+        Ok(())
+    })?;
     pb.finish_and_clear();
     if let Some(w) = gsd.as_mut() {
         w.sync()?;
