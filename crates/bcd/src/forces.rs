@@ -361,41 +361,31 @@ impl ExternalForce for CosineForce {
         f
     }
 
-    /// Two simple passes per run of up to 64 rods (reduction, then the series), so that the
-    /// compiler can overlap neighbouring rods' long dependency chains.
     fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
-        let mut w = [0.0f64; 64];
-        let mut far = false;
-        for (xs, os) in x.chunks(64).zip(out.chunks_mut(64)) {
-            os.fill(self.drive);
-            let w = &mut w[..os.len()];
-            for &[k, a] in &self.terms {
-                for (wk, &xk) in w.iter_mut().zip(xs) {
-                    let u = (xk + offset) * k;
-                    far |= !reducible(u);
-                    *wk = sin_turns_arg(u);
-                }
-                add_sines(os, w, a);
-            }
-        }
-        if far {
-            for (o, &xk) in out.iter_mut().zip(x) {
-                *o = self.force(xk + offset);
-            }
-        }
+        self.forces_at(x, 0, out, |xk, _| xk + offset);
     }
 
     fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
+        // (i0 + i) in `forces_at` is exact: the same index as (first + 64 c + i) as f64.
+        self.forces_at(y, first, out, |yk, i| yk + i * sigma);
+    }
+}
+
+impl CosineForce {
+    /// `out[k]` = the force at `pos(v[k], first + k)` (the index as a float). Two simple passes
+    /// per run of up to 64 rods (reduction, then the series), so that the compiler can overlap
+    /// neighbouring rods' long dependency chains.
+    #[inline(always)]
+    fn forces_at(&self, v: &[f64], first: usize, out: &mut [f64], pos: impl Fn(f64, f64) -> f64) {
         let mut w = [0.0f64; 64];
         let mut far = false;
-        for (c, (ys, os)) in y.chunks(64).zip(out.chunks_mut(64)).enumerate() {
+        for (c, (vs, os)) in v.chunks(64).zip(out.chunks_mut(64)).enumerate() {
             os.fill(self.drive);
             let w = &mut w[..os.len()];
             let i0 = (first + 64 * c) as f64;
             for &[k, a] in &self.terms {
-                for ((wk, &yk), &i) in w.iter_mut().zip(ys).zip(&IOTA) {
-                    // (i0 + i) is exact: the same index as (first + 64 c + i) as f64.
-                    let u = (yk + (i0 + i) * sigma) * k;
+                for ((wk, &vk), &i) in w.iter_mut().zip(vs).zip(&IOTA) {
+                    let u = pos(vk, i0 + i) * k;
                     far |= !reducible(u);
                     *wk = sin_turns_arg(u);
                 }
@@ -403,8 +393,8 @@ impl ExternalForce for CosineForce {
             }
         }
         if far {
-            for (i, (o, &yk)) in out.iter_mut().zip(y).enumerate() {
-                *o = self.force(yk + (first + i) as f64 * sigma);
+            for (i, (o, &vk)) in out.iter_mut().zip(v).enumerate() {
+                *o = self.force(pos(vk, (first + i) as f64));
             }
         }
     }
