@@ -382,11 +382,8 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
 
     /// The first cluster start in ring order, given the bonds.
     fn origin(&self, bond: &[u8]) -> usize {
-        let n = self.len();
-        match self.cfg.boundary {
-            Boundary::Walls => 0,
-            Boundary::Periodic => (0..n).find(|&i| bond[(i + n - 1) % n] == 0).unwrap_or(0),
-        }
+        let periodic = self.cfg.boundary == Boundary::Periodic;
+        cluster_origin(self.len(), periodic, |i| bond[i] != 0)
     }
 
     /// Advance by one time step.
@@ -988,11 +985,7 @@ fn cluster_walk(
     bonded: impl Fn(usize) -> bool,
     mut visit: impl FnMut(usize),
 ) {
-    let origin = if periodic {
-        (0..n).find(|&i| !bonded((i + n - 1) % n)).unwrap_or(0)
-    } else {
-        0
-    };
+    let origin = cluster_origin(n, periodic, &bonded);
     let mut size = 0;
     for w in origin..origin + n {
         size += 1;
@@ -1003,5 +996,15 @@ fn cluster_walk(
     }
     if size > 0 {
         visit(size);
+    }
+}
+
+/// The first cluster start in ring order: the first rod not bonded to its left neighbour (on
+/// a ring; 0 between walls, or when every rod is bonded).
+fn cluster_origin(n: usize, periodic: bool, bonded: impl Fn(usize) -> bool) -> usize {
+    if periodic {
+        (0..n).find(|&i| !bonded((i + n - 1) % n)).unwrap_or(0)
+    } else {
+        0
     }
 }

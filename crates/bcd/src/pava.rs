@@ -25,8 +25,14 @@
 //! interleaved scalar streams ([`portable::Stream`]). Both do the same arithmetic in the same
 //! order and give the same bits (tested).
 
-/// A block of rods: `[sum of z, rods]` while pooling (the count is an integer-valued float).
+/// A block of rods: `[sum of z, rods]` while pooling (the count is an integer-valued float);
+/// the ring step then stores the block's end-of-step position in place of the sum.
 pub(crate) type Block = [f64; 2];
+
+/// Zeroed stacks for the [`LANES`] streams of a chunk.
+pub(crate) fn new_stacks() -> Box<[[Block; STACK]]> {
+    vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice()
+}
 
 /// Capacity of one stream's stack: a power of two, so that a masked index needs no bounds
 /// check. A stream of `m` rods needs `m + 3` entries.
@@ -360,7 +366,7 @@ pub struct PoolBench {
 impl Default for PoolBench {
     fn default() -> Self {
         Self {
-            stacks: vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice(),
+            stacks: new_stacks(),
             pool: vec![[0.0; 2]; LANES * (STACK - 8)],
         }
     }
@@ -417,7 +423,7 @@ mod tests {
     }
 
     fn chunk(z: &[f64], scalar: bool) -> Vec<Block> {
-        let mut stacks = vec![[[0.0; 2]; STACK]; LANES];
+        let mut stacks = new_stacks();
         let mut pool = vec![[0.0; 2]; z.len()];
         let n = if scalar {
             let q = z.len() / LANES;
@@ -440,7 +446,7 @@ mod tests {
 
     /// Each stream's blocks (before they are joined), from the scalar or the default kernel.
     fn streams(z: &[f64], scalar: bool) -> Vec<Vec<Block>> {
-        let mut stacks = vec![[[0.0; 2]; STACK]; LANES];
+        let mut stacks = new_stacks();
         let q = z.len() / LANES;
         let zq: [&[f64]; LANES] = std::array::from_fn(|j| &z[j * q..(j + 1) * q]);
         let streams = if scalar {

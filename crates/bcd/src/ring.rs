@@ -158,7 +158,7 @@ impl Scratch {
     fn new() -> Self {
         Self {
             z: vec![0.0; CHUNK],
-            stacks: vec![[[0.0; 2]; STACK]; LANES].into_boxed_slice(),
+            stacks: pava::new_stacks(),
             blocks: vec![[0.0; 2]; CHUNK],
             noise: [0.0; SEG],
         }
