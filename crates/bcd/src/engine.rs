@@ -587,6 +587,46 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         rayon::scope(|_| (0..steps).try_for_each(|_| self.step()))
     }
 
+    /// The systematic force on every rod at the current positions (external field, drive and
+    /// pair forces; no noise, no hard-core constraint), in ring order.
+    pub fn systematic_forces(&self) -> Vec<f64> {
+        let x = self.positions();
+        let n = x.len();
+        let periodic = self.cfg.boundary == Boundary::Periodic;
+        let (l, range) = (self.cfg.length, self.pair.range());
+        (0..n)
+            .map(|i| {
+                let mut f = self.ext.force(x[i]);
+                if range > 0.0 {
+                    // Right neighbours push rod i to the left, left neighbours to the right.
+                    for k in 1..n {
+                        let (j, wrap) = ((i + k) % n, (i + k) / n);
+                        if !periodic && wrap > 0 {
+                            break;
+                        }
+                        let r = x[j] + wrap as f64 * l - x[i];
+                        if r >= range {
+                            break;
+                        }
+                        f -= self.pair.force(r);
+                    }
+                    for k in 1..n {
+                        if !periodic && k > i {
+                            break;
+                        }
+                        let j = (i + n - k) % n;
+                        let r = x[i] - (x[j] - if j > i { l } else { 0.0 });
+                        if r >= range {
+                            break;
+                        }
+                        f += self.pair.force(r);
+                    }
+                }
+                f
+            })
+            .collect()
+    }
+
     /// Check the hard core and the walls (for tests): returns the smallest gap minus sigma.
     pub fn min_clearance(&self) -> f64 {
         let x = self.positions();

@@ -188,6 +188,21 @@ impl Msd {
         }
     }
 
+    /// The first step from `step` on at which [`Msd::sample`] uses the configuration (a time
+    /// origin, or an origin plus a lag); calling `sample` only there gives the same sums as
+    /// calling it every step.
+    pub fn next_due(&self, step: u64) -> u64 {
+        let mut due = step.next_multiple_of(self.origin_every);
+        for (t0, _) in &self.origins {
+            let need = step.saturating_sub(*t0);
+            let k = self.lags.partition_point(|&l| l < need);
+            if let Some(&lag) = self.lags.get(k) {
+                due = due.min(t0 + lag);
+            }
+        }
+        due
+    }
+
     /// Rows `(lag steps, msd, standard error)`; the error treats origin averages separated by
     /// more than the lag as independent.
     pub fn rows(&self) -> Vec<(u64, f64, f64)> {

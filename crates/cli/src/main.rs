@@ -1,35 +1,68 @@
-//! `colloidsim`: run a scenario, compute its theory, check it, or benchmark an engine.
+//! `colloidsim`: run a scenario, compute its theory, check it, list its keys, or benchmark an
+//! engine. Argument parsing, a progress bar and Ctrl-C; the run path is `colloidsim-run`.
 
-mod bcd_cmd;
+mod bench_bcd;
+mod bench_bd;
 mod common;
 mod dpd_bench;
-mod dpd_cmd;
-mod droplet;
-mod plot;
-mod theory_droplet;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand};
-use common::RunOptions;
-use std::path::PathBuf;
+use clap::{Parser, Subcommand, ValueEnum};
+use colloidsim_run::{Control, Progress, RunOptions, Scenario, TheoryOptions};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// The methods and where they are documented, for `--help`.
+fn methods_help() -> String {
+    let mut s = String::from("Methods (the `method` key of a scenario):\n");
+    for m in colloidsim_run::method::all() {
+        s.push_str(&format!(
+            "  {:<28} {}\n  {:<28} keys: colloidsim keys {}; docs: {}\n",
+            m.names().join(", "),
+            m.about(),
+            "",
+            m.names()[0],
+            m.docs()
+        ));
+    }
+    s.push_str(
+        "\nExamples: examples/*/*.toml (each says what it shows). Every scenario key has a unit, a\n\
+         default and an allowed range (colloidsim keys METHOD); unknown keys are errors.",
+    );
+    s
+}
 
 #[derive(Parser)]
 #[command(
     name = "colloidsim",
     version,
-    about = "Simulations of colloidal suspensions"
+    about = "Simulations of colloidal suspensions: Brownian cluster dynamics of rods beside the exact 1D theory, drying droplets of hard spheres beside their DDFT, DPD colloids",
+    after_help = methods_help()
 )]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
+/// `--set key.path=value`, repeatable: override a scenario key (same validation as in the file).
+#[derive(clap::Args, Clone)]
+struct Overrides {
+    /// Override a scenario key, e.g. `--set run.dt=1e-4 --set system.boundary=walls`
+    /// (repeatable; values are TOML).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Run the simulation a scenario file describes and write its outputs.
     Run {
-        /// Scenario file (TOML).
-        scenario: PathBuf,
+        /// Scenario file (TOML); with --restart it may be left out (the run's own is used).
+        #[arg(required_unless_present = "restart")]
+        scenario: Option<PathBuf>,
         /// Output folder (default: the scenario's file name without extension).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -39,15 +72,18 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
-        /// No progress bar.
+        /// No progress bar, no closing line.
         #[arg(long)]
         quiet: bool,
-        /// Write into an output folder that already holds files.
+        /// Write into an output folder that already holds files (the files of an earlier run
+        /// are removed and listed; other files are kept and listed).
         #[arg(long)]
         force: bool,
         /// Continue an interrupted run from the checkpoint in this output folder.
         #[arg(long, conflicts_with_all = ["out", "force"])]
         restart: Option<PathBuf>,
+        #[command(flatten)]
+        overrides: Overrides,
     },
     /// Compute the continuum (theory) counterpart of a scenario on the same grid and file names.
     Theory {
@@ -67,11 +103,23 @@ enum Command {
         /// unphysical).
         #[arg(long)]
         hydrodynamics: Option<String>,
+        #[command(flatten)]
+        overrides: Overrides,
     },
     /// Validate a scenario and print the resolved parameters.
     Check {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        #[command(flatten)]
+        overrides: Overrides,
+    },
+    /// List every scenario key of a method with its unit, default and allowed range.
+    Keys {
+        /// Method (bcd, droplet-bd, dpd, ...).
+        method: String,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = KeyFormat::Text)]
+        format: KeyFormat,
     },
     /// Benchmark an engine and print a table.
     Bench {
@@ -81,38 +129,116 @@ enum Command {
     },
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum KeyFormat {
+    /// Aligned columns.
+    Text,
+    /// A Markdown table (as in docs/).
+    Markdown,
+    /// JSON.
+    Json,
+}
+
 #[derive(Subcommand)]
 enum BenchKind {
     /// Fast BCD scaling case of fast-bcd Fig. 6 (sigma = 0.99, U0 = 6, density 1, dt = 1e-3).
-    Bcd(bcd_cmd::BenchArgs),
+    Bcd(bench_bcd::BenchArgs),
     /// WCA Brownian dynamics, 25,000 particles at phi = 0.1 in a periodic box, beside LAMMPS.
-    Bd(droplet::BenchArgs),
+    Bd(bench_bd::BenchArgs),
     /// Pure DPD water, 81,000 beads at density 3 (L = 30, dt = 0.04), beside LAMMPS.
     Dpd(dpd_bench::BenchArgs),
 }
 
-/// The `method` key of a scenario decides which engine reads the rest of the file.
-fn method_of(doc: &toml::Table, path: &std::path::Path) -> Result<String> {
-    match doc.get("method") {
-        Some(toml::Value::String(s)) => Ok(s.clone()),
-        Some(other) => bail!(
-            "{}: key 'method' must be a string, got {}",
-            path.display(),
-            other.type_str()
-        ),
-        None => bail!(
-            "{}: missing key 'method' (one of: bcd, bcd-chronological, droplet-bd, dpd)",
-            path.display()
-        ),
+/// The progress bar: appears only on a terminal, only when not quiet, and only once the run
+/// has lasted a second (short runs print nothing but their result).
+struct Bar {
+    quiet: bool,
+    bar: Mutex<Option<ProgressBar>>,
+}
+
+impl Bar {
+    fn new(quiet: bool) -> Self {
+        Self {
+            quiet,
+            bar: Mutex::new(None),
+        }
+    }
+
+    fn with(&self, f: impl FnOnce(&ProgressBar)) {
+        if let Some(pb) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+            f(pb);
+        }
     }
 }
 
-fn read_scenario(path: &std::path::Path) -> Result<(String, String)> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read scenario {}", path.display()))?;
-    let doc: toml::Table =
-        toml::from_str(&text).with_context(|| format!("{} is not valid TOML", path.display()))?;
-    Ok((method_of(&doc, path)?, text))
+impl Progress for Bar {
+    fn begin(&self, label: &str, total: u64, done: u64) {
+        if self.quiet || !std::io::stderr().is_terminal() {
+            return;
+        }
+        let pb =
+            ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::hidden());
+        pb.set_style(
+            ProgressStyle::with_template(&format!(
+                "{label} {{bar:40}} {{percent:>3}}% {{elapsed_precise}} eta {{eta}} {{msg}}"
+            ))
+            .expect("static template"),
+        );
+        pb.set_position(done);
+        pb.enable_steady_tick(Duration::from_millis(500));
+        let reveal = pb.clone();
+        std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_secs(1));
+            if !reveal.is_finished() {
+                reveal.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+        });
+        *self.bar.lock().unwrap_or_else(|e| e.into_inner()) = Some(pb);
+    }
+
+    fn advance(&self, done: u64) {
+        self.with(|pb| pb.set_position(done));
+    }
+
+    fn message(&self, text: &str) {
+        let mut shown = false;
+        self.with(|pb| {
+            pb.suspend(|| eprintln!("{text}"));
+            shown = true;
+        });
+        if !shown {
+            eprintln!("{text}");
+        }
+    }
+
+    fn warning(&self, text: &str) {
+        self.message(&format!("warning: {text}"));
+    }
+
+    fn end(&self) {
+        if let Some(pb) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            pb.finish_and_clear();
+        }
+    }
+}
+
+/// A control whose interrupt flag Ctrl-C sets; a second Ctrl-C stops at once.
+fn control(quiet: bool) -> Control {
+    let ctl = Control::new(Arc::new(Bar::new(quiet)));
+    let flag = ctl.interrupt_flag();
+    let _ = ctrlc::set_handler(move || {
+        if flag.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            eprintln!(
+                "\nsecond Ctrl-C: stopping without a checkpoint (the last regular one remains)"
+            );
+            std::process::exit(130);
+        }
+    });
+    ctl
+}
+
+fn scenario(path: &Path, overrides: &Overrides) -> Result<Scenario> {
+    Scenario::from_path(path)?.with_overrides(&overrides.set)
 }
 
 fn main() -> std::process::ExitCode {
@@ -125,17 +251,41 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// The error of an interrupted run, with the command that continues it.
+fn continue_hint(e: anyhow::Error) -> anyhow::Error {
+    match e.downcast_ref::<colloidsim_run::Interrupted>() {
+        Some(i) => anyhow::anyhow!(
+            "{i}. Continue with: colloidsim run --restart {}",
+            shell_word(&i.out.display().to_string())
+        ),
+        None => e,
+    }
+}
+
+/// `s` quoted for a POSIX shell when it needs it.
+fn shell_word(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=+,:@%".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
 fn run_cli() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run {
-            scenario,
+            scenario: path,
             out,
             seed,
             threads,
             quiet,
             force,
             restart,
+            overrides,
         } => {
             if let Some(n) = threads {
                 if n == 0 {
@@ -146,64 +296,74 @@ fn run_cli() -> Result<()> {
                     .build_global()
                     .context("cannot start the thread pool")?;
             }
-            let (method, text) = read_scenario(&scenario)?;
-            let opts = RunOptions {
-                out: common::default_out(&scenario, out, ""),
-                seed,
-                quiet,
-                force,
-                restart,
-            };
-            match method.as_str() {
-                "bcd" | "bcd-chronological" => bcd_cmd::run(&scenario, &text, &opts),
-                "droplet-bd" => droplet::run(&scenario, &text, &opts),
-                "dpd" => dpd_cmd::run(&scenario, &text, &opts),
-                m => bail!(
-                    "{}: unknown method '{m}' (one of: bcd, bcd-chronological, droplet-bd, dpd)",
-                    scenario.display()
-                ),
+            let sc = path
+                .as_deref()
+                .map(|p| scenario(p, &overrides))
+                .transpose()?;
+            if sc.is_none() && !overrides.set.is_empty() {
+                bail!(
+                    "--set needs the scenario file: colloidsim run SCENARIO --set ... --restart DIR"
+                );
             }
+            let ctl = control(quiet);
+            let report = match (&restart, &sc) {
+                (Some(dir), _) => colloidsim_run::resume(dir, sc.as_ref(), seed, &ctl),
+                (None, Some(sc)) => colloidsim_run::run(sc, &RunOptions { out, seed, force }, &ctl),
+                (None, None) => unreachable!("clap requires a scenario without --restart"),
+            }
+            .map_err(continue_hint)?;
+            if !quiet {
+                println!("{}", report.message);
+            }
+            Ok(())
         }
         Command::Theory {
-            scenario,
+            scenario: path,
             out,
             dx,
             force,
             hydrodynamics,
+            overrides,
         } => {
-            let (method, text) = read_scenario(&scenario)?;
-            let out = common::default_out(&scenario, out, "-theory");
-            if hydrodynamics.is_some() && method != "droplet-bd" {
-                bail!("--hydrodynamics applies to droplet-bd scenarios only");
-            }
-            match method.as_str() {
-                "bcd" | "bcd-chronological" => bcd_cmd::theory(&scenario, &text, &out, dx, force),
-                "droplet-bd" => theory_droplet::theory(
-                    &scenario,
-                    &text,
-                    &out,
+            let sc = scenario(&path, &overrides)?;
+            let report = colloidsim_run::theory(
+                &sc,
+                &TheoryOptions {
+                    out,
                     dx,
                     force,
-                    hydrodynamics.as_deref(),
-                ),
-                m => bail!(
-                    "{}: method '{m}' has no theory counterpart",
-                    scenario.display()
-                ),
-            }
+                    hydrodynamics,
+                },
+                &control(false),
+            )?;
+            println!("{}", report.message);
+            Ok(())
         }
-        Command::Check { scenario } => {
-            let (method, text) = read_scenario(&scenario)?;
-            match method.as_str() {
-                "bcd" | "bcd-chronological" => bcd_cmd::check(&scenario, &text),
-                "droplet-bd" => droplet::check(&scenario, &text),
-                "dpd" => dpd_cmd::check(&scenario, &text),
-                m => bail!("{}: unknown method '{m}'", scenario.display()),
+        Command::Check {
+            scenario: path,
+            overrides,
+        } => {
+            let sc = scenario(&path, &overrides)?;
+            let checked = colloidsim_run::check(&sc)?;
+            for w in &checked.warnings {
+                eprintln!("warning: {w}");
             }
+            println!("{}", serde_json::to_string_pretty(&checked.resolved)?);
+            println!("scenario {} is valid", path.display());
+            Ok(())
+        }
+        Command::Keys { method, format } => {
+            let keys = colloidsim_run::keys(&method)?;
+            match format {
+                KeyFormat::Json => println!("{}", serde_json::to_string_pretty(&keys)?),
+                KeyFormat::Markdown => print!("{}", colloidsim_run::keys::markdown(&keys)),
+                KeyFormat::Text => print!("{}", colloidsim_run::keys::text(&keys)),
+            }
+            Ok(())
         }
         Command::Bench { which } => match which {
-            BenchKind::Bcd(args) => bcd_cmd::bench(&args),
-            BenchKind::Bd(args) => droplet::bench(&args),
+            BenchKind::Bcd(args) => bench_bcd::bench(&args),
+            BenchKind::Bd(args) => bench_bd::bench(&args),
             BenchKind::Dpd(args) => dpd_bench::bench(&args),
         },
     }

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::sync::Once;
 
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
 static REGISTER: Once = Once::new();
 
 fn register_font() {
@@ -44,8 +45,32 @@ const COLOURS: [RGBColor; 5] = [
     RGBColor(255, 127, 14),
 ];
 
-/// Draw `series` into a PNG at `path` (800x500 px).
+/// Draw `series` into a PNG at `path` (800x500 px). The picture is drawn under a temporary
+/// name and renamed into place, so a failed or interrupted drawing never leaves a truncated
+/// picture under the final name.
 pub fn line_plot(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    scale: Scale,
+) -> Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // The extension stays .png: the encoder is chosen by it.
+    let tmp = path.with_file_name(format!(".{name}.partial.png"));
+    let drawn = draw_line_plot(&tmp, title, xlabel, ylabel, series, scale)
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
+    if drawn.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+}
+
+fn draw_line_plot(
     path: &Path,
     title: &str,
     xlabel: &str,
@@ -66,7 +91,7 @@ pub fn line_plot(
         }
     }
     if xr.0 >= xr.1 {
-        return Err(anyhow!("plot {}: no finite data to draw", path.display()));
+        return Err(anyhow!("no finite data to draw"));
     }
     if yr.0 >= yr.1 {
         yr = (yr.0 - 1.0, yr.1 + 1.0);
@@ -142,4 +167,18 @@ pub fn line_plot(
     }
     root.present().map_err(|e| anyhow!("plot: {e}"))?;
     Ok(())
+}
+
+/// A picture is a companion of the data: when it cannot be drawn (say, no finite value), the
+/// run's tables stand and a warning says so; `name` joins `files` only when it was written.
+pub fn picture(
+    result: Result<()>,
+    name: &str,
+    files: &mut Vec<String>,
+    warnings: &mut Vec<String>,
+) {
+    match result {
+        Ok(()) => files.push(name.to_string()),
+        Err(e) => warnings.push(format!("{name} not drawn: {e:#}")),
+    }
 }

@@ -1,48 +1,148 @@
-//! `colloidsim run|theory|check|bench` for Brownian cluster dynamics scenarios.
+//! Brownian cluster dynamics scenarios (`method = "bcd"`, `"bcd-chronological"`): the run's
+//! session (engine, observers on their triggers, GSD frames), its outputs beside the exact
+//! theory, and `theory`.
 
-use crate::common::{RunOptions, progress};
-use crate::plot::{Scale, Series, line_plot};
+use crate::checkpoint::Envelope;
+use crate::control::Control;
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot, picture};
+use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
-use colloidsim_bcd::forces::{NoField, NoPair};
+use colloidsim_bcd::forces::{ExternalForce, NoPair, PairForce};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
 use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
-use colloidsim_bcd::{Bcd, BcdConfig, BcdState, Boundary, Update, init};
-use colloidsim_core::field1d::{ExternalField, FieldTerm};
+use colloidsim_bcd::{Bcd, BcdState, Boundary};
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-const CHECKPOINT: &str = "checkpoint.bin";
+/// The BCD family of scenarios.
+pub struct BcdMethod;
 
-fn parse(path: &Path, text: &str) -> Result<Scenario> {
-    toml::from_str(text).with_context(|| format!("scenario {}", path.display()))
+fn parse(src: &Source) -> Result<Scenario> {
+    toml::from_str(src.text()).with_context(|| src.label())
 }
 
-fn resolve(path: &Path, sc: &Scenario, seed: Option<u64>) -> Result<Resolved> {
-    let base = path.parent().unwrap_or(Path::new("."));
-    sc.resolve(base, seed)
-        .with_context(|| format!("scenario {}", path.display()))
+fn resolve(src: &Source, sc: &Scenario, seed: Option<u64>) -> Result<Resolved> {
+    sc.resolve(src.base(), seed).with_context(|| src.label())
 }
 
-/// `colloidsim check`: validate and print the resolved parameters.
-pub fn check(path: &Path, text: &str) -> Result<()> {
-    let sc = parse(path, text)?;
-    let r = resolve(path, &sc, None)?;
-    for w in &r.warnings {
-        eprintln!("warning: {w}");
+impl Method for BcdMethod {
+    fn names(&self) -> &'static [&'static str] {
+        &["bcd", "bcd-chronological"]
     }
-    // Building the engine checks the initial positions (overlaps, walls).
-    Bcd::new(r.config.clone(), r.initial.clone(), NoField, NoPair)
-        .with_context(|| format!("scenario {}", path.display()))?;
-    println!("{}", serde_json::to_string_pretty(&resolved_json(&sc, &r))?);
-    println!("scenario {} is valid", path.display());
-    Ok(())
+
+    fn about(&self) -> &'static str {
+        "1D Brownian cluster dynamics of hard and sticky rods, beside the exact theory"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/bcd.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let sc = parse(src)?;
+        let r = resolve(src, &sc, None)?;
+        // Building the engine checks the initial positions (overlaps, walls).
+        Bcd::new(r.config.clone(), r.initial.clone(), Field::None, NoPair)
+            .with_context(|| src.label())?;
+        Ok(Checked {
+            resolved: resolved_json(&sc, &r),
+            warnings: r.warnings.clone(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let sc = parse(src)?;
+        let r = resolve(src, &sc, seed)?;
+        session(sc, r, None)
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        _out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let sc = parse(src)?;
+        let r = resolve(src, &sc, Some(seed))?;
+        let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        session(sc, r, Some(saved))
+    }
+
+    fn has_theory(&self) -> bool {
+        true
+    }
+
+    fn theory(&self, src: &Source, opts: &TheoryOptions, _ctl: &Control) -> Result<Report> {
+        theory(src, opts)
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::bcd()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let sc = parse(src)?;
+        let r = resolve(src, &sc, seed)?;
+        let bcd = Bcd::new(
+            r.config.clone(),
+            r.initial.clone(),
+            r.engine_field.clone(),
+            r.pair.clone(),
+        )?;
+        Ok(Box::new(BcdEngine {
+            bcd,
+            method: sc.method,
+        }))
+    }
+}
+
+/// The session of a scenario, fresh or from a checkpoint's state, with the engine specialised
+/// for the pair force present (hard rods: no pair loop at all).
+fn session(sc: Scenario, r: Resolved, saved: Option<Saved>) -> Result<Box<dyn Session>> {
+    if r.pair.range() > 0.0 {
+        let pair = r.pair.clone();
+        build(sc, r, pair, saved)
+    } else {
+        build(sc, r, NoPair, saved)
+    }
+}
+
+fn build<P: PairForce + Clone + Send + 'static>(
+    sc: Scenario,
+    r: Resolved,
+    pair: P,
+    saved: Option<Saved>,
+) -> Result<Box<dyn Session>> {
+    let field = r.engine_field.clone();
+    let (bcd, obs, frames) = match saved {
+        Some(s) => (
+            Bcd::from_state(r.config.clone(), s.state, field, pair)?,
+            s.observers,
+            s.frames,
+        ),
+        None => (
+            Bcd::new(r.config.clone(), r.initial.clone(), field, pair)?,
+            observers(&sc, &r),
+            0,
+        ),
+    };
+    let triggers = Triggers::of(&sc, &r);
+    Ok(Box::new(BcdSession {
+        sc,
+        r,
+        bcd,
+        obs,
+        frames,
+        gsd: None,
+        triggers,
+    }))
 }
 
 fn resolved_json(sc: &Scenario, r: &Resolved) -> serde_json::Value {
@@ -94,14 +194,12 @@ struct Observers {
     current: Option<Current>,
 }
 
+/// The method's part of `checkpoint.bin`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-struct Checkpoint {
-    version: String,
-    scenario: String,
-    seed: u64,
+struct Saved {
     state: BcdState,
     observers: Observers,
-    wall_seconds: f64,
+    /// Frames in trajectory.gsd.
     frames: u64,
 }
 
@@ -134,188 +232,234 @@ fn observers(sc: &Scenario, r: &Resolved) -> Observers {
     }
 }
 
-/// `colloidsim run` for BCD scenarios.
-pub fn run(path: &Path, text: &str, opts: &RunOptions) -> Result<()> {
-    let sc = parse(path, text)?;
-    let r = resolve(path, &sc, opts.seed)?;
-    for w in &r.warnings {
-        eprintln!("warning: {w}");
-    }
-    let (out, ckpt) = match &opts.restart {
-        Some(dir) => {
-            let out = OutputDir::reopen(dir)?;
-            let bytes = std::fs::read(out.join(CHECKPOINT)).with_context(|| {
-                format!(
-                    "--restart {}: no {CHECKPOINT} to continue from",
-                    dir.display()
-                )
-            })?;
-            crate::common::check_checkpoint_version(&bytes, &out.join(CHECKPOINT))?;
-            let ck: Checkpoint = bincode::deserialize(&bytes)
-                .with_context(|| format!("{}: unreadable checkpoint", dir.display()))?;
-            if ck.scenario != text {
-                bail!(
-                    "--restart {}: the scenario differs from the one this run started with (saved as {}/scenario.toml)",
-                    dir.display(),
-                    dir.display()
-                );
-            }
-            if ck.seed != r.config.seed as u64 {
-                bail!(
-                    "--restart: seed {} differs from the checkpoint's {}",
-                    r.config.seed,
-                    ck.seed
-                );
-            }
-            (out, Some(ck))
+/// When observations are due, in steps.
+#[derive(Debug, Clone, Copy)]
+struct Triggers {
+    /// Steps before sampling starts.
+    equilibrate: u64,
+    total: u64,
+    /// Density, contact density and clusters: every this many sampled steps.
+    every: u64,
+    /// The particle current: every this many sampled steps.
+    current_every: u64,
+    /// GSD frames: every this many steps (of the whole run).
+    trajectory: Option<u64>,
+    /// Regular checkpoints.
+    checkpoint_every: u64,
+}
+
+impl Triggers {
+    fn of(sc: &Scenario, r: &Resolved) -> Self {
+        let total = r.equilibrate_steps + r.sampled_steps;
+        Self {
+            equilibrate: r.equilibrate_steps,
+            total,
+            every: sc.observe.every.unwrap_or(1),
+            current_every: (r.sampled_steps / 200).max(1),
+            trajectory: sc.observe.trajectory.as_ref().map(|t| t.every),
+            checkpoint_every: sc.run.checkpoint_every.unwrap_or((total / 10).max(1000)),
         }
-        None => {
-            let out = OutputDir::create(&opts.out, opts.force)?;
-            out.write_bytes("scenario.toml", text.as_bytes())?;
-            (out, None)
-        }
-    };
-    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
-    match (&r.engine_field, r.pair.range() > 0.0) {
-        (Field::None, false) => simulate(&sc, &r, &out, ckpt, opts, Field::None, NoPair),
-        (f, false) => simulate(&sc, &r, &out, ckpt, opts, f.clone(), NoPair),
-        (f, true) => simulate(&sc, &r, &out, ckpt, opts, f.clone(), r.pair.clone()),
     }
 }
 
-use colloidsim_bcd::forces::PairForce;
+/// First multiple of `m` strictly after `s`.
+fn next_multiple_after(s: u64, m: u64) -> u64 {
+    (s / m + 1) * m
+}
 
-fn simulate<P: PairForce + Clone>(
-    sc: &Scenario,
-    r: &Resolved,
-    out: &OutputDir,
-    ckpt: Option<Checkpoint>,
-    opts: &RunOptions,
-    field: Field,
-    pair: P,
-) -> Result<()> {
-    let cfg = r.config.clone();
-    let n = r.initial.len();
-    let (mut bcd, mut obs, mut wall_before, mut frames) = match ckpt {
-        Some(ck) => (
-            Bcd::from_state(cfg.clone(), ck.state, field, pair)?,
-            ck.observers,
-            ck.wall_seconds,
-            ck.frames,
-        ),
-        None => (
-            Bcd::new(cfg.clone(), r.initial.clone(), field, pair)?,
-            observers(sc, r),
-            0.0,
-            0,
-        ),
-    };
-    let total = r.equilibrate_steps + r.sampled_steps;
-    let every = sc.observe.every.unwrap_or(1);
-    let ck_every = sc.run.checkpoint_every.unwrap_or((total / 10).max(1000));
-    let current_every = (r.sampled_steps / 200).max(1);
-    let traj_every = sc.observe.trajectory.as_ref().map(|t| t.every);
-    let mut gsd = match traj_every {
-        Some(_) => Some(open_trajectory(out, frames > 0 || bcd.steps() > 0)?),
-        None => None,
-    };
-    // Test hook: behave as if Ctrl-C arrived at this step.
-    let stop_at: Option<u64> = std::env::var("COLLOIDSIM_INTERRUPT_AT_STEP")
-        .ok()
-        .and_then(|v| v.parse().ok());
-    let pb = progress(total, opts.quiet, "bcd");
-    pb.set_position(bcd.steps());
-    let start = Instant::now();
-    // Checkpoint: flush the trajectory first, so that the file holds every frame the state knows.
-    let save = |bcd: &Bcd<Field, P>,
-                obs: &Observers,
-                gsd: &mut Option<hoomd_gsd::hoomd::HoomdGsdFile>,
-                wall: f64,
-                frames: u64|
-     -> Result<()> {
-        if let Some(g) = gsd.as_mut() {
-            g.sync_all()?;
+/// A BCD run: the engine, its observers and the trajectory file.
+struct BcdSession<P: PairForce> {
+    sc: Scenario,
+    r: Resolved,
+    bcd: Bcd<Field, P>,
+    obs: Observers,
+    frames: u64,
+    gsd: Option<hoomd_gsd::hoomd::HoomdGsdFile>,
+    triggers: Triggers,
+}
+
+impl<P: PairForce + Clone + Send> BcdSession<P> {
+    /// The first step after `s` at which an observation is due.
+    fn next_observation(&self, s: u64) -> u64 {
+        let t = &self.triggers;
+        let o = &self.obs;
+        let mut next = t.total;
+        if let Some(e) = t.trajectory {
+            next = next.min(next_multiple_after(s, e));
         }
-        let ck = Checkpoint {
-            version: crate::common::checkpoint_version(),
-            scenario: std::fs::read_to_string(out.join("scenario.toml"))?,
-            seed: cfg.seed as u64,
-            state: bcd.state().clone(),
-            observers: obs.clone(),
-            wall_seconds: wall,
-            frames,
-        };
-        out.write_bytes(CHECKPOINT, &bincode::serialize(&ck)?)?;
-        Ok(())
-    };
-    // The steps run on a worker of the thread pool, so that each step's chunks start without a
-    // hand-over from this thread (see `Bcd::run`).
-    rayon::scope(|_| -> Result<()> {
-        while bcd.steps() < total {
-            if stop_at == Some(bcd.steps()) {
-                INTERRUPTED.store(true, Ordering::SeqCst);
+        if s < t.equilibrate {
+            if o.current.is_some() {
+                next = next.min(t.equilibrate);
             }
-            if INTERRUPTED.load(Ordering::Relaxed) {
-                let wall = wall_before + start.elapsed().as_secs_f64();
-                save(&bcd, &obs, &mut gsd, wall, frames)?;
-                pb.abandon();
-                bail!(
-                    "interrupted at step {}; checkpoint written. Continue with: colloidsim run SCENARIO --restart {}",
-                    bcd.steps(),
-                    out.path().display()
-                );
-            }
-            bcd.step()?;
-            let s = bcd.steps();
-            if s > r.equilibrate_steps {
-                let k = s - r.equilibrate_steps;
-                let x = bcd.positions();
-                if k.is_multiple_of(every) {
-                    if let Some(d) = obs.density.as_mut() {
+            // Sampling starts after equilibration: the first sampled step is equilibrate + 1.
+            return next.min(t.equilibrate + 1);
+        }
+        let k = s - t.equilibrate;
+        if o.density.is_some() || o.contact.is_some() || o.clusters.is_some() {
+            next = next.min(t.equilibrate + next_multiple_after(k, t.every));
+        }
+        if o.current.is_some() {
+            next = next.min(t.equilibrate + next_multiple_after(k, t.current_every));
+        }
+        if let Some(m) = &o.msd {
+            // The MSD is offered sampled step k' - 1 at step equilibrate + k'.
+            next = next.min(t.equilibrate + m.next_due(k) + 1);
+        }
+        next
+    }
+
+    /// Take the observations due at step `s` (just reached).
+    fn observe(&mut self, s: u64) -> Result<()> {
+        let t = self.triggers;
+        let n = self.r.initial.len() as f64;
+        let dt = self.r.config.dt;
+        if s > t.equilibrate {
+            let k = s - t.equilibrate;
+            let every = k.is_multiple_of(t.every);
+            let msd = self
+                .obs
+                .msd
+                .as_ref()
+                .is_some_and(|m| m.next_due(k - 1) == k - 1);
+            let current = self.obs.current.is_some() && k.is_multiple_of(t.current_every);
+            if every || msd || current {
+                let x = self.bcd.positions();
+                if every {
+                    if let Some(d) = self.obs.density.as_mut() {
                         d.sample(x);
                     }
-                    if let Some(c) = obs.contact.as_mut() {
+                    if let Some(c) = self.obs.contact.as_mut() {
                         c.sample(x);
                     }
-                    if let Some(c) = obs.clusters.as_mut() {
-                        c.sample(&bcd);
+                    if let Some(c) = self.obs.clusters.as_mut() {
+                        c.sample(&self.bcd);
                     }
                 }
-                if let Some(m) = obs.msd.as_mut() {
+                if msd && let Some(m) = self.obs.msd.as_mut() {
                     m.sample(k - 1, x);
                 }
-                if let Some(c) = obs.current.as_mut()
-                    && k.is_multiple_of(current_every)
-                {
-                    c.t.push(k as f64 * cfg.dt);
-                    c.displacement
-                        .push(x.iter().sum::<f64>() / n as f64 - c.x0_sum);
+                if current && let Some(c) = self.obs.current.as_mut() {
+                    c.t.push(k as f64 * dt);
+                    c.displacement.push(x.iter().sum::<f64>() / n - c.x0_sum);
                 }
-            } else if s == r.equilibrate_steps
-                && let Some(c) = obs.current.as_mut()
-            {
-                c.x0_sum = bcd.positions().iter().sum::<f64>() / n as f64;
             }
-            if let (Some(g), Some(e)) = (gsd.as_mut(), traj_every)
-                && s.is_multiple_of(e)
-            {
-                write_frame(g, &bcd)?;
-                frames += 1;
-            }
-            if s.is_multiple_of(ck_every) && s < total {
-                let wall = wall_before + start.elapsed().as_secs_f64();
-                save(&bcd, &obs, &mut gsd, wall, frames)?;
-            }
-            if s.is_multiple_of(256) {
-                pb.set_position(s);
-            }
+        } else if s == t.equilibrate
+            && let Some(c) = self.obs.current.as_mut()
+        {
+            c.x0_sum = self.bcd.positions().iter().sum::<f64>() / n;
+        }
+        if let (Some(g), Some(e)) = (self.gsd.as_mut(), t.trajectory)
+            && s.is_multiple_of(e)
+        {
+            write_frame(g, &self.bcd)?;
+            self.frames += 1;
         }
         Ok(())
-    })?;
-    pb.finish_and_clear();
-    wall_before += start.elapsed().as_secs_f64();
-    save(&bcd, &obs, &mut gsd, wall_before, frames)?;
-    write_outputs(sc, r, out, &bcd, &obs, wall_before, frames)
+    }
+}
+
+impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
+    fn label(&self) -> String {
+        "bcd".into()
+    }
+
+    fn total(&self) -> u64 {
+        self.triggers.total
+    }
+
+    fn position(&self) -> u64 {
+        self.bcd.steps()
+    }
+
+    fn seed(&self) -> u64 {
+        self.r.config.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        resolved_json(&self.sc, &self.r)
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        self.r.warnings.clone()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        [
+            "final_configuration.csv",
+            "density.csv",
+            "density_theory.csv",
+            "density.png",
+            "contact_density.csv",
+            "contact_density_theory.csv",
+            "msd.csv",
+            "msd.png",
+            "current.csv",
+            "clusters.csv",
+            "trajectory.gsd",
+        ]
+        .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, _fresh: bool) -> Result<()> {
+        if self.triggers.trajectory.is_some() {
+            self.gsd = Some(open_trajectory(
+                out,
+                self.frames > 0 || self.bcd.steps() > 0,
+            )?);
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        Some(next_multiple_after(
+            self.bcd.steps(),
+            self.triggers.checkpoint_every,
+        ))
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        while self.bcd.steps() < until {
+            let s = self.bcd.steps();
+            let next = self.next_observation(s).min(until);
+            if let Err(e) = self.bcd.run(next - s) {
+                return Ok(Some(e.to_string()));
+            }
+            self.observe(next)?;
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(g) = self.gsd.as_mut() {
+            g.sync_all()?;
+        }
+        Ok(())
+    }
+
+    fn save(&mut self, _out: &OutputDir) -> Result<Vec<u8>> {
+        Ok(bincode::serialize(&Saved {
+            state: self.bcd.state().clone(),
+            observers: self.obs.clone(),
+            frames: self.frames,
+        })?)
+    }
+
+    fn finish(
+        self: Box<Self>,
+        out: &OutputDir,
+        wall_seconds: f64,
+        _failure: Option<&str>,
+    ) -> Result<Finished> {
+        write_outputs(
+            &self.sc,
+            &self.r,
+            out,
+            &self.bcd,
+            &self.obs,
+            wall_seconds,
+            self.frames,
+        )
+    }
 }
 
 fn open_trajectory(out: &OutputDir, append: bool) -> Result<hoomd_gsd::hoomd::HoomdGsdFile> {
@@ -331,7 +475,7 @@ fn open_trajectory(out: &OutputDir, append: bool) -> Result<hoomd_gsd::hoomd::Ho
 /// wrapped into [-L/2, L/2); the unwrapped positions go to `log/particles/x_unwrapped`.
 fn write_frame<E, P>(g: &mut hoomd_gsd::hoomd::HoomdGsdFile, bcd: &Bcd<E, P>) -> Result<()>
 where
-    E: colloidsim_bcd::forces::ExternalForce,
+    E: ExternalForce,
     P: PairForce,
 {
     let c = bcd.config();
@@ -350,6 +494,48 @@ where
     Ok(())
 }
 
+/// A BCD engine stepped by hand.
+struct BcdEngine {
+    bcd: Bcd<Field, colloidsim_bcd::scenario::Pair>,
+    method: String,
+}
+
+impl crate::Engine for BcdEngine {
+    fn method(&self) -> &str {
+        &self.method
+    }
+    fn dimensions(&self) -> usize {
+        1
+    }
+    fn particles(&self) -> usize {
+        self.bcd.len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        Ok(self.bcd.run(steps)?)
+    }
+    fn steps(&self) -> u64 {
+        self.bcd.steps()
+    }
+    fn time(&self) -> f64 {
+        self.bcd.time()
+    }
+    fn dt(&self) -> f64 {
+        self.bcd.config().dt
+    }
+    fn positions(&self) -> Vec<f64> {
+        self.bcd.positions().to_vec()
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        None
+    }
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(self.bcd.systematic_forces())
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        vec![self.bcd.config().length]
+    }
+}
+
 fn write_outputs<E, P>(
     sc: &Scenario,
     r: &Resolved,
@@ -358,24 +544,21 @@ fn write_outputs<E, P>(
     obs: &Observers,
     wall: f64,
     frames: u64,
-) -> Result<()>
+) -> Result<Finished>
 where
-    E: colloidsim_bcd::forces::ExternalForce,
+    E: ExternalForce,
     P: PairForce,
 {
     let c = &r.config;
     let n = r.initial.len();
-    let mut files = vec![
-        "scenario.toml".to_string(),
-        CHECKPOINT.to_string(),
-        "final_configuration.csv".to_string(),
-    ];
+    let mut warnings = Vec::new();
+    let mut files = vec!["final_configuration.csv".to_string()];
     out.write_table("final_configuration.csv", &[("x", bcd.positions())])?;
     // The theory is a companion: if it fails, the simulation's outputs are still written.
     let (theory, theory_error) = match equilibrium_counterpart(sc, r, None, obs) {
         Ok(t) => (t, None),
         Err(e) => {
-            eprintln!("warning: no theory curve: {e:#}");
+            warnings.push(format!("no theory curve: {e:#}"));
             (None, Some(format!("{e:#}")))
         }
     };
@@ -399,18 +582,22 @@ where
                 points: false,
             });
         }
-        line_plot(
-            &out.join("density.png"),
-            &format!(
-                "density profile, N = {n}, L = {}, sigma = {}",
-                c.length, c.sigma
+        picture(
+            line_plot(
+                &out.join("density.png"),
+                &format!(
+                    "density profile, N = {n}, L = {}, sigma = {}",
+                    c.length, c.sigma
+                ),
+                "x",
+                "rho(x)",
+                &series,
+                Scale::Linear,
             ),
-            "x",
-            "rho(x)",
-            &series,
-            Scale::Linear,
-        )?;
-        files.push("density.png".into());
+            "density.png",
+            &mut files,
+            &mut warnings,
+        );
     }
     if let Some(cd) = &obs.contact {
         let (x, rho2) = cd.profile();
@@ -465,15 +652,19 @@ where
                     points: false,
                 });
             }
-            line_plot(
-                &out.join("msd.png"),
-                "mean-square displacement",
-                "t",
-                "MSD",
-                &series,
-                Scale::LogLog,
-            )?;
-            files.push("msd.png".into());
+            picture(
+                line_plot(
+                    &out.join("msd.png"),
+                    "mean-square displacement",
+                    "t",
+                    "MSD",
+                    &series,
+                    Scale::LogLog,
+                ),
+                "msd.png",
+                &mut files,
+                &mut warnings,
+            );
         }
     }
     let mut mean_velocity = None;
@@ -508,7 +699,7 @@ where
     }
     let steps = bcd.steps();
     let summary = json!({
-        "software": format!("colloidsim {}", env!("CARGO_PKG_VERSION")),
+        "software": crate::software(),
         "method": sc.method,
         "seed": c.seed,
         "parameters": resolved_json(sc, r),
@@ -521,16 +712,20 @@ where
         "particle_current": mean_velocity.map(|v| v * n as f64 / c.length),
         "theory": theory.as_ref().map(|(_, _)| "density_theory.csv: exact equilibrium (colloidsim theory) on the same bins"),
         "theory_error": theory_error,
-        "files": files,
+        "warnings": warnings,
     });
-    out.write_json("summary.json", &summary)?;
-    println!(
+    let message = format!(
         "{} steps of {n} rods in {wall:.2} s ({:.3e} particle-steps/s); outputs in {}",
         steps,
         (steps as f64 * n as f64) / wall.max(1e-9),
         out.path().display()
     );
-    Ok(())
+    Ok(Finished {
+        summary,
+        files,
+        message,
+        warnings,
+    })
 }
 
 /// The exact equilibrium profile averaged over the scenario's density bins, when the scenario
@@ -574,9 +769,10 @@ fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
 }
 
 /// `colloidsim theory`: the exact equilibrium of a BCD scenario on the simulation's bins.
-pub fn theory(path: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool) -> Result<()> {
-    let sc = parse(path, text)?;
-    let r = resolve(path, &sc, None)?;
+fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
+    let sc = parse(src)?;
+    let r = resolve(src, &sc, None)?;
+    let dx = opts.dx;
     let c = &r.config;
     if r.field.drive != 0.0 {
         bail!(
@@ -598,7 +794,11 @@ pub fn theory(path: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool)
     let start = Instant::now();
     let eq = solve_theory(&r, dx)?;
     let wall = start.elapsed().as_secs_f64();
-    let outdir = OutputDir::create(out, force)?;
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
+    let outdir = OutputDir::create(&out, opts.force)?;
     let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
     let b = eq.bin_average(bins, r.period)?;
     let mut files = vec!["density.csv"];
@@ -627,24 +827,28 @@ pub fn theory(path: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool)
         ],
     )?;
     files.push("profile_grid.csv");
-    line_plot(
-        &outdir.join("density.png"),
-        &format!("exact equilibrium density, sigma = {}", c.sigma),
-        "x",
-        "rho(x)",
-        &[Series {
-            label: "exact theory",
-            x: &eq.x,
-            y: &eq.rho,
-            points: false,
-        }],
-        Scale::Linear,
-    )?;
-    files.push("density.png");
-    outdir.write_json(
-        "summary.json",
-        &json!({
-            "software": format!("colloidsim {}", env!("CARGO_PKG_VERSION")),
+    let mut files: Vec<String> = files.into_iter().map(String::from).collect();
+    let mut warnings = Vec::new();
+    picture(
+        line_plot(
+            &outdir.join("density.png"),
+            &format!("exact equilibrium density, sigma = {}", c.sigma),
+            "x",
+            "rho(x)",
+            &[Series {
+                label: "exact theory",
+                x: &eq.x,
+                y: &eq.rho,
+                points: false,
+            }],
+            Scale::Linear,
+        ),
+        "density.png",
+        &mut files,
+        &mut warnings,
+    );
+    let summary = json!({
+            "software": crate::software(),
             "method": "exact 1D density functional (Percus hard rods / Baxter sticky rods)",
             "parameters": resolved_json(&sc, &r),
             "dx": eq.dx,
@@ -657,9 +861,10 @@ pub fn theory(path: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool)
             "beta_mu": eq.beta_mu,
             "wall_seconds": wall,
             "files": files,
-        }),
-    )?;
-    println!(
+            "warnings": warnings,
+    });
+    outdir.write_json("summary.json", &summary)?;
+    let message = format!(
         "exact equilibrium: {} grid points, residual {:.2e} after {} iterations in {:.3} s; outputs in {}",
         eq.x.len(),
         eq.residual,
@@ -667,110 +872,20 @@ pub fn theory(path: &Path, text: &str, out: &Path, dx: Option<f64>, force: bool)
         wall,
         outdir.path().display()
     );
-    Ok(())
-}
-
-/// Arguments of `colloidsim bench bcd`.
-#[derive(clap::Args)]
-pub struct BenchArgs {
-    /// Particle numbers for the premerging update.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "1000,10000,100000,1000000"
-    )]
-    pub n: Vec<usize>,
-    /// Particle numbers for the chronological update (O(N^2)); 0 skips it.
-    #[arg(long, value_delimiter = ',', default_value = "100,300,1000,3000,10000")]
-    pub chronological: Vec<usize>,
-    /// Particle-steps per measurement (steps = this / N, at least 20).
-    #[arg(long, default_value_t = 20_000_000)]
-    pub work: u64,
-    /// Repetitions; the median is reported.
-    #[arg(long, default_value_t = 5)]
-    pub repeats: usize,
-}
-
-fn rss_bytes() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/self/statm").ok()?;
-    let pages: f64 = s.split_whitespace().nth(1)?.parse().ok()?;
-    Some(pages * 4096.0)
-}
-
-/// `colloidsim bench bcd`: the fast-bcd scaling case (sigma = 0.99, U0 = 6 kT, density 1 per
-/// wavelength, dt = 1e-3, periodic), nanoseconds per particle-step.
-pub fn bench(a: &BenchArgs) -> Result<()> {
-    let field = ExternalField {
-        terms: vec![FieldTerm::Cosine {
-            amplitude: 6.0,
-            wavelength: 1.0,
-        }],
-        drive: 0.0,
-    };
-    // The force as `colloidsim run` evaluates this field.
-    let force = Field::new(&field);
-    println!(
-        "# colloidsim bench bcd: sigma = 0.99, U0 = 6 kT, rho = 1, dt = 1e-3, periodic; {} threads, median of {}",
-        rayon::current_num_threads(),
-        a.repeats
-    );
-    println!("method\tN\tsteps\tns_per_particle_step\tmin\tmax\tRSS_bytes_per_particle");
-    let run = |n: usize, update: Update| -> Result<()> {
-        let cfg = BcdConfig {
-            length: n as f64,
-            sigma: 0.99,
-            mobility: 1.0,
-            kt: 1.0,
-            dt: 1e-3,
-            boundary: Boundary::Periodic,
-            seed: 1,
-            update,
-        };
-        let steps = (a.work / n as u64).max(20);
-        let mut times = Vec::new();
-        let mut mem = f64::NAN;
-        let x0 = init::lattice(&cfg, n)?;
-        for rep in 0..a.repeats.max(1) {
-            let before = rss_bytes();
-            let mut b = Bcd::new(cfg.clone(), x0.clone(), force.clone(), NoPair)?;
-            b.run(steps.min(50))?; // warm-up: clusters form, buffers reach their size
-            let t = Instant::now();
-            b.run(steps)?;
-            times.push(t.elapsed().as_secs_f64() * 1e9 / (steps as f64 * n as f64));
-            if rep == 0
-                && let (Some(b0), Some(b1)) = (before, rss_bytes())
-            {
-                mem = (b1 - b0) / n as f64;
-            }
-            drop(b);
-        }
-        times.sort_by(f64::total_cmp);
-        let name = match update {
-            Update::Premerge => "premerge",
-            Update::Chronological => "chronological",
-        };
-        println!(
-            "{name}\t{n}\t{steps}\t{:.2}\t{:.2}\t{:.2}\t{:.0}",
-            times[times.len() / 2],
-            times[0],
-            times[times.len() - 1],
-            mem
-        );
-        Ok(())
-    };
-    // A 0 in a list skips that method.
-    for &n in a.n.iter().filter(|&&n| n > 0) {
-        run(n, Update::Premerge)?;
-    }
-    for &n in a.chronological.iter().filter(|&&n| n > 0) {
-        run(n, Update::Chronological)?;
-    }
-    Ok(())
+    Ok(Report {
+        out: outdir.path().to_path_buf(),
+        summary,
+        files,
+        warnings,
+        message,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use colloidsim_bcd::forces::NoField;
+    use colloidsim_bcd::{BcdConfig, Update, init};
 
     /// Engine states round-trip through the checkpoint encoding bit for bit, with and without
     /// the ring update's reduced coordinates (bincode is not self-describing, so every field

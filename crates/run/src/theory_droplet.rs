@@ -22,8 +22,9 @@ use colloidsim_dft::radial::{
 };
 use colloidsim_md::droplet::{DropletParams, DropletScenario};
 
-use crate::common;
+use crate::control::Control;
 use crate::plot::{self, Scale, Series};
+use crate::{Report, Scenario as Source, TheoryOptions};
 
 /// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,
 /// more when the fraction needs them).
@@ -83,20 +84,11 @@ fn parse_hydrodynamics(h: Option<&str>) -> Result<Hydrodynamics> {
 }
 
 /// `colloidsim theory SCENARIO` for a drying droplet.
-pub fn theory(
-    scenario: &Path,
-    text: &str,
-    out: &Path,
-    dx: Option<f64>,
-    force: bool,
-    hydrodynamics: Option<&str>,
-) -> Result<()> {
-    let hydro = parse_hydrodynamics(hydrodynamics)?;
-    let sc =
-        DropletScenario::from_toml(text).map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
-    let p = sc
-        .validate()
-        .map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
+pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
+    let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref())?;
+    let dx = topts.dx;
+    let sc = DropletScenario::from_toml(src.text()).map_err(|e| anyhow!("{}: {e}", src.label()))?;
+    let p = sc.validate().map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let dr = grid_spacing(&p, dx)?;
     // Output times of the BD run (`step * dt`, the last one up to dt past t_end), in ascending
     // order (fractions may be listed in any order).
@@ -111,13 +103,18 @@ pub fn theory(
     };
     setup
         .validate()
-        .map_err(|e| anyhow!("{}: {e}", scenario.display()))?;
+        .map_err(|e| anyhow!("{}: {e}", src.label()))?;
 
-    let dir = OutputDir::create(out, force)
+    let out = topts
+        .out
+        .clone()
+        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
+    let dir = OutputDir::create(&out, topts.force)
         .with_context(|| format!("cannot use output folder {}", out.display()))?;
     let opts = DdftOptions::new(p.d0, p.diameter);
     let eq_opts = EquilibriumOptions::default();
-    let pb = common::progress(1000, false, "theory");
+    let pb = ctl.progress();
+    pb.begin("theory", 1000, 0);
     let vp = PI * p.diameter.powi(3) / 6.0;
     let mut written: Vec<Written> = Vec::new();
     let mut write_err: Option<anyhow::Error> = None;
@@ -163,9 +160,9 @@ pub fn theory(
                 })),
             }
         },
-        |rep| pb.set_position((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
+        |rep| pb.advance((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
     );
-    pb.finish_and_clear();
+    pb.end();
     let wall = start.elapsed().as_secs_f64();
     if let Some(e) = write_err {
         return Err(e);
@@ -184,6 +181,7 @@ pub fn theory(
             Hydrodynamics::Rpy => "rpy (pairwise RPY flux, dilute pair correlation)",
         },
         "software_version": env!("CARGO_PKG_VERSION"),
+        "software": crate::software(),
         "status": status,
         "message": message,
         "parameters": p,
@@ -207,22 +205,32 @@ pub fn theory(
         "wall_seconds": wall,
     });
     dir.write_json("summary.json", &summary)?;
+    let mut files: Vec<String> = written.iter().map(|w| profile_name(w.fraction)).collect();
+    let mut warnings = Vec::new();
     if !written.is_empty() {
         let tag = match hydro {
             Hydrodynamics::FreeDraining => "free-draining",
             Hydrodynamics::Rpy => "RPY",
         };
-        draw(scenario, &dir, &written, tag)?;
+        plot::picture(
+            draw(Path::new(src.name()), &dir, &written, tag),
+            "profiles.png",
+            &mut files,
+            &mut warnings,
+        );
     }
     match result {
-        Ok(_) => {
-            println!(
+        Ok(_) => Ok(Report {
+            out: dir.path().to_path_buf(),
+            summary,
+            files,
+            warnings,
+            message: format!(
                 "theory: {} profiles in {} ({wall:.1} s)",
                 written.len(),
                 dir.path().display()
-            );
-            Ok(())
-        }
+            ),
+        }),
         Err(e) => bail!(
             "theory stopped after {} of {} profiles: {e}",
             written.len(),
@@ -267,7 +275,7 @@ fn write_snapshot(
 }
 
 /// `profiles.png`: theory lines, BD points from the run folder (`<scenario stem>/`) when present.
-fn draw(scenario: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Result<()> {
+fn draw(run_dir: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Result<()> {
     let labels: Vec<String> = written
         .iter()
         .map(|w| format!("DDFT {:.0}%", 100.0 * w.fraction))
@@ -282,7 +290,7 @@ fn draw(scenario: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Res
             points: false,
         })
         .collect();
-    let run_dir = common::default_out(scenario, None, "");
+    let run_dir = run_dir.to_path_buf();
     let bd: Vec<(String, Vec<f64>, Vec<f64>)> = written
         .iter()
         .filter_map(|w| {

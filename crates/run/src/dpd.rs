@@ -1,0 +1,898 @@
+//! DPD colloids in explicit solvent (`method = "dpd"`): velocity Verlet with DPD pair forces
+//! as the thermostat; thermodynamics, MSD, g(r), S(q), coordination and clusters, GSD frames.
+
+use crate::Scenario as Source;
+use crate::checkpoint::Envelope;
+use crate::droplet::{flat, trim_trajectory};
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot, picture};
+use anyhow::{Context, Result, bail};
+use colloidsim_analysis::{
+    Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
+    pair_distribution, structure_factor_windowed,
+};
+use colloidsim_core::output::OutputDir;
+use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
+use colloidsim_md::dpd::{Dpd, Thermo};
+use colloidsim_md::gsd::GsdWriter;
+use colloidsim_md::{Particles, SimBox};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+/// The DPD family of scenarios.
+pub struct DpdMethod;
+
+/// Parse and validate a scenario, with the seed given if any.
+fn resolve(src: &Source, seed: Option<u64>) -> Result<(DpdScenario, DpdSetup)> {
+    let mut sc = DpdScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+        sc.seed = s;
+    }
+    let setup = sc.validate().with_context(|| src.label())?;
+    Ok((sc, setup))
+}
+
+impl Method for DpdMethod {
+    fn names(&self) -> &'static [&'static str] {
+        &["dpd"]
+    }
+
+    fn about(&self) -> &'static str {
+        "DPD colloids in explicit solvent (contact, Morse and squeeze-lubrication forces)"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/dpd.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let (_, s) = resolve(src, None)?;
+        Ok(Checked {
+            resolved: describe(&s),
+            warnings: s.warnings.clone(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let (_, s) = resolve(src, seed)?;
+        let (sync_every, _) = periods(s.steps);
+        let mut sim = s.build()?;
+        sim.set_sync_every(sync_every);
+        DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let (_, s) = resolve(src, Some(seed))?;
+        let ck: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if ck.sync_every != periods(s.steps).0 {
+            bail!(
+                "checkpoint: synchronisation period {} does not fit the scenario's {}",
+                ck.sync_every,
+                periods(s.steps).0
+            );
+        }
+        let sim = Dpd::restart(
+            ck.particles,
+            &ck.forces,
+            SimBox::new(ck.box_l),
+            s.params,
+            DpdSetup::colloid_types(),
+            ck.step,
+            ck.sync_every,
+        )?;
+        let traj = out.join("trajectory.gsd");
+        if traj.exists() {
+            trim_trajectory(&traj, ck.obs.frames, &["time_tau"], true)?;
+        } else if ck.obs.frames > 0 {
+            bail!(
+                "trajectory.gsd is missing (the checkpoint expects {} frames)",
+                ck.obs.frames
+            );
+        }
+        // Restoring builds the lists the interrupted run built at this step: count them once.
+        let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
+        DpdSession::new(s, sim, ck.obs, builds0).map(|d| Box::new(d) as Box<dyn Session>)
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::dpd()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let (_, s) = resolve(src, seed)?;
+        Ok(Box::new(DpdEngine { sim: s.build()? }))
+    }
+}
+
+/// The method's part of `checkpoint.bin`: everything a run needs to continue bitwise from
+/// step `step`, a multiple of `sync_every` (`O` is `&Observed` when written, `Observed` when
+/// read).
+#[derive(Serialize, Deserialize)]
+struct Checkpoint<O> {
+    /// The engine rebuilds every list at multiples of this many steps.
+    sync_every: u64,
+    /// Steps done; every observation up to and including this step is in `obs`.
+    step: u64,
+    box_l: [f64; 3],
+    /// The particles in tag order, exactly.
+    particles: Particles,
+    /// Forces of step `step`, tag order.
+    forces: Vec<[f64; 3]>,
+    /// Neighbour-list builds so far.
+    neighbor_builds: u64,
+    obs: O,
+}
+
+type Saved = Checkpoint<Observed>;
+
+/// A DPD run: the engine, its observations, the trajectory and the temperature monitor.
+struct DpdSession {
+    s: DpdSetup,
+    sim: Dpd,
+    obs: Observed,
+    builds0: u64,
+    sync_every: u64,
+    checkpoint_every: u64,
+    colloid_tags: Vec<u32>,
+    solvent_tags: Vec<u32>,
+    radii: Vec<f64>,
+    gsd: Option<GsdWriter>,
+    monitor: TemperatureMonitor,
+}
+
+impl DpdSession {
+    fn new(s: DpdSetup, sim: Dpd, obs: Observed, builds0: u64) -> Result<Self> {
+        let (sync_every, checkpoint_every) = periods(s.steps);
+        let p = sim.snapshot();
+        let colloid_tags: Vec<u32> = (0..p.len() as u32)
+            .filter(|&t| p.typeid[t as usize] == DpdSetup::COLLOID_TYPE)
+            .collect();
+        let solvent_tags: Vec<u32> = (0..p.len() as u32)
+            .filter(|&t| p.typeid[t as usize] != DpdSetup::COLLOID_TYPE)
+            .take(s.observe.msd_solvent_beads)
+            .collect();
+        let radii: Vec<f64> = colloid_tags
+            .iter()
+            .map(|&t| 0.5 * p.diameter[t as usize])
+            .collect();
+        let mut monitor =
+            TemperatureMonitor::new(s.params.kt, s.max_temperature_drift, s.temperature_window);
+        for &(step, t) in &obs.monitor {
+            monitor
+                .push(step, t)
+                .map_err(|e| anyhow::anyhow!("the checkpoint's temperatures: {e}"))?;
+        }
+        Ok(Self {
+            s,
+            sim,
+            obs,
+            builds0,
+            sync_every,
+            checkpoint_every,
+            colloid_tags,
+            solvent_tags,
+            radii,
+            gsd: None,
+            monitor,
+        })
+    }
+
+    /// Record what is due at the engine's current step.
+    fn record(&mut self) -> Result<()> {
+        let (s, sim, obs, o) = (&self.s, &self.sim, &mut self.obs, &self.s.observe);
+        let (dt, tau) = (s.params.dt, s.tau);
+        let step = sim.step;
+        if o.msd_every > 0 && step.is_multiple_of(o.msd_every) {
+            let mut a = Vec::new();
+            sim.unwrapped(&self.colloid_tags, &mut a);
+            let mut b = Vec::new();
+            sim.unwrapped(&self.solvent_tags, &mut b);
+            obs.msd_steps.push(step);
+            obs.colloid_frames.push(a);
+            obs.solvent_frames.push(b);
+        }
+        if o.structure_every > 0 && step.is_multiple_of(o.structure_every) && self.radii.len() >= 2
+        {
+            let snap = sim.snapshot();
+            let pos: Vec<[f64; 3]> = self
+                .colloid_tags
+                .iter()
+                .map(|&t| snap.pos[t as usize])
+                .collect();
+            let (r, g) = pair_distribution(&pos, sim.sbox.l, s.gr_max, o.gr_bins);
+            if obs.gr_sum.is_empty() {
+                obs.gr_sum = vec![0.0; g.len()];
+                obs.gr_r = r;
+            }
+            for (a, b) in obs.gr_sum.iter_mut().zip(&g) {
+                *a += b;
+            }
+            obs.gr_samples += 1;
+            let bonds = contacts(&pos, &self.radii, sim.sbox.l, s.contact_gap);
+            let z = coordination_numbers(pos.len(), &bonds);
+            let h = coordination_histogram(&z);
+            if obs.coordination.len() < h.len() {
+                obs.coordination.resize(h.len(), 0);
+            }
+            for (a, b) in obs.coordination.iter_mut().zip(&h) {
+                *a += b;
+            }
+            let cs = cluster_stats(pos.len(), &bonds);
+            obs.clusters.push([
+                step as f64,
+                step as f64 * dt / tau,
+                cs.n_clusters as f64,
+                cs.largest as f64,
+                cs.mean_degree,
+            ]);
+        }
+        if let Some(w) = self.gsd.as_mut()
+            && step.is_multiple_of(o.trajectory_every)
+        {
+            let snap = sim.snapshot();
+            w.write_frame(
+                step,
+                &sim.sbox,
+                &snap,
+                false,
+                &[("time_tau", step as f64 * dt / tau)],
+            )?;
+            obs.frames += 1;
+        }
+        Ok(())
+    }
+
+    /// One step with its thermodynamics and temperature check; `Some(why)` when the run
+    /// cannot go on.
+    fn step(&mut self) -> Result<Option<String>> {
+        let o = &self.s.observe;
+        let dt = self.s.params.dt;
+        let next = self.sim.step + 1;
+        let result = if o.thermo_every > 0 && next.is_multiple_of(o.thermo_every) {
+            self.sim
+                .advance_with_thermo()
+                .map(|th| self.obs.thermo.push((next as f64 * dt, th)))
+        } else {
+            self.sim.advance()
+        };
+        if let Err(e) = result {
+            return Ok(Some(e.to_string()));
+        }
+        let check_every = if o.thermo_every > 0 {
+            o.thermo_every
+        } else {
+            100
+        };
+        if next.is_multiple_of(check_every) {
+            let t = self
+                .obs
+                .thermo
+                .last()
+                .filter(|(_, th)| th.step == next)
+                .map(|(_, th)| th.temperature)
+                .unwrap_or_else(|| self.sim.thermo().temperature);
+            self.obs.monitor.push((next, t));
+            if let Err(e) = self.monitor.push(next, t) {
+                return Ok(Some(e));
+            }
+        }
+        self.record()?;
+        Ok(None)
+    }
+}
+
+impl Session for DpdSession {
+    fn label(&self) -> String {
+        "dpd".into()
+    }
+
+    fn total(&self) -> u64 {
+        self.s.steps
+    }
+
+    fn position(&self) -> u64 {
+        self.sim.step
+    }
+
+    fn seed(&self) -> u64 {
+        self.s.params.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        describe(&self.s)
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        self.s.warnings.clone()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        [
+            "thermo.csv",
+            "msd.csv",
+            "msd.png",
+            "gr.csv",
+            "gr.png",
+            "sq.csv",
+            "coordination.csv",
+            "clusters.csv",
+            "trajectory.gsd",
+        ]
+        .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        if self.s.observe.trajectory_every > 0 {
+            let traj = out.join("trajectory.gsd");
+            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            self.gsd = Some(if traj.exists() {
+                GsdWriter::append(&traj)?.with_velocities()
+            } else {
+                GsdWriter::create_new(&traj)?.with_velocities()
+            });
+        }
+        if fresh {
+            self.record()?;
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        Some((self.sim.step / self.checkpoint_every + 1) * self.checkpoint_every)
+    }
+
+    /// The engine restarts bitwise only where it rebuilds every list.
+    fn stop_point(&self) -> u64 {
+        self.sim
+            .step
+            .next_multiple_of(self.sync_every)
+            .min(self.s.steps)
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        while self.sim.step < until {
+            if let Some(why) = self.step()? {
+                return Ok(Some(why));
+            }
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    fn save(&mut self, _out: &OutputDir) -> Result<Vec<u8>> {
+        let ck = Checkpoint {
+            sync_every: self.sync_every,
+            step: self.sim.step,
+            box_l: self.sim.sbox.l,
+            particles: self.sim.snapshot(),
+            forces: self.sim.forces(),
+            neighbor_builds: self.builds0 + self.sim.neighbor_builds(),
+            obs: &self.obs,
+        };
+        Ok(bincode::serialize(&ck)?)
+    }
+
+    fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        let mut warnings = Vec::new();
+        Ok(write_outputs(out, &self.s, &self.sim, &self.obs, &mut warnings)?.0)
+    }
+
+    fn finish(
+        self: Box<Self>,
+        out: &OutputDir,
+        wall: f64,
+        _failure: Option<&str>,
+    ) -> Result<Finished> {
+        let mut warnings = Vec::new();
+        let (files, diffusion) = write_outputs(out, &self.s, &self.sim, &self.obs, &mut warnings)?;
+        let builds = self.builds0 + self.sim.neighbor_builds();
+        let summary = summary(
+            &self.s, &self.sim, &self.obs, diffusion, builds, wall, &warnings,
+        );
+        let (s, dt, tau) = (&self.s, self.s.params.dt, self.s.tau);
+        let message = format!(
+            "dpd: {} colloids + {} solvent beads, {} steps ({:.3} tau_D) in {:.1} s -> {}\nwrote {}",
+            s.colloids,
+            s.solvent,
+            self.sim.step,
+            self.sim.step as f64 * dt / tau,
+            wall,
+            out.path().display(),
+            files.join(", ")
+        );
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+/// A DPD engine stepped by hand.
+struct DpdEngine {
+    sim: Dpd,
+}
+
+impl crate::Engine for DpdEngine {
+    fn method(&self) -> &str {
+        "dpd"
+    }
+    fn dimensions(&self) -> usize {
+        3
+    }
+    fn particles(&self) -> usize {
+        self.sim.snapshot().len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        for _ in 0..steps {
+            self.sim.advance()?;
+        }
+        Ok(())
+    }
+    fn steps(&self) -> u64 {
+        self.sim.step
+    }
+    fn time(&self) -> f64 {
+        self.sim.step as f64 * self.sim.params().dt
+    }
+    fn dt(&self) -> f64 {
+        self.sim.params().dt
+    }
+    fn positions(&self) -> Vec<f64> {
+        let n = self.sim.snapshot().len() as u32;
+        let mut x = Vec::new();
+        self.sim.unwrapped(&(0..n).collect::<Vec<_>>(), &mut x);
+        flat(&x)
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        Some(flat(&self.sim.snapshot().vel))
+    }
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(flat(&self.sim.forces()))
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        self.sim.sbox.l.to_vec()
+    }
+}
+
+fn describe(s: &DpdSetup) -> serde_json::Value {
+    let p = &s.params;
+    let c = &p.colloid;
+    json!({
+        "box": s.sbox.l,
+        "colloids": s.colloids,
+        "solvent_beads": s.solvent,
+        "colloid_radius": s.radius,
+        "radius_distribution": format!("{:?}", s.distribution),
+        "density": s.density,
+        "solvent_mass": s.solvent_mass,
+        "kT": p.kt,
+        "gamma": p.gamma,
+        "rc": p.rc,
+        "repulsion_solvent_solvent": p.repulsion * p.kt / p.rc,
+        "colloid_solvent_surface_cutoff": colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
+        "colloid_solvent_centre_cutoff": s.radius + colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
+        "repulsion_colloid_solvent": p.repulsion_cs * p.kt / colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
+        "colloid_colloid_surface_cutoff": p.colloid_cutoff,
+        "contact_modulus": c.contact,
+        "contact_range": c.contact_range,
+        "morse_depth": c.morse_depth,
+        "morse_kappa": c.morse_kappa,
+        "morse_r0": c.morse_r0,
+        "eta0_lubrication": c.eta0,
+        "lubrication_gap": c.lubrication_gap,
+        "lubrication_noise": format!("{:?}", p.lubrication_noise).to_lowercase(),
+        "dt": p.dt,
+        "skin": p.skin,
+        "steps": s.steps,
+        "stokes_einstein_diffusion_D0": s.d0,
+        "diffusion_time_tau": s.tau,
+        "steps_per_tau": s.tau / p.dt,
+        "contact_gap": s.contact_gap,
+    })
+}
+
+/// What a run accumulates; all of it is saved in every checkpoint.
+#[derive(Default, Serialize, Deserialize)]
+struct Observed {
+    #[serde(with = "thermo_rows")]
+    thermo: Vec<(f64, Thermo)>,
+    msd_steps: Vec<u64>,
+    colloid_frames: Vec<Vec<[f64; 3]>>,
+    solvent_frames: Vec<Vec<[f64; 3]>>,
+    gr_sum: Vec<f64>,
+    gr_r: Vec<f64>,
+    gr_samples: usize,
+    coordination: Vec<u64>,
+    clusters: Vec<[f64; 5]>,
+    /// Every (step, temperature) fed to the temperature monitor: a restart feeds them again,
+    /// which restores its state exactly.
+    monitor: Vec<(u64, f64)>,
+    /// Frames in trajectory.gsd.
+    frames: u64,
+}
+
+/// `(time, Thermo)` rows through a serialisable mirror of [`Thermo`].
+mod thermo_rows {
+    use colloidsim_md::dpd::{PairVirial, Thermo};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    struct Row {
+        time: f64,
+        step: u64,
+        temperature_by_type: Vec<f64>,
+        temperature: f64,
+        kinetic: [f64; 6],
+        /// Conservative, dissipative, random, contact, Morse, lubrication.
+        virial: [[f64; 6]; 6],
+        /// Conservative, contact, Morse energies.
+        energies: [f64; 3],
+        pressure: [f64; 6],
+        potential_energy: f64,
+        momentum: [f64; 3],
+    }
+
+    pub fn serialize<S: Serializer>(rows: &[(f64, Thermo)], s: S) -> Result<S::Ok, S::Error> {
+        let rows: Vec<Row> = rows
+            .iter()
+            .map(|(time, t)| {
+                let v = &t.virial;
+                Row {
+                    time: *time,
+                    step: t.step,
+                    temperature_by_type: t.temperature_by_type.clone(),
+                    temperature: t.temperature,
+                    kinetic: t.kinetic,
+                    virial: [
+                        v.conservative,
+                        v.dissipative,
+                        v.random,
+                        v.contact,
+                        v.morse,
+                        v.lubrication,
+                    ],
+                    energies: [v.energy_conservative, v.energy_contact, v.energy_morse],
+                    pressure: t.pressure,
+                    potential_energy: t.potential_energy,
+                    momentum: t.momentum,
+                }
+            })
+            .collect();
+        rows.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(f64, Thermo)>, D::Error> {
+        let rows = Vec::<Row>::deserialize(d)?;
+        Ok(rows
+            .into_iter()
+            .map(|r| {
+                let [
+                    conservative,
+                    dissipative,
+                    random,
+                    contact,
+                    morse,
+                    lubrication,
+                ] = r.virial;
+                let [energy_conservative, energy_contact, energy_morse] = r.energies;
+                let thermo = Thermo {
+                    step: r.step,
+                    temperature_by_type: r.temperature_by_type,
+                    temperature: r.temperature,
+                    kinetic: r.kinetic,
+                    virial: PairVirial {
+                        conservative,
+                        dissipative,
+                        random,
+                        contact,
+                        morse,
+                        lubrication,
+                        energy_conservative,
+                        energy_contact,
+                        energy_morse,
+                    },
+                    pressure: r.pressure,
+                    potential_energy: r.potential_energy,
+                    momentum: r.momentum,
+                };
+                (r.time, thermo)
+            })
+            .collect())
+    }
+}
+
+/// The synchronisation period and the period of the regular checkpoints (a multiple of it,
+/// about 10 % of the run): the engine rebuilds every list at multiples of the first, so that a
+/// run restarted there continues bitwise; Ctrl-C runs on to the next such step.
+fn periods(steps: u64) -> (u64, u64) {
+    let tenth = (steps / 10).max(1);
+    let sync = tenth.min(SYNC_MAX);
+    let every = ((tenth as f64 / sync as f64).round() as u64).max(1) * sync;
+    (sync, every)
+}
+
+/// Longest synchronisation period (steps).
+const SYNC_MAX: u64 = 1000;
+
+/// MSD at lags of whole frames, averaged over at most ~200 time origins per lag.
+fn msd(frames: &[Vec<[f64; 3]>]) -> Vec<f64> {
+    let f = frames.len();
+    let stride = (f / 200).max(1);
+    (1..f)
+        .map(|lag| {
+            let mut s = 0.0;
+            let mut c = 0usize;
+            for t0 in (0..f - lag).step_by(stride) {
+                for (a, b) in frames[t0].iter().zip(&frames[t0 + lag]) {
+                    s += (0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>();
+                }
+                c += frames[t0].len();
+            }
+            if c > 0 { s / c as f64 } else { f64::NAN }
+        })
+        .collect()
+}
+
+/// The tables and pictures of what has been observed so far; returns their names and the
+/// long-time colloid diffusion coefficient.
+fn write_outputs(
+    out: &OutputDir,
+    s: &DpdSetup,
+    sim: &Dpd,
+    obs: &Observed,
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<String>, Option<f64>)> {
+    let dt = s.params.dt;
+    let tau = s.tau;
+    let mut files = Vec::new();
+    let vol = sim.sbox.volume();
+    // thermo.csv
+    if !obs.thermo.is_empty() {
+        let rows = &obs.thermo;
+        let col = |f: &dyn Fn(&Thermo) -> f64| rows.iter().map(|(_, t)| f(t)).collect::<Vec<_>>();
+        let tr = |v: &[f64; 6]| (v[0] + v[1] + v[2]) / (3.0 * vol);
+        let step = col(&|t| t.step as f64);
+        let time: Vec<f64> = rows.iter().map(|(t, _)| *t).collect();
+        let time_tau: Vec<f64> = time.iter().map(|t| t / tau).collect();
+        let tt = col(&|t| t.temperature);
+        let ts = col(&|t| t.temperature_by_type[0]);
+        let tc = col(&|t| t.temperature_by_type.get(1).copied().unwrap_or(f64::NAN));
+        let pk: Vec<Vec<f64>> = (0..6).map(|k| col(&|t| t.pressure[k])).collect();
+        let p = col(&|t| (t.pressure[0] + t.pressure[1] + t.pressure[2]) / 3.0);
+        let pkin = col(&|t| (t.kinetic[0] + t.kinetic[1] + t.kinetic[2]) / 3.0);
+        let pc = col(&|t| tr(&t.virial.conservative));
+        let pd = col(&|t| tr(&t.virial.dissipative));
+        let pr = col(&|t| tr(&t.virial.random));
+        let pcon = col(&|t| tr(&t.virial.contact));
+        let pm = col(&|t| tr(&t.virial.morse));
+        let pl = col(&|t| tr(&t.virial.lubrication));
+        let ec = col(&|t| t.virial.energy_conservative);
+        let econ = col(&|t| t.virial.energy_contact);
+        let em = col(&|t| t.virial.energy_morse);
+        let ep = col(&|t| t.potential_energy);
+        out.write_table(
+            "thermo.csv",
+            &[
+                ("step", &step),
+                ("time", &time),
+                ("time_tau", &time_tau),
+                ("T", &tt),
+                ("T_solvent", &ts),
+                ("T_colloid", &tc),
+                ("p", &p),
+                ("pxx", &pk[0]),
+                ("pyy", &pk[1]),
+                ("pzz", &pk[2]),
+                ("pxy", &pk[3]),
+                ("pxz", &pk[4]),
+                ("pyz", &pk[5]),
+                ("p_kinetic", &pkin),
+                ("p_conservative", &pc),
+                ("p_dissipative", &pd),
+                ("p_random", &pr),
+                ("p_contact", &pcon),
+                ("p_morse", &pm),
+                ("p_lubrication", &pl),
+                ("energy_conservative", &ec),
+                ("energy_contact", &econ),
+                ("energy_morse", &em),
+                ("energy_potential", &ep),
+            ],
+        )?;
+        files.push("thermo.csv".to_string());
+    }
+    // msd.csv
+    let mut diffusion = None;
+    if obs.msd_steps.len() >= 2 {
+        let mc = msd(&obs.colloid_frames);
+        let ms = msd(&obs.solvent_frames);
+        let lag_steps: Vec<f64> = (1..obs.msd_steps.len())
+            .map(|k| (obs.msd_steps[k] - obs.msd_steps[0]) as f64)
+            .collect();
+        let time: Vec<f64> = lag_steps.iter().map(|l| l * dt).collect();
+        let time_tau: Vec<f64> = time.iter().map(|t| t / tau).collect();
+        out.write_table(
+            "msd.csv",
+            &[
+                ("lag_steps", &lag_steps),
+                ("time", &time),
+                ("time_tau", &time_tau),
+                ("msd_colloid", &mc),
+                ("msd_solvent", &ms),
+            ],
+        )?;
+        files.push("msd.csv".into());
+        // Long-time colloid diffusion: slope of the MSD over the second half of the lags
+        // (least squares), D = slope / 6.
+        let n = mc.len();
+        if s.colloids > 0 && n >= 4 {
+            let (a, b) = (n / 2, n);
+            let xs = &time[a..b];
+            let ys = &mc[a..b];
+            let mx = xs.iter().sum::<f64>() / xs.len() as f64;
+            let my = ys.iter().sum::<f64>() / ys.len() as f64;
+            let sxy: f64 = xs.iter().zip(ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+            let sxx: f64 = xs.iter().map(|x| (x - mx).powi(2)).sum();
+            if sxx > 0.0 {
+                diffusion = Some(sxy / sxx / 6.0);
+            }
+        }
+        let series = [
+            Series {
+                label: "colloids",
+                x: &time_tau,
+                y: &mc,
+                points: false,
+            },
+            Series {
+                label: "solvent beads",
+                x: &time_tau,
+                y: &ms,
+                points: false,
+            },
+        ];
+        let n_series = if s.colloids > 0 { 2 } else { 1 };
+        picture(
+            line_plot(
+                &out.join("msd.png"),
+                &format!(
+                    "MSD, DPD colloids (phi = {:.3}, {} colloids)",
+                    s.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3) / vol,
+                    s.colloids
+                ),
+                "t / tau_D",
+                "mean-squared displacement [rc^2]",
+                &series[2 - n_series..],
+                Scale::LogLog,
+            ),
+            "msd.png",
+            &mut files,
+            warnings,
+        );
+    }
+    // g(r), S(q), coordination, clusters
+    if obs.gr_samples > 0 {
+        let g: Vec<f64> = obs
+            .gr_sum
+            .iter()
+            .map(|x| x / obs.gr_samples as f64)
+            .collect();
+        let r = &obs.gr_r;
+        let r_over_d: Vec<f64> = r.iter().map(|x| x / (2.0 * s.radius)).collect();
+        out.write_table(
+            "gr.csv",
+            &[("r", r), ("r_over_diameter", &r_over_d), ("g", &g)],
+        )?;
+        files.push("gr.csv".into());
+        let rho = s.colloids as f64 / vol;
+        let q = default_q_grid(s.gr_max, g.len());
+        let sq = structure_factor_windowed(r, &g, rho, &q, Window::Lorch);
+        let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.radius).collect();
+        out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;
+        files.push("sq.csv".into());
+        picture(
+            line_plot(
+                &out.join("gr.png"),
+                &format!("Colloid g(r), {} samples", obs.gr_samples),
+                "r / (2 R_c)",
+                "g(r)",
+                &[Series {
+                    label: "colloids",
+                    x: &r_over_d,
+                    y: &g,
+                    points: false,
+                }],
+                Scale::Linear,
+            ),
+            "gr.png",
+            &mut files,
+            warnings,
+        );
+        let total: u64 = obs.coordination.iter().sum();
+        let z: Vec<f64> = (0..obs.coordination.len()).map(|k| k as f64).collect();
+        let pz: Vec<f64> = obs
+            .coordination
+            .iter()
+            .map(|&c| c as f64 / total.max(1) as f64)
+            .collect();
+        out.write_table("coordination.csv", &[("z", &z), ("probability", &pz)])?;
+        files.push("coordination.csv".into());
+        let col = |k: usize| obs.clusters.iter().map(|r| r[k]).collect::<Vec<f64>>();
+        out.write_table(
+            "clusters.csv",
+            &[
+                ("step", &col(0)),
+                ("time_tau", &col(1)),
+                ("clusters", &col(2)),
+                ("largest", &col(3)),
+                ("mean_degree", &col(4)),
+            ],
+        )?;
+        files.push("clusters.csv".into());
+    }
+    if s.observe.trajectory_every > 0 {
+        files.push("trajectory.gsd".into());
+    }
+    Ok((files, diffusion))
+}
+
+/// The method's summary fields.
+fn summary(
+    s: &DpdSetup,
+    sim: &Dpd,
+    obs: &Observed,
+    diffusion: Option<f64>,
+    neighbor_builds: u64,
+    wall: f64,
+    warnings: &[String],
+) -> serde_json::Value {
+    let (dt, tau) = (s.params.dt, s.tau);
+    let last = obs.thermo.last().map(|(_, t)| t.clone());
+    let n = (s.colloids + s.solvent) as f64;
+    json!({
+        "software": crate::software(),
+        "method": "dpd",
+        "seed": s.params.seed,
+        "parameters": describe(s),
+        "steps": sim.step,
+        "time": sim.step as f64 * dt,
+        "time_tau": sim.step as f64 * dt / tau,
+        "wall_seconds": wall,
+        "particle_steps_per_second": n * sim.step as f64 / wall,
+        "threads": rayon::current_num_threads(),
+        "neighbor_builds": neighbor_builds,
+        "final_temperature": last.as_ref().map(|t| t.temperature),
+        "final_temperature_by_type": last.as_ref().map(|t| t.temperature_by_type.clone()),
+        "mean_temperature_second_half": mean_second_half(&obs.thermo, |t| t.temperature),
+        "mean_colloid_temperature_second_half": mean_second_half(&obs.thermo, |t| t.temperature_by_type.get(1).copied().unwrap_or(f64::NAN)),
+        "mean_pressure_second_half": mean_second_half(&obs.thermo, |t| (t.pressure[0] + t.pressure[1] + t.pressure[2]) / 3.0),
+        "colloid_diffusion_long_time": diffusion,
+        "colloid_diffusion_over_stokes_einstein": diffusion.map(|d| d / s.d0),
+        "warnings": warnings,
+    })
+}
+
+fn mean_second_half(rows: &[(f64, Thermo)], f: impl Fn(&Thermo) -> f64) -> Option<f64> {
+    let h = &rows[rows.len() / 2..];
+    if h.is_empty() {
+        None
+    } else {
+        Some(h.iter().map(|(_, t)| f(t)).sum::<f64>() / h.len() as f64)
+    }
+}

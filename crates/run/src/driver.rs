@@ -1,0 +1,362 @@
+//! The loop every run shares: output folder, chunks of work between interrupt checks, regular
+//! checkpoints, verified restarts, test hooks, progress and `summary.json`.
+
+use crate::checkpoint::{self, CHECKPOINT, Envelope};
+use crate::control::Control;
+use crate::method::{self, Session};
+use crate::{Failed, Interrupted, Report, RunOptions, Scenario};
+use anyhow::{Context, Result, bail};
+use colloidsim_core::output::OutputDir;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Test hooks read from the environment: behave as if Ctrl-C arrived at this position
+/// (`COLLOIDSIM_INTERRUPT_AT_STEP`), or as if the process were killed there, without a
+/// checkpoint, after the trajectory reached the disk (`COLLOIDSIM_KILL_AT_STEP`).
+struct Hooks {
+    interrupt: Option<u64>,
+    kill: Option<u64>,
+}
+
+impl Hooks {
+    fn from_env() -> Self {
+        let read = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
+        Self {
+            interrupt: read("COLLOIDSIM_INTERRUPT_AT_STEP"),
+            kill: read("COLLOIDSIM_KILL_AT_STEP"),
+        }
+    }
+}
+
+/// The resolved parameters and seed as a restart compares them.
+fn resolved(s: &dyn Session) -> Result<String> {
+    Ok(serde_json::to_string(
+        &json!({ "seed": s.seed(), "parameters": s.parameters() }),
+    )?)
+}
+
+/// The keys of two resolved-parameter JSON strings that differ, as `key = now (was then)`.
+fn changed_keys(now: &str, then: &str) -> String {
+    let parse = |s: &str| serde_json::from_str::<serde_json::Value>(s).unwrap_or_default();
+    let (now, then) = (parse(now), parse(then));
+    let mut out = Vec::new();
+    if now["seed"] != then["seed"] {
+        out.push(format!("seed = {} (was {})", now["seed"], then["seed"]));
+    }
+    if let Some(m) = now["parameters"].as_object() {
+        for (k, v) in m {
+            let old = &then["parameters"][k.as_str()];
+            if old != v {
+                out.push(format!("{k} = {v} (was {old})"));
+            }
+        }
+    }
+    out.join(", ")
+}
+
+fn absolute(p: &Path) -> PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// Run a scenario from the start. Everything is validated and the engine built before the
+/// output folder is touched, so bad input leaves nothing behind.
+pub fn run(sc: &Scenario, opts: &RunOptions, ctl: &Control) -> Result<Report> {
+    let m = method::of(sc)?;
+    if let Some(s) = opts.seed {
+        crate::seed32(s)?;
+    }
+    let mut session = m.start(sc, opts.seed)?;
+    let mut warnings = session.warnings();
+    for w in &warnings {
+        ctl.progress().warning(w);
+    }
+    let out_path = opts.out.clone().unwrap_or_else(|| PathBuf::from(sc.name()));
+    let out = OutputDir::create(&out_path, opts.force)?;
+    if opts.force {
+        for w in clear_earlier_outputs(&out, &*session)? {
+            ctl.progress().warning(&w);
+            warnings.push(w);
+        }
+    }
+    out.write_bytes("scenario.toml", sc.text().as_bytes())?;
+    let envelope = Envelope {
+        method: sc.method()?,
+        scenario: sc.text().to_string(),
+        base: absolute(sc.base()),
+        seed: session.seed(),
+        resolved: resolved(&*session)?,
+        position: 0,
+        wall_seconds: 0.0,
+        payload: Vec::new(),
+    };
+    session.begin(&out, true)?;
+    drive(session, out, envelope, ctl, warnings)
+}
+
+/// `--force`: remove the files an earlier run of this method left (so that none mixes with the
+/// new run); keep any other file. Returns what to tell the user.
+fn clear_earlier_outputs(out: &OutputDir, s: &dyn Session) -> Result<Vec<String>> {
+    let mut removed = Vec::new();
+    let mut kept = Vec::new();
+    let entries =
+        std::fs::read_dir(out.path()).with_context(|| out.path().display().to_string())?;
+    for e in entries {
+        let e = e?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !e.file_type()?.is_file() {
+            kept.push(name);
+            continue;
+        }
+        let ours = s.writes(&name)
+            || ["summary.json", "scenario.toml", CHECKPOINT].contains(&name.as_str())
+            || name.ends_with(".partial");
+        if ours {
+            std::fs::remove_file(e.path()).with_context(|| e.path().display().to_string())?;
+            removed.push(name);
+        } else {
+            kept.push(name);
+        }
+    }
+    removed.sort();
+    kept.sort();
+    let mut w = Vec::new();
+    if !removed.is_empty() {
+        w.push(format!(
+            "--force: removed {} file(s) of an earlier run in {}: {}",
+            removed.len(),
+            out.path().display(),
+            removed.join(", ")
+        ));
+    }
+    if !kept.is_empty() {
+        w.push(format!(
+            "--force: kept what this run does not write in {}: {}",
+            out.path().display(),
+            kept.join(", ")
+        ));
+    }
+    Ok(w)
+}
+
+/// Continue the interrupted run in `dir` from its checkpoint, bitwise as if it had never
+/// stopped. `sc`, when given, must be the scenario the run started with (by default the one
+/// saved in the checkpoint); `seed`, when given, must be the run's.
+pub fn resume(
+    dir: &Path,
+    sc: Option<&Scenario>,
+    seed: Option<u64>,
+    ctl: &Control,
+) -> Result<Report> {
+    if !dir.is_dir() {
+        bail!("--restart {}: no such folder", dir.display());
+    }
+    let out = OutputDir::reopen(dir)?;
+    let summary = out.join("summary.json");
+    if summary.exists() {
+        let failed = std::fs::read(&summary)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .is_some_and(|v| v["completed"] == false);
+        if failed {
+            bail!(
+                "--restart {}: this run stopped with an error (summary.json says completed = false) and keeps no checkpoint; start a new run with --out",
+                dir.display()
+            );
+        }
+        bail!(
+            "--restart {}: this run is complete (summary.json is written); nothing to continue. Start a new run with --out",
+            dir.display()
+        );
+    }
+    let file = out.join(CHECKPOINT);
+    if !file.exists() {
+        bail!(
+            "--restart {}: no {CHECKPOINT} to continue from (checkpoints are written every 10 % of a run and on Ctrl-C)",
+            dir.display()
+        );
+    }
+    let envelope = checkpoint::read(&file)?;
+    let sc = match sc {
+        Some(s) => {
+            if s.text() != envelope.scenario {
+                bail!(
+                    "--restart {}: {} differs from the scenario this run started with (saved as {})",
+                    dir.display(),
+                    s.origin()
+                        .map_or("the scenario given".into(), |p| p.display().to_string()),
+                    out.join("scenario.toml").display()
+                );
+            }
+            s.clone()
+        }
+        None => Scenario::from_toml(&envelope.scenario, &envelope.base)?,
+    };
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+    }
+    let m = method::of(&sc)?;
+    let seed = seed.unwrap_or(envelope.seed);
+    let mut session = m
+        .restore(&sc, seed, &out, &envelope)
+        .with_context(|| format!("--restart {}", dir.display()))?;
+    let now = resolved(&*session)?;
+    if now != envelope.resolved {
+        bail!(
+            "--restart {}: the resolved scenario differs from the checkpoint's: {}",
+            dir.display(),
+            changed_keys(&now, &envelope.resolved)
+        );
+    }
+    if session.position() != envelope.position {
+        bail!(
+            "{}: the state is at step {}, the checkpoint says {}",
+            file.display(),
+            session.position(),
+            envelope.position
+        );
+    }
+    let warnings = session.warnings();
+    for w in &warnings {
+        ctl.progress().warning(w);
+    }
+    session.begin(&out, false)?;
+    drive(session, out, envelope, ctl, warnings)
+}
+
+/// Write a checkpoint at the session's position.
+fn save(s: &mut dyn Session, out: &OutputDir, env: &mut Envelope, wall: f64) -> Result<()> {
+    s.flush()?;
+    env.payload = s.save(out)?;
+    env.position = s.position();
+    env.wall_seconds = wall;
+    out.write_bytes(CHECKPOINT, &checkpoint::encode(env)?)?;
+    env.payload = Vec::new();
+    s.after_save(out);
+    Ok(())
+}
+
+/// Work units per chunk are adapted so that a chunk takes about this long: interrupts are
+/// seen within it and the progress moves. Outputs never depend on the chunks.
+const CHUNK_SECONDS: f64 = 0.2;
+
+fn drive(
+    mut s: Box<dyn Session>,
+    out: OutputDir,
+    mut env: Envelope,
+    ctl: &Control,
+    mut warnings: Vec<String>,
+) -> Result<Report> {
+    let total = s.total();
+    let hooks = Hooks::from_env();
+    ctl.progress().begin(&s.label(), total, s.position());
+    let start = Instant::now();
+    let wall0 = env.wall_seconds;
+    let wall = || wall0 + start.elapsed().as_secs_f64();
+    // The steps run on a worker of the thread pool, so that each step's parallel passes start
+    // without a hand-over from this thread.
+    let failure = rayon::scope(|_| -> Result<Option<String>> {
+        let mut chunk = 16u64;
+        // Interrupted where no checkpoint can be written before the end: run to the end.
+        let mut draining = false;
+        loop {
+            let pos = s.position();
+            if pos >= total {
+                return Ok(None);
+            }
+            if hooks.kill == Some(pos) {
+                s.flush()?;
+                eprintln!("killed at step {pos} (test hook)");
+                std::process::exit(3);
+            }
+            if hooks.interrupt == Some(pos) {
+                ctl.interrupt();
+            }
+            if !draining && ctl.interrupted() {
+                let stop = s.stop_point();
+                if stop >= total {
+                    draining = true;
+                } else {
+                    if stop > pos {
+                        ctl.progress().message(&format!(
+                            "interrupted at step {pos}: running on to step {stop} to write a checkpoint (Ctrl-C again stops at once)"
+                        ));
+                        if let Some(why) = s.advance(stop)? {
+                            return Ok(Some(why));
+                        }
+                    }
+                    save(&mut *s, &out, &mut env, wall())?;
+                    let outputs = s.interim_outputs(&out)?;
+                    ctl.progress().end();
+                    return Err(Interrupted {
+                        at: pos,
+                        checkpoint: s.position(),
+                        out: out.path().to_path_buf(),
+                        outputs,
+                    }
+                    .into());
+                }
+            }
+            let due = s.next_checkpoint().filter(|&c| c > pos && c < total);
+            let mut next = pos.saturating_add(chunk).min(total);
+            if let Some(c) = due {
+                next = next.min(c);
+            }
+            for h in [hooks.interrupt, hooks.kill].into_iter().flatten() {
+                if h > pos {
+                    next = next.min(h);
+                }
+            }
+            let t = Instant::now();
+            if let Some(why) = s.advance(next)? {
+                return Ok(Some(why));
+            }
+            let secs = t.elapsed().as_secs_f64();
+            if secs < 0.5 * CHUNK_SECONDS && next - pos == chunk {
+                chunk = (chunk * 2).min(1 << 20);
+            } else if secs > 2.0 * CHUNK_SECONDS {
+                chunk = (chunk / 2).max(1);
+            }
+            if due == Some(s.position()) {
+                save(&mut *s, &out, &mut env, wall())?;
+            }
+            ctl.progress().advance(s.position());
+        }
+    });
+    ctl.progress().end();
+    let failure = failure?;
+    s.flush()?;
+    let wall_seconds = wall();
+    let position = s.position();
+    let fin = s.finish(&out, wall_seconds, failure.as_deref())?;
+    for w in &fin.warnings {
+        ctl.progress().warning(w);
+    }
+    warnings.extend(fin.warnings);
+    let mut summary = fin.summary;
+    let mut files = vec!["scenario.toml".to_string()];
+    files.extend(fin.files.into_iter().filter(|f| f != "scenario.toml"));
+    if let Some(m) = summary.as_object_mut() {
+        m.insert("completed".into(), json!(failure.is_none()));
+        m.insert("error".into(), json!(failure));
+        m.insert("files".into(), json!(files));
+    }
+    out.write_json("summary.json", &summary)?;
+    // The run is over: its checkpoint is no longer needed (a restart now refuses).
+    let _ = std::fs::remove_file(out.join(CHECKPOINT));
+    if let Some(message) = failure {
+        return Err(Failed {
+            message,
+            position,
+            out: out.path().to_path_buf(),
+        }
+        .into());
+    }
+    Ok(Report {
+        out: out.path().to_path_buf(),
+        summary,
+        files,
+        warnings,
+        message: fin.message,
+    })
+}

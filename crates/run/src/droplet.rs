@@ -1,0 +1,741 @@
+//! The drying droplet (`method = "droplet-bd"`): free-draining Brownian dynamics of WCA
+//! spheres in a shrinking harmonic interface, replicas one after the other, radial
+//! volume-fraction profiles at fractions of the drying time; `theory` is the radial FMT DDFT
+//! ([`crate::theory_droplet`]).
+
+use crate::checkpoint::{Envelope, file_crc};
+use crate::control::Control;
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot, picture};
+use crate::theory_droplet::profile_name;
+use crate::{Report, Scenario as Source, TheoryOptions};
+use anyhow::{Context, Result, bail};
+use colloidsim_analysis::radial_profile;
+use colloidsim_core::output::OutputDir;
+use colloidsim_md::droplet::DropletSim;
+use colloidsim_md::gsd::{self, GsdWriter};
+use colloidsim_md::{BdParams, DropletParams, DropletScenario, LennardJones};
+use hoomd_gsd::file_layer::{GsdFile, Mode};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::path::Path;
+
+/// The drying-droplet family of scenarios.
+pub struct DropletBd;
+
+/// Parse and validate a scenario; `system.initial` is taken relative to the scenario's folder.
+pub(crate) fn resolve(src: &Source, seed: Option<u64>) -> Result<(DropletScenario, DropletParams)> {
+    let mut sc = DropletScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+        sc.seed = s;
+    }
+    if let Some(init) = &sc.system.initial
+        && init.is_relative()
+    {
+        sc.system.initial = Some(src.base().join(init));
+    }
+    let p = sc.validate().with_context(|| src.label())?;
+    Ok((sc, p))
+}
+
+impl Method for DropletBd {
+    fn names(&self) -> &'static [&'static str] {
+        &["droplet-bd"]
+    }
+
+    fn about(&self) -> &'static str {
+        "a drying droplet of hard-sphere colloids, free-draining Brownian dynamics, beside its FMT DDFT"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/droplet.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let (_, p) = resolve(src, None)?;
+        Ok(Checked {
+            resolved: serde_json::to_value(&p)?,
+            warnings: Vec::new(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let (_, p) = resolve(src, seed)?;
+        // Set up replica 0 before the output folder is created: bad input leaves nothing.
+        let sim = p.build_replica(0)?;
+        let acc = Accum::new(&p);
+        Ok(Box::new(DropletSession::new(p, acc, 0, Some((sim, 0)))))
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let (_, p) = resolve(src, Some(seed))?;
+        let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if saved.replica >= p.replicas || saved.acc.sums.len() != p.fractions.len() {
+            bail!(
+                "checkpoint: replica {} of {} with {} profiles does not fit the scenario",
+                saved.replica,
+                p.replicas,
+                saved.acc.sums.len()
+            );
+        }
+        let sim = restore_replica(out, &p, &saved)?;
+        let traj = out.join("trajectory.gsd");
+        if saved.replica == 0 && p.trajectory_every > 0 && traj.exists() {
+            trim_trajectory(
+                &traj,
+                saved.acc.frames,
+                &["droplet/radius", "droplet/time"],
+                false,
+            )?;
+        }
+        Ok(Box::new(DropletSession::new(
+            p,
+            saved.acc,
+            saved.replica,
+            sim,
+        )))
+    }
+
+    fn has_theory(&self) -> bool {
+        true
+    }
+
+    fn theory(&self, src: &Source, opts: &TheoryOptions, ctl: &Control) -> Result<Report> {
+        crate::theory_droplet::theory(src, opts, ctl)
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::droplet()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let (_, p) = resolve(src, seed)?;
+        let sim = p.build_replica(0)?;
+        Ok(Box::new(BdEngine { sim }))
+    }
+}
+
+/// Everything a droplet run accumulates across replicas, saved in every checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Accum {
+    /// Per profile fraction: sum over the replicas that reached it of the volume-fraction
+    /// profile.
+    sums: Vec<Vec<f64>>,
+    /// Per profile fraction: how many replicas reached it.
+    counts: Vec<u64>,
+    /// Droplet radius at each profile time.
+    radii: Vec<f64>,
+    /// Shell mid-points of each profile.
+    r_axes: Vec<Vec<f64>>,
+    max_excursion: f64,
+    outside_final: u64,
+    /// Neighbour-list builds of the finished replicas.
+    builds: u64,
+    /// Frames in trajectory.gsd.
+    frames: u64,
+    /// Checkpoints written so far (alternates the GSD file name).
+    checkpoints: u64,
+}
+
+impl Accum {
+    fn new(p: &DropletParams) -> Self {
+        let n_frac = p.fractions.len();
+        Self {
+            sums: vec![vec![0.0; p.bins]; n_frac],
+            counts: vec![0; n_frac],
+            radii: vec![0.0; n_frac],
+            r_axes: vec![Vec::new(); n_frac],
+            max_excursion: f64::NEG_INFINITY,
+            outside_final: 0,
+            builds: 0,
+            frames: 0,
+            checkpoints: 0,
+        }
+    }
+}
+
+/// The integrator parameters of the running replica (`BdParams`), so that it continues with
+/// exactly the parameters it started with.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct Engine {
+    kt: f64,
+    viscosity: f64,
+    dt: f64,
+    seed: u32,
+    replica: u32,
+    skin: f64,
+    sort_every: u64,
+    max_drift: f64,
+    /// Neighbour-list builds of this replica so far.
+    builds: u64,
+}
+
+impl Engine {
+    fn of(s: &DropletSim, builds: u64) -> Self {
+        let b = s.params();
+        Self {
+            kt: b.kt,
+            viscosity: b.viscosity,
+            dt: b.dt,
+            seed: b.seed,
+            replica: b.replica,
+            skin: b.skin,
+            sort_every: b.sort_every,
+            max_drift: b.max_drift,
+            builds,
+        }
+    }
+
+    fn params(&self) -> BdParams {
+        BdParams {
+            kt: self.kt,
+            viscosity: self.viscosity,
+            dt: self.dt,
+            seed: self.seed,
+            replica: self.replica,
+            skin: self.skin,
+            sort_every: self.sort_every,
+            max_drift: self.max_drift,
+        }
+    }
+}
+
+/// The method's part of `checkpoint.bin`. The running replica's particles (exact positions,
+/// images, box, storage order, list reference positions) are in the GSD file it names, whose
+/// CRC-32 it keeps.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Saved {
+    /// Replica to continue.
+    replica: usize,
+    /// Its step: every event (profile, frame) up to and including this step is in `acc`.
+    step: u64,
+    /// GSD checkpoint of the replica at `step`, its CRC-32 and its engine parameters; `None`:
+    /// the replica has not started (step 0, built afresh).
+    state: Option<(String, u32, Engine)>,
+    acc: Accum,
+}
+
+/// Restore the running replica from a checkpoint (verified against its CRC first).
+fn restore_replica(
+    out: &OutputDir,
+    p: &DropletParams,
+    saved: &Saved,
+) -> Result<Option<(DropletSim, u64)>> {
+    let Some((name, crc, engine)) = &saved.state else {
+        return Ok(None);
+    };
+    let path = out.join(name);
+    let found = file_crc(&path)?;
+    if found != *crc {
+        bail!(
+            "{}: damaged: checksum {found:08x}, the checkpoint recorded {crc:08x}",
+            path.display()
+        );
+    }
+    let f = gsd::read_frame(&path, None)?;
+    if f.step != saved.step
+        || !f.exact
+        || f.list.is_none()
+        || engine.replica as usize != saved.replica
+    {
+        bail!(
+            "{}: not the checkpoint of replica {} at step {} that checkpoint.bin names",
+            path.display(),
+            saved.replica,
+            saved.step
+        );
+    }
+    let sim = DropletSim::restart(
+        f.particles,
+        f.sbox,
+        LennardJones::wca(p.kt, p.diameter),
+        p.interface(),
+        engine.params(),
+        f.step,
+        f.list.as_ref(),
+    )
+    .with_context(|| format!("restart from {}", path.display()))?;
+    // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
+    let builds = engine.builds.saturating_sub(sim.neighbor_builds());
+    Ok(Some((sim, builds)))
+}
+
+/// A droplet run: replicas one after the other.
+struct DropletSession {
+    p: DropletParams,
+    acc: Accum,
+    /// The running replica (or the next one, when `sim` is `None`).
+    rep: usize,
+    /// The running replica and its neighbour-list builds before this session.
+    sim: Option<(DropletSim, u64)>,
+    /// Steps of a replica at which something is recorded (profiles, frames, the end).
+    stops: Vec<u64>,
+    /// Steps between a replica's regular checkpoints.
+    ck_every: u64,
+    gsd: Option<GsdWriter>,
+    /// The trajectory's path, once the folder is known.
+    traj: Option<std::path::PathBuf>,
+    /// GSD file the previous checkpoint named, removed once the next one is in place.
+    stale: Vec<String>,
+}
+
+impl DropletSession {
+    fn new(p: DropletParams, acc: Accum, rep: usize, sim: Option<(DropletSim, u64)>) -> Self {
+        let mut stops: Vec<u64> = p.profile_steps.clone();
+        if p.trajectory_every > 0 {
+            stops.extend((0..=p.steps).step_by(p.trajectory_every as usize));
+        }
+        stops.push(p.steps);
+        stops.sort_unstable();
+        stops.dedup();
+        let ck_every = (p.steps / 10).max(1);
+        Self {
+            p,
+            acc,
+            rep,
+            sim,
+            stops,
+            ck_every,
+            gsd: None,
+            traj: None,
+            stale: Vec::new(),
+        }
+    }
+
+    /// Open (or reopen) the trajectory when replica 0 runs.
+    fn open_trajectory(&mut self) -> Result<()> {
+        if self.rep == 0
+            && self.p.trajectory_every > 0
+            && let Some(traj) = &self.traj
+        {
+            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            self.gsd = Some(if traj.exists() {
+                GsdWriter::append(traj)?
+            } else {
+                GsdWriter::create_new(traj)?
+            });
+        }
+        Ok(())
+    }
+
+    /// Record what is due at step `ev` of the running replica: profiles, the excursion
+    /// beyond the wall, trajectory frames.
+    fn record(&mut self, ev: u64) -> Result<()> {
+        let Some((s, _)) = &self.sim else {
+            return Ok(());
+        };
+        let p = &self.p;
+        let acc = &mut self.acc;
+        let t = s.time();
+        let radius = p.radius_at(t);
+        let wall_r = radius + p.offset;
+        let part = s.particles();
+        for x in &part.pos {
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            acc.max_excursion = acc.max_excursion.max(r - wall_r);
+        }
+        for (j, &ps) in p.profile_steps.iter().enumerate() {
+            if ps == ev {
+                let prof = radial_profile(&part.pos, &part.diameter, [0.0; 3], radius, p.bins);
+                for (a, b) in acc.sums[j].iter_mut().zip(&prof.phi) {
+                    *a += b;
+                }
+                acc.counts[j] += 1;
+                acc.radii[j] = radius;
+                acc.r_axes[j] = prof.r;
+                if ev == p.steps {
+                    acc.outside_final += prof.outside as u64;
+                }
+            }
+        }
+        if let Some(w) = self.gsd.as_mut()
+            && ev.is_multiple_of(p.trajectory_every)
+        {
+            w.write_frame(
+                ev,
+                &s.sbox,
+                &s.snapshot(),
+                false,
+                &[("droplet/radius", radius), ("droplet/time", t)],
+            )?;
+            acc.frames += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Session for DropletSession {
+    fn label(&self) -> String {
+        "droplet-bd".into()
+    }
+
+    fn total(&self) -> u64 {
+        self.p.steps * self.p.replicas as u64
+    }
+
+    fn position(&self) -> u64 {
+        self.rep as u64 * self.p.steps + self.sim.as_ref().map_or(0, |(s, _)| s.step)
+    }
+
+    fn seed(&self) -> u64 {
+        self.p.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::to_value(&self.p).unwrap_or_default()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        let profile = |prefix: &str| {
+            name.strip_prefix(prefix)
+                .and_then(|r| r.strip_suffix(".csv"))
+                .is_some_and(|f| f.parse::<f64>().is_ok())
+        };
+        profile("profile_")
+            || [
+                "profiles.png",
+                "trajectory.gsd",
+                "checkpoint-0.gsd",
+                "checkpoint-1.gsd",
+            ]
+            .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        self.traj = Some(out.join("trajectory.gsd"));
+        if self.sim.is_some() {
+            self.open_trajectory()?;
+            if fresh && self.stops.first() == Some(&0) {
+                self.record(0)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        let steps = self.p.steps;
+        let pos = self.position();
+        let (rep, local) = (pos / steps, pos % steps);
+        // Every 10 % of a replica, and between replicas.
+        let k = local / self.ck_every + 1;
+        if k <= 9 && k * self.ck_every < steps {
+            Some(rep * steps + k * self.ck_every)
+        } else if rep + 1 < self.p.replicas as u64 {
+            Some((rep + 1) * steps)
+        } else {
+            None
+        }
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        let steps = self.p.steps;
+        while self.position() < until {
+            if self.sim.is_none() {
+                self.sim = Some((self.p.build_replica(self.rep as u32)?, 0));
+                self.open_trajectory()?;
+                if self.stops.first() == Some(&0) {
+                    self.record(0)?;
+                }
+            }
+            let local_until = until.min((self.rep as u64 + 1) * steps) - self.rep as u64 * steps;
+            loop {
+                let step = self.sim.as_ref().map_or(0, |(s, _)| s.step);
+                if step >= local_until {
+                    break;
+                }
+                let k = self.stops.partition_point(|&e| e <= step);
+                let stop = self.stops.get(k).copied().unwrap_or(steps);
+                let target = stop.min(local_until);
+                let (s, _) = self.sim.as_mut().expect("a running replica");
+                if let Err(e) = s.run(target - step) {
+                    return Ok(Some(format!("replica {}: {e}", self.rep)));
+                }
+                if target == stop {
+                    self.record(stop)?;
+                }
+            }
+            if local_until == steps {
+                // The replica is complete.
+                if let Some(mut w) = self.gsd.take() {
+                    w.sync()?;
+                }
+                let (s, builds0) = self.sim.take().expect("a running replica");
+                self.acc.builds += builds0 + s.neighbor_builds();
+                self.rep += 1;
+            }
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    /// The running replica to the GSD file the current checkpoint does not name, then (by the
+    /// driver) `checkpoint.bin` naming it, then [`Session::after_save`] removes the older one:
+    /// a run killed at any point leaves a consistent checkpoint.
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        self.acc.checkpoints += 1;
+        let name = format!("checkpoint-{}.gsd", self.acc.checkpoints % 2);
+        let old = format!("checkpoint-{}.gsd", (self.acc.checkpoints + 1) % 2);
+        self.stale = vec![old];
+        let state = match &self.sim {
+            Some((s, builds)) => {
+                let path = out.join(&name);
+                let _ = std::fs::remove_file(&path);
+                let mut w = GsdWriter::create_new(&path)?;
+                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?;
+                w.sync()?;
+                drop(w);
+                let crc = file_crc(&path)?;
+                Some((name, crc, Engine::of(s, builds + s.neighbor_builds())))
+            }
+            None => {
+                self.stale.push(name);
+                None
+            }
+        };
+        let saved = Saved {
+            replica: self.rep,
+            step: self.sim.as_ref().map_or(0, |(s, _)| s.step),
+            state,
+            acc: self.acc.clone(),
+        };
+        Ok(bincode::serialize(&saved)?)
+    }
+
+    fn after_save(&mut self, out: &OutputDir) {
+        for f in self.stale.drain(..) {
+            let _ = std::fs::remove_file(out.join(&f));
+        }
+    }
+
+    fn finish(
+        self: Box<Self>,
+        out: &OutputDir,
+        wall_s: f64,
+        _failure: Option<&str>,
+    ) -> Result<Finished> {
+        let p = &self.p;
+        let n_frac = p.fractions.len();
+        let Accum {
+            sums,
+            counts,
+            radii,
+            r_axes,
+            max_excursion,
+            outside_final,
+            builds,
+            frames,
+            ..
+        } = self.acc;
+        let mut warnings = Vec::new();
+        let mut files = Vec::new();
+        let mut means: Vec<Vec<f64>> = Vec::new();
+        let mut drawn = Vec::new();
+        for j in 0..n_frac {
+            if counts[j] == 0 {
+                continue;
+            }
+            let reps = counts[j] as f64;
+            let phi: Vec<f64> = sums[j].iter().map(|v| v / reps).collect();
+            let name = profile_name(p.fractions[j]);
+            out.write_table(&name, &[("r", &r_axes[j]), ("phi", &phi)])?;
+            files.push(name);
+            means.push(phi);
+            drawn.push(j);
+        }
+        let labels: Vec<String> = drawn
+            .iter()
+            .map(|&j| format!("t = {:.0} % (R = {:.2})", p.fractions[j] * 100.0, radii[j]))
+            .collect();
+        let xs: Vec<Vec<f64>> = drawn
+            .iter()
+            .map(|&j| r_axes[j].iter().map(|x| x / radii[j]).collect())
+            .collect();
+        let series: Vec<Series> = (0..drawn.len())
+            .map(|k| Series {
+                label: &labels[k],
+                x: &xs[k],
+                y: &means[k],
+                points: false,
+            })
+            .collect();
+        picture(
+            line_plot(
+                &out.join("profiles.png"),
+                &format!(
+                    "Drying droplet, free-draining BD: N = {}, Pe = {}, {} replica(s)",
+                    p.particles, p.peclet, p.replicas
+                ),
+                "r / R(t)",
+                "volume fraction phi(r)",
+                &series,
+                Scale::Linear,
+            ),
+            "profiles.png",
+            &mut files,
+            &mut warnings,
+        );
+        if frames > 0 {
+            files.push("trajectory.gsd".into());
+        }
+        let particle_steps = (p.steps * p.replicas as u64) as f64 * p.particles as f64;
+        let summary = json!({
+            "software": crate::software(),
+            "method": "droplet-bd",
+            "seed": p.seed,
+            "parameters": p,
+            "steps": p.steps,
+            "time": p.steps as f64 * p.dt,
+            "final_radius": p.radius_at(p.steps as f64 * p.dt),
+            "final_mean_volume_fraction": p.volume_fraction_at_radius(p.radius_at(p.steps as f64 * p.dt)),
+            "max_excursion_beyond_wall": max_excursion,
+            "centres_beyond_R_at_end": outside_final,
+            "neighbor_list_builds": builds,
+            "wall_seconds": wall_s,
+            "particle_steps_per_second": particle_steps / wall_s.max(1e-9),
+            "threads": rayon::current_num_threads(),
+            "trajectory_frames": frames,
+            "warnings": warnings,
+        });
+        // The run is over: the replica checkpoints are no longer needed.
+        for f in ["checkpoint-0.gsd", "checkpoint-1.gsd"] {
+            let _ = std::fs::remove_file(out.join(f));
+        }
+        let message = format!(
+            "{} replica(s) x {} steps of {} colloids in {wall_s:.1} s ({:.3e} particle-steps/s); outputs in {}",
+            p.replicas,
+            p.steps,
+            p.particles,
+            particle_steps / wall_s.max(1e-9),
+            out.path().display()
+        );
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+/// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
+/// may have written more), so that the continuation appends exactly where the checkpoint stood.
+/// The frames are written again as [`GsdWriter`] wrote them, with the scalars `log/NAME` of
+/// `logs` and, with `velocities`, the velocities and masses: byte for byte the same file.
+pub(crate) fn trim_trajectory(
+    path: &Path,
+    frames: u64,
+    logs: &[&str],
+    velocities: bool,
+) -> Result<()> {
+    let have = gsd::frame_count(path)?;
+    if have == frames {
+        return Ok(());
+    }
+    if have < frames {
+        bail!(
+            "{}: holds {have} frames, the checkpoint expects {frames}; the trajectory was damaged",
+            path.display()
+        );
+    }
+    let tmp = path.with_extension("gsd.trim");
+    let _ = std::fs::remove_file(&tmp);
+    {
+        let file = GsdFile::open(path, Mode::Read)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let mut w = GsdWriter::create_new(&tmp)?;
+        if velocities {
+            w = w.with_velocities();
+        }
+        for k in 0..frames {
+            let mut f = gsd::read_frame(path, Some(k))?;
+            let e = |e: hoomd_gsd::file_layer::ReadError| {
+                anyhow::anyhow!("{}: frame {k}: {e}", path.display())
+            };
+            if velocities {
+                f.particles.vel = file
+                    .iter_arrays::<f32, 3>(k, "particles/velocity")
+                    .map_err(e)?
+                    .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
+                    .collect();
+                if f.particles.vel.len() != f.particles.len() {
+                    bail!("{}: frame {k}: velocities missing", path.display());
+                }
+            }
+            let values = logs
+                .iter()
+                .map(|name| -> Result<(&str, f64)> {
+                    let v = file
+                        .iter_scalars::<f64>(k, &format!("log/{name}"))
+                        .map_err(e)?
+                        .next()
+                        .with_context(|| format!("{}: frame {k}: no log/{name}", path.display()))?;
+                    Ok((*name, v))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            w.write_frame(f.step, &f.sbox, &f.particles, false, &values)?;
+        }
+        w.sync()?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
+    Ok(())
+}
+
+/// Replica 0 of a droplet scenario, stepped by hand.
+struct BdEngine {
+    sim: DropletSim,
+}
+
+/// Flatten `[x, y, z]` rows.
+pub(crate) fn flat(v: &[[f64; 3]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+
+impl crate::Engine for BdEngine {
+    fn method(&self) -> &str {
+        "droplet-bd"
+    }
+    fn dimensions(&self) -> usize {
+        3
+    }
+    fn particles(&self) -> usize {
+        self.sim.particles().len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        Ok(self.sim.run(steps)?)
+    }
+    fn steps(&self) -> u64 {
+        self.sim.step
+    }
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    fn dt(&self) -> f64 {
+        self.sim.params().dt
+    }
+    fn positions(&self) -> Vec<f64> {
+        flat(&self.sim.snapshot().pos)
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        None
+    }
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(flat(&self.sim.forces()))
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        self.sim.sbox.l.to_vec()
+    }
+}

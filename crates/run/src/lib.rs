@@ -1,0 +1,140 @@
+//! The one run path of colloidsim, used by the CLI and by Python alike.
+//!
+//! A [`Scenario`] (TOML text) names a method; the [`method`] registry turns it into that
+//! method's [`Session`](method::Session) (engine + observers), and [`run`] drives every session
+//! the same way: output folder, observers on their triggers, checkpoints every ~10 % and on
+//! interrupt, verified restarts, atomic writers and `summary.json`. [`theory`] computes a
+//! scenario's continuum counterpart, [`check`] validates it, [`keys`] lists its keys.
+
+pub mod checkpoint;
+pub mod control;
+mod driver;
+pub mod engine;
+pub mod keys;
+pub mod method;
+pub mod plot;
+pub mod scenario;
+
+mod bcd;
+mod dpd;
+mod droplet;
+mod theory_droplet;
+
+pub use control::{Control, Progress, Silent};
+pub use driver::{resume, run};
+pub use engine::Engine;
+pub use method::{Checked, Finished, Method};
+pub use scenario::Scenario;
+
+use std::path::PathBuf;
+
+/// The software name and version written into every summary.
+pub fn software() -> String {
+    format!("colloidsim {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// Options of a run.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Output folder (default: the scenario's name, in the current folder).
+    pub out: Option<PathBuf>,
+    /// Seed replacing the scenario's (0 ..= 4294967295).
+    pub seed: Option<u64>,
+    /// Write into a folder that already holds files (this method's earlier outputs are
+    /// replaced; other files are kept and listed).
+    pub force: bool,
+}
+
+/// Options of a theory solve.
+#[derive(Debug, Clone, Default)]
+pub struct TheoryOptions {
+    /// Output folder (default: the scenario's name followed by `-theory`).
+    pub out: Option<PathBuf>,
+    /// Grid spacing (default: fine enough for the scenario).
+    pub dx: Option<f64>,
+    /// Write into a folder that already holds files.
+    pub force: bool,
+    /// Droplet DDFT only: `free-draining` (default) or `rpy`.
+    pub hydrodynamics: Option<String>,
+}
+
+/// What a finished run or theory solve produced.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// The output folder.
+    pub out: PathBuf,
+    /// `summary.json` as written.
+    pub summary: serde_json::Value,
+    /// The files written (besides `summary.json`).
+    pub files: Vec<String>,
+    /// Warnings met on the way.
+    pub warnings: Vec<String>,
+    /// One line saying what was done.
+    pub message: String,
+}
+
+/// A run stopped on request (Ctrl-C, or the caller's interrupt) after writing a checkpoint.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error(
+    "interrupted at step {at}; checkpoint written at step {checkpoint} in {}{}",
+    out.display(),
+    if outputs.is_empty() { String::new() } else {
+        format!(" with the outputs so far ({}; summary.json is written when the run completes)", outputs.join(", "))
+    }
+)]
+pub struct Interrupted {
+    /// Position at which the interrupt was seen.
+    pub at: u64,
+    /// Position of the checkpoint written.
+    pub checkpoint: u64,
+    /// The run folder (continue with `--restart` on it).
+    pub out: PathBuf,
+    /// Outputs written so far.
+    pub outputs: Vec<String>,
+}
+
+/// A run that could not go on (e.g. non-finite positions, a heating time step); its outputs
+/// so far and a `summary.json` with `completed = false` are written.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error(
+    "{message}\nthe outputs up to step {position} are in {} (summary.json says completed = false)",
+    out.display()
+)]
+pub struct Failed {
+    /// Why it stopped.
+    pub message: String,
+    /// Position reached.
+    pub position: u64,
+    /// The run folder.
+    pub out: PathBuf,
+}
+
+/// Validate a scenario (`colloidsim check`).
+pub fn check(sc: &Scenario) -> anyhow::Result<Checked> {
+    method::of(sc)?.check(sc)
+}
+
+/// The continuum counterpart of a scenario (`colloidsim theory`).
+pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Result<Report> {
+    let m = method::of(sc)?;
+    if opts.hydrodynamics.is_some() && m.names()[0] != "droplet-bd" {
+        anyhow::bail!("--hydrodynamics applies to droplet-bd scenarios only");
+    }
+    m.theory(sc, opts, ctl)
+}
+
+/// Every key of a method's scenarios (`colloidsim keys METHOD`).
+pub fn keys(method: &str) -> anyhow::Result<Vec<keys::Key>> {
+    Ok(method::find(method)?.keys())
+}
+
+/// An engine built from a scenario, to be stepped by hand.
+pub fn engine(sc: &Scenario, seed: Option<u64>) -> anyhow::Result<Box<dyn Engine>> {
+    method::of(sc)?.engine(sc, seed)
+}
+
+/// Validate a seed from the scenario or the caller: the counter-based streams take 32 bits.
+pub fn seed32(seed: u64) -> anyhow::Result<u32> {
+    u32::try_from(seed)
+        .map_err(|_| anyhow::anyhow!("seed: must lie in [0, 4294967295], got {seed}"))
+}

@@ -1,0 +1,165 @@
+//! The interface every method implements once, and the one place methods are registered.
+//!
+//! A [`Method`] turns a scenario into a [`Session`] (a fresh one, or one restored from a
+//! checkpoint); the driver ([`crate::run`]) then owns everything every run shares: the output
+//! folder, Ctrl-C, the checkpoint cadence and envelope, restart checks, test hooks, progress and
+//! `summary.json`. A session owns its engine and its observers, and writes its own tables.
+
+use crate::checkpoint::Envelope;
+use crate::control::Control;
+use crate::keys::Key;
+use crate::{Report, TheoryOptions};
+use anyhow::{Result, bail};
+use colloidsim_core::output::OutputDir;
+
+/// The outcome of `check`: the resolved parameters and any warnings.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    /// The resolved parameters (what `colloidsim check` prints).
+    pub resolved: serde_json::Value,
+    /// Warnings about the scenario.
+    pub warnings: Vec<String>,
+}
+
+/// What a finished (or failed) session leaves: the summary fields of the method, the files it
+/// wrote and the line the CLI prints.
+#[derive(Debug, Clone)]
+pub struct Finished {
+    /// The method's summary fields (the driver adds `completed`, `error` and `files`).
+    pub summary: serde_json::Value,
+    /// Files written beside `summary.json`.
+    pub files: Vec<String>,
+    /// One line saying what was done.
+    pub message: String,
+    /// Warnings met while writing (e.g. a picture that could not be drawn).
+    pub warnings: Vec<String>,
+}
+
+/// One method's family of scenarios (`method = "..."`).
+pub trait Method: Sync {
+    /// The `method` values this method answers to (the first is its name).
+    fn names(&self) -> &'static [&'static str];
+    /// One line for `colloidsim --help`.
+    fn about(&self) -> &'static str;
+    /// Where its scenario keys and outputs are documented.
+    fn docs(&self) -> &'static str;
+    /// Validate a scenario (everything `run` would validate before it starts).
+    fn check(&self, sc: &Scenario) -> Result<Checked>;
+    /// A fresh session; nothing is written.
+    fn start(&self, sc: &Scenario, seed: Option<u64>) -> Result<Box<dyn Session>>;
+    /// The session a verified checkpoint continues, run with `seed` (the checkpoint's, or the
+    /// one asked for).
+    fn restore(
+        &self,
+        sc: &Scenario,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>>;
+    /// Does `colloidsim theory` apply?
+    fn has_theory(&self) -> bool {
+        false
+    }
+    /// The continuum counterpart of a scenario on the run's grid and file names.
+    fn theory(&self, sc: &Scenario, _opts: &TheoryOptions, _ctl: &Control) -> Result<Report> {
+        bail!(
+            "{}: method '{}' has no theory counterpart",
+            sc.label(),
+            self.names()[0]
+        )
+    }
+    /// Every scenario key with its unit, default and allowed range.
+    fn keys(&self) -> Vec<Key>;
+    /// An engine a script can step by hand (Python's engine classes).
+    fn engine(&self, sc: &Scenario, seed: Option<u64>) -> Result<Box<dyn crate::Engine>>;
+}
+
+/// A run of one scenario: its engine, its observers and where it stands. Progress is counted
+/// in *positions* (steps, over all replicas), which is also what test hooks and checkpoints use.
+pub trait Session: Send {
+    /// Label of the progress bar.
+    fn label(&self) -> String;
+    /// Positions of the whole run.
+    fn total(&self) -> u64;
+    /// Positions done.
+    fn position(&self) -> u64;
+    /// The run's seed.
+    fn seed(&self) -> u64;
+    /// The resolved parameters (JSON; `parameters` of `summary.json`).
+    fn parameters(&self) -> serde_json::Value;
+    /// Warnings about the scenario, printed before the run.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Does this session write the file `name` (so that `--force` replaces it)?
+    fn writes(&self, name: &str) -> bool;
+    /// The output folder is ready: open trajectories; on a fresh run take the observations of
+    /// position 0.
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()>;
+    /// The next position after the current one at which a regular checkpoint is due.
+    fn next_checkpoint(&self) -> Option<u64>;
+    /// The first position from the current one at which a checkpoint can be written (some
+    /// engines restart bitwise only at list rebuilds).
+    fn stop_point(&self) -> u64 {
+        self.position()
+    }
+    /// Run up to position `until`, taking every observation due on the way. `Ok(Some(why))`:
+    /// the run cannot go on (e.g. it went non-finite); the driver writes the outputs so far and
+    /// a summary saying so.
+    fn advance(&mut self, until: u64) -> Result<Option<String>>;
+    /// Bring trajectories to the disk.
+    fn flush(&mut self) -> Result<()>;
+    /// The method's checkpoint state at the current position (the driver wraps and writes it).
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>>;
+    /// `checkpoint.bin` now names the state just saved: remove what the previous checkpoint
+    /// needed beside it.
+    fn after_save(&mut self, _out: &OutputDir) {}
+    /// Outputs written when the run is interrupted (the tables so far); their names.
+    fn interim_outputs(&mut self, _out: &OutputDir) -> Result<Vec<String>> {
+        Ok(Vec::new())
+    }
+    /// Write every output; `failure` says why the run stopped early.
+    fn finish(
+        self: Box<Self>,
+        out: &OutputDir,
+        wall_seconds: f64,
+        failure: Option<&str>,
+    ) -> Result<Finished>;
+}
+
+pub use crate::scenario::Scenario;
+
+/// Every method, in the order `--help` lists them. New methods register here.
+static METHODS: &[&dyn Method] = &[
+    &crate::bcd::BcdMethod,
+    &crate::droplet::DropletBd,
+    &crate::dpd::DpdMethod,
+];
+
+/// Every registered method.
+pub fn all() -> &'static [&'static dyn Method] {
+    METHODS
+}
+
+/// Every `method` value a scenario may name.
+pub fn names() -> Vec<&'static str> {
+    METHODS
+        .iter()
+        .flat_map(|m| m.names().iter().copied())
+        .collect()
+}
+
+/// The method a scenario names.
+pub fn find(name: &str) -> Result<&'static dyn Method> {
+    METHODS
+        .iter()
+        .copied()
+        .find(|m| m.names().contains(&name))
+        .ok_or_else(|| anyhow::anyhow!("unknown method '{name}' (one of: {})", names().join(", ")))
+}
+
+/// The method of a scenario, with the scenario named in the error.
+pub fn of(sc: &Scenario) -> Result<&'static dyn Method> {
+    let name = sc.method()?;
+    find(&name).map_err(|e| anyhow::anyhow!("{}: {e}", sc.label()))
+}
