@@ -1027,11 +1027,14 @@ fn cluster_walk(
 ) {
     let origin = cluster_origin(n, periodic, &bonded);
     let mut size = 0;
-    for w in origin..origin + n {
-        size += 1;
-        if !bonded(w % n) {
-            visit(size);
-            size = 0;
+    // From the origin to the end, then from the start to the origin (no index wrap per rod).
+    for range in [origin..n, 0..origin] {
+        for w in range {
+            size += 1;
+            if !bonded(w) {
+                visit(size);
+                size = 0;
+            }
         }
     }
     if size > 0 {

@@ -21,6 +21,10 @@ pub struct DensityProfile {
     counts: Vec<u64>,
     samples: u64,
     folds: f64,
+    /// The bins of one configuration (scratch: the bin arithmetic runs as its own,
+    /// vectorised pass before the counting).
+    #[serde(skip)]
+    scratch: Vec<u32>,
 }
 
 impl DensityProfile {
@@ -31,6 +35,7 @@ impl DensityProfile {
             counts: vec![0; bins],
             samples: 0,
             folds: length / period,
+            scratch: Vec::new(),
         }
     }
 
@@ -38,9 +43,14 @@ impl DensityProfile {
     pub fn sample(&mut self, x: &[f64]) {
         let m = self.counts.len();
         let scale = m as f64 / self.period;
-        for &xi in x {
-            let b = (fold(xi, self.period) * scale) as usize;
-            self.counts[b.min(m - 1)] += 1;
+        let (period, top) = (self.period, (m - 1) as u32);
+        self.scratch.clear();
+        self.scratch.extend(
+            x.iter()
+                .map(|&xi| ((fold(xi, period) * scale) as u32).min(top)),
+        );
+        for &b in &self.scratch {
+            self.counts[b as usize] += 1;
         }
         self.samples += 1;
     }

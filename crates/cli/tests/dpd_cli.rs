@@ -114,7 +114,7 @@ fn bad_scenarios_name_the_key() {
         ("[dpd]\ngamma = 300.0\n", "dpd.gamma"),
         ("[colloids]\ncutoff = 0.0001\n", "colloids.cutoff"),
         ("[run]\nskin = 0.0\n", "run.skin"),
-        ("[observe]\nfoo = 1\n", "unknown field"),
+        ("[observe]\nfoo = 1\n", "observe.foo: unknown key"),
     ] {
         let sc = SMALL.replace("[run]\ndt = 0.001", &format!("{patch}[run]\ndt = 0.001"));
         // Duplicate tables are invalid TOML; put the patch in a fresh file instead.

@@ -24,6 +24,7 @@ use std::time::Instant;
 pub struct BcdMethod;
 
 fn parse(src: &Source) -> Result<Scenario> {
+    crate::keys::validate(&src.table()?, crate::keys::BCD).with_context(|| src.label())?;
     toml::from_str(src.text()).with_context(|| src.label())
 }
 
@@ -147,7 +148,8 @@ fn build<P: PairForce + Clone + Send + 'static>(
 
 fn resolved_json(sc: &Scenario, r: &Resolved) -> serde_json::Value {
     let c = &r.config;
-    json!({
+    let t = Triggers::of(sc, r);
+    let mut v = json!({
         "method": sc.method,
         "seed": c.seed,
         "system": {
@@ -174,7 +176,11 @@ fn resolved_json(sc: &Scenario, r: &Resolved) -> serde_json::Value {
             Field::Table(t) => Some(t.spacing()),
             _ => None,
         },
-    })
+    });
+    // The values the run uses where the scenario left them out.
+    v["observe"]["every"] = json!(t.every);
+    v["run"]["checkpoint_every"] = json!(t.checkpoint_every);
+    v
 }
 
 /// Mean displacement per rod since sampling started, for the particle current.

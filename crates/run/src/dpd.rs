@@ -25,6 +25,7 @@ pub struct DpdMethod;
 
 /// Parse and validate a scenario, with the seed given if any.
 fn resolve(src: &Source, seed: Option<u64>) -> Result<(DpdScenario, DpdSetup)> {
+    crate::keys::validate(&src.table()?, crate::keys::DPD).with_context(|| src.label())?;
     let mut sc = DpdScenario::from_toml(src.text()).with_context(|| src.label())?;
     if let Some(s) = seed {
         crate::seed32(s)?;

@@ -26,6 +26,7 @@ pub struct DropletBd;
 
 /// Parse and validate a scenario; `system.initial` is taken relative to the scenario's folder.
 pub(crate) fn resolve(src: &Source, seed: Option<u64>) -> Result<(DropletScenario, DropletParams)> {
+    crate::keys::validate(&src.table()?, crate::keys::DROPLET).with_context(|| src.label())?;
     let mut sc = DropletScenario::from_toml(src.text()).with_context(|| src.label())?;
     if let Some(s) = seed {
         crate::seed32(s)?;

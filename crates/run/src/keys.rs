@@ -1,35 +1,1098 @@
-//! The scenario keys of every method, with unit, default and allowed range.
+//! Every scenario key of every method: unit, default, allowed values and meaning, in one table
+//! per method. The same table
+//! - checks a scenario before its method reads it ([`validate`]: unknown keys, types and the
+//!   range of each key, each error naming the key and what is allowed), and
+//! - is what `colloidsim keys METHOD` prints (and what docs/ quotes),
+//!
+//! so the listing cannot drift from the validation. Checks that relate several keys (a drying
+//! time against the droplet's lifetime, a skin against the diameter) stay with each method and
+//! are described in the key's `allowed` text. Tests check that every key the method's parser
+//! knows is in its table, that every table key is known to the parser, and that each
+//! documented default is the one the method uses.
 
+use anyhow::{Result, bail};
 use serde::Serialize;
 
-/// One scenario key.
-#[derive(Debug, Clone, Serialize)]
-pub struct Key {
-    /// Dotted path, e.g. `run.dt`.
+/// What values a key takes (checked on the key alone).
+#[derive(Debug, Clone, Copy)]
+pub enum Allowed {
+    /// A table of further keys.
+    Table,
+    /// A finite number > 0.
+    Positive,
+    /// A finite number >= 0.
+    NonNegative,
+    /// Any finite number.
+    Finite,
+    /// A finite number in `[lo, hi]`.
+    Closed(f64, f64),
+    /// A finite number in `(lo, hi]`.
+    LeftOpen(f64, f64),
+    /// An integer in `[lo, hi]`.
+    Integer(i64, i64),
+    /// One of these words.
+    OneOf(&'static [&'static str]),
+    /// `true` or `false`.
+    Bool,
+    /// A file name (relative to the scenario file).
+    Path,
+    /// A list of finite numbers in `[lo, hi]`, of length `len` (any when `None`).
+    Numbers(f64, f64, Option<usize>),
+}
+
+impl Allowed {
+    /// The allowed values, as a user reads them.
+    pub fn describe(&self) -> String {
+        match *self {
+            Allowed::Table => "a table".into(),
+            Allowed::Positive => "> 0".into(),
+            Allowed::NonNegative => ">= 0".into(),
+            Allowed::Finite => "any finite number".into(),
+            Allowed::Closed(lo, hi) => format!("[{lo}, {hi}]"),
+            Allowed::LeftOpen(lo, hi) => format!("({lo}, {hi}]"),
+            Allowed::Integer(lo, hi) if hi == i64::MAX => format!("integer >= {lo}"),
+            Allowed::Integer(lo, hi) => format!("integer in [{lo}, {hi}]"),
+            Allowed::OneOf(words) => words
+                .iter()
+                .map(|w| format!("\"{w}\""))
+                .collect::<Vec<_>>()
+                .join(", "),
+            Allowed::Bool => "true, false".into(),
+            Allowed::Path => "a file name".into(),
+            Allowed::Numbers(lo, hi, len) => {
+                let n = len.map_or("a list".to_string(), |n| format!("{n} numbers"));
+                if lo == f64::MIN && hi == f64::MAX {
+                    format!("{n} of finite numbers")
+                } else if hi == f64::MAX {
+                    format!("{n} of numbers > {lo}")
+                } else {
+                    format!("{n} of numbers in [{lo}, {hi}]")
+                }
+            }
+        }
+    }
+
+    /// Check `v`; the message says what is allowed and what was given.
+    fn check(&self, v: &toml::Value) -> Result<(), String> {
+        let number = |v: &toml::Value| match v {
+            toml::Value::Float(x) => Some(*x),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        };
+        let got = || match v {
+            toml::Value::String(s) => format!("\"{s}\""),
+            other => other.to_string(),
+        };
+        let must = |what: String| Err(format!("must be {what}, got {}", got()));
+        match *self {
+            Allowed::Table => match v {
+                toml::Value::Table(_) => Ok(()),
+                _ => must("a table (e.g. { key = value })".into()),
+            },
+            Allowed::Positive => match number(v) {
+                Some(x) if x.is_finite() && x > 0.0 => Ok(()),
+                _ => must("a finite number > 0".into()),
+            },
+            Allowed::NonNegative => match number(v) {
+                Some(x) if x.is_finite() && x >= 0.0 => Ok(()),
+                _ => must("a finite number >= 0".into()),
+            },
+            Allowed::Finite => match number(v) {
+                Some(x) if x.is_finite() => Ok(()),
+                _ => must("a finite number".into()),
+            },
+            Allowed::Closed(lo, hi) => match number(v) {
+                Some(x) if x.is_finite() && x >= lo && x <= hi => Ok(()),
+                _ => must(format!("a number in [{lo}, {hi}]")),
+            },
+            Allowed::LeftOpen(lo, hi) => match number(v) {
+                Some(x) if x.is_finite() && x > lo && x <= hi => Ok(()),
+                _ => must(format!("a number in ({lo}, {hi}]")),
+            },
+            Allowed::Integer(lo, hi) => match v {
+                toml::Value::Integer(i) if *i >= lo && *i <= hi => Ok(()),
+                _ => must(format!("an {}", self.describe())),
+            },
+            Allowed::OneOf(words) => match v {
+                toml::Value::String(s) if words.contains(&s.as_str()) => Ok(()),
+                _ => must(format!("one of {}", self.describe())),
+            },
+            Allowed::Bool => match v {
+                toml::Value::Boolean(_) => Ok(()),
+                _ => must("true or false".into()),
+            },
+            Allowed::Path => match v {
+                toml::Value::String(s) if !s.is_empty() => Ok(()),
+                _ => must("a file name in quotes".into()),
+            },
+            Allowed::Numbers(lo, hi, len) => {
+                let ok = match v {
+                    toml::Value::Array(a) => {
+                        len.is_none_or(|n| a.len() == n)
+                            && a.iter().all(|x| {
+                                number(x).is_some_and(|x| x.is_finite() && x >= lo && x <= hi)
+                            })
+                    }
+                    _ => false,
+                };
+                if ok { Ok(()) } else { must(self.describe()) }
+            }
+        }
+    }
+}
+
+/// One key of a method's scenarios.
+#[derive(Debug, Clone, Copy)]
+pub struct Spec {
+    /// Dotted path.
     pub path: &'static str,
-    /// Unit, or `-` for a pure number or a word.
+    /// Unit (`-` for a pure number or a word).
     pub unit: &'static str,
-    /// Default, or `required`.
+    /// Default (`required`, or how it is derived).
     pub default: &'static str,
-    /// Allowed values.
-    pub range: &'static str,
+    /// Allowed values of the key alone.
+    pub allowed: Allowed,
+    /// Further conditions that involve other keys (checked by the method).
+    pub also: &'static str,
     /// What it sets.
     pub doc: &'static str,
 }
 
-/// The keys of `bcd` scenarios.
-pub fn bcd() -> Vec<Key> {
-    Vec::new()
+/// One scenario key as listed by `colloidsim keys`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Key {
+    /// Dotted path, e.g. `run.dt`.
+    pub path: String,
+    /// Unit, or `-` for a pure number or a word.
+    pub unit: String,
+    /// Default, or `required`.
+    pub default: String,
+    /// Allowed values.
+    pub range: String,
+    /// What it sets.
+    pub doc: String,
 }
+
+impl From<&Spec> for Key {
+    fn from(s: &Spec) -> Self {
+        let mut range = s.allowed.describe();
+        if !s.also.is_empty() {
+            range = format!("{range}; {}", s.also);
+        }
+        Key {
+            path: s.path.into(),
+            unit: s.unit.into(),
+            default: s.default.into(),
+            range,
+            doc: s.doc.into(),
+        }
+    }
+}
+
+const fn key(
+    path: &'static str,
+    unit: &'static str,
+    default: &'static str,
+    allowed: Allowed,
+    doc: &'static str,
+) -> Spec {
+    Spec {
+        path,
+        unit,
+        default,
+        allowed,
+        also: "",
+        doc,
+    }
+}
+
+impl Spec {
+    const fn also(mut self, also: &'static str) -> Self {
+        self.also = also;
+        self
+    }
+}
+
+use Allowed::*;
+
+const SEED: Allowed = Integer(0, u32::MAX as i64);
+/// Step counts and other integers a run can hold.
+const COUNT: i64 = 1 << 53;
+
+/// The keys of `bcd` scenarios.
+pub static BCD: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["bcd", "bcd-chronological"]),
+        "premerging BCD, O(N) per step, or the chronological event-driven update, O(N^2) (test oracle)",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of all random streams (--seed overrides)",
+    ),
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "the rods and their ring or channel",
+    ),
+    key(
+        "system.length",
+        "length",
+        "required",
+        Positive,
+        "L: ring circumference or distance between the walls",
+    )
+    .also("a whole number of potential periods on a ring"),
+    key(
+        "system.particles",
+        "-",
+        "required",
+        Integer(1, COUNT),
+        "N, the number of rods",
+    )
+    .also("N diameter < length"),
+    key(
+        "system.diameter",
+        "length",
+        "required",
+        Positive,
+        "rod length sigma (the hard core)",
+    ),
+    key(
+        "system.mobility",
+        "length^2 / (energy time)",
+        "1",
+        Positive,
+        "mu; D = mu kT",
+    ),
+    key(
+        "system.kT",
+        "energy",
+        "1",
+        NonNegative,
+        "thermal energy; 0 gives deterministic cluster dynamics",
+    ),
+    key(
+        "system.boundary",
+        "-",
+        "periodic",
+        OneOf(&["periodic", "walls"]),
+        "a ring, or hard walls at 0 and L (centres in [sigma/2, L - sigma/2])",
+    ),
+    key(
+        "potential",
+        "-",
+        "none",
+        Table,
+        "external potential: the sum of the terms given",
+    ),
+    key(
+        "potential.cosine",
+        "-",
+        "none",
+        Table,
+        "U = (U0/2) cos(2 pi x / lambda)",
+    ),
+    key(
+        "potential.cosine.amplitude",
+        "energy",
+        "required",
+        Finite,
+        "U0, peak to peak",
+    ),
+    key(
+        "potential.cosine.wavelength",
+        "length",
+        "required",
+        Positive,
+        "lambda",
+    ),
+    key(
+        "potential.drive",
+        "energy / length",
+        "0",
+        Finite,
+        "constant force f (tilted washboard; the system then has no equilibrium)",
+    ),
+    key(
+        "potential.harmonic",
+        "-",
+        "none",
+        Table,
+        "U = k/2 (x - x0)^2 (minimum image on a ring)",
+    ),
+    key(
+        "potential.harmonic.stiffness",
+        "energy / length^2",
+        "required",
+        NonNegative,
+        "k",
+    ),
+    key("potential.harmonic.centre", "length", "L/2", Finite, "x0"),
+    key(
+        "potential.fourier",
+        "-",
+        "none",
+        Table,
+        "U = sum_n a_n cos(2 pi n x / lambda) + b_n sin(2 pi n x / lambda)",
+    ),
+    key(
+        "potential.fourier.wavelength",
+        "length",
+        "required",
+        Positive,
+        "lambda, the fundamental period",
+    ),
+    key(
+        "potential.fourier.cos",
+        "energy",
+        "[]",
+        Numbers(f64::MIN, f64::MAX, None),
+        "a_1, a_2, ...",
+    ),
+    key(
+        "potential.fourier.sin",
+        "energy",
+        "[]",
+        Numbers(f64::MIN, f64::MAX, None),
+        "b_1, b_2, ...",
+    ),
+    key(
+        "potential.table",
+        "-",
+        "none",
+        Path,
+        "CSV with columns x,U over exactly one period (last U equal to the first); periodic cubic spline",
+    ),
+    key(
+        "interaction",
+        "-",
+        "hard rods",
+        Table,
+        "pair interactions beyond the hard core",
+    ),
+    key(
+        "interaction.sticky",
+        "-",
+        "none",
+        Table,
+        "Baxter adhesion by the power law of the hard-rods paper's Eq. (33) on [sigma, sigma + eps]",
+    ),
+    key(
+        "interaction.sticky.gamma",
+        "-",
+        "required",
+        Positive,
+        "stickiness gamma",
+    )
+    .also("run.dt must satisfy Eq. (34): mu max|f| dt < eps"),
+    key(
+        "interaction.sticky.range",
+        "length",
+        "0.05",
+        Positive,
+        "virtual range eps",
+    ),
+    key(
+        "interaction.sticky.order",
+        "-",
+        "3",
+        Closed(1.0, 100.0),
+        "power p",
+    ),
+    key(
+        "interaction.yukawa",
+        "-",
+        "none",
+        Table,
+        "U = A exp(-(r - sigma)/l), force-shifted at the cut-off",
+    ),
+    key(
+        "interaction.yukawa.strength",
+        "energy",
+        "required",
+        Finite,
+        "A, the energy at contact",
+    ),
+    key(
+        "interaction.yukawa.screening",
+        "length",
+        "required",
+        Positive,
+        "l",
+    ),
+    key(
+        "interaction.yukawa.cutoff",
+        "length",
+        "required",
+        Positive,
+        "cut-off rc (centre distance)",
+    )
+    .also("> diameter"),
+    key(
+        "interaction.table",
+        "-",
+        "none",
+        Path,
+        "CSV with columns r,f (pair force, positive repulsive), linear interpolation, last f = 0",
+    ),
+    key(
+        "initial",
+        "-",
+        "random placement",
+        Table,
+        "the initial configuration",
+    ),
+    key(
+        "initial.placement",
+        "-",
+        "random",
+        OneOf(&["random", "lattice", "file"]),
+        "random (the exact hard-rod equilibrium without field), a lattice, or a file",
+    ),
+    key(
+        "initial.file",
+        "-",
+        "none",
+        Path,
+        "CSV with a column x (e.g. an earlier run's final_configuration.csv)",
+    )
+    .also("needs placement = \"file\""),
+    key("run", "-", "required", Table, "time stepping"),
+    key("run.dt", "time", "required", Positive, "time step"),
+    key(
+        "run.equilibrate",
+        "time",
+        "0",
+        NonNegative,
+        "time run before sampling",
+    ),
+    key("run.time", "time", "required", Positive, "sampled time"),
+    key(
+        "run.checkpoint_every",
+        "steps",
+        "10 % of the run (at least 1000)",
+        Integer(1, COUNT),
+        "steps between checkpoints",
+    ),
+    key("observe", "-", "no observables", Table, "what to measure"),
+    key(
+        "observe.every",
+        "steps",
+        "1",
+        Integer(1, COUNT),
+        "steps between samples of density, contact density and clusters",
+    ),
+    key(
+        "observe.density",
+        "-",
+        "off",
+        Table,
+        "density histogram over one period of the potential (or over L): density.csv",
+    ),
+    key(
+        "observe.density.bins",
+        "-",
+        "required",
+        Integer(1, 100_000_000),
+        "number of bins",
+    ),
+    key(
+        "observe.contact_density",
+        "-",
+        "off",
+        Table,
+        "two-particle density at contact (hard-rods paper Eq. 27): contact_density.csv",
+    ),
+    key(
+        "observe.contact_density.bins",
+        "-",
+        "required",
+        Integer(1, 100_000_000),
+        "number of bins",
+    ),
+    key(
+        "observe.contact_density.window",
+        "length",
+        "required",
+        Positive,
+        "contact window Delta'",
+    ),
+    key(
+        "observe.msd",
+        "-",
+        "off",
+        Table,
+        "mean-square displacement at log-spaced lags: msd.csv",
+    ),
+    key(
+        "observe.msd.points",
+        "-",
+        "40",
+        Integer(2, 100_000),
+        "number of lag times",
+    ),
+    key(
+        "observe.msd.max_lag",
+        "time",
+        "run.time / 2",
+        Positive,
+        "longest lag",
+    )
+    .also("in [run.dt, run.time]"),
+    key(
+        "observe.current",
+        "-",
+        "false",
+        Bool,
+        "mean displacement and particle current: current.csv",
+    ),
+    key(
+        "observe.clusters",
+        "-",
+        "false",
+        Bool,
+        "cluster-size distribution: clusters.csv",
+    ),
+    key(
+        "observe.trajectory",
+        "-",
+        "off",
+        Table,
+        "GSD frames: trajectory.gsd",
+    ),
+    key(
+        "observe.trajectory.every",
+        "steps",
+        "required",
+        Integer(1, COUNT),
+        "steps between frames",
+    ),
+];
 
 /// The keys of `droplet-bd` scenarios.
-pub fn droplet() -> Vec<Key> {
-    Vec::new()
-}
+pub static DROPLET: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["droplet-bd"]),
+        "free-draining Brownian dynamics of a drying droplet",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of the counter-based random streams (--seed overrides)",
+    ),
+    key(
+        "replicas",
+        "-",
+        "1",
+        Integer(1, 1_000_000),
+        "independent droplets whose profiles are averaged (replica r: initial stream r, noise keyed by (seed, step, r, block))",
+    ),
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "particles, solvent and the initial droplet",
+    ),
+    key(
+        "system.particles",
+        "-",
+        "required",
+        Integer(1, 100_000_000),
+        "number of colloids N",
+    ),
+    key(
+        "system.diameter",
+        "length",
+        "1",
+        Positive,
+        "colloid diameter d",
+    ),
+    key("system.kT", "energy", "1", Positive, "thermal energy"),
+    key(
+        "system.viscosity",
+        "energy time / length^3",
+        "1",
+        Positive,
+        "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
+    ),
+    key(
+        "system.phi0",
+        "-",
+        "give phi0 or radius",
+        LeftOpen(0.0, 0.64),
+        "initial mean volume fraction N d^3 / (8 R0^3)",
+    )
+    .also(
+        "at most 0.3 for random insertion (0.64 with system.initial); give this or system.radius",
+    ),
+    key(
+        "system.radius",
+        "length",
+        "give phi0 or radius",
+        Positive,
+        "initial droplet radius R0",
+    )
+    .also("phi0 within the same limits"),
+    key(
+        "system.initial",
+        "-",
+        "random insertion",
+        Path,
+        "start from the last frame of this GSD file (HOOMD schema) instead of random insertion",
+    )
+    .also("must hold system.particles particles within R0 + offset + range"),
+    key(
+        "drying",
+        "-",
+        "Pe = 10 to phi = 0.55",
+        Table,
+        "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi))",
+    ),
+    key(
+        "drying.peclet",
+        "-",
+        "10",
+        Positive,
+        "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha",
+    ),
+    key(
+        "drying.alpha",
+        "length^2 / time",
+        "8 pi Pe D0",
+        Positive,
+        "rate of loss of surface area",
+    ),
+    key(
+        "drying.final_volume_fraction",
+        "-",
+        "0.55",
+        LeftOpen(0.0, 0.64),
+        "run until the mean volume fraction reaches this; or give drying.duration",
+    )
+    .also("> phi0"),
+    key(
+        "drying.duration",
+        "time",
+        "until final_volume_fraction",
+        Positive,
+        "run for this time",
+    )
+    .also("before R^2 would turn negative (t < 4 pi R0^2 / alpha)"),
+    key(
+        "interface",
+        "-",
+        "k = 50 kT/d^2, range d/2, offset -d/2",
+        Table,
+        "harmonic interface V = k/2 s^2 for 0 <= s < range, linear beyond, s = r - (R(t) + offset)",
+    ),
+    key(
+        "interface.stiffness",
+        "energy / length^2",
+        "50 kT / d^2",
+        Positive,
+        "spring constant k",
+    ),
+    key(
+        "interface.range",
+        "length",
+        "d / 2",
+        Positive,
+        "range of the harmonic part Delta",
+    ),
+    key(
+        "interface.offset",
+        "length",
+        "-d / 2",
+        Finite,
+        "wall position relative to R(t) (-d/2: the colloid surface at R(t))",
+    )
+    .also("in [-R0, R0] and R_end + offset > 0"),
+    key("run", "-", "defaults", Table, "time stepping"),
+    key(
+        "run.dt",
+        "time",
+        "2e-4 d^2 / D0",
+        Positive,
+        "time step (too large a step for the WCA core stops the run naming the step and particle)",
+    )
+    .also("at most 1e12 steps"),
+    key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]"),
+    key("observe", "-", "profiles", Table, "what to measure"),
+    key(
+        "observe.profile",
+        "-",
+        "50 bins at 0, 25, 50, 75, 100 %",
+        Table,
+        "radial volume-fraction profiles: profile_<f>.csv",
+    ),
+    key(
+        "observe.profile.bins",
+        "-",
+        "50",
+        Integer(1, 10_000_000),
+        "radial bins of equal width between 0 and R(t)",
+    ),
+    key(
+        "observe.profile.fractions",
+        "-",
+        "[0, 0.25, 0.5, 0.75, 1.0]",
+        Numbers(0.0, 1.0, None),
+        "fractions of the drying time at which profiles are written",
+    )
+    .also("at least one"),
+    key(
+        "observe.trajectory",
+        "-",
+        "none",
+        Table,
+        "GSD frames of replica 0: trajectory.gsd",
+    ),
+    key(
+        "observe.trajectory.every",
+        "steps",
+        "0",
+        Integer(0, COUNT),
+        "steps between frames (0: none)",
+    ),
+];
 
 /// The keys of `dpd` scenarios.
+pub static DPD: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["dpd"]),
+        "DPD colloids in explicit solvent",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of the counter-based random streams (--seed overrides)",
+    ),
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "box, solvent and colloids",
+    ),
+    key(
+        "system.box_length",
+        "rc",
+        "give box_length or box_edges",
+        Positive,
+        "cube edge",
+    )
+    .also("each edge must hold 3 neighbour cells and twice the colloid range"),
+    key(
+        "system.box_edges",
+        "rc",
+        "give box_length or box_edges",
+        Numbers(0.0, f64::MAX, Some(3)),
+        "[Lx, Ly, Lz]",
+    )
+    .also("each > 0, the same conditions as box_length"),
+    key(
+        "system.density",
+        "1/rc^3",
+        "3",
+        Closed(1e-3, 20.0),
+        "solvent beads per volume the colloids leave free",
+    ),
+    key(
+        "system.phi",
+        "-",
+        "0",
+        Closed(0.0, 0.35),
+        "colloid volume fraction (random insertion)",
+    ),
+    key("system.kT", "energy", "0.1", Positive, "thermal energy"),
+    key(
+        "system.colloid_radius",
+        "rc",
+        "1",
+        Positive,
+        "mean colloid radius R_c",
+    ),
+    key(
+        "system.radius_distribution",
+        "-",
+        "monodisperse",
+        OneOf(&["monodisperse", "gaussian", "lognormal", "uniform"]),
+        "distribution of the colloid radii (gaussian truncated at +-3 sd)",
+    ),
+    key(
+        "system.radius_spread",
+        "-",
+        "0",
+        Closed(0.0, 0.5),
+        "relative sd (gaussian, lognormal) or half-width (uniform)",
+    ),
+    key(
+        "system.solvent_mass",
+        "bead mass",
+        "1",
+        Positive,
+        "m_s (colloid mass: 4/3 pi R^3 density m_s)",
+    ),
+    key("dpd", "-", "defaults", Table, "DPD pair forces"),
+    key(
+        "dpd.cutoff",
+        "rc",
+        "1",
+        Positive,
+        "solvent cut-off rc (the length unit)",
+    ),
+    key(
+        "dpd.repulsion",
+        "kT / rc",
+        "25",
+        NonNegative,
+        "solvent-solvent conservative amplitude a",
+    ),
+    key(
+        "dpd.repulsion_colloid_solvent",
+        "kT / rc'",
+        "25",
+        NonNegative,
+        "colloid-solvent amplitude a_cs",
+    ),
+    key(
+        "dpd.gamma",
+        "mass / time",
+        "4.5",
+        LeftOpen(0.0, 200.0),
+        "dissipation gamma (below 4.5: a warning)",
+    ),
+    key("colloids", "-", "defaults", Table, "colloid-colloid forces"),
+    key(
+        "colloids.cutoff",
+        "rc",
+        "1",
+        Positive,
+        "colloid-colloid surface cut-off",
+    )
+    .also("> contact_range"),
+    key(
+        "colloids.contact",
+        "kT / rc",
+        "10000",
+        NonNegative,
+        "contact modulus f_contact",
+    ),
+    key(
+        "colloids.contact_range",
+        "rc",
+        "0.001",
+        Positive,
+        "contact range Delta",
+    ),
+    key(
+        "colloids.morse_depth",
+        "kT",
+        "0",
+        NonNegative,
+        "Morse depth D0 (0: no attraction; ~12 for gels)",
+    ),
+    key(
+        "colloids.morse_kappa",
+        "1/rc",
+        "30",
+        Positive,
+        "Morse kappa",
+    ),
+    key("colloids.morse_r0", "rc", "0", NonNegative, "Morse r0").also("<= colloids.cutoff"),
+    key(
+        "colloids.eta0",
+        "mass / (rc time)",
+        "0.3",
+        NonNegative,
+        "background viscosity of the squeeze lubrication (and the time unit)",
+    ),
+    key(
+        "colloids.lubrication",
+        "-",
+        "true",
+        Bool,
+        "squeeze lubrication on or off",
+    ),
+    key(
+        "colloids.lubrication_gap",
+        "rc",
+        "0.001",
+        Positive,
+        "smallest gap delta of the lubrication",
+    )
+    .also("< colloids.cutoff"),
+    key(
+        "colloids.lubrication_noise",
+        "-",
+        "exact",
+        OneOf(&["exact", "authors"]),
+        "the lubrication pair's own noise (exact equilibrium) or the authors' weighted noise",
+    ),
+    key("run", "-", "defaults", Table, "time stepping"),
+    key("run.dt", "DPD time", "0.001", Positive, "time step"),
+    key("run.steps", "-", "10000", Integer(0, COUNT), "steps"),
+    key(
+        "run.skin",
+        "rc",
+        "0.4",
+        Closed(0.05, 2.0),
+        "neighbour-list skin",
+    ),
+    key(
+        "run.max_temperature_drift",
+        "-",
+        "0.1",
+        LeftOpen(0.0, 10.0),
+        "stop when the window-averaged kinetic temperature differs from kT by more than this fraction",
+    ),
+    key(
+        "run.temperature_window",
+        "steps",
+        "1000",
+        Integer(1, COUNT),
+        "window of that check",
+    ),
+    key(
+        "run.neighbors",
+        "-",
+        "auto",
+        OneOf(&["auto", "verlet", "cells"]),
+        "how solvent pairs are found: Verlet lists, cells every step, or chosen by the list lifetime",
+    ),
+    key("observe", "-", "defaults", Table, "what to measure"),
+    key(
+        "observe.thermo_every",
+        "steps",
+        "100",
+        Integer(0, COUNT),
+        "steps between rows of thermo.csv (0: none)",
+    ),
+    key(
+        "observe.trajectory_every",
+        "steps",
+        "1000",
+        Integer(0, COUNT),
+        "steps between GSD frames (0: none)",
+    ),
+    key(
+        "observe.msd_every",
+        "steps",
+        "100",
+        Integer(0, COUNT),
+        "steps between the positions kept for msd.csv (0: none)",
+    ),
+    key(
+        "observe.msd_solvent_beads",
+        "-",
+        "1000",
+        Integer(0, 100_000_000),
+        "solvent beads followed for the solvent MSD",
+    ),
+    key(
+        "observe.structure_every",
+        "steps",
+        "1000",
+        Integer(0, COUNT),
+        "steps between g(r), S(q), contacts and clusters (0: none)",
+    ),
+    key(
+        "observe.gr_bins",
+        "-",
+        "200",
+        Integer(1, 10_000_000),
+        "bins of g(r)",
+    ),
+    key("observe.gr_max", "rc", "L/2", Positive, "range of g(r)")
+        .also("at most half the shortest box edge"),
+    key(
+        "observe.contact_gap",
+        "rc",
+        "3 / morse_kappa",
+        Positive,
+        "a contact is a surface gap below this",
+    ),
+];
+
+/// The keys of `bcd` scenarios, as listed.
+pub fn bcd() -> Vec<Key> {
+    BCD.iter().map(Key::from).collect()
+}
+
+/// The keys of `droplet-bd` scenarios, as listed.
+pub fn droplet() -> Vec<Key> {
+    DROPLET.iter().map(Key::from).collect()
+}
+
+/// The keys of `dpd` scenarios, as listed.
 pub fn dpd() -> Vec<Key> {
-    Vec::new()
+    DPD.iter().map(Key::from).collect()
+}
+
+/// Check a scenario's table against a method's keys: unknown keys (with the keys of that
+/// table), types and each key's own range. `prefix` is the path of `table` (empty at the top).
+pub fn validate(table: &toml::Table, spec: &[Spec]) -> Result<()> {
+    walk(table, "", spec)
+}
+
+fn walk(table: &toml::Table, prefix: &str, spec: &[Spec]) -> Result<()> {
+    for (k, v) in table {
+        let path = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        let Some(s) = spec.iter().find(|s| s.path == path) else {
+            let siblings: Vec<&str> = spec
+                .iter()
+                .filter_map(|s| {
+                    let rest = if prefix.is_empty() {
+                        Some(s.path)
+                    } else {
+                        s.path
+                            .strip_prefix(prefix)
+                            .and_then(|r| r.strip_prefix('.'))
+                    }?;
+                    (!rest.contains('.')).then_some(rest)
+                })
+                .collect();
+            let place = if prefix.is_empty() {
+                "the top level".to_string()
+            } else {
+                format!("[{prefix}]")
+            };
+            bail!(
+                "{path}: unknown key (the keys of {place} are: {}); see colloidsim keys",
+                siblings.join(", ")
+            );
+        };
+        if let Err(m) = s.allowed.check(v) {
+            bail!("{path}: {m}");
+        }
+        if let (Allowed::Table, toml::Value::Table(t)) = (s.allowed, v) {
+            walk(t, &path, spec)?;
+        }
+    }
+    Ok(())
 }
 
 /// The keys as aligned text columns.
@@ -60,4 +1123,87 @@ pub fn markdown(keys: &[Key]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn each_key_is_checked_alone_with_its_name_and_range() {
+        let ok = table(
+            "method = \"bcd\"\n[system]\nlength = 10\nparticles = 3\ndiameter = 0.5\n[run]\ndt = 1e-3\ntime = 1.0\n",
+        );
+        validate(&ok, BCD).unwrap();
+        for (bad, words) in [
+            (
+                "[run]\ndt = -1",
+                "run.dt: must be a finite number > 0, got -1",
+            ),
+            (
+                "[run]\ndt = nan",
+                "run.dt: must be a finite number > 0, got nan",
+            ),
+            (
+                "[system]\nparticles = 2.5",
+                "system.particles: must be an integer in [1,",
+            ),
+            (
+                "[system]\nboundary = \"ring\"",
+                "one of \"periodic\", \"walls\", got \"ring\"",
+            ),
+            (
+                "[observe]\ncurrent = 1",
+                "observe.current: must be true or false",
+            ),
+            (
+                "[observe]\nnonsense = 1",
+                "observe.nonsense: unknown key (the keys of [observe] are: every, density",
+            ),
+            (
+                "sedd = 3",
+                "sedd: unknown key (the keys of the top level are: method, seed, system",
+            ),
+            (
+                "[potential]\ncosine = 3",
+                "potential.cosine: must be a table",
+            ),
+            (
+                "[potential.fourier]\nwavelength = 1\ncos = [1, \"a\"]",
+                "potential.fourier.cos: must be a list of finite numbers",
+            ),
+            (
+                "seed = 4294967296",
+                "seed: must be an integer in [0, 4294967295]",
+            ),
+        ] {
+            let e = validate(&table(bad), BCD).unwrap_err().to_string();
+            assert!(e.contains(words), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn every_path_is_listed_once_under_a_listed_table() {
+        for spec in [BCD, DROPLET, DPD] {
+            for (i, s) in spec.iter().enumerate() {
+                assert!(
+                    spec[..i].iter().all(|t| t.path != s.path),
+                    "{} twice",
+                    s.path
+                );
+                if let Some((parent, _)) = s.path.rsplit_once('.') {
+                    assert!(
+                        spec.iter()
+                            .any(|t| t.path == parent && matches!(t.allowed, Allowed::Table)),
+                        "{}: no table {parent}",
+                        s.path
+                    );
+                }
+            }
+        }
+    }
 }

@@ -74,10 +74,23 @@ impl Scenario {
         if overrides.is_empty() {
             return Ok(self.clone());
         }
+        let values = overrides
+            .iter()
+            .map(|o| parse_override(o))
+            .collect::<Result<Vec<_>>>()?;
+        self.with_values(&values)
+    }
+
+    /// The scenario with `(key.path, value)` overrides applied, in order (Python's
+    /// `overrides={"run.dt": 1e-4}`).
+    pub fn with_values(&self, values: &[(String, toml::Value)]) -> Result<Self> {
+        if values.is_empty() {
+            return Ok(self.clone());
+        }
         let mut table = self.table()?;
-        for o in overrides {
-            let (key, value) = parse_override(o)?;
-            set_key(&mut table, &key, value).with_context(|| format!("--set {o}"))?;
+        for (key, value) in values {
+            check_key_path(key)?;
+            set_key(&mut table, key, value.clone()).with_context(|| format!("--set {key}"))?;
         }
         let text = toml::to_string(&table).context("scenario: cannot be written as TOML")?;
         Ok(Self {
@@ -147,13 +160,7 @@ fn parse_override(o: &str) -> Result<(String, toml::Value)> {
         bail!("--set {o}: expected key.path=value, e.g. --set run.dt=1e-4");
     };
     let key = key.trim();
-    if key.is_empty()
-        || key
-            .split('.')
-            .any(|part| part.is_empty() || part.contains(char::is_whitespace))
-    {
-        bail!("--set {o}: '{key}' is not a key path (names separated by dots, e.g. run.dt)");
-    }
+    check_key_path(key).with_context(|| format!("--set {o}"))?;
     let value = value.trim();
     let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
         .ok()
@@ -172,6 +179,18 @@ fn parse_override(o: &str) -> Result<(String, toml::Value)> {
         }
     };
     Ok((key.to_string(), value))
+}
+
+/// A key path is names separated by dots.
+fn check_key_path(key: &str) -> Result<()> {
+    if key.is_empty()
+        || key
+            .split('.')
+            .any(|part| part.is_empty() || part.contains(char::is_whitespace))
+    {
+        bail!("'{key}' is not a key path (names separated by dots, e.g. run.dt)");
+    }
+    Ok(())
 }
 
 /// Set `key` (dotted) in `table`, creating the tables on the way.

@@ -87,6 +87,7 @@ fn parse_hydrodynamics(h: Option<&str>) -> Result<Hydrodynamics> {
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref())?;
     let dx = topts.dx;
+    crate::keys::validate(&src.table()?, crate::keys::DROPLET).with_context(|| src.label())?;
     let sc = DropletScenario::from_toml(src.text()).map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let p = sc.validate().map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let dr = grid_spacing(&p, dx)?;

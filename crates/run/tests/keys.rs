@@ -1,0 +1,259 @@
+//! The key tables of `colloidsim keys` against the methods' parsers and defaults: a key the
+//! parser knows but the table lacks (or the reverse), or a documented default that is not the
+//! one the method uses, fails here.
+
+use colloidsim_run::Scenario;
+use colloidsim_run::keys::{self, Allowed, Spec};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// Scenarios with every table present (and valid), one per method.
+const BCD: &str = r#"
+method = "bcd"
+seed = 1
+[system]
+length = 20.0
+particles = 10
+diameter = 0.5
+mobility = 1.0
+kT = 1.0
+boundary = "periodic"
+[potential]
+drive = 0.0
+cosine = { amplitude = 1.0, wavelength = 1.0 }
+harmonic = { stiffness = 0.1, centre = 10.0 }
+fourier = { wavelength = 2.0, cos = [0.1], sin = [0.2] }
+[interaction]
+sticky = { gamma = 1.0, range = 0.05, order = 3.0 }
+yukawa = { strength = 1.0, screening = 0.5, cutoff = 2.0 }
+[initial]
+placement = "random"
+[run]
+dt = 1e-5
+equilibrate = 0.0
+time = 0.01
+checkpoint_every = 1000
+[observe]
+every = 1
+current = false
+clusters = false
+density = { bins = 10 }
+contact_density = { bins = 10, window = 0.1 }
+msd = { points = 40, max_lag = 0.005 }
+trajectory = { every = 10 }
+"#;
+
+const DROPLET: &str = r#"
+method = "droplet-bd"
+seed = 1
+replicas = 1
+[system]
+particles = 10
+diameter = 1.0
+kT = 1.0
+viscosity = 1.0
+phi0 = 0.05
+[drying]
+peclet = 10.0
+[interface]
+stiffness = 50.0
+range = 0.5
+offset = -0.5
+[run]
+dt = 1e-4
+skin = 0.6
+[observe.profile]
+bins = 50
+fractions = [0.0, 0.25, 0.5, 0.75, 1.0]
+[observe.trajectory]
+every = 0
+"#;
+
+const DPD: &str = r#"
+method = "dpd"
+seed = 1
+[system]
+box_length = 8.0
+density = 3.0
+phi = 0.05
+kT = 0.1
+colloid_radius = 1.0
+radius_distribution = "monodisperse"
+radius_spread = 0.0
+solvent_mass = 1.0
+[dpd]
+cutoff = 1.0
+repulsion = 25.0
+repulsion_colloid_solvent = 25.0
+gamma = 4.5
+[colloids]
+cutoff = 1.0
+contact = 10000.0
+contact_range = 0.001
+morse_depth = 0.0
+morse_kappa = 30.0
+morse_r0 = 0.0
+eta0 = 0.3
+lubrication = true
+lubrication_gap = 0.001
+lubrication_noise = "exact"
+[run]
+dt = 0.001
+steps = 10000
+skin = 0.4
+max_temperature_drift = 0.1
+temperature_window = 1000
+neighbors = "auto"
+[observe]
+thermo_every = 100
+trajectory_every = 1000
+msd_every = 100
+msd_solvent_beads = 1000
+structure_every = 1000
+gr_bins = 200
+"#;
+
+type Parse = fn(&str) -> Result<(), String>;
+
+fn methods() -> [(&'static str, &'static [Spec], Parse); 3] {
+    [
+        (BCD, keys::BCD, |t| {
+            toml::from_str::<colloidsim_bcd::scenario::Scenario>(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (DROPLET, keys::DROPLET, |t| {
+            colloidsim_md::DropletScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (DPD, keys::DPD, |t| {
+            colloidsim_md::dpd::scenario::DpdScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+    ]
+}
+
+/// The table at `path` (created on the way).
+fn table_at<'a>(t: &'a mut toml::Table, path: &str) -> &'a mut toml::Table {
+    if path.is_empty() {
+        return t;
+    }
+    let mut t = t;
+    for part in path.split('.') {
+        t = t
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(Default::default()))
+            .as_table_mut()
+            .unwrap();
+    }
+    t
+}
+
+/// The field names serde lists in its "unknown field `x`, expected one of `a`, `b`" message.
+fn expected_fields(msg: &str) -> BTreeSet<String> {
+    let tail = &msg[msg.find("expected").unwrap_or_else(|| panic!("{msg}"))..];
+    let tail = tail.lines().next().unwrap();
+    tail.split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn every_key_the_parser_knows_is_listed_and_nothing_else() {
+    for (text, spec, parse) in methods() {
+        parse(text).unwrap_or_else(|e| panic!("the full scenario does not parse: {e}"));
+        let tables: Vec<&str> = std::iter::once("")
+            .chain(
+                spec.iter()
+                    .filter(|s| matches!(s.allowed, Allowed::Table))
+                    .map(|s| s.path),
+            )
+            .collect();
+        for t in tables {
+            let mut doc: toml::Table = toml::from_str(text).unwrap();
+            table_at(&mut doc, t).insert("zzz_unknown".into(), toml::Value::Integer(1));
+            let e = parse(&toml::to_string(&doc).unwrap()).unwrap_err();
+            let parser: BTreeSet<String> = expected_fields(&e);
+            let listed: BTreeSet<String> = spec
+                .iter()
+                .filter_map(|s| {
+                    let rest = if t.is_empty() {
+                        s.path
+                    } else {
+                        s.path.strip_prefix(t)?.strip_prefix('.')?
+                    };
+                    (!rest.contains('.')).then(|| rest.to_string())
+                })
+                .collect();
+            assert_eq!(parser, listed, "the keys of [{t}] ({e})");
+        }
+    }
+}
+
+#[test]
+fn documented_defaults_are_the_defaults_the_methods_use() {
+    let mut tested = 0;
+    for (text, spec, _) in methods() {
+        let full: toml::Table = toml::from_str(text).unwrap();
+        let check = |doc: &toml::Table| {
+            colloidsim_run::check(&Scenario::from_table(doc, Path::new(".")).unwrap())
+                .unwrap_or_else(|e| panic!("{e:#}"))
+                .resolved
+        };
+        for s in spec {
+            let Ok(value) = toml::from_str::<toml::Table>(&format!("v = {}", s.default))
+                .map(|mut t| t.remove("v").unwrap())
+            else {
+                continue; // required, or derived from other keys
+            };
+            let (parent, name) = s.path.rsplit_once('.').unwrap_or(("", s.path));
+            let mut with = full.clone();
+            let mut without = full.clone();
+            if !matches!(s.allowed, Allowed::Table) {
+                table_at(&mut with, parent).insert(name.into(), value);
+                table_at(&mut without, parent).remove(name);
+                assert_eq!(check(&with), check(&without), "default of {}", s.path);
+                tested += 1;
+            }
+        }
+    }
+    assert!(tested > 40, "only {tested} defaults compared");
+}
+
+#[test]
+fn a_value_outside_each_range_is_refused_naming_the_key() {
+    for (text, spec, _) in methods() {
+        let full: toml::Table = toml::from_str(text).unwrap();
+        // `method` is the registry's: an unknown one names the methods there.
+        for s in spec.iter().filter(|s| s.path != "method") {
+            let bad = match s.allowed {
+                Allowed::Positive => toml::Value::Float(0.0),
+                Allowed::NonNegative => toml::Value::Float(-1e-9),
+                Allowed::Finite => toml::Value::Float(f64::INFINITY),
+                Allowed::Closed(_, hi) | Allowed::LeftOpen(_, hi) => {
+                    toml::Value::Float(hi * 1.000001 + 1e-9)
+                }
+                Allowed::Integer(lo, _) if lo > i64::MIN => toml::Value::Integer(lo - 1),
+                Allowed::OneOf(_) => toml::Value::String("no-such-word".into()),
+                Allowed::Bool => toml::Value::Integer(1),
+                _ => continue,
+            };
+            let (parent, name) = s.path.rsplit_once('.').unwrap_or(("", s.path));
+            let mut doc = full.clone();
+            table_at(&mut doc, parent).insert(name.into(), bad.clone());
+            let e = colloidsim_run::check(&Scenario::from_table(&doc, Path::new(".")).unwrap())
+                .map(|_| ())
+                .unwrap_err();
+            let msg = format!("{e:#}");
+            assert!(
+                msg.contains(&format!("{}: must", s.path)),
+                "{} = {bad}: {msg}",
+                s.path
+            );
+        }
+    }
+}

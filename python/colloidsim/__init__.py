@@ -1,0 +1,383 @@
+"""colloidsim from Python: the same run path as the ``colloidsim`` command.
+
+Run a scenario and get its observables as numpy arrays::
+
+    import colloidsim
+    r = colloidsim.run("examples/bcd/hard-rods-cosine.toml", out="hard-rods")
+    r.density.x, r.density.rho          # density.csv, column by column
+    r.summary["steps"]                  # summary.json as a dict
+    th = colloidsim.theory("examples/bcd/hard-rods-cosine.toml", out="hard-rods-theory")
+
+or step an engine by hand::
+
+    bcd = colloidsim.BCD({"method": "bcd", "system": {...}, "run": {...}})
+    bcd.step(1000)
+    bcd.positions                       # numpy array, read-only
+
+A scenario is a path to a TOML file, a TOML string, or a dict with the file's structure.
+``overrides`` sets keys by their dotted path (``{"run.dt": 1e-4}``), with the same validation as
+in the file; so does the CLI's ``--set run.dt=1e-4``. Every key, with its unit, default and
+allowed range: ``colloidsim.keys("bcd")``. Errors raise :class:`ColloidsimError` with the
+message the CLI prints; Ctrl-C stops a run at the next point where it can write a checkpoint
+and raises ``KeyboardInterrupt`` (continue it with :func:`resume`).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _colloidsim
+from ._colloidsim import ColloidsimError
+
+__all__ = [
+    "BCD",
+    "BrownianDynamics",
+    "ColloidsimError",
+    "DPD",
+    "Engine",
+    "Result",
+    "Table",
+    "check",
+    "keys",
+    "methods",
+    "resume",
+    "run",
+    "theory",
+]
+
+__version__ = _colloidsim.version
+
+ScenarioLike = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+
+
+def _jsonable(v: Any) -> Any:
+    """numpy scalars and arrays to plain Python values."""
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, os.PathLike):
+        return os.fspath(v)
+    raise TypeError(f"scenario value {v!r} of type {type(v).__name__} is not a TOML value")
+
+
+def _scenario(scenario: ScenarioLike) -> Tuple[str, str, str, Optional[str]]:
+    """(TOML text, base folder, name, file) of a scenario given as path, TOML string or dict."""
+    if isinstance(scenario, Mapping):
+        text = _colloidsim.toml_from_json(json.dumps(dict(scenario), default=_jsonable))
+        return text, os.getcwd(), "scenario", None
+    if isinstance(scenario, os.PathLike) or (
+        isinstance(scenario, str)
+        and (os.path.isfile(scenario) or ("\n" not in scenario and "=" not in scenario))
+    ):
+        path = Path(scenario)
+        if not path.is_file():
+            raise ColloidsimError(f"cannot read scenario {path}: no such file")
+        return "", str(path.parent), path.stem, str(path)
+    if isinstance(scenario, str):
+        return scenario, os.getcwd(), "scenario", None
+    raise TypeError(
+        "scenario must be a path, a TOML string or a dict, not " + type(scenario).__name__
+    )
+
+
+def _overrides(overrides: Optional[Union[Mapping[str, Any], Sequence[str]]]) -> str:
+    """Overrides as the JSON list the extension reads: ``[key, value]`` pairs (from a dict) or
+    ``"key.path=value"`` strings (read as the CLI's ``--set``)."""
+    if overrides is None:
+        return "[]"
+    if isinstance(overrides, str):
+        overrides = [overrides]
+    if isinstance(overrides, Mapping):
+        items: List[Any] = [[str(k), v] for k, v in overrides.items()]
+    else:
+        items = [str(o) for o in overrides]
+    return json.dumps(items, default=_jsonable)
+
+
+def _warn(report: Dict[str, Any]) -> None:
+    for w in report.get("warnings", []):
+        warnings.warn(w, stacklevel=3)
+
+
+class Table(Mapping[str, np.ndarray]):
+    """A CSV table of a run: its columns as numpy arrays, by header name (``t["rho"]`` or
+    ``t.rho``)."""
+
+    def __init__(self, path: Union[str, "os.PathLike[str]"]):
+        self.path = Path(path)
+        with open(self.path, newline="") as f:
+            rows = list(csv.reader(f))
+        self.columns: List[str] = [c.strip() for c in rows[0]] if rows else []
+        data = np.array([[float(x) for x in r] for r in rows[1:]], dtype=float)
+        data = data.reshape(len(rows) - 1, len(self.columns)) if rows else data
+        self._data = {c: data[:, k] for k, c in enumerate(self.columns)}
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        return self._data[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.columns)
+
+    def __len__(self) -> int:
+        return len(self.columns)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        try:
+            return self.__dict__["_data"][name]
+        except KeyError:
+            raise AttributeError(
+                f"{self.path.name} has no column {name!r} (columns: {', '.join(self.columns)})"
+            ) from None
+
+    def __repr__(self) -> str:
+        n = len(next(iter(self._data.values()))) if self._data else 0
+        return f"Table({self.path.name}: {', '.join(self.columns)}; {n} rows)"
+
+
+class Result:
+    """What a run or a theory solve wrote: ``out`` (the folder), ``summary`` (summary.json as a
+    dict), ``files``, ``message``, ``warnings``, and every CSV table as a :class:`Table`, by
+    file stem (``result.density``, ``result["profile_0.50"]``, ``result.tables``)."""
+
+    def __init__(self, report: Dict[str, Any]):
+        self.out = Path(report["out"])
+        self.summary: Dict[str, Any] = report["summary"]
+        self.files: List[str] = list(report["files"])
+        self.message: str = report["message"]
+        self.warnings: List[str] = list(report.get("warnings", []))
+        self.tables: Dict[str, Table] = {}
+        for name in sorted(os.listdir(self.out)):
+            if name.endswith(".csv"):
+                self.tables[name[:-4]] = Table(self.out / name)
+
+    def __getitem__(self, name: str) -> Table:
+        return self.tables[name]
+
+    def __getattr__(self, name: str) -> Table:
+        tables = self.__dict__.get("tables", {})
+        if name in tables:
+            return tables[name]
+        raise AttributeError(
+            f"{name!r}: no table {name}.csv in {self.__dict__.get('out')} "
+            f"(tables: {', '.join(tables)})"
+        )
+
+    def __repr__(self) -> str:
+        return f"Result({self.out}: {', '.join(self.tables)})"
+
+
+def _out(out: Optional[Union[str, "os.PathLike[str]"]]) -> Optional[str]:
+    return None if out is None else os.fspath(out)
+
+
+def run(
+    scenario: ScenarioLike,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    force: bool = False,
+) -> Result:
+    """Run a scenario and write its outputs (as ``colloidsim run``).
+
+    ``out`` defaults to a new temporary folder (its path is ``result.out``); an existing
+    non-empty folder is refused unless ``force``. ``seed`` replaces the scenario's; ``threads``
+    sets the worker threads of this call (default: all cores). The run releases the GIL;
+    Ctrl-C writes a checkpoint and raises ``KeyboardInterrupt``.
+    """
+    text, base, name, origin = _scenario(scenario)
+    if out is None:
+        out = tempfile.mkdtemp(prefix=f"colloidsim-{name}-")
+    report = json.loads(
+        _colloidsim.run(
+            text, base, name, origin, _overrides(overrides), _out(out), seed, threads, force
+        )
+    )
+    _warn(report)
+    return Result(report)
+
+
+def resume(
+    folder: Union[str, "os.PathLike[str]"],
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+) -> Result:
+    """Continue the interrupted run in ``folder`` from its checkpoint (as
+    ``colloidsim run --restart folder``); the result is bitwise that of an uninterrupted run."""
+    report = json.loads(_colloidsim.resume(os.fspath(folder), seed, threads))
+    _warn(report)
+    return Result(report)
+
+
+def theory(
+    scenario: ScenarioLike,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
+    dx: Optional[float] = None,
+    force: bool = False,
+    hydrodynamics: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> Result:
+    """The continuum counterpart of a scenario on the run's grid and file names (as
+    ``colloidsim theory``); ``out`` defaults to a new temporary folder."""
+    text, base, name, origin = _scenario(scenario)
+    if out is None:
+        out = tempfile.mkdtemp(prefix=f"colloidsim-{name}-theory-")
+    report = json.loads(
+        _colloidsim.theory(
+            text,
+            base,
+            name,
+            origin,
+            _overrides(overrides),
+            _out(out),
+            dx,
+            force,
+            hydrodynamics,
+            threads,
+        )
+    )
+    _warn(report)
+    return Result(report)
+
+
+def check(
+    scenario: ScenarioLike,
+    overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
+) -> Dict[str, Any]:
+    """Validate a scenario (as ``colloidsim check``): the resolved parameters as a dict;
+    warnings are issued as Python warnings."""
+    text, base, name, origin = _scenario(scenario)
+    c = json.loads(_colloidsim.check(text, base, name, origin, _overrides(overrides)))
+    _warn(c)
+    return c["resolved"]
+
+
+def keys(method: str) -> List[Dict[str, str]]:
+    """Every scenario key of ``method`` with its unit, default and allowed range."""
+    return json.loads(_colloidsim.keys(method))
+
+
+def methods() -> List[Dict[str, Any]]:
+    """The registered methods: their ``method`` names, one line each, and their docs."""
+    return json.loads(_colloidsim.methods())
+
+
+class Engine:
+    """A method's engine built from a scenario, stepped by hand.
+
+    ``positions``, ``velocities`` and ``forces`` are read-only numpy arrays (copies of the
+    engine's state at the time of reading), shaped ``(N,)`` for rods and ``(N, 3)`` for spheres,
+    in the particles' input order.
+    """
+
+    _method: Optional[Tuple[str, ...]] = None
+
+    def __init__(
+        self,
+        scenario: ScenarioLike,
+        overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
+        seed: Optional[int] = None,
+    ):
+        text, base, name, origin = _scenario(scenario)
+        self._engine = _colloidsim.Engine(text, base, name, origin, _overrides(overrides), seed)
+        if self._method is not None and self._engine.method not in self._method:
+            raise ColloidsimError(
+                f"{type(self).__name__} takes a scenario with method = "
+                f"{' or '.join(repr(m) for m in self._method)}, got {self._engine.method!r}"
+            )
+
+    def step(self, steps: int = 1, threads: Optional[int] = None) -> None:
+        """Advance ``steps`` steps (releases the GIL; Ctrl-C stops at a whole step)."""
+        if steps < 0:
+            raise ValueError(f"steps: must be >= 0, got {steps}")
+        self._engine.step(steps, threads)
+
+    def _array(self, b: Optional[bytes]) -> Optional[np.ndarray]:
+        if b is None:
+            return None
+        a = np.frombuffer(b, dtype="<f8")
+        d = self._engine.dimensions
+        return a if d == 1 else a.reshape(-1, d)
+
+    @property
+    def method(self) -> str:
+        """The scenario's method."""
+        return self._engine.method
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Positions (unwrapped where the engine keeps them so)."""
+        return self._array(self._engine.positions_bytes())
+
+    @property
+    def velocities(self) -> Optional[np.ndarray]:
+        """Velocities (DPD); None for Brownian engines, which have none."""
+        return self._array(self._engine.velocities_bytes())
+
+    @property
+    def forces(self) -> np.ndarray:
+        """Forces: for Brownian engines the systematic force at the current positions; for
+        DPD the total force of the last step (conservative, dissipative and random)."""
+        return self._array(self._engine.forces_bytes())
+
+    @property
+    def steps(self) -> int:
+        """Steps done."""
+        return self._engine.steps
+
+    @property
+    def time(self) -> float:
+        """Simulated time."""
+        return self._engine.time
+
+    @property
+    def dt(self) -> float:
+        """Time step."""
+        return self._engine.dt
+
+    @property
+    def particles(self) -> int:
+        """Number of particles."""
+        return self._engine.particles
+
+    @property
+    def box(self) -> np.ndarray:
+        """System length (rods) or box edges (spheres)."""
+        return np.array(self._engine.box_lengths)
+
+    def __repr__(self) -> str:
+        if "_engine" not in self.__dict__:
+            return f"{type(self).__name__}(not built)"
+        return (
+            f"{type(self).__name__}({self.method}: {self.particles} particles, "
+            f"step {self.steps}, t = {self.time:g})"
+        )
+
+
+class BCD(Engine):
+    """1D Brownian cluster dynamics (``method = "bcd"`` or ``"bcd-chronological"``)."""
+
+    _method = ("bcd", "bcd-chronological")
+
+
+class BrownianDynamics(Engine):
+    """Free-draining Brownian dynamics of a droplet scenario (``method = "droplet-bd"``),
+    replica 0."""
+
+    _method = ("droplet-bd",)
+
+
+class DPD(Engine):
+    """DPD colloids in explicit solvent (``method = "dpd"``)."""
+
+    _method = ("dpd",)

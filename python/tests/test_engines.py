@@ -1,0 +1,72 @@
+"""Engines stepped by hand: deterministic, consistent with `run`, arrays read-only."""
+
+import numpy as np
+import pytest
+
+import colloidsim
+from conftest import EXAMPLES
+
+BCD_SCENARIO = {
+    "method": "bcd",
+    "seed": 7,
+    "system": {"length": 20.0, "particles": 10, "diameter": 0.5},
+    "potential": {"cosine": {"amplitude": 6.0, "wavelength": 1.0}},
+    "run": {"dt": 1e-3, "time": 1.0},
+}
+
+
+def test_bcd_steps_are_deterministic_and_split_freely():
+    a = colloidsim.BCD(BCD_SCENARIO)
+    b = colloidsim.BCD(BCD_SCENARIO)
+    a.step(200)
+    b.step(50)
+    b.step(150)
+    assert a.steps == b.steps == 200
+    assert np.array_equal(a.positions, b.positions)
+    assert a.time == pytest.approx(0.2)
+    c = colloidsim.BCD(BCD_SCENARIO, seed=8)
+    c.step(200)
+    assert not np.array_equal(a.positions, c.positions)
+
+
+def test_bcd_engine_ends_where_the_run_ends(tmp_path):
+    # A run of the same scenario writes its last positions to final_configuration.csv.
+    sc = dict(BCD_SCENARIO, run={"dt": 1e-3, "time": 0.5})
+    r = colloidsim.run(sc, out=tmp_path / "r")
+    e = colloidsim.BCD(sc)
+    e.step(r.summary["steps"])
+    assert np.array_equal(e.positions, r.final_configuration.x)
+
+
+def test_bcd_positions_keep_order_and_hard_core_and_forces_are_the_field():
+    e = colloidsim.BCD(BCD_SCENARIO)
+    e.step(500)
+    x = e.positions
+    assert x.shape == (10,)
+    assert np.all(np.diff(x) >= 0.5 - 1e-12)
+    # f = -dU/dx for U = (U0/2) cos(2 pi x): f = pi U0 sin(2 pi x).
+    assert np.allclose(e.forces, np.pi * 6.0 * np.sin(2 * np.pi * x), rtol=1e-12, atol=1e-12)
+    with pytest.raises(ValueError):
+        x[0] = 1.0  # read-only
+    assert e.velocities is None
+
+
+def test_brownian_dynamics_and_dpd_engines():
+    bd = colloidsim.BrownianDynamics(EXAMPLES / "droplet/drying-bd.toml")
+    p0 = bd.positions.copy()
+    bd.step(10)
+    assert bd.positions.shape == (bd.particles, 3)
+    assert not np.array_equal(p0, bd.positions)
+    assert bd.forces.shape == (bd.particles, 3)
+    dpd = colloidsim.DPD(EXAMPLES / "dpd/colloids-equilibrium.toml", overrides={"system.box_length": 8.0})
+    dpd.step(5)
+    v = dpd.velocities
+    assert v.shape == (dpd.particles, 3) and np.all(np.isfinite(v))
+    assert dpd.steps == 5
+
+
+def test_engine_classes_check_the_method():
+    with pytest.raises(colloidsim.ColloidsimError, match="method = 'dpd'"):
+        colloidsim.DPD(BCD_SCENARIO)
+    with pytest.raises(ValueError, match="steps"):
+        colloidsim.BCD(BCD_SCENARIO).step(-1)
