@@ -315,12 +315,28 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 let sigma = self.cfg.sigma;
                 let mut x =
                     std::mem::take(&mut *self.spare.lock().unwrap_or_else(|e| e.into_inner()));
-                x.clear();
-                x.extend(r.y.iter().enumerate().map(|(i, &yi)| yi + i as f64 * sigma));
+                x.resize(r.y.len(), 0.0);
+                if r.y.len() <= i32::MAX as usize {
+                    // Rod numbers through i32, whose conversion to f64 vectorises (the same
+                    // values: integers below 2^31 are exact either way).
+                    for (i, (xi, &yi)) in x.iter_mut().zip(&r.y).enumerate() {
+                        *xi = yi + (i as i32) as f64 * sigma;
+                    }
+                } else {
+                    for (i, (xi, &yi)) in x.iter_mut().zip(&r.y).enumerate() {
+                        *xi = yi + i as f64 * sigma;
+                    }
+                }
                 x
             }),
         }
     }
+    /// On a ring, the reduced positions `y_i = x_i - i sigma` the step works on (no copy);
+    /// `None` between walls and for the chronological update.
+    pub fn reduced(&self) -> Option<&[f64]> {
+        self.ring.as_ref().map(|r| r.y.as_slice())
+    }
+
     /// The dynamic state (for checkpoints).
     pub fn state(&self) -> &BcdState {
         match &self.ring {
@@ -376,6 +392,31 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 let bond = &self.state.bond;
                 let periodic = self.cfg.boundary == Boundary::Periodic;
                 cluster_walk(n, periodic, |i| bond[i] != 0, visit)
+            }
+        }
+    }
+
+    /// Add the current clusters to a histogram of sizes (`counts[s]`: clusters of `s` rods;
+    /// `counts` grows to N + 1 entries), the same counts as [`Bcd::cluster_sizes`] gives,
+    /// without a branch per rod: every rod adds 0 or 1 to the count of the size its cluster
+    /// has if it ends there.
+    pub fn count_cluster_sizes(&self, counts: &mut Vec<u64>) {
+        let n = self.len();
+        if counts.len() <= n {
+            counts.resize(n + 1, 0);
+        }
+        match &self.ring {
+            // Rod i is bonded to rod i + 1 when their reduced positions are equal, the last rod
+            // to the first when the seam is bonded.
+            Some(r) => {
+                let ends = r.y.windows(2).map(|w| w[0] != w[1]);
+                histogram_clusters(n, ends, r.seam, counts);
+            }
+            None => {
+                let bond = &self.state.bond;
+                let periodic = self.cfg.boundary == Boundary::Periodic;
+                let ends = bond[..n - 1].iter().map(|&b| b == 0);
+                histogram_clusters(n, ends, periodic && bond[n - 1] != 0, counts);
             }
         }
     }
@@ -1039,6 +1080,36 @@ fn cluster_walk(
     }
     if size > 0 {
         visit(size);
+    }
+}
+
+/// Add the clusters of `n` rods to `counts` (at least `n + 1` long): `ends` says for each of
+/// rods 0 to n - 2 whether it ends its cluster (is not bonded to the next); `wraps`: the last
+/// rod is bonded to the first. Every rod adds 0 or 1 to the count of the size its cluster has if it ends there (no
+/// branch per rod); a cluster across the seam is then moved from its first part's size to its
+/// whole size.
+fn histogram_clusters(
+    n: usize,
+    ends: impl Iterator<Item = bool> + Clone,
+    wraps: bool,
+    counts: &mut [u64],
+) {
+    let mut start = 0;
+    for (i, end) in ends.clone().enumerate() {
+        counts[i + 1 - start] += u64::from(end);
+        start = if end { i + 1 } else { start };
+    }
+    // The open cluster [start, n - 1].
+    let tail = n - start;
+    if !wraps {
+        counts[tail] += 1;
+    } else if start == 0 {
+        // No rod ends a cluster: one cluster round the ring.
+        counts[n] += 1;
+    } else {
+        let first = ends.take_while(|e| !e).count() + 1;
+        counts[first] -= 1;
+        counts[first + tail] += 1;
     }
 }
 

@@ -13,6 +13,10 @@ fn fold(x: f64, period: f64) -> f64 {
     x - (x / period).floor() * period
 }
 
+/// `1.5 * 2^52`: for an integer-valued `v` in `[0, 2^31)`, the low 32 bits of `v + MANTISSA_SHIFT`
+/// are `v`.
+const MANTISSA_SHIFT: f64 = 6_755_399_441_055_744.0;
+
 /// Histogram of rod centres over `[0, period)`, folded when the system is longer.
 /// `rho(x_a + dx/2) = p_a / (M dx (L / period))`, so its mean is the mean density N/L.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -43,12 +47,44 @@ impl DensityProfile {
     pub fn sample(&mut self, x: &[f64]) {
         let m = self.counts.len();
         let scale = m as f64 / self.period;
-        let (period, top) = (self.period, (m - 1) as u32);
-        self.scratch.clear();
-        self.scratch.extend(
-            x.iter()
-                .map(|&xi| ((fold(xi, period) * scale) as u32).min(top)),
-        );
+        let (period, top) = (self.period, (m - 1).min(i32::MAX as usize) as f64);
+        // Clamped to [0, last bin] and floored in f64, then read off the mantissa after adding
+        // 1.5 * 2^52 (exact for integers below 2^31): the same bins as a truncation to usize
+        // clamped to the last bin (NaN to bin 0), in a loop that vectorises (a float-to-int
+        // conversion does not).
+        self.scratch.resize(x.len(), 0);
+        for (b, &xi) in self.scratch.iter_mut().zip(x) {
+            let v = (fold(xi, period) * scale).max(0.0).min(top).floor();
+            *b = (v + MANTISSA_SHIFT).to_bits() as u32;
+        }
+        for &b in &self.scratch {
+            self.counts[b as usize] += 1;
+        }
+        self.samples += 1;
+    }
+
+    /// Add one configuration given by reduced positions `y_i = x_i - i sigma` (a ring's
+    /// [`Bcd::reduced`]): the same counts as [`DensityProfile::sample`] of
+    /// `x_i = y_i + i sigma`, without building `x`.
+    pub fn sample_reduced(&mut self, y: &[f64], sigma: f64) {
+        if y.len() > i32::MAX as usize {
+            let x: Vec<f64> = y
+                .iter()
+                .enumerate()
+                .map(|(i, &yi)| yi + i as f64 * sigma)
+                .collect();
+            return self.sample(&x);
+        }
+        let m = self.counts.len();
+        let scale = m as f64 / self.period;
+        let (period, top) = (self.period, (m - 1).min(i32::MAX as usize) as f64);
+        self.scratch.resize(y.len(), 0);
+        for (i, (b, &yi)) in self.scratch.iter_mut().zip(y).enumerate() {
+            // x_i exactly as Bcd::positions forms it.
+            let xi = yi + (i as i32) as f64 * sigma;
+            let v = (fold(xi, period) * scale).max(0.0).min(top).floor();
+            *b = (v + MANTISSA_SHIFT).to_bits() as u32;
+        }
         for &b in &self.scratch {
             self.counts[b as usize] += 1;
         }
@@ -241,13 +277,7 @@ pub struct ClusterSizes {
 impl ClusterSizes {
     /// Add the clusters of the current configuration.
     pub fn sample<E: ExternalForce, P: PairForce>(&mut self, bcd: &Bcd<E, P>) {
-        let counts = &mut self.counts;
-        bcd.cluster_sizes(|s| {
-            if counts.len() <= s {
-                counts.resize(s + 1, 0);
-            }
-            counts[s] += 1;
-        });
+        bcd.count_cluster_sizes(&mut self.counts);
     }
 
     /// Rows `(size, probability)`: the fraction of clusters of each size.
@@ -262,5 +292,96 @@ impl ClusterSizes {
             }
         }
         (s, p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Offering the MSD only the configurations it uses ([`Msd::next_due`]) gives the same
+    /// rows, bit for bit, as offering every step.
+    #[test]
+    fn msd_sampled_when_due_equals_msd_sampled_every_step() {
+        let lags = colloidsim_core::trigger::log_spaced(1, 300, 12);
+        let mut every = Msd::new(lags.clone(), 7);
+        let mut due = Msd::new(lags, 7);
+        let mut next = due.next_due(0);
+        let mut offered = 0;
+        let mut x = vec![0.0f64; 5];
+        for step in 0..2000u64 {
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi += ((step * 31 + i as u64 * 17) % 13) as f64 * 0.01 - 0.06;
+            }
+            every.sample(step, &x);
+            if step == next {
+                due.sample(step, &x);
+                offered += 1;
+                next = due.next_due(step + 1);
+                assert!(next > step);
+            }
+        }
+        assert_eq!(every.rows(), due.rows());
+        assert!(offered < 2000, "offered {offered} of 2000 steps");
+        assert!(!every.rows().is_empty());
+    }
+}
+
+#[cfg(test)]
+mod bin_tests {
+    use super::*;
+
+    /// The vectorised binning puts every position in the bin of the plain truncation,
+    /// including the edges, out-of-range and non-finite values.
+    #[test]
+    fn density_bins_equal_truncation_clamped_to_the_last_bin() {
+        let (period, m) = (1.0f64, 100usize);
+        let mut x: Vec<f64> = (0..20_000).map(|i| -3.0 + i as f64 * 3.7e-4).collect();
+        x.extend([
+            0.0,
+            1.0,
+            -0.0,
+            0.01,
+            0.99,
+            0.999_999_999_999_999_9,
+            1e300,
+            -1e300,
+        ]);
+        x.extend([
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            12345.678,
+            -1e-320,
+        ]);
+        let mut d = DensityProfile::new(m, period, 10.0);
+        d.sample(&x);
+        let mut want = vec![0u64; m];
+        let scale = m as f64 / period;
+        for &xi in &x {
+            let b = (fold(xi, period) * scale) as usize;
+            want[b.min(m - 1)] += 1;
+        }
+        assert_eq!(d.counts, want);
+    }
+
+    /// Binning from reduced positions gives the counts of binning the positions.
+    #[test]
+    fn density_from_reduced_positions_equals_density_from_positions() {
+        let sigma = 0.37;
+        let y: Vec<f64> = (0..5000)
+            .map(|i| (i as f64 * 0.618).sin() * 3.0 + 0.001 * i as f64)
+            .collect();
+        let x: Vec<f64> = y
+            .iter()
+            .enumerate()
+            .map(|(i, &yi)| yi + i as f64 * sigma)
+            .collect();
+        let mut a = DensityProfile::new(73, 1.3, 100.0);
+        let mut b = DensityProfile::new(73, 1.3, 100.0);
+        a.sample(&x);
+        b.sample_reduced(&y, sigma);
+        assert_eq!(a.counts, b.counts);
+        assert_eq!(a.samples, b.samples);
     }
 }

@@ -322,3 +322,55 @@ fn ring_cluster_sizes_follow_the_bonds_of_the_state() {
     }
     assert!(across_seam > 0, "no cluster crossed the seam");
 }
+
+#[test]
+fn branch_free_cluster_histogram_equals_the_cluster_walk() {
+    // Dense rods (many clusters, some across the seam) on a ring and between walls.
+    // The chronological update keeps the bonds in the state on a ring too.
+    for (boundary, update) in [
+        (Boundary::Periodic, Update::Premerge),
+        (Boundary::Walls, Update::Premerge),
+        (Boundary::Periodic, Update::Chronological),
+    ] {
+        let cfg = config(105.0, 0.99, 1e-3, boundary, update);
+        let x = init::random(&cfg, 100, 5).unwrap();
+        let mut a = Bcd::new(cfg, x, NoField, NoPair).unwrap();
+        let mut counts = Vec::new();
+        let mut want: Vec<u64> = Vec::new();
+        for _ in 0..300 {
+            a.run(1).unwrap();
+            a.count_cluster_sizes(&mut counts);
+            a.cluster_sizes(|s| {
+                if want.len() <= s {
+                    want.resize(s + 1, 0);
+                }
+                want[s] += 1;
+            });
+            want.resize(counts.len().max(want.len()), 0);
+            assert_eq!(
+                counts,
+                want,
+                "{boundary:?} {update:?} at step {}",
+                a.steps()
+            );
+        }
+    }
+    // One cluster of every rod round the ring (nothing ends): dense rods, long steps.
+    let cfg = config(10.0, 0.99, 1.0, Boundary::Periodic, Update::Premerge);
+    let x = init::random(&cfg, 10, 1).unwrap();
+    let mut a = Bcd::new(cfg, x, NoField, NoPair).unwrap();
+    let mut seen = false;
+    for _ in 0..200 {
+        a.run(1).unwrap();
+        let mut walk = Vec::new();
+        a.cluster_sizes(|s| walk.push(s));
+        if walk == [10] {
+            let mut counts = Vec::new();
+            a.count_cluster_sizes(&mut counts);
+            assert_eq!(counts.iter().sum::<u64>(), 1);
+            assert_eq!(counts[10], 1);
+            seen = true;
+        }
+    }
+    assert!(seen, "the ring never formed one cluster");
+}

@@ -26,6 +26,11 @@ pub struct BenchArgs {
     /// Repetitions; the median is reported.
     #[arg(long, default_value_t = 5)]
     pub repeats: usize,
+    /// Instead: the whole run path (`colloidsim run`) at these N, with no observers and with
+    /// the main example's (density of 100 bins, MSD of 30 lags and clusters, every step),
+    /// beside the bare engine, alternating the three in each repetition.
+    #[arg(long, value_delimiter = ',')]
+    pub observers: Vec<usize>,
 }
 
 fn rss_bytes() -> Option<f64> {
@@ -37,6 +42,9 @@ fn rss_bytes() -> Option<f64> {
 /// `colloidsim bench bcd`: the fast-bcd scaling case (sigma = 0.99, U0 = 6 kT, density 1 per
 /// wavelength, dt = 1e-3, periodic), nanoseconds per particle-step.
 pub fn bench(a: &BenchArgs) -> Result<()> {
+    if !a.observers.is_empty() {
+        return bench_observers(a);
+    }
     let field = ExternalField {
         terms: vec![FieldTerm::Cosine {
             amplitude: 6.0,
@@ -103,4 +111,102 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         run(n, Update::Chronological)?;
     }
     Ok(())
+}
+
+/// The fast-bcd case as a scenario for `colloidsim run`, with or without the main example's
+/// observers; `steps` sampled steps.
+fn scenario(n: usize, steps: u64, observers: bool) -> String {
+    let mut s = format!(
+        "method = \"bcd\"\nseed = 1\n[system]\nlength = {n}.0\nparticles = {n}\ndiameter = 0.99\n\
+         [potential]\ncosine = {{ amplitude = 6.0, wavelength = 1.0 }}\n\
+         [run]\ndt = 1e-3\ntime = {}\ncheckpoint_every = {}\n",
+        steps as f64 * 1e-3,
+        10 * steps
+    );
+    if observers {
+        s.push_str("[observe]\nevery = 1\ndensity = { bins = 100 }\nmsd = { points = 30 }\nclusters = true\n");
+    }
+    s
+}
+
+/// `colloidsim bench bcd --observers N,...`: nanoseconds per particle-step of the bare engine
+/// (`Bcd::run`), of `colloidsim run` without observers and with the main example's, in the
+/// same process, alternating; the run path's time is its step loop (`wall_seconds` of
+/// summary.json: observers included, the writing of outputs and the theory after the run not;
+/// no regular checkpoint, whose writing and fsync would be timed too).
+fn bench_observers(a: &BenchArgs) -> Result<()> {
+    use colloidsim_run::{Control, RunOptions, Scenario};
+    println!(
+        "# colloidsim bench bcd --observers: sigma = 0.99, U0 = 6 kT, rho = 1, dt = 1e-3, periodic, no regular checkpoint; {} threads, median (min-max) of {}",
+        rayon::current_num_threads(),
+        a.repeats
+    );
+    println!("N\tsteps\tengine_ns\trun_bare_ns\trun_observers_ns\tobservers_over_engine");
+    let field = Field::new(&ExternalField {
+        terms: vec![FieldTerm::Cosine {
+            amplitude: 6.0,
+            wavelength: 1.0,
+        }],
+        drive: 0.0,
+    });
+    let dir = std::env::temp_dir().join(format!("colloidsim-bench-obs-{}", std::process::id()));
+    for &n in &a.observers {
+        let steps = (a.work / n as u64).max(1000);
+        let (mut eng, mut bare, mut obs) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..a.repeats.max(1) {
+            let cfg = BcdConfig {
+                length: n as f64,
+                sigma: 0.99,
+                mobility: 1.0,
+                kt: 1.0,
+                dt: 1e-3,
+                boundary: Boundary::Periodic,
+                seed: 1,
+                update: Update::Premerge,
+            };
+            let mut b = Bcd::new(
+                cfg.clone(),
+                init::random(&cfg, n, 1)?,
+                field.clone(),
+                NoPair,
+            )?;
+            let t = Instant::now();
+            b.run(steps)?;
+            eng.push(t.elapsed().as_secs_f64() * 1e9 / (steps as f64 * n as f64));
+            for (with, out) in [(false, &mut bare), (true, &mut obs)] {
+                let _ = std::fs::remove_dir_all(&dir);
+                let sc = Scenario::from_toml(&scenario(n, steps, with), &dir)?;
+                let opts = RunOptions {
+                    out: Some(dir.clone()),
+                    seed: None,
+                    force: false,
+                };
+                let r = colloidsim_run::run(&sc, &opts, &Control::default())?;
+                let wall = r.summary["wall_seconds"].as_f64().unwrap_or(f64::NAN);
+                out.push(wall * 1e9 / (steps as f64 * n as f64));
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+        let (e, b, o) = (med(&mut eng), med(&mut bare), med(&mut obs));
+        println!(
+            "{n}\t{steps}\t{:.2} ({:.2}-{:.2})\t{:.2} ({:.2}-{:.2})\t{:.2} ({:.2}-{:.2})\t{:.2}",
+            e.0,
+            e.1,
+            e.2,
+            b.0,
+            b.1,
+            b.2,
+            o.0,
+            o.1,
+            o.2,
+            o.0 / e.0
+        );
+    }
+    Ok(())
+}
+
+/// Median, min, max.
+fn med(v: &mut [f64]) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[v.len() / 2], v[0], v[v.len() - 1])
 }

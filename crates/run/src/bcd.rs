@@ -135,6 +135,9 @@ fn build<P: PairForce + Clone + Send + 'static>(
         ),
     };
     let triggers = Triggers::of(&sc, &r);
+    // The next offer the MSD uses, from the sampled steps already done.
+    let sampled = bcd.steps().saturating_sub(triggers.equilibrate);
+    let msd_due = obs.msd.as_ref().map_or(0, |m| m.next_due(sampled));
     Ok(Box::new(BcdSession {
         sc,
         r,
@@ -143,6 +146,7 @@ fn build<P: PairForce + Clone + Send + 'static>(
         frames,
         gsd: None,
         triggers,
+        msd_due,
     }))
 }
 
@@ -282,6 +286,8 @@ struct BcdSession<P: PairForce> {
     frames: u64,
     gsd: Option<hoomd_gsd::hoomd::HoomdGsdFile>,
     triggers: Triggers,
+    /// The next sampled step the MSD uses (from [`Msd::next_due`], kept between samples).
+    msd_due: u64,
 }
 
 impl<P: PairForce + Clone + Send> BcdSession<P> {
@@ -307,9 +313,9 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         if o.current.is_some() {
             next = next.min(t.equilibrate + next_multiple_after(k, t.current_every));
         }
-        if let Some(m) = &o.msd {
+        if o.msd.is_some() {
             // The MSD is offered sampled step k' - 1 at step equilibrate + k'.
-            next = next.min(t.equilibrate + m.next_due(k) + 1);
+            next = next.min(t.equilibrate + self.msd_due + 1);
         }
         next
     }
@@ -322,13 +328,18 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         if s > t.equilibrate {
             let k = s - t.equilibrate;
             let every = k.is_multiple_of(t.every);
-            let msd = self
-                .obs
-                .msd
-                .as_ref()
-                .is_some_and(|m| m.next_due(k - 1) == k - 1);
+            let msd = self.obs.msd.is_some() && self.msd_due == k - 1;
             let current = self.obs.current.is_some() && k.is_multiple_of(t.current_every);
-            if every || msd || current {
+            let reduced = self.bcd.reduced();
+            if every && !msd && !current && self.obs.contact.is_none() && reduced.is_some() {
+                // Density and clusters only: straight from the ring's reduced positions.
+                if let (Some(d), Some(y)) = (self.obs.density.as_mut(), reduced) {
+                    d.sample_reduced(y, self.r.config.sigma);
+                }
+                if let Some(c) = self.obs.clusters.as_mut() {
+                    c.sample(&self.bcd);
+                }
+            } else if every || msd || current {
                 let x = self.bcd.positions();
                 if every {
                     if let Some(d) = self.obs.density.as_mut() {
@@ -343,6 +354,7 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
                 }
                 if msd && let Some(m) = self.obs.msd.as_mut() {
                     m.sample(k - 1, x);
+                    self.msd_due = m.next_due(k);
                 }
                 if current && let Some(c) = self.obs.current.as_mut() {
                     c.t.push(k as f64 * dt);
