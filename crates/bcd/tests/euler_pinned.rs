@@ -4,7 +4,7 @@
 
 use colloidsim_bcd::engine::CHUNK;
 use colloidsim_bcd::forces::{CosineForce, NoPair, PairForce, Sticky};
-use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
+use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Integrator, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 
 fn cosine() -> CosineForce {
@@ -23,6 +23,7 @@ fn run<P: PairForce>(
     pair: P,
     (length, n): (f64, usize),
     steps: u64,
+    integrator: Option<Integrator>,
 ) -> Vec<u64> {
     let cfg = BcdConfig {
         length,
@@ -36,6 +37,9 @@ fn run<P: PairForce>(
     };
     let x = init::random(&cfg, n, 5).unwrap();
     let mut b = Bcd::new(cfg, x, cosine(), pair).unwrap();
+    if let Some(i) = integrator {
+        b = b.with_integrator(i);
+    }
     b.run(steps).unwrap();
     let x = b.positions();
     // FNV-1a over the bits of every position, then a few positions themselves.
@@ -51,9 +55,25 @@ fn run<P: PairForce>(
 }
 
 /// The pins were printed by this file's `run` at main 4161e63, before the integrator choice
-/// existed (Euler was the only scheme).
+/// existed (Euler was the only scheme). They hold for the default integrator and for Euler
+/// chosen explicitly; Leimkuhler–Matthews gives other positions.
 #[test]
 fn euler_runs_are_bitwise_those_of_main() {
+    for integrator in [None, Some(Integrator::Euler)] {
+        euler_pins(integrator);
+    }
+    let st = Sticky::new(1.0, 0.05, 3.0, 0.5, 1.0).unwrap();
+    let lm = run(
+        (Boundary::Periodic, Update::Premerge),
+        st,
+        (100.0, 80),
+        2000,
+        Some(Integrator::Lm),
+    );
+    assert_ne!(lm[0], 0x0771153c55c3882f, "LM gave Euler's positions");
+}
+
+fn euler_pins(integrator: Option<Integrator>) {
     let st = Sticky::new(1.0, 0.05, 3.0, 0.5, 1.0).unwrap();
     let ring = (Boundary::Periodic, Update::Premerge);
     let walls = (Boundary::Walls, Update::Premerge);
@@ -61,7 +81,7 @@ fn euler_runs_are_bitwise_those_of_main() {
     let cases: [(&str, Vec<u64>, Vec<u64>); 7] = [
         (
             "ring",
-            run(ring, NoPair, (100.0, 80), 2000),
+            run(ring, NoPair, (100.0, 80), 2000, integrator),
             vec![
                 0x92168eb747bfeae7,
                 0x404144b48e91c617,
@@ -72,7 +92,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "ring sticky",
-            run(ring, st, (100.0, 80), 2000),
+            run(ring, st, (100.0, 80), 2000, integrator),
             vec![
                 0x0771153c55c3882f,
                 0x404144b48e91c617,
@@ -83,7 +103,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "walls",
-            run(walls, NoPair, (100.0, 80), 2000),
+            run(walls, NoPair, (100.0, 80), 2000, integrator),
             vec![
                 0xfa61a171c2349d49,
                 0x3ff89691d238c2ff,
@@ -94,7 +114,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "walls sticky",
-            run(walls, st, (100.0, 80), 2000),
+            run(walls, st, (100.0, 80), 2000, integrator),
             vec![
                 0x5f13932f33a8a341,
                 0x3ff89691d238c2ff,
@@ -105,7 +125,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "chronological",
-            run(chrono, NoPair, (100.0, 80), 500),
+            run(chrono, NoPair, (100.0, 80), 500, integrator),
             vec![
                 0x3225c964dc262d76,
                 0x40414b65698b0c60,
@@ -116,7 +136,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "ring, three chunks",
-            run(ring, NoPair, (10000.0, 9000), 100),
+            run(ring, NoPair, (10000.0, 9000), 100, integrator),
             vec![
                 0xbf833695c5424929,
                 0x40bc937da1a56c8c,
@@ -129,7 +149,7 @@ fn euler_runs_are_bitwise_those_of_main() {
         ),
         (
             "walls, three chunks",
-            run(walls, NoPair, (10000.0, 9000), 100),
+            run(walls, NoPair, (10000.0, 9000), 100, integrator),
             vec![
                 0x8a18d4b0f3142520,
                 0x3fdf68affb5ae18b,
