@@ -4,7 +4,7 @@
 //! Units: lengths in the unit of `system.length`, energies in units of the energy scale of the
 //! potential (kT = 1 by default), time in (length unit)^2 / D when mobility = kT = 1.
 
-use crate::engine::{BcdConfig, Boundary, Update};
+use crate::engine::{BcdConfig, Boundary, Integrator, Update};
 use crate::forces::{CosineForce, ForceTable, PairForce, Sticky, TabulatedPair, Yukawa};
 use crate::init;
 use colloidsim_core::ParamError;
@@ -203,6 +203,8 @@ pub struct Run {
     pub time: f64,
     /// Steps between checkpoints (default: about every 10% of the run).
     pub checkpoint_every: Option<u64>,
+    /// Integrator of the free motion: `euler` (default) or `lm` (Leimkuhler–Matthews).
+    pub integrator: Option<String>,
 }
 
 /// `[observe]`.
@@ -367,6 +369,8 @@ impl PairForce for Pair {
 pub struct Resolved {
     /// Engine configuration.
     pub config: BcdConfig,
+    /// Integrator of the free motion (`run.integrator`), for [`crate::Bcd::with_integrator`].
+    pub integrator: Integrator,
     /// The external field (potential and drive).
     pub field: ExternalField,
     /// Force as evaluated by the engine.
@@ -395,6 +399,18 @@ impl Scenario {
                 return Err(ParamError::new(
                     "method",
                     format!("'{m}' is not a BCD method (bcd, bcd-chronological)"),
+                ));
+            }
+        };
+        let integrator = match self.run.integrator.as_deref() {
+            None | Some("euler") => Integrator::Euler,
+            Some("lm") => Integrator::Lm,
+            Some(other) => {
+                return Err(ParamError::new(
+                    "run.integrator",
+                    format!(
+                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
+                    ),
                 ));
             }
         };
@@ -532,6 +548,7 @@ impl Scenario {
         };
         Ok(Resolved {
             config,
+            integrator,
             field,
             engine_field,
             pair,
@@ -656,4 +673,42 @@ fn read_pair(
         read_column(path, names.0, key)?,
         read_column(path, names.1, key)?,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scenario(run_extra: &str) -> Result<Resolved, ParamError> {
+        let text = format!(
+            "method = \"bcd\"\n[system]\nlength = 20.0\nparticles = 10\ndiameter = 0.5\n\
+             [run]\ndt = 1e-3\ntime = 1.0\n{run_extra}\n"
+        );
+        let sc: Scenario = toml::from_str(&text).expect("scenario syntax");
+        sc.resolve(Path::new("."), None)
+    }
+
+    #[test]
+    fn run_integrator_is_parsed_and_defaults_to_euler() {
+        assert_eq!(scenario("").unwrap().integrator, Integrator::Euler);
+        let euler = scenario("integrator = \"euler\"").unwrap();
+        assert_eq!(euler.integrator, Integrator::Euler);
+        assert_eq!(
+            scenario("integrator = \"lm\"").unwrap().integrator,
+            Integrator::Lm
+        );
+    }
+
+    #[test]
+    fn unknown_integrator_names_the_key_and_the_choices() {
+        let e = scenario("integrator = \"rk4\"").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("run.integrator") && msg.contains("rk4"),
+            "{msg}"
+        );
+        assert!(msg.contains("euler") && msg.contains("lm"), "{msg}");
+        // Names are case-sensitive, like every other choice in a scenario.
+        assert!(scenario("integrator = \"LM\"").is_err());
+    }
 }
