@@ -4,13 +4,16 @@
 //!
 //! ```text
 //! nice -n 10 cargo run --release -p colloidsim-bcd --example dt_errors -- \
-//!     [--cases NAME,..] [--dt 1e-2,1e-3,..] [--seeds 8] [--time 200] [--steps 2000000] [--csv FILE]
+//!     [--cases NAME,..] [--dt 1e-2,1e-3,..] [--seeds 8] [--time 200] [--steps 2000000]
+//!     [--relax 2] [--csv FILE]
 //! ```
 //!
 //! Cases (`--cases`, default all):
 //!
 //! - `hard-S-R`: the hard-rods paper's Fig. 3 set, rods of length S at mean density R on a ring
 //!   of L = 100 in `U = 3 cos(2 pi x)` kT (U0 = 6 kT), S, R in {0.2, 0.5, 0.8};
+//! - `hard-0.5-1`: the case of issue #21, 100 rods of length 0.5 on L = 100 (packing 0.5; the
+//!   issue compares colloidsim and the authors' code there at dt = 1e-3);
 //! - `sticky`: Baxter rods, sigma = rho = 0.5, gamma = 1, power law p = 3 over eps = 0.05
 //!   (paper Fig. 6), against the exact eps -> 0 theory (so a finite-eps offset remains at dt -> 0);
 //! - `dilute`: 100 rods of length 0.5 on L = 10^4 in the same potential, one rod per hundred wells:
@@ -25,8 +28,8 @@
 //!   collisions (rod–rod and rod–wall) alone.
 //!
 //! Each seed starts from an exact hard-rod configuration without field, relaxes for 40 time
-//! units (`gravity`: 400, the sediment settles) at dt = 1e-4 (Leimkuhler–Matthews), and from there each scheme and dt relaxes 2 more
-//! time units before sampling `min(time / dt, steps)` steps, every `max(1, 1e-3 / dt)` steps.
+//! units (`gravity`: 400, the sediment settles) at dt = 1e-4 (Leimkuhler–Matthews), and from
+//! there each scheme and dt relaxes `--relax` (default 2) more time units before sampling `min(time / dt, steps)` steps, every `max(1, 1e-3 / dt)` steps.
 //! Errors: density L1 `sum |rho - rho_exact| / sum rho_exact` over the bins (error by jackknife
 //! over the seeds; "floor" is the L1 that the statistical noise alone would give,
 //! `sqrt(2/pi) sum se / sum rho_exact`) and the relative error of the bin holding the exact
@@ -172,6 +175,17 @@ fn cases() -> Vec<Case> {
         }
     }
     v.push(Case {
+        name: "hard-0.5-1".into(),
+        sigma: 0.5,
+        n: 100,
+        length: 100.0,
+        boundary: Boundary::Periodic,
+        potential: Potential::Cosine(6.0),
+        gamma: None,
+        bins: 50,
+        windows: vec![1e-3],
+    });
+    v.push(Case {
         name: "sticky".into(),
         sigma: 0.5,
         n: 50,
@@ -251,29 +265,36 @@ fn relax<P: PairForce>(cfg: BcdConfig, x0: Vec<f64>, f: Field, p: P, steps: u64)
     b.state().clone()
 }
 
-/// Continue `state` with `scheme` at `dt`: 2 time units of relaxation, then `steps` sampled.
+/// Continue `state` with `scheme` at `dt`: `relax` time units of relaxation, then `steps`
+/// sampled.
 fn sample(
     case: &Case,
     state: &BcdState,
-    scheme: Integrator,
-    dt: f64,
+    (scheme, dt): (Integrator, f64),
     seed: u32,
-    steps: u64,
+    (relax, steps): (f64, u64),
 ) -> Profiles {
     let field = Field::new(&case.field());
     match pair_of(case) {
-        Some(st) => sample_with(case, state, scheme, dt, seed, steps, field, st),
-        None => sample_with(case, state, scheme, dt, seed, steps, field, NoPair),
+        Some(st) => sample_with(case, state, (scheme, dt), seed, (relax, steps), field, st),
+        None => sample_with(
+            case,
+            state,
+            (scheme, dt),
+            seed,
+            (relax, steps),
+            field,
+            NoPair,
+        ),
     }
 }
 
 fn sample_with<P: PairForce>(
     case: &Case,
     state: &BcdState,
-    scheme: Integrator,
-    dt: f64,
+    (scheme, dt): (Integrator, f64),
     seed: u32,
-    steps: u64,
+    (relax, steps): (f64, u64),
     field: Field,
     pair: P,
 ) -> Profiles {
@@ -284,7 +305,7 @@ fn sample_with<P: PairForce>(
     let mut b = Bcd::from_state(case.config(dt, key), st, field, pair)
         .expect("engine")
         .with_integrator(scheme);
-    b.run((2.0 / dt).round() as u64).expect("relaxation");
+    b.run((relax / dt).round() as u64).expect("relaxation");
     let period = case.period();
     let mut d = DensityProfile::new(case.bins, period, case.length);
     let mut c: Vec<ContactDensity> = case
@@ -371,6 +392,7 @@ struct Args {
     seeds: u32,
     time: f64,
     steps: u64,
+    relax: f64,
     csv: Option<String>,
 }
 
@@ -381,6 +403,7 @@ fn args() -> Args {
         seeds: 8,
         time: 200.0,
         steps: 2_000_000,
+        relax: 2.0,
         csv: None,
     };
     let v: Vec<String> = std::env::args().skip(1).collect();
@@ -393,6 +416,7 @@ fn args() -> Args {
             "--seeds" => a.seeds = val.parse().expect("--seeds"),
             "--time" => a.time = val.parse().expect("--time"),
             "--steps" => a.steps = val.parse::<f64>().expect("--steps") as u64,
+            "--relax" => a.relax = val.parse().expect("--relax"),
             "--csv" => a.csv = Some(val),
             other => panic!("unknown option {other} (see the example's doc comment)"),
         }
@@ -432,7 +456,7 @@ fn main() {
                 let runs: Vec<Profiles> = seeds
                     .par_iter()
                     .zip(&states)
-                    .map(|(&s, st)| sample(&case, st, scheme, dt, s, steps))
+                    .map(|(&s, st)| sample(&case, st, (scheme, dt), s, (a.relax, steps)))
                     .collect();
                 let name = match scheme {
                     Integrator::Euler => "euler",

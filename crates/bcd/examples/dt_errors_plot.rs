@@ -5,7 +5,9 @@
 //! Left: the density's L1 error for the force-only case (`dilute`), two of the hard-rods paper's
 //! Fig. 3 cases and the collision-only case (`gravity`). Right: the contact density's error in
 //! the Tonks gas (collisions only) for two windows, with Siegmund's prediction for Euler.
-//! Filled circles and solid lines: Euler; open circles and dashed lines: LM. Points whose error
+//! Thin lines on the right: Siegmund's leading-order boundary layer for Euler; grey lines on the
+//! left: slopes dt, dt^2 and dt^1/2. Filled circles and solid lines: Euler; open circles and
+//! dashed lines: LM. Points whose error
 //! is not resolved (L1 below twice its noise floor; |error| below twice its standard error) are
 //! drawn as crosses at that bound: the true error lies below them.
 
@@ -95,8 +97,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "L1 error of rho(x)",
         (1e-4, 1.0),
         &curves,
-        &[(1.0, "dt"), (2.0, "dt^2"), (0.5, "dt^1/2")],
+        &[(1.0, "dt", 0.8), (2.0, "dt^2", 0.06), (0.5, "dt^1/2", 0.8)],
         None,
+        SeriesLabelPosition::UpperLeft,
     )?;
     let contact = [
         ("1e-1", "Tonks gas, w = 0.1"),
@@ -136,6 +139,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ),
             (Box::new(siegmund(0.01)), COLOURS[1]),
         ]),
+        SeriesLabelPosition::LowerRight,
     )?;
     root.present()?;
     Ok(())
@@ -149,8 +153,9 @@ fn panel(
     ylabel: &str,
     (ymin, ymax): (f64, f64),
     curves: &[(String, Vec<Point>, Vec<Point>)],
-    slopes: &[(f64, &str)],
+    slopes: &[(f64, &str, f64)],
     predictions: Option<[Prediction; 2]>,
+    legend: SeriesLabelPosition,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (xmin, xmax): (f64, f64) = (7e-6, 1.4e-2);
     let mut chart = ChartBuilder::on(area)
@@ -168,19 +173,20 @@ fn panel(
         .label_style(("sans-serif", 15))
         .draw()?;
     let grey = RGBColor(160, 160, 160);
-    for &(p, label) in slopes {
-        // Guides through (1e-2, 0.3).
-        let f = |dt: f64| 0.3 * (dt / 1e-2).powf(p);
+    for &(p, label, at) in slopes {
+        // Guides through (1e-2, at).
+        let f = |dt: f64| at * (dt / 1e-2).powf(p);
         let pts: Vec<(f64, f64)> = (0..=60)
             .map(|k| xmin * (xmax / xmin).powf(k as f64 / 60.0))
             .map(|dt| (dt, f(dt)))
             .filter(|&(_, y)| y > ymin && y < ymax)
             .collect();
         chart.draw_series(LineSeries::new(pts.clone(), grey.stroke_width(1)))?;
-        if let Some(&(x, y)) = pts.first() {
+        // The label a third of the way along the visible part of the guide.
+        if let Some(&(x, y)) = pts.get(pts.len() / 3) {
             chart.draw_series(std::iter::once(Text::new(
                 label.to_string(),
-                (x * 1.1, y),
+                (x, y * 1.15),
                 ("sans-serif", 14).into_font().color(&grey),
             )))?;
         }
@@ -191,10 +197,7 @@ fn panel(
                 .map(|k| xmin * (xmax / xmin).powf(k as f64 / 60.0))
                 .map(|dt| (dt, f(dt)))
                 .collect();
-            chart
-                .draw_series(LineSeries::new(pts, c.mix(0.5).stroke_width(1)))?
-                .label("Siegmund, Euler")
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+            chart.draw_series(LineSeries::new(pts, c.mix(0.5).stroke_width(1)))?;
         }
     }
     for (k, (label, euler, lm)) in curves.iter().enumerate() {
@@ -239,7 +242,7 @@ fn panel(
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(legend)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
