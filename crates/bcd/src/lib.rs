@@ -21,4 +21,4 @@ pub use pava::PoolBench;
 mod ring;
 pub mod scenario;
 
-pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Update};
+pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Integrator, Update};

@@ -52,6 +52,9 @@ pub(crate) struct Motion {
     pub mobility: f64,
     /// Noise amplitude `sqrt(2 D / dt)`.
     pub noise_amp: f64,
+    /// Leimkuhler–Matthews noise `(xi_n + xi_{n+1}) / 2` instead of Euler's `xi_n` (only with
+    /// noise, `noise_amp > 0`).
+    pub lm: bool,
     pub seed: u32,
     pub step: u64,
     pub sigma: f64,
@@ -61,10 +64,11 @@ pub(crate) struct Motion {
 }
 
 impl Motion {
-    pub fn new(cfg: &crate::engine::BcdConfig, noise_amp: f64, step: u64) -> Self {
+    pub fn new(cfg: &crate::engine::BcdConfig, noise_amp: f64, step: u64, lm: bool) -> Self {
         Self {
             mobility: cfg.mobility,
             noise_amp,
+            lm: lm && noise_amp > 0.0,
             seed: cfg.seed,
             step,
             sigma: cfg.sigma,
@@ -81,6 +85,9 @@ pub(crate) struct RingCtx<'a, E, P> {
     pub ext: &'a E,
     pub pair: &'a P,
     pub m: Motion,
+    /// Leimkuhler–Matthews only: the chunks' kept deviates are not those of this step (first
+    /// step, restart, or after an error) and are drawn afresh from the step counter.
+    pub fresh: bool,
 }
 
 impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
@@ -90,9 +97,9 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
     }
 
     /// Forces `f` on rods `[a0, a0 + f.len())` (external and pair) and their noise deviates
-    /// `xi`, within one segment. The free velocities are
+    /// `xi` of step `step`, within one segment. Euler's free velocities are
     /// `u = mu f + sqrt(2D/dt) xi` (fast-bcd Eq. 3).
-    fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64]) {
+    fn forces(&self, a0: usize, f: &mut [f64], xi: &mut [f64], step: u64) {
         let (sigma, len) = (self.m.sigma, f.len());
         self.ext
             .force_block_reduced(&self.y[a0..a0 + len], a0, sigma, f);
@@ -103,7 +110,7 @@ impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
             }
         }
         if self.m.noise_amp > 0.0 {
-            noise_segment(self.m.seed, self.m.step, a0 / SEG, xi);
+            noise_segment(self.m.seed, step, a0 / SEG, xi);
         } else {
             xi.fill(0.0);
         }
@@ -181,6 +188,9 @@ struct Chunk {
     dirty: bool,
     /// First rod whose free velocity went non-finite, with that velocity.
     bad: Option<(usize, f64)>,
+    /// Leimkuhler–Matthews: the deviates `xi_{n+1}` of the chunk's rods, drawn in step n and
+    /// kept for step n + 1 (empty for Euler).
+    kept: Vec<f64>,
 }
 
 /// State and buffers of the ring step.
@@ -193,6 +203,10 @@ pub(crate) struct RingStep {
     chunks: Vec<Chunk>,
     live: Vec<usize>,
     scratch: Vec<Mutex<Option<Scratch>>>,
+    /// Leimkuhler–Matthews noise (the chunks keep the next step's deviates).
+    lm: bool,
+    /// The step whose deviates the chunks keep (`None`: draw them from the step counter).
+    kept_step: Option<u64>,
 }
 
 impl RingStep {
@@ -213,6 +227,22 @@ impl RingStep {
             chunks,
             live: Vec::new(),
             scratch: Vec::new(),
+            lm: false,
+            kept_step: None,
+        }
+    }
+
+    /// Use the Leimkuhler–Matthews noise (`true`) or Euler's (`false`). Costs 8 bytes per rod
+    /// for the kept deviates, which are drawn again from the step counter at the next step.
+    pub fn set_lm(&mut self, lm: bool) {
+        self.lm = lm;
+        self.kept_step = None;
+        for c in &mut self.chunks {
+            if lm {
+                c.kept.resize(c.a1 - c.a0, 0.0);
+            } else {
+                c.kept = Vec::new();
+            }
         }
     }
 
@@ -230,11 +260,13 @@ impl RingStep {
         if self.scratch.len() < threads {
             self.scratch.resize_with(threads, || Mutex::new(None));
         }
+        let m = Motion::new(cfg, noise_amp, step, self.lm);
         let ctx = RingCtx {
             y: &self.y,
             ext,
             pair,
-            m: Motion::new(cfg, noise_amp, step),
+            m,
+            fresh: m.lm && self.kept_step != Some(step),
         };
         let scratch = &self.scratch;
         self.chunks
@@ -247,8 +279,11 @@ impl RingStep {
                 chunk_pass(c, out, s, &ctx);
             });
         if let Some(bad) = self.chunks.iter().find_map(|c| c.bad) {
+            // Some chunks have moved on to the next step's deviates: draw them again.
+            self.kept_step = None;
             return Err(bad);
         }
+        self.kept_step = m.lm.then_some(step + 1);
         let n = self.y.len();
         let lred = cfg.length - n as f64 * cfg.sigma;
         stitch(&mut self.chunks, &mut self.live, lred);
@@ -293,10 +328,26 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     for (k, zs) in z.chunks_mut(SEG).enumerate() {
         let a = a0 + k * SEG;
         let m = zs.len();
-        ctx.forces(a, zs, &mut noise[..m]);
-        let rods = ctx.y[a..a + m].iter().zip(&noise[..m]);
-        for (zk, (&yk, &g)) in zs.iter_mut().zip(rods) {
-            *zk = (yk - yref) + (mu * *zk + amp * g) * dt;
+        if !ctx.m.lm {
+            ctx.forces(a, zs, &mut noise[..m], ctx.m.step);
+            let rods = ctx.y[a..a + m].iter().zip(&noise[..m]);
+            for (zk, (&yk, &g)) in zs.iter_mut().zip(rods) {
+                *zk = (yk - yref) + (mu * *zk + amp * g) * dt;
+            }
+        } else {
+            // Leimkuhler–Matthews: u = mu f + sqrt(2D/dt) (xi_n + xi_{n+1}) / 2, with xi_n kept
+            // from the last step and xi_{n+1} kept for the next one (one deviate per rod and step).
+            let kept = &mut c.kept[k * SEG..k * SEG + m];
+            if ctx.fresh {
+                noise_segment(ctx.m.seed, ctx.m.step, a / SEG, kept);
+            }
+            ctx.forces(a, zs, &mut noise[..m], ctx.m.step + 1);
+            let half = 0.5 * amp;
+            let rods = ctx.y[a..a + m].iter().zip(kept.iter_mut().zip(&noise[..m]));
+            for (zk, (&yk, (xi_n, &xi_next))) in zs.iter_mut().zip(rods) {
+                *zk = (yk - yref) + (mu * *zk + half * (*xi_n + xi_next)) * dt;
+                *xi_n = xi_next;
+            }
         }
     }
     let blocks = pava::pool_chunk(&mut s.stacks, z, &mut s.blocks);
@@ -340,12 +391,20 @@ fn first_non_finite<E: ExternalForce, P: PairForce>(
 ) -> Option<(usize, f64)> {
     let mut u = [0.0f64; SEG];
     let mut noise = [0.0f64; SEG];
+    let mut next = [0.0f64; SEG];
     let mut a = a0;
     while a < a1 {
         let m = (a1 - a).min(SEG);
-        ctx.forces(a, &mut u[..m], &mut noise[..m]);
-        for (uk, &g) in u[..m].iter_mut().zip(&noise[..m]) {
-            *uk = ctx.m.mobility * *uk + ctx.m.noise_amp * g;
+        ctx.forces(a, &mut u[..m], &mut noise[..m], ctx.m.step);
+        if ctx.m.lm {
+            noise_segment(ctx.m.seed, ctx.m.step + 1, a / SEG, &mut next[..m]);
+            for (uk, (&g, &h)) in u[..m].iter_mut().zip(noise[..m].iter().zip(&next[..m])) {
+                *uk = ctx.m.mobility * *uk + 0.5 * ctx.m.noise_amp * (g + h);
+            }
+        } else {
+            for (uk, &g) in u[..m].iter_mut().zip(&noise[..m]) {
+                *uk = ctx.m.mobility * *uk + ctx.m.noise_amp * g;
+            }
         }
         if let Some(k) = u[..m].iter().position(|v| !v.is_finite()) {
             return Some((a + k, u[k]));

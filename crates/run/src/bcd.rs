@@ -96,7 +96,8 @@ impl Method for BcdMethod {
             r.initial.clone(),
             r.engine_field.clone(),
             r.pair.clone(),
-        )?;
+        )?
+        .with_integrator(r.integrator);
         Ok(Box::new(BcdEngine {
             bcd,
             method: sc.method,
@@ -124,12 +125,13 @@ fn build<P: PairForce + Clone + Send + 'static>(
     let field = r.engine_field.clone();
     let (bcd, obs, frames) = match saved {
         Some(s) => (
-            Bcd::from_state(r.config.clone(), s.state, field, pair)?,
+            Bcd::from_state(r.config.clone(), s.state, field, pair)?.with_integrator(r.integrator),
             s.observers,
             s.frames,
         ),
         None => (
-            Bcd::new(r.config.clone(), r.initial.clone(), field, pair)?,
+            Bcd::new(r.config.clone(), r.initial.clone(), field, pair)?
+                .with_integrator(r.integrator),
             observers(&sc, &r),
             0,
         ),
@@ -165,7 +167,7 @@ fn resolved_json(sc: &Scenario, r: &Resolved) -> serde_json::Value {
         "potential": sc.potential,
         "interaction": sc.interaction,
         "run": {
-            "dt": c.dt, "equilibrate_steps": r.equilibrate_steps,
+            "dt": c.dt, "integrator": r.integrator, "equilibrate_steps": r.equilibrate_steps,
             "sampled_steps": r.sampled_steps, "equilibrate": sc.run.equilibrate, "time": sc.run.time,
         },
         "observe": sc.observe,

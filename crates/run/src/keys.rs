@@ -468,6 +468,13 @@ pub static BCD: &[Spec] = &[
     key("run", "-", "required", Table, "time stepping"),
     key("run.dt", "time", "required", Positive, "time step"),
     key(
+        "run.integrator",
+        "-",
+        "euler",
+        OneOf(&["euler", "lm"]),
+        "free motion: Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2, second order for the forces, the same collisions; see docs/bcd.md)",
+    ),
+    key(
         "run.equilibrate",
         "time",
         "0",
