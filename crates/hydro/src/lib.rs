@@ -21,15 +21,18 @@
 
 pub mod direct;
 pub mod ewald;
+mod fft3;
 pub mod lanczos;
 pub mod noise;
 pub mod params;
+pub mod pse;
 pub mod rpy;
 
 pub use direct::{DirectRpy, FreeDraining};
 pub use lanczos::{LanczosError, LanczosParams, SqrtReport};
 pub use noise::NoiseKey;
 pub use params::{HydroMethod, HydroModel, HydroParams, HydrodynamicsSection};
+pub use pse::{Pse, PseGeometry, PseParams};
 
 use colloidsim_core::ParamError;
 
