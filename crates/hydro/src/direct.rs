@@ -111,46 +111,68 @@ impl Kernel {
             Radii::Equal(a) => {
                 let (a, inv_a, four_a2) = (*a, 1.0 / *a, 4.0 * a * a);
                 let mu0 = 1.0 / (6.0 * PI * self.eta * a);
-                let u = self.row_sum(p, |r2, _| mono_lane(r2, a, inv_a, four_a2));
+                // The radii slice is not read by this lane function: pass any of length N.
+                let u = self.row_sum(p, &self.x, |r2, _| mono_lane(r2, a, inv_a, four_a2));
                 u.map(|c| c * mu0)
             }
             Radii::Each(r) => {
                 let ai = r[i];
-                let u = self.row_sum(p, |r2, j| zuk_lane(r2, ai, r[j]));
+                let u = self.row_sum(p, r, |r2, aj| zuk_lane(r2, ai, aj));
                 u.map(|c| c / (8.0 * PI * self.eta))
             }
         }
     }
 
-    /// `sum_j (A_j F_j + B_j d_j (d_j . F_j))` over all j, `(A, B) = lane(r2, j)`, in
-    /// [`LANES`] accumulators.
+    /// `sum_j (A_j F_j + B_j d_j (d_j . F_j))` over all j, `(A, B) = lane(r2, a_j)`, in
+    /// [`LANES`] accumulators: consecutive j in consecutive lanes, fixed-length chunks of the
+    /// structure of arrays (the loop LLVM vectorises), the last partial chunk in the first
+    /// lanes, and the lanes added in a fixed order.
     #[inline(always)]
-    fn row_sum(&self, p: [f64; 3], lane: impl Fn(f64, usize) -> (f64, f64)) -> [f64; 3] {
-        let n = self.len();
-        let full = n / LANES * LANES;
-        let mut acc = [[0.0f64; LANES]; 3];
-        let pair = |acc: &mut [[f64; LANES]; 3], l: usize, j: usize| {
-            let d = [p[0] - self.x[j], p[1] - self.y[j], p[2] - self.z[j]];
+    fn row_sum(
+        &self,
+        p: [f64; 3],
+        radii: &[f64],
+        lane: impl Fn(f64, f64) -> (f64, f64),
+    ) -> [f64; 3] {
+        const L: usize = LANES;
+        let mut acc = [[0.0f64; L]; 3];
+        let pair = |acc: &mut [[f64; L]; 3], l: usize, x: [f64; 3], f: [f64; 3], aj: f64| {
+            let d = [p[0] - x[0], p[1] - x[1], p[2] - x[2]];
             let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let (a, b) = lane(r2, j);
-            let f = [self.fx[j], self.fy[j], self.fz[j]];
+            let (a, b) = lane(r2, aj);
             let df = b * (d[0] * f[0] + d[1] * f[1] + d[2] * f[2]);
             acc[0][l] += a * f[0] + df * d[0];
             acc[1][l] += a * f[1] + df * d[1];
             acc[2][l] += a * f[2] + df * d[2];
         };
-        for j0 in (0..full).step_by(LANES) {
-            for l in 0..LANES {
-                pair(&mut acc, l, j0 + l);
+        let chunks = self
+            .x
+            .chunks_exact(L)
+            .zip(self.y.chunks_exact(L))
+            .zip(self.z.chunks_exact(L))
+            .zip(self.fx.chunks_exact(L))
+            .zip(self.fy.chunks_exact(L))
+            .zip(self.fz.chunks_exact(L))
+            .zip(radii.chunks_exact(L));
+        for ((((((x, y), z), fx), fy), fz), r) in chunks {
+            for l in 0..L {
+                pair(&mut acc, l, [x[l], y[l], z[l]], [fx[l], fy[l], fz[l]], r[l]);
             }
         }
-        for j in full..n {
-            pair(&mut acc, j - full, j);
+        let full = self.len() / L * L;
+        for j in full..self.len() {
+            pair(
+                &mut acc,
+                j - full,
+                [self.x[j], self.y[j], self.z[j]],
+                [self.fx[j], self.fy[j], self.fz[j]],
+                radii[j],
+            );
         }
         acc.map(|c| {
-            let mut s = [0.0; LANES / 2];
-            for l in 0..LANES / 2 {
-                s[l] = c[l] + c[l + LANES / 2];
+            let mut s = [0.0; L / 2];
+            for l in 0..L / 2 {
+                s[l] = c[l] + c[l + L / 2];
             }
             (s[0] + s[2]) + (s[1] + s[3])
         })

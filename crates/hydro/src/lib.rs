@@ -19,6 +19,7 @@
 //! (seed, step, particle) ([`noise`]); every sum runs in a fixed order, so results do not
 //! depend on the thread count.
 
+pub mod bench;
 pub mod direct;
 pub mod ewald;
 mod fft3;
@@ -32,7 +33,7 @@ pub use direct::{DirectRpy, FreeDraining};
 pub use lanczos::{LanczosError, LanczosParams, SqrtReport};
 pub use noise::NoiseKey;
 pub use params::{HydroMethod, HydroModel, HydroParams, HydrodynamicsSection};
-pub use pse::{Pse, PseGeometry, PseParams};
+pub use pse::{Pse, PseGeometry, PseParams, PseTimes};
 
 use colloidsim_core::ParamError;
 
@@ -75,7 +76,7 @@ pub enum HydroError {
 ///
 /// Vectors are 3N numbers stored as `[f64; 3]` per particle, in the order of the positions
 /// last given to [`Mobility::set_positions`].
-pub trait Mobility: Send {
+pub trait Mobility: Send + Sync {
     /// Number of particles.
     fn len(&self) -> usize;
 
@@ -114,4 +115,86 @@ pub trait Mobility: Send {
 
     /// Bytes of memory the operator holds (buffers, lists, grids).
     fn bytes(&self) -> usize;
+}
+
+/// One of the mobilities, chosen at run time (the scenario's `[hydrodynamics]`): the engines
+/// call it once per step, so the dispatch costs nothing next to the product.
+#[derive(Debug)]
+pub enum AnyMobility {
+    /// Free draining.
+    FreeDraining(FreeDraining),
+    /// RPY, direct free-space sums (boxed, like PSE: the variants stay small).
+    Direct(Box<DirectRpy>),
+    /// RPY, positively split Ewald in a periodic cube (boxed: it holds the grids).
+    Pse(Box<Pse>),
+}
+
+impl AnyMobility {
+    fn inner(&mut self) -> &mut dyn Mobility {
+        match self {
+            Self::FreeDraining(m) => m,
+            Self::Direct(m) => m.as_mut(),
+            Self::Pse(m) => m.as_mut(),
+        }
+    }
+
+    fn inner_ref(&self) -> &dyn Mobility {
+        match self {
+            Self::FreeDraining(m) => m,
+            Self::Direct(m) => m.as_ref(),
+            Self::Pse(m) => m.as_ref(),
+        }
+    }
+
+    /// The PSE operator, if that is the method.
+    pub fn pse(&self) -> Option<&Pse> {
+        match self {
+            Self::Pse(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The PSE operator, if that is the method (mutable, e.g. to reset its timers).
+    pub fn pse_mut(&mut self) -> Option<&mut Pse> {
+        match self {
+            Self::Pse(m) => Some(m),
+            _ => None,
+        }
+    }
+}
+
+impl Mobility for AnyMobility {
+    fn len(&self) -> usize {
+        self.inner_ref().len()
+    }
+    fn set_positions(&mut self, pos: &[[f64; 3]]) -> Result<(), HydroError> {
+        self.inner().set_positions(pos)
+    }
+    fn apply(&mut self, f: &[[f64; 3]], out: &mut [[f64; 3]]) {
+        self.inner().apply(f, out)
+    }
+    fn brownian(
+        &mut self,
+        key: NoiseKey,
+        scale: f64,
+        out: &mut [[f64; 3]],
+    ) -> Result<SqrtReport, HydroError> {
+        self.inner().brownian(key, scale, out)
+    }
+    fn displacement(
+        &mut self,
+        f: &[[f64; 3]],
+        dt: f64,
+        kt: f64,
+        key: NoiseKey,
+        out: &mut [[f64; 3]],
+    ) -> Result<SqrtReport, HydroError> {
+        self.inner().displacement(f, dt, kt, key, out)
+    }
+    fn stokes_mobility(&self, i: usize) -> f64 {
+        self.inner_ref().stokes_mobility(i)
+    }
+    fn bytes(&self) -> usize {
+        self.inner_ref().bytes()
+    }
 }

@@ -26,8 +26,9 @@
 //! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 3 eps`,
 //! `x = K^2/(4 xi^2)`; grid spacing `h <= pi / K` (n points per axis, the next even 2-3-5-smooth
 //! size); Gaussian `sigma = (h / pi) sqrt(ln(1/e_s))` (aliasing `exp(−pi^2 sigma^2 / h^2) = e_s`,
-//! `e_s = 2 eps`), support `P = 2 ceil(w / h) + 2` points per axis with half-width
-//! `w = sigma sqrt(2 ln(1/e_s))`; real-space cut-off `r_c`: beyond it `|A_r|, |B_r| < 0.2 eps mu0`.
+//! `e_s = 2 eps`), support: the fewest points `P` per axis that cover the half-width
+//! `w = sigma sqrt(2 ln(1/e_s))` on both sides of any particle (`P = 2m` reaches `(m − 1) h`,
+//! `P = 2m + 1` centred on the nearest point `(m − 1/2) h`); real-space cut-off `r_c`: beyond it `|A_r|, |B_r| < 0.2 eps mu0`.
 //! The shares were set by measurement: against Beenakker's Ewald sum the error of the product
 //! is set by the real-space cut-off and lies between 0.15 and 0.6 of the tolerance
 //! (`tests/pse.rs`, docs/hydrodynamics.md).
@@ -47,6 +48,7 @@ use colloidsim_core::ParamError;
 use colloidsim_core::rng::{Purpose, Ziggurat, stream};
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::time::Instant;
 
 /// Threshold of the Fourier cut-off, relative to the tolerance.
 const FOURIER_SHARE: f64 = 3.0;
@@ -265,6 +267,25 @@ impl WaveTable {
     }
 }
 
+/// Seconds spent in the parts of PSE since the last [`Pse::reset_times`] (for benchmarks).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct PseTimes {
+    /// Forward and inverse 3D FFTs.
+    pub fft: f64,
+    /// Spreading forces to the grid.
+    pub spread: f64,
+    /// The wave-space kernel and Fourier noise.
+    pub kernel: f64,
+    /// Interpolating velocities from the grid.
+    pub interpolate: f64,
+    /// Real-space products (including those of the Lanczos iterations).
+    pub real: f64,
+    /// Neighbour lists, pair tensors and Gaussian weights (`set_positions`).
+    pub setup: f64,
+    /// Lanczos iterations.
+    pub lanczos_iterations: u64,
+}
+
 /// One real-space pair of a neighbour list: `M^r_ij = a I + b e e^T`.
 #[derive(Debug, Clone, Copy, Default)]
 struct Entry {
@@ -290,14 +311,29 @@ pub struct Pse {
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
     cell_order: Vec<u32>,
+    /// Verlet skin of the candidate lists.
+    skin: f64,
+    /// Positions at the last candidate build.
+    reference: Vec<[f64; 3]>,
+    /// Row `i` of the candidates and of the entries starts at `offsets[i]`.
     offsets: Vec<usize>,
+    candidates: Vec<u32>,
+    /// The first `counts[i]` entries of row i are the pairs within the cut-off.
     entries: Vec<Entry>,
+    counts: Vec<u32>,
     // Gaussian spreading: first grid index per axis and P weights per axis per particle.
     base: Vec<[u32; 3]>,
     weights: Vec<f64>,
+    /// Sort key of each particle: first grid plane and row of its support, `z g + y`.
     plane_key: Vec<u32>,
     plane_start: Vec<u32>,
+    /// Particles by sort key (spreading and interpolation visit them in this order, so that
+    /// consecutive particles touch nearby grid rows).
     plane_order: Vec<u32>,
+    /// Position of each particle in `plane_order`.
+    slot_of: Vec<u32>,
+    /// Interpolated velocities in `plane_order`.
+    sorted: Vec<[f64; 3]>,
     // Grids: real `[z][y][x]`, one shared half spectrum, full spectra `[ky][kx][kz]`.
     fft: Fft3,
     real: [Vec<f64>; 3],
@@ -312,6 +348,7 @@ pub struct Pse {
     lanczos: Lanczos,
     noise: Vec<[f64; 3]>,
     scratch: Vec<[f64; 3]>,
+    times: PseTimes,
 }
 
 impl std::fmt::Debug for Pse {
@@ -363,7 +400,13 @@ impl Pse {
             let h = l / grid as f64;
             let sigma = h / PI * ln.sqrt();
             let w = sigma * (2.0 * ln).sqrt();
-            (h, sigma, 2 * (w / h).ceil() as usize + 2)
+            // Fewest points whose worst-placed particle still has w covered on both sides:
+            // 2m points reach (m - 1) h, 2m + 1 points (m - 1/2) h.
+            let pts = (2..).find(|&p: &usize| {
+                let m = (p / 2) as f64;
+                (if p % 2 == 0 { m - 1.0 } else { m - 0.5 }) * h >= w
+            });
+            (h, sigma, pts.expect("finite support"))
         };
         let (mut h, mut sigma, mut pts) = support(grid);
         if pts > grid {
@@ -452,7 +495,9 @@ impl Pse {
             });
         let n3 = grid * grid * grid;
         let len = fft.spectrum_len();
-        let n_cells = ((l / r_cut).floor() as usize).max(1);
+        // Skin of the candidate lists: a tenth of the cut-off, less where the box is tight.
+        let skin = (0.1 * r_cut).min(0.5 * (0.5 * l - r_cut)).max(0.0);
+        let n_cells = ((l / (r_cut + skin)).floor() as usize).max(1);
         Ok(Self {
             params,
             geom,
@@ -465,12 +510,18 @@ impl Pse {
             cell_of: vec![0; n],
             cell_start: vec![0; n_cells.pow(3) + 1],
             cell_order: vec![0; n],
+            skin,
+            reference: Vec::new(),
             offsets: vec![0; n + 1],
+            candidates: Vec::new(),
             entries: Vec::new(),
+            counts: vec![0; n],
             base: vec![[0; 3]; n],
             weights: vec![0.0; 3 * pts * n],
             plane_key: vec![0; n],
-            plane_start: vec![0; grid + 1],
+            plane_start: vec![0; grid * grid + 1],
+            slot_of: vec![0; n],
+            sorted: vec![[0.0; 3]; n],
             plane_order: vec![0; n],
             fft,
             real: [vec![0.0; n3], vec![0.0; n3], vec![0.0; n3]],
@@ -486,7 +537,18 @@ impl Pse {
             lanczos: Lanczos::default(),
             noise: vec![[0.0; 3]; n],
             scratch: vec![[0.0; 3]; n],
+            times: PseTimes::default(),
         })
+    }
+
+    /// Time spent in each part since the last reset.
+    pub fn times(&self) -> &PseTimes {
+        &self.times
+    }
+
+    /// Zero the timers.
+    pub fn reset_times(&mut self) {
+        self.times = PseTimes::default();
     }
 
     /// The chosen grid and cut-offs.
@@ -499,99 +561,113 @@ impl Pse {
         &self.params
     }
 
-    /// Real-space neighbour pairs stored (both directions).
+    /// Real-space neighbour pairs within the cut-off (both directions).
     pub fn pairs(&self) -> usize {
-        self.entries.len()
+        self.counts.iter().map(|&c| c as usize).sum()
     }
 
-    /// Build the cell list and the real-space pair tensors.
-    fn build_real_space(&mut self) {
+    /// Candidate lists: for each particle, the others within `r_cut + skin` (cell list, each
+    /// row sorted by index), kept until a particle has moved more than half the skin.
+    fn build_candidates(&mut self) {
         let (n, l, nc) = (self.n, self.params.box_length, self.n_cells);
-        let rc2 = self.geom.r_cut * self.geom.r_cut;
+        let range = self.geom.r_cut + self.skin;
         let cell = |x: f64| (((x / l + 0.5) * nc as f64) as usize).min(nc - 1);
         for (c, p) in self.cell_of.iter_mut().zip(&self.pos) {
             *c = ((cell(p[2]) * nc + cell(p[1])) * nc + cell(p[0])) as u32;
         }
         counting_sort(&self.cell_of, &mut self.cell_start, &mut self.cell_order);
-        let (pos, cell_of, cell_start, cell_order) =
-            (&self.pos, &self.cell_of, &self.cell_start, &self.cell_order);
-        let (a, eta, table) = (self.params.radius, self.params.viscosity, &self.table);
-        // The neighbours of i in a fixed order: 27 cells (all pairs when there are fewer than
-        // 3 cells per axis), particles of a cell in index order.
-        let visit = |i: usize, f: &mut dyn FnMut(u32, [f64; 3], f64)| {
-            let xi = pos[i];
-            let mut pair = |j: u32| {
-                if j as usize == i {
-                    return;
-                }
-                let xj = pos[j as usize];
-                let d = [0, 1, 2].map(|k| {
-                    let d = xi[k] - xj[k];
-                    d - l * (d / l).round()
-                });
-                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                if r2 < rc2 {
-                    f(j, d, r2);
-                }
-            };
-            if nc < 3 {
-                (0..n as u32).for_each(&mut pair);
-                return;
-            }
-            let c = cell_of[i] as usize;
-            let (cx, cy, cz) = (c % nc, (c / nc) % nc, c / (nc * nc));
-            for dz in [nc - 1, 0, 1] {
-                for dy in [nc - 1, 0, 1] {
-                    for dx in [nc - 1, 0, 1] {
-                        let k = (((cz + dz) % nc) * nc + (cy + dy) % nc) * nc + (cx + dx) % nc;
-                        for &j in &cell_order[cell_start[k] as usize..cell_start[k + 1] as usize] {
-                            pair(j);
-                        }
-                    }
-                }
-            }
+        let cells = Cells {
+            pos: &self.pos,
+            cell_of: &self.cell_of,
+            cell_start: &self.cell_start,
+            cell_order: &self.cell_order,
+            nc,
+            l,
+            rc2: range * range,
         };
-        // Counts, offsets, then the entries of each chunk of particles in parallel.
-        const CH: usize = 256;
-        let mut counts = std::mem::take(&mut self.offsets);
-        counts[1..].par_iter_mut().enumerate().for_each(|(i, c)| {
+        let mut off = std::mem::take(&mut self.offsets);
+        off[1..].par_iter_mut().enumerate().for_each(|(i, c)| {
             let mut k = 0;
-            visit(i, &mut |_, _, _| k += 1);
+            cells.visit(i, &mut |_, _, _| k += 1);
             *c = k;
         });
-        counts[0] = 0;
+        off[0] = 0;
         for i in 0..n {
-            counts[i + 1] += counts[i];
+            off[i + 1] += off[i];
         }
-        self.entries.resize(counts[n], Entry::default());
-        let mut rest: &mut [Entry] = &mut self.entries;
-        let mut chunks = Vec::with_capacity(n.div_ceil(CH));
-        for c in 0..n.div_ceil(CH) {
-            let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
-            let (head, tail) = rest.split_at_mut(counts[hi] - counts[lo]);
-            chunks.push((lo, hi, head));
-            rest = tail;
-        }
-        let offsets = &counts;
-        chunks.into_par_iter().for_each(|(lo, hi, out)| {
-            let base = offsets[lo];
+        self.candidates.resize(off[n], 0);
+        self.entries.resize(off[n], Entry::default());
+        for_row_chunks(&off, &mut self.candidates, |lo, hi, out| {
+            let base = off[lo];
             for i in lo..hi {
-                let mut k = offsets[i] - base;
-                visit(i, &mut |j, d, r2| {
-                    let r = r2.sqrt();
-                    let t = rpy(r, a, eta);
-                    let (aw, bw) = table.eval(r);
-                    out[k] = Entry {
-                        j,
-                        a: t.a - aw,
-                        b: t.b - bw,
-                        e: d.map(|x| x / r),
-                    };
+                let row = &mut out[off[i] - base..off[i + 1] - base];
+                let mut k = 0;
+                cells.visit(i, &mut |j, _, _| {
+                    row[k] = j;
                     k += 1;
                 });
+                row.sort_unstable();
             }
         });
-        self.offsets = counts;
+        self.offsets = off;
+        self.reference.clone_from(&self.pos);
+    }
+
+    /// The real-space pair tensors of the pairs within the cut-off, each row in increasing
+    /// index (a function of the positions alone, whenever the candidates were built).
+    fn build_real_space(&mut self) {
+        let l = self.params.box_length;
+        let lim = 0.25 * self.skin * self.skin;
+        let (pos, reference) = (&self.pos, &self.reference);
+        let moved = reference.len() != pos.len()
+            || pos.par_iter().zip(reference.par_iter()).any(|(p, q)| {
+                let d = [0, 1, 2].map(|k| {
+                    let d = p[k] - q[k];
+                    d - l * (d / l).round()
+                });
+                d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim
+            });
+        if moved {
+            self.build_candidates();
+        }
+        let rc2 = self.geom.r_cut * self.geom.r_cut;
+        let (a, eta, table) = (self.params.radius, self.params.viscosity, &self.table);
+        let (pos, off, cand) = (&self.pos, &self.offsets, &self.candidates);
+        let counts = &mut self.counts;
+        let mut rows: Vec<(usize, usize, &mut [Entry], &mut [u32])> = Vec::new();
+        for_row_chunks_collect(off, &mut self.entries, counts, &mut rows);
+        rows.into_par_iter().for_each(|(lo, hi, out, count)| {
+            let base = off[lo];
+            for i in lo..hi {
+                let xi = pos[i];
+                let mut k = off[i] - base;
+                for &j in &cand[off[i]..off[i + 1]] {
+                    let xj = pos[j as usize];
+                    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                    for c in d.iter_mut() {
+                        if *c >= 0.5 * l {
+                            *c -= l;
+                        } else if *c < -0.5 * l {
+                            *c += l;
+                        }
+                    }
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if r2 < rc2 {
+                        let r = r2.sqrt();
+                        let t = rpy(r, a, eta);
+                        let (aw, bw) = table.eval(r);
+                        out[k] = Entry {
+                            j,
+                            a: t.a - aw,
+                            b: t.b - bw,
+                            e: d.map(|x| x / r),
+                        };
+                        k += 1;
+                    }
+                }
+                count[i - lo] = (k - (off[i] - base)) as u32;
+            }
+        });
     }
 
     /// Gaussian weights and grid bases of every particle, and their order by first plane.
@@ -600,7 +676,8 @@ impl Pse {
         let (h, l, sigma) = (self.geom.spacing, self.params.box_length, self.geom.sigma);
         let norm = 1.0 / (2.0 * PI * sigma * sigma).sqrt();
         let c = -0.5 / (sigma * sigma);
-        let half = (pts / 2 - 1) as isize;
+        // Odd supports centre on the nearest grid point, even ones on the cell.
+        let (half, shift) = ((pts as isize - 1) / 2, if pts % 2 == 1 { 0.5 } else { 0.0 });
         self.base
             .par_iter_mut()
             .zip(self.weights.par_chunks_mut(3 * pts))
@@ -608,7 +685,7 @@ impl Pse {
             .for_each(|((base, w), x)| {
                 for k in 0..3 {
                     let s = (x[k] + 0.5 * l) / h;
-                    let i0 = s.floor() as isize - half;
+                    let i0 = (s + shift).floor() as isize - half;
                     base[k] = i0.rem_euclid(g as isize) as u32;
                     for m in 0..pts {
                         let d = ((i0 + m as isize) as f64 - s) * h;
@@ -617,13 +694,16 @@ impl Pse {
                 }
             });
         for (o, b) in self.plane_key.iter_mut().zip(&self.base) {
-            *o = b[2];
+            *o = b[2] * g as u32 + b[1];
         }
         counting_sort(
             &self.plane_key,
             &mut self.plane_start,
             &mut self.plane_order,
         );
+        for (k, &j) in self.plane_order.iter().enumerate() {
+            self.slot_of[j as usize] = k as u32;
+        }
     }
 
     /// Spread the forces `f` onto the three real grids (a gather per plane).
@@ -642,7 +722,7 @@ impl Pse {
                 pz.iter_mut().for_each(|v| *v = 0.0);
                 for m in 0..pts {
                     let b = (p + g * pts - m) % g;
-                    for &j in &order[start[b] as usize..start[b + 1] as usize] {
+                    for &j in &order[start[b * g] as usize..start[(b + 1) * g] as usize] {
                         let j = j as usize;
                         let w = &weights[3 * pts * j..3 * pts * (j + 1)];
                         let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
@@ -663,38 +743,52 @@ impl Pse {
             });
     }
 
-    /// `out_i (+)= h^3 sum_g u(x_g) g(x_g − x_i)` from the three real grids.
-    fn interpolate(&self, out: &mut [[f64; 3]], add: bool) {
+    /// `out_i (+)= h^3 sum_g u(x_g) g(x_g − x_i)` from the three real grids (particles in the
+    /// sorted order, then scattered back).
+    fn interpolate(&mut self, out: &mut [[f64; 3]], add: bool) {
         let (g, pts, h) = (self.geom.grid, self.geom.support, self.geom.spacing);
         let h3 = h * h * h;
         let [gx, gy, gz] = &self.real;
-        out.par_iter_mut().enumerate().for_each(|(j, o)| {
-            let w = &self.weights[3 * pts * j..3 * pts * (j + 1)];
-            let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
-            let [bx, by, bz] = self.base[j];
-            let mut u = [0.0; 3];
-            for (iz, &wzv) in wz.iter().enumerate() {
-                let plane = (bz as usize + iz) % g * g * g;
-                for (iy, &wyv) in wy.iter().enumerate() {
-                    let row = plane + (by as usize + iy) % g * g;
-                    let mut s = [0.0; 3];
-                    for_row(bx as usize, pts, g, |x, ix| {
-                        let wv = wx[ix];
-                        s[0] += gx[row + x] * wv;
-                        s[1] += gy[row + x] * wv;
-                        s[2] += gz[row + x] * wv;
-                    });
-                    let c = wzv * wyv;
-                    for k in 0..3 {
-                        u[k] += c * s[k];
+        let (weights, base, order) = (&self.weights, &self.base, &self.plane_order);
+        self.sorted
+            .par_iter_mut()
+            .zip(order.par_iter())
+            .with_min_len(64)
+            .for_each(|(o, &j)| {
+                let j = j as usize;
+                let w = &weights[3 * pts * j..3 * pts * (j + 1)];
+                let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
+                let [bx, by, bz] = base[j];
+                let mut u = [0.0; 3];
+                for (iz, &wzv) in wz.iter().enumerate() {
+                    let plane = (bz as usize + iz) % g * g * g;
+                    for (iy, &wyv) in wy.iter().enumerate() {
+                        let row = plane + (by as usize + iy) % g * g;
+                        let mut s = [0.0; 3];
+                        for_row(bx as usize, pts, g, |x, ix| {
+                            let wv = wx[ix];
+                            s[0] += gx[row + x] * wv;
+                            s[1] += gy[row + x] * wv;
+                            s[2] += gz[row + x] * wv;
+                        });
+                        let c = wzv * wyv;
+                        for k in 0..3 {
+                            u[k] += c * s[k];
+                        }
                     }
                 }
-            }
-            for k in 0..3 {
-                let v = h3 * u[k];
-                o[k] = if add { o[k] + v } else { v };
-            }
-        });
+                *o = u.map(|c| h3 * c);
+            });
+        let (sorted, slot_of) = (&self.sorted, &self.slot_of);
+        out.par_iter_mut()
+            .zip(slot_of.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &k)| {
+                let v = sorted[k as usize];
+                for c in 0..3 {
+                    o[c] = if add { o[c] + v[c] } else { v[c] };
+                }
+            });
     }
 
     /// The wave-space pass: `out (+)= dt M^w f + scale (M^w)^(1/2) W` (either part optional).
@@ -710,11 +804,15 @@ impl Pse {
         let vol = l * l * l;
         let h = self.geom.spacing;
         let det = if let Some((f, dt)) = f {
+            let t = Instant::now();
             self.spread(f);
+            let t1 = Instant::now();
+            self.times.spread += (t1 - t).as_secs_f64();
             for c in 0..3 {
                 self.fft
                     .forward(&mut self.real[c], &mut self.spec, &mut self.work[c]);
             }
+            self.times.fft += t1.elapsed().as_secs_f64();
             h * h * h / vol * dt
         } else {
             0.0
@@ -723,6 +821,7 @@ impl Pse {
             Some((key, scale)) => (Some(key), scale / vol.sqrt()),
             None => (None, 0.0),
         };
+        let t0 = Instant::now();
         if let Some(key) = key {
             self.plane_noise_fill(key);
         }
@@ -785,11 +884,16 @@ impl Pse {
                     }
                 }
             });
+        let t1 = Instant::now();
+        self.times.kernel += (t1 - t0).as_secs_f64();
         for c in 0..3 {
             self.fft
                 .inverse(&mut self.work[c], &mut self.spec, &mut self.real[c]);
         }
+        let t2 = Instant::now();
+        self.times.fft += (t2 - t1).as_secs_f64();
         self.interpolate(out, add);
+        self.times.interpolate += t2.elapsed().as_secs_f64();
     }
 
     /// The Hermitian-symmetric noise of the kx = 0 plane: each pair `(ky, kz)`, `(−ky, −kz)`
@@ -827,12 +931,13 @@ impl Pse {
     /// `out (+)= M^r f`.
     fn real_product(&self, f: &[f64], out: &mut [f64], add: bool) {
         let (offsets, entries, s) = (&self.offsets, &self.entries, self.self_real);
+        let counts = &self.counts;
         out.par_chunks_mut(3)
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, o)| {
                 let mut u = [s * f[3 * i], s * f[3 * i + 1], s * f[3 * i + 2]];
-                for e in &entries[offsets[i]..offsets[i + 1]] {
+                for e in &entries[offsets[i]..offsets[i] + counts[i] as usize] {
                     let j = e.j as usize;
                     let fj = [f[3 * j], f[3 * j + 1], f[3 * j + 2]];
                     let ef = e.b * (e.e[0] * fj[0] + e.e[1] * fj[1] + e.e[2] * fj[2]);
@@ -859,19 +964,122 @@ impl Pse {
             tolerance: self.params.tolerance,
             max_iterations: self.params.max_iterations,
         };
+        let t = Instant::now();
         let rep = lanczos.sqrt_times(
             &lp,
             self.noise.as_flattened(),
             |v, w| self.real_product(v, w, false),
             out.as_flattened_mut(),
         );
+        self.times.real += t.elapsed().as_secs_f64();
         self.lanczos = lanczos;
+        if let Ok(r) = &rep {
+            self.times.lanczos_iterations += r.iterations as u64;
+        }
         let rep = rep.map_err(|source| HydroError::Lanczos {
             step: key.step,
             source,
         })?;
         out.iter_mut().flatten().for_each(|x| *x *= scale);
         Ok(rep)
+    }
+}
+
+/// The cell list of the real-space part.
+struct Cells<'a> {
+    pos: &'a [[f64; 3]],
+    cell_of: &'a [u32],
+    cell_start: &'a [u32],
+    cell_order: &'a [u32],
+    nc: usize,
+    l: f64,
+    rc2: f64,
+}
+
+impl Cells<'_> {
+    /// Call `f(j, x_i − x_j, r^2)` (nearest image) for the particles `j != i` within the
+    /// cut-off, in a fixed order: the 27 cells around i's (all particles when there are fewer
+    /// than 3 cells per axis), a cell's particles in index order.
+    #[inline(always)]
+    fn visit<F: FnMut(u32, [f64; 3], f64) + ?Sized>(&self, i: usize, f: &mut F) {
+        let (nc, l, rc2, pos) = (self.nc, self.l, self.rc2, self.pos);
+        let xi = pos[i];
+        let mut pair = |j: u32| {
+            let xj = pos[j as usize];
+            let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            for c in d.iter_mut() {
+                // Positions lie in [-L/2, L/2): one shift at most.
+                if *c >= 0.5 * l {
+                    *c -= l;
+                } else if *c < -0.5 * l {
+                    *c += l;
+                }
+            }
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if r2 < rc2 && j as usize != i {
+                f(j, d, r2);
+            }
+        };
+        if nc < 3 {
+            (0..pos.len() as u32).for_each(&mut pair);
+            return;
+        }
+        let c = self.cell_of[i] as usize;
+        let (cx, cy, cz) = (c % nc, (c / nc) % nc, c / (nc * nc));
+        for dz in [nc - 1, 0, 1] {
+            for dy in [nc - 1, 0, 1] {
+                let row = (((cz + dz) % nc) * nc + (cy + dy) % nc) * nc;
+                for dx in [nc - 1, 0, 1] {
+                    let k = row + (cx + dx) % nc;
+                    let (lo, hi) = (self.cell_start[k] as usize, self.cell_start[k + 1] as usize);
+                    for &j in &self.cell_order[lo..hi] {
+                        pair(j);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Run `f(lo, hi, rows)` in parallel over chunks of rows `lo..hi` of a CSR array `data` with
+/// row offsets `off` (`rows` = the chunk's part of `data`).
+fn for_row_chunks<T: Send>(
+    off: &[usize],
+    data: &mut [T],
+    f: impl Fn(usize, usize, &mut [T]) + Sync + Send,
+) {
+    const CH: usize = 256;
+    let n = off.len() - 1;
+    let mut rest = data;
+    let mut chunks = Vec::with_capacity(n.div_ceil(CH));
+    for c in 0..n.div_ceil(CH) {
+        let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
+        let (head, tail) = rest.split_at_mut(off[hi] - off[lo]);
+        chunks.push((lo, hi, head));
+        rest = tail;
+    }
+    chunks
+        .into_par_iter()
+        .for_each(|(lo, hi, rows)| f(lo, hi, rows));
+}
+
+/// The chunks of [`for_row_chunks`] of a CSR array and of a per-row array, collected.
+fn for_row_chunks_collect<'a, T, U>(
+    off: &[usize],
+    data: &'a mut [T],
+    per_row: &'a mut [U],
+    out: &mut Vec<(usize, usize, &'a mut [T], &'a mut [U])>,
+) {
+    const CH: usize = 256;
+    let n = off.len() - 1;
+    let (mut rest, mut rest_row) = (data, per_row);
+    for c in 0..n.div_ceil(CH) {
+        let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
+        let (head, tail) = rest.split_at_mut(off[hi] - off[lo]);
+        let (rh, rt) = rest_row.split_at_mut(hi - lo);
+        out.push((lo, hi, head, rh));
+        rest = tail;
+        rest_row = rt;
     }
 }
 
@@ -936,14 +1144,18 @@ impl Mobility for Pse {
                 if y >= 0.5 * l { y - l } else { y }
             });
         }
+        let t = Instant::now();
         self.build_real_space();
         self.build_spreading();
+        self.times.setup += t.elapsed().as_secs_f64();
         Ok(())
     }
 
     fn apply(&mut self, f: &[[f64; 3]], out: &mut [[f64; 3]]) {
         self.wave(Some((f, 1.0)), None, out, false);
+        let t = Instant::now();
         self.real_product(f.as_flattened(), out.as_flattened_mut(), true);
+        self.times.real += t.elapsed().as_secs_f64();
     }
 
     fn brownian(
@@ -968,6 +1180,7 @@ impl Mobility for Pse {
         let scale = (2.0 * kt * dt).sqrt();
         let rep = self.real_noise(key, scale, out)?;
         self.wave(Some((f, dt)), Some((key, scale)), out, true);
+        let t = Instant::now();
         let mut u = std::mem::take(&mut self.scratch);
         self.real_product(f.as_flattened(), u.as_flattened_mut(), false);
         for (o, u) in out.iter_mut().zip(&u) {
@@ -976,6 +1189,7 @@ impl Mobility for Pse {
             }
         }
         self.scratch = u;
+        self.times.real += t.elapsed().as_secs_f64();
         Ok(rep)
     }
 

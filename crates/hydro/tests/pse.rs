@@ -238,3 +238,31 @@ fn bad_parameters_are_refused_naming_the_key() {
     .to_string();
     assert!(e.contains("raise the splitting"), "{e}");
 }
+
+#[test]
+fn pse_state_is_a_function_of_the_current_positions_whatever_the_history() {
+    // The real-space candidate lists are kept between small moves; the result must not
+    // depend on when they were built.
+    let (a, eta, l) = (0.5, 1.0, 12.0);
+    let (pos0, f) = random_config(200, l, 21);
+    let pos1: Vec<[f64; 3]> = pos0
+        .iter()
+        .enumerate()
+        .map(|(i, x)| x.map(|c| c + 0.01 * ((i % 7) as f64 - 3.0)))
+        .collect();
+    let key = NoiseKey {
+        seed: 2,
+        step: 9,
+        key0: 0,
+    };
+    let mut u1 = vec![[0.0; 3]; 200];
+    let mut m1 = Pse::new(200, PseParams::paper(a, eta, l)).unwrap();
+    m1.set_positions(&pos0).unwrap();
+    m1.set_positions(&pos1).unwrap();
+    m1.displacement(&f, 1e-3, 1.0, key, &mut u1).unwrap();
+    let mut u2 = vec![[0.0; 3]; 200];
+    let mut m2 = Pse::new(200, PseParams::paper(a, eta, l)).unwrap();
+    m2.set_positions(&pos1).unwrap();
+    m2.displacement(&f, 1e-3, 1.0, key, &mut u2).unwrap();
+    assert_eq!(u1, u2);
+}
