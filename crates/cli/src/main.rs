@@ -6,6 +6,7 @@ mod dpd_bench;
 mod dpd_cmd;
 mod droplet;
 mod plot;
+mod rpy_bench;
 mod theory_droplet;
 
 use anyhow::{Context, Result, bail};
@@ -89,6 +90,8 @@ enum BenchKind {
     Bd(droplet::BenchArgs),
     /// Pure DPD water, 81,000 beads at density 3 (L = 30, dt = 0.04), beside LAMMPS.
     Dpd(dpd_bench::BenchArgs),
+    /// RPY mobility: direct product beside pystokes, PSE from 10^3 to 10^5, BD+RPY step.
+    Rpy(rpy_bench::BenchArgs),
 }
 
 /// The `method` key of a scenario decides which engine reads the rest of the file.
@@ -205,6 +208,7 @@ fn run_cli() -> Result<()> {
             BenchKind::Bcd(args) => bcd_cmd::bench(&args),
             BenchKind::Bd(args) => droplet::bench(&args),
             BenchKind::Dpd(args) => dpd_bench::bench(&args),
+            BenchKind::Rpy(args) => rpy_bench::bench(&args),
         },
     }
 }
