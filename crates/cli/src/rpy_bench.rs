@@ -45,6 +45,9 @@ pub struct BenchArgs {
     /// Do not run pystokes.
     #[arg(long)]
     pub no_pystokes: bool,
+    /// Parts to run: direct, pse, bd.
+    #[arg(long, value_delimiter = ',', default_value = "direct,pse,bd")]
+    pub parts: Vec<String>,
 }
 
 /// Positions and forces of one benchmark system.
@@ -112,8 +115,23 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         "# colloidsim bench rpy: spheres of radius {RADIUS}, viscosity 1, random positions at phi = {}, random forces; median of {reps}",
         a.phi
     );
+    let part = |p: &str| a.parts.iter().any(|x| x == p);
+    if part("direct") {
+        direct(a, reps)?;
+    }
+    if part("pse") {
+        pse(a, reps)?;
+    }
+    if part("bd") {
+        bd_step(a, reps)?;
+    }
+    Ok(())
+}
+
+/// The direct product beside pystokes.
+fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
     println!(
-        "## direct RPY product M F (free space), beside pystokes.unbounded.Rbm.mobilityTT (one thread)"
+        "## direct RPY product M F (free space, non-overlapping spheres), beside pystokes.unbounded.Rbm.mobilityTT (OMP_NUM_THREADS=1); speed-ups of medians (and of minima)"
     );
     // Non-overlapping spheres (pystokes has only the r >= 2a branch of the tensor).
     let systems = a
@@ -138,7 +156,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     } else {
         pystokes(a, &systems)
     };
-    println!("code\tN\tthreads\tseconds\tns_per_pair\tspeed-up_vs_pystokes\trel_diff_vs_pystokes");
+    println!(
+        "code\tN\tthreads\tseconds\tmin_seconds\tns_per_pair\tspeed-up_vs_pystokes\tof_minima\trel_diff_vs_pystokes"
+    );
     for (timing, u) in &ours {
         let case = peer.as_ref().and_then(|v| {
             v["cases"]
@@ -147,9 +167,10 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .find(|c| c["n"].as_u64() == Some(timing.n as u64))
                 .cloned()
         });
-        let (speed, diff) = match &case {
+        let (speed, speed_min, diff) = match &case {
             Some(c) => {
                 let s = c["median_s"].as_f64().unwrap_or(f64::NAN);
+                let smin = c["min_s"].as_f64().unwrap_or(f64::NAN);
                 let v: Vec<f64> = c["velocity"]
                     .as_array()
                     .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
@@ -161,28 +182,35 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 }
                 (
                     format!("{:.2}", s / timing.seconds),
+                    format!("{:.2}", smin / timing.min_seconds),
                     format!("{:.2e}", (d2 / w2).sqrt()),
                 )
             }
-            None => ("-".into(), "-".into()),
+            None => ("-".into(), "-".into(), "-".into()),
         };
         println!(
-            "colloidsim\t{}\t{}\t{:.4e}\t{:.3}\t{speed}\t{diff}",
-            timing.n, timing.threads, timing.seconds, timing.ns_per_pair
+            "colloidsim\t{}\t{}\t{:.4e}\t{:.4e}\t{:.3}\t{speed}\t{speed_min}\t{diff}",
+            timing.n, timing.threads, timing.seconds, timing.min_seconds, timing.ns_per_pair
         );
     }
     if let Some(v) = &peer {
         for c in v["cases"].as_array().into_iter().flatten() {
             println!(
-                "pystokes-{}\t{}\t1\t{:.4e}\t{:.3}\t1.00\t0",
+                "pystokes-{}\t{}\t1\t{:.4e}\t{:.4e}\t{:.3}\t1.00\t1.00\t0",
                 v["version"].as_str().unwrap_or("?"),
                 c["n"],
                 c["median_s"].as_f64().unwrap_or(f64::NAN),
+                c["min_s"].as_f64().unwrap_or(f64::NAN),
                 c["median_s"].as_f64().unwrap_or(f64::NAN) * 1e9
                     / (c["n"].as_f64().unwrap_or(1.0)).powi(2)
             );
         }
     }
+    Ok(())
+}
+
+/// PSE per product and per displacement.
+fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
     println!(
         "## PSE (xi = 0.5/a, tolerance {}) per product and per Brownian displacement (new positions + dt M F + sqrt(2 kT dt) M^1/2 z); shares of the displacement",
         a.tolerance
@@ -215,48 +243,54 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+/// A BD+RPY step against a free-draining step of the `bench bd` system.
+fn bd_step(a: &BenchArgs, reps: usize) -> Result<()> {
     println!(
         "## Brownian dynamics step, N = {}, phi = {} (the bench bd system: WCA, friction 1, dt = 1e-4): free draining vs RPY by PSE",
         a.bd_n, a.phi
     );
-    println!("mobility\tthreads\tseconds_per_step\tratio\tfft_share");
+    println!(
+        "# the two engines alternate (one free-draining run of 200 steps, then one RPY step, {reps} times); minima are the least disturbed by other load"
+    );
+    println!(
+        "threads\tfree_draining_s\tfd_min_s\trpy_pse_s\trpy_min_s\tratio_of_medians\tratio_of_minima\tfft_share"
+    );
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build()
             .context("thread pool")?;
-        let fd = pool.install(|| -> Result<f64> {
-            let mut sim = colloidsim_md::bench::wca_periodic(a.bd_n, a.phi, 1e-4, 1)?;
-            sim.run(100)?;
-            let mut ts = Vec::new();
-            for _ in 0..reps {
-                let s = Instant::now();
-                sim.run(200)?;
-                ts.push(s.elapsed().as_secs_f64() / 200.0);
-            }
-            Ok(median(&mut ts))
-        })?;
-        let (hi, share) = pool.install(|| -> Result<(f64, f64)> {
-            let mut sim =
+        let row = pool.install(|| -> Result<[f64; 5]> {
+            let mut fd = colloidsim_md::bench::wca_periodic(a.bd_n, a.phi, 1e-4, 1)?;
+            let mut hi =
                 colloidsim_md::bench::wca_periodic_rpy(a.bd_n, a.phi, 1e-4, 1, a.tolerance)?;
-            sim.run(2)?;
-            if let Some(p) = sim.mobility_mut().pse_mut() {
+            fd.run(100)?;
+            hi.run(2)?;
+            if let Some(p) = hi.mobility_mut().pse_mut() {
                 p.reset_times();
             }
-            let mut ts = Vec::new();
+            let (mut tf, mut th) = (Vec::new(), Vec::new());
             for _ in 0..reps {
                 let s = Instant::now();
-                sim.run(1)?;
-                ts.push(s.elapsed().as_secs_f64());
+                fd.run(200)?;
+                tf.push(s.elapsed().as_secs_f64() / 200.0);
+                let s = Instant::now();
+                hi.run(1)?;
+                th.push(s.elapsed().as_secs_f64());
             }
-            let total: f64 = ts.iter().sum();
-            let fft = sim.mobility().pse().map_or(0.0, |p| p.times().fft);
-            Ok((median(&mut ts), fft / total))
+            let total: f64 = th.iter().sum();
+            let fft = hi.mobility().pse().map_or(0.0, |p| p.times().fft);
+            let (mf, mh) = (median(&mut tf), median(&mut th));
+            Ok([mf, tf[0], mh, th[0], fft / total])
         })?;
-        println!("free-draining\t{t}\t{fd:.4e}\t1\t-");
+        let [mf, f0, mh, h0, share] = row;
         println!(
-            "rpy-pse\t{t}\t{hi:.4e}\t{:.1}\t{:.1}%",
-            hi / fd,
+            "{t}\t{mf:.4e}\t{f0:.4e}\t{mh:.4e}\t{h0:.4e}\t{:.1}\t{:.1}\t{:.1}%",
+            mh / mf,
+            h0 / f0,
             100.0 * share
         );
     }

@@ -62,6 +62,8 @@ pub struct DirectTiming {
     pub threads: usize,
     /// Median seconds per product `M F`.
     pub seconds: f64,
+    /// Fastest product (the least disturbed by other load on the machine).
+    pub min_seconds: f64,
     /// Nanoseconds per pair tensor (N^2 per product).
     pub ns_per_pair: f64,
 }
@@ -94,6 +96,7 @@ pub fn time_direct(
                 n,
                 threads,
                 seconds,
+                min_seconds: t[0],
                 ns_per_pair: seconds * 1e9 / (n as f64 * n as f64),
             },
             u,
@@ -228,7 +231,8 @@ for case in req["cases"]:
     times.sort()
     m = len(times) // 2
     med = times[m] if len(times) % 2 else 0.5 * (times[m - 1] + times[m])
-    out.append({"n": n, "median_s": med, "velocity": v.reshape(3, n).T.ravel().tolist()})
+    out.append({"n": n, "median_s": med, "min_s": times[0],
+                "velocity": v.reshape(3, n).T.ravel().tolist()})
 version = getattr(pystokes, "__version__", "unknown")
 print(json.dumps({"version": version, "cases": out}))
 "#;

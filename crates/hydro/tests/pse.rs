@@ -115,6 +115,13 @@ fn single_sphere_self_mobility_follows_hasimoto() {
                 f[0][k] = 1.0;
                 m.apply(&f, &mut u);
                 let mu = u[0][k] / mu0;
+                if k == 0 {
+                    eprintln!(
+                        "L/a {l_over_a} tol {tol:e}: mu/mu0 {mu:.7} Hasimoto {:.7} (RPY terms {:.7})",
+                        hasimoto(a, l),
+                        hasimoto_rpy(a, l)
+                    );
+                }
                 // Hasimoto's series with its (a/L)^6 term (beyond RPY: 27.4 (a/L)^6 <= 2.7e-5).
                 let x = a / l;
                 assert!(
