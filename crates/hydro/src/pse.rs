@@ -318,9 +318,16 @@ pub struct Pse {
     /// Row `i` of the candidates and of the entries starts at `offsets[i]`.
     offsets: Vec<usize>,
     candidates: Vec<u32>,
-    /// The first `counts[i]` entries of row i are the pairs within the cut-off.
+    /// The first `counts[r]` entries of row r are the pairs within the cut-off; an entry's
+    /// `j` is the neighbour's row.
     entries: Vec<Entry>,
     counts: Vec<u32>,
+    /// Particle of each row, and row of each particle (cell order at the last candidate build).
+    row_particle: Vec<u32>,
+    row_of: Vec<u32>,
+    /// Forces and velocities of the real-space product in row order.
+    f_rows: Vec<f64>,
+    u_rows: Vec<f64>,
     // Gaussian spreading: first grid index per axis and P weights per axis per particle.
     base: Vec<[u32; 3]>,
     weights: Vec<f64>,
@@ -516,6 +523,10 @@ impl Pse {
             candidates: Vec::new(),
             entries: Vec::new(),
             counts: vec![0; n],
+            row_particle: (0..n as u32).collect(),
+            row_of: (0..n as u32).collect(),
+            f_rows: vec![0.0; 3 * n],
+            u_rows: vec![0.0; 3 * n],
             base: vec![[0; 3]; n],
             weights: vec![0.0; 3 * pts * n],
             plane_key: vec![0; n],
@@ -585,10 +596,14 @@ impl Pse {
             l,
             rc2: range * range,
         };
+        // Rows are stored in cell order (row r holds particle cell_order[r]), so that a row's
+        // neighbours lie close in memory; within a row the neighbours stay in increasing
+        // particle index, which fixes the order of the sums whatever the storage.
+        let perm = &self.cell_order;
         let mut off = std::mem::take(&mut self.offsets);
-        off[1..].par_iter_mut().enumerate().for_each(|(i, c)| {
+        off[1..].par_iter_mut().enumerate().for_each(|(r, c)| {
             let mut k = 0;
-            cells.visit(i, &mut |_, _, _| k += 1);
+            cells.visit(perm[r] as usize, &mut |_, _, _| k += 1);
             *c = k;
         });
         off[0] = 0;
@@ -599,10 +614,10 @@ impl Pse {
         self.entries.resize(off[n], Entry::default());
         for_row_chunks(&off, &mut self.candidates, |lo, hi, out| {
             let base = off[lo];
-            for i in lo..hi {
-                let row = &mut out[off[i] - base..off[i + 1] - base];
+            for r in lo..hi {
+                let row = &mut out[off[r] - base..off[r + 1] - base];
                 let mut k = 0;
-                cells.visit(i, &mut |j, _, _| {
+                cells.visit(perm[r] as usize, &mut |j, _, _| {
                     row[k] = j;
                     k += 1;
                 });
@@ -611,6 +626,10 @@ impl Pse {
         });
         self.offsets = off;
         self.reference.clone_from(&self.pos);
+        self.row_particle.clone_from(&self.cell_order);
+        for (r, &p) in self.row_particle.iter().enumerate() {
+            self.row_of[p as usize] = r as u32;
+        }
     }
 
     /// The real-space pair tensors of the pairs within the cut-off, each row in increasing
@@ -633,15 +652,16 @@ impl Pse {
         let rc2 = self.geom.r_cut * self.geom.r_cut;
         let (a, eta, table) = (self.params.radius, self.params.viscosity, &self.table);
         let (pos, off, cand) = (&self.pos, &self.offsets, &self.candidates);
+        let (row_particle, row_of) = (&self.row_particle, &self.row_of);
         let counts = &mut self.counts;
         let mut rows: Vec<(usize, usize, &mut [Entry], &mut [u32])> = Vec::new();
         for_row_chunks_collect(off, &mut self.entries, counts, &mut rows);
         rows.into_par_iter().for_each(|(lo, hi, out, count)| {
             let base = off[lo];
-            for i in lo..hi {
-                let xi = pos[i];
-                let mut k = off[i] - base;
-                for &j in &cand[off[i]..off[i + 1]] {
+            for r in lo..hi {
+                let xi = pos[row_particle[r] as usize];
+                let mut k = off[r] - base;
+                for &j in &cand[off[r]..off[r + 1]] {
                     let xj = pos[j as usize];
                     let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
                     for c in d.iter_mut() {
@@ -657,7 +677,7 @@ impl Pse {
                         let t = rpy(r, a, eta);
                         let (aw, bw) = table.eval(r);
                         out[k] = Entry {
-                            j,
+                            j: row_of[j as usize],
                             a: t.a - aw,
                             b: t.b - bw,
                             e: d.map(|x| x / r),
@@ -665,7 +685,7 @@ impl Pse {
                         k += 1;
                     }
                 }
-                count[i - lo] = (k - (off[i] - base)) as u32;
+                count[r - lo] = (k - (off[r] - base)) as u32;
             }
         });
     }
@@ -928,23 +948,44 @@ impl Pse {
         }
     }
 
-    /// `out (+)= M^r f`.
-    fn real_product(&self, f: &[f64], out: &mut [f64], add: bool) {
+    /// `out (+)= M^r f`: the forces gathered into row (cell) order, the rows summed there,
+    /// the velocities gathered back.
+    fn real_product(&mut self, f: &[f64], out: &mut [f64], add: bool) {
         let (offsets, entries, s) = (&self.offsets, &self.entries, self.self_real);
-        let counts = &self.counts;
-        out.par_chunks_mut(3)
+        let (counts, row_particle, row_of) = (&self.counts, &self.row_particle, &self.row_of);
+        let (f_rows, u_rows) = (&mut self.f_rows, &mut self.u_rows);
+        f_rows
+            .par_chunks_mut(3)
+            .zip(row_particle.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &p)| o.copy_from_slice(&f[3 * p as usize..3 * p as usize + 3]));
+        let f_rows = &*f_rows;
+        u_rows
+            .par_chunks_mut(3)
             .enumerate()
             .with_min_len(256)
-            .for_each(|(i, o)| {
-                let mut u = [s * f[3 * i], s * f[3 * i + 1], s * f[3 * i + 2]];
-                for e in &entries[offsets[i]..offsets[i] + counts[i] as usize] {
+            .for_each(|(r, o)| {
+                let mut u = [
+                    s * f_rows[3 * r],
+                    s * f_rows[3 * r + 1],
+                    s * f_rows[3 * r + 2],
+                ];
+                for e in &entries[offsets[r]..offsets[r] + counts[r] as usize] {
                     let j = e.j as usize;
-                    let fj = [f[3 * j], f[3 * j + 1], f[3 * j + 2]];
+                    let fj = [f_rows[3 * j], f_rows[3 * j + 1], f_rows[3 * j + 2]];
                     let ef = e.b * (e.e[0] * fj[0] + e.e[1] * fj[1] + e.e[2] * fj[2]);
                     for k in 0..3 {
                         u[k] += e.a * fj[k] + ef * e.e[k];
                     }
                 }
+                o.copy_from_slice(&u);
+            });
+        let u_rows = &*u_rows;
+        out.par_chunks_mut(3)
+            .zip(row_of.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &r)| {
+                let u = &u_rows[3 * r as usize..3 * r as usize + 3];
                 for k in 0..3 {
                     o[k] = if add { o[k] + u[k] } else { u[k] };
                 }
@@ -964,15 +1005,17 @@ impl Pse {
             tolerance: self.params.tolerance,
             max_iterations: self.params.max_iterations,
         };
+        let noise = std::mem::take(&mut self.noise);
         let t = Instant::now();
         let rep = lanczos.sqrt_times(
             &lp,
-            self.noise.as_flattened(),
+            noise.as_flattened(),
             |v, w| self.real_product(v, w, false),
             out.as_flattened_mut(),
         );
         self.times.real += t.elapsed().as_secs_f64();
         self.lanczos = lanczos;
+        self.noise = noise;
         if let Ok(r) = &rep {
             self.times.lanczos_iterations += r.iterations as u64;
         }
