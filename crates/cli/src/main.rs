@@ -5,6 +5,7 @@ mod bench_bcd;
 mod bench_bd;
 mod common;
 mod dpd_bench;
+mod rpy_bench;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -147,6 +148,8 @@ enum BenchKind {
     Bd(bench_bd::BenchArgs),
     /// Pure DPD water, 81,000 beads at density 3 (L = 30, dt = 0.04), beside LAMMPS.
     Dpd(dpd_bench::BenchArgs),
+    /// RPY mobility: direct product beside pystokes, PSE from 10^3 to 10^5, BD+RPY step.
+    Rpy(rpy_bench::BenchArgs),
 }
 
 /// The progress bar: appears only on a terminal, only when not quiet, and only once the run
@@ -365,6 +368,7 @@ fn run_cli() -> Result<()> {
             BenchKind::Bcd(args) => bench_bcd::bench(&args),
             BenchKind::Bd(args) => bench_bd::bench(&args),
             BenchKind::Dpd(args) => dpd_bench::bench(&args),
+            BenchKind::Rpy(args) => rpy_bench::bench(&args),
         },
     }
 }

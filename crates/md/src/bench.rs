@@ -3,10 +3,12 @@
 
 use crate::brownian::{BdError, BdParams, Brownian};
 use crate::dpd::{Dpd, DpdError, DpdParams};
+use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::init::random_in_box;
 use crate::potential::{LennardJones, NoExternal};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::rng::{Purpose, stream};
+use colloidsim_hydro::{AnyMobility, Pse, PseParams};
 use rand::RngExt;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
@@ -43,6 +45,34 @@ pub fn wca_periodic_skin(
         LennardJones::wca(1.0, 1.0),
         NoExternal,
         params,
+        0,
+    )
+}
+
+/// The system of [`wca_periodic`] (WCA, friction 1 from viscosity `1 / (3 pi)` and diameter 1,
+/// skin 0.3) with RPY hydrodynamics by positively split Ewald in the same periodic cube
+/// (splitting `xi = 0.5 / a`, tolerance `tolerance`): the BD+RPY case of `colloidsim bench rpy`.
+pub fn wca_periodic_rpy(
+    n: usize,
+    phi: f64,
+    dt: f64,
+    seed: u32,
+    tolerance: f64,
+) -> Result<HydroBrownian<LennardJones, NoExternal, AnyMobility>, HydroBdError> {
+    let l = (n as f64 * PI / 6.0 / phi).cbrt();
+    let sbox = SimBox::cube(l);
+    let pos =
+        random_in_box(n, 1.0, &sbox, seed, 0).map_err(|e| HydroBdError::Invalid(e.to_string()))?;
+    let mut p = PseParams::paper(0.5, 1.0 / (3.0 * PI), l);
+    p.tolerance = tolerance;
+    let mobility = AnyMobility::Pse(Box::new(Pse::new(n, p)?));
+    HydroBrownian::new(
+        Particles::monodisperse(pos, 1.0),
+        sbox,
+        LennardJones::wca(1.0, 1.0),
+        NoExternal,
+        mobility,
+        HydroBdParams::new(dt, seed),
         0,
     )
 }

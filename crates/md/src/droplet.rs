@@ -9,11 +9,16 @@
 
 use crate::brownian::{BdError, BdParams, Brownian};
 use crate::gsd::read_frame;
+use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::init::random_in_sphere;
 use crate::potential::{HarmonicInterface, LennardJones, SphereAreaLaw};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{at_least, in_range, positive};
+use colloidsim_hydro::direct::DEFAULT_MAX_DIRECT;
+use colloidsim_hydro::{
+    AnyMobility, DirectRpy, FreeDraining, HydroMethod, HydroModel, HydroParams, Pse, PseParams,
+};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -591,7 +596,17 @@ pub enum DropletError {
     /// The engine refused the configuration.
     #[error(transparent)]
     Engine(#[from] BdError),
+    /// The hydrodynamic engine or its mobility refused the configuration.
+    #[error(transparent)]
+    Hydro(#[from] HydroBdError),
+    /// A hydrodynamics parameter does not fit the droplet.
+    #[error(transparent)]
+    Param(#[from] ParamError),
 }
+
+/// The engine of a droplet replica with hydrodynamics (`[hydrodynamics]`): WCA colloids inside
+/// the moving harmonic interface, moved by the chosen mobility.
+pub type HydroDropletSim = HydroBrownian<LennardJones, HarmonicInterface, AnyMobility>;
 
 /// The engine a droplet replica runs: WCA colloids inside the moving harmonic interface.
 pub type DropletSim = Brownian<LennardJones, HarmonicInterface>;
@@ -619,11 +634,10 @@ impl DropletParams {
             + 2.0 * self.diameter
     }
 
-    /// Set up replica `replica` (0-based) at step 0: random insertion (stream index
-    /// `replica`) or the last frame of `system.initial`, noise keyed by the replica.
-    pub fn build_replica(&self, replica: u32) -> Result<DropletSim, DropletError> {
-        let sbox = SimBox::cube(self.box_edge());
-        let particles = match &self.initial {
+    /// The initial particles of replica `replica`: random insertion (stream index `replica`)
+    /// or the last frame of `system.initial`.
+    fn initial_particles(&self, replica: u32) -> Result<Particles, DropletError> {
+        Ok(match &self.initial {
             None => Particles::monodisperse(
                 random_in_sphere(
                     self.particles,
@@ -665,7 +679,14 @@ impl DropletParams {
                 p.diameter.iter_mut().for_each(|d| *d = self.diameter);
                 p
             }
-        };
+        })
+    }
+
+    /// Set up replica `replica` (0-based) at step 0: random insertion (stream index
+    /// `replica`) or the last frame of `system.initial`, noise keyed by the replica.
+    pub fn build_replica(&self, replica: u32) -> Result<DropletSim, DropletError> {
+        let sbox = SimBox::cube(self.box_edge());
+        let particles = self.initial_particles(replica)?;
         let params = BdParams {
             kt: self.kt,
             viscosity: self.viscosity,
@@ -681,6 +702,86 @@ impl DropletParams {
             sbox,
             LennardJones::wca(self.kt, self.diameter),
             self.interface(),
+            params,
+            0,
+        )?)
+    }
+}
+
+impl DropletParams {
+    /// Edge of the simulation box with hydrodynamics: `box_factor` times the initial droplet
+    /// diameter for PSE (the periodic hydrodynamic box; the paper: 2), [`Self::box_edge`]
+    /// otherwise. A PSE box must hold the droplet with its interface and two neighbour ranges
+    /// of margin (`hydrodynamics.box_factor`, with the least allowed value in the message).
+    pub fn hydro_box_edge(&self, hydro: &HydroParams) -> Result<f64, ParamError> {
+        if hydro.method != Some(HydroMethod::Pse) {
+            return Ok(self.box_edge());
+        }
+        let l = hydro.box_factor * 2.0 * self.r0;
+        let min = self.box_edge() - 2.0 * self.diameter;
+        if l < min {
+            return Err(ParamError::new(
+                "hydrodynamics.box_factor",
+                format!(
+                    "a box of {} droplet diameters (edge {l:.4}) cannot hold the droplet with its interface \
+                     and neighbour margins (edge {min:.4}); box_factor must be at least {:.4}",
+                    hydro.box_factor,
+                    min / (2.0 * self.r0)
+                ),
+            ));
+        }
+        Ok(l)
+    }
+
+    /// Set up replica `replica` at step 0 with the mobility of `hydro` (free draining, RPY by
+    /// direct free-space sums, or RPY by PSE in a periodic box of `box_factor` droplet
+    /// diameters), noise keyed by the replica.
+    pub fn build_hydro_replica(
+        &self,
+        replica: u32,
+        hydro: &HydroParams,
+    ) -> Result<HydroDropletSim, DropletError> {
+        let l = self.hydro_box_edge(hydro)?;
+        let particles = self.initial_particles(replica)?;
+        let n = particles.len();
+        let a = 0.5 * self.diameter;
+        let mobility = match (hydro.model, hydro.method) {
+            (HydroModel::FreeDraining, _) => AnyMobility::FreeDraining(
+                FreeDraining::new(&vec![a; n], self.viscosity).map_err(HydroBdError::from)?,
+            ),
+            (HydroModel::Rpy, Some(HydroMethod::Pse)) => AnyMobility::Pse(Box::new(
+                Pse::new(
+                    n,
+                    PseParams {
+                        radius: a,
+                        viscosity: self.viscosity,
+                        box_length: l,
+                        splitting: hydro.splitting,
+                        tolerance: hydro.tolerance,
+                        max_iterations: hydro.max_iterations,
+                    },
+                )
+                .map_err(HydroBdError::from)?,
+            )),
+            (HydroModel::Rpy, _) => AnyMobility::Direct(Box::new(
+                DirectRpy::new(n, a, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)
+                    .map_err(HydroBdError::from)?,
+            )),
+        };
+        let params = HydroBdParams {
+            kt: self.kt,
+            dt: self.dt,
+            seed: self.seed,
+            replica,
+            skin: self.skin,
+            max_drift: 0.2,
+        };
+        Ok(HydroBrownian::new(
+            particles,
+            SimBox::cube(l),
+            LennardJones::wca(self.kt, self.diameter),
+            self.interface(),
+            mobility,
             params,
             0,
         )?)

@@ -8,17 +8,20 @@ mod cells;
 pub mod dpd;
 pub mod droplet;
 pub mod gsd;
+pub mod hydro_bd;
 pub mod init;
 pub mod neighbor;
 pub mod potential;
 pub mod state;
 
 pub use brownian::{BdError, BdParams, Brownian};
+pub use colloidsim_hydro as hydro;
 pub use dpd::{Dpd, DpdError, DpdParams};
 pub use droplet::{DropletParams, DropletScenario};
+pub use hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 pub use neighbor::NeighborList;
 pub use potential::{
-    External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair, Pair, PairSum,
-    SphereAreaLaw,
+    ConstantForce, External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair,
+    Pair, PairSum, SphereAreaLaw,
 };
 pub use state::{Particles, SimBox};

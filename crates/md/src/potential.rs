@@ -223,6 +223,20 @@ impl External for NoExternal {
     }
 }
 
+/// A constant body force on every particle (e.g. gravity less buoyancy, for sedimentation).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ConstantForce(pub [f64; 3]);
+
+impl External for ConstantForce {
+    #[inline(always)]
+    fn force(&self, _: [f64; 3], _: f64) -> [f64; 3] {
+        self.0
+    }
+    fn energy(&self, p: [f64; 3], _: f64) -> f64 {
+        -(self.0[0] * p[0] + self.0[1] * p[1] + self.0[2] * p[2])
+    }
+}
+
 /// Sphere whose surface area falls linearly: `R(t) = sqrt(R0^2 - alpha t / (4 pi))`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SphereAreaLaw {

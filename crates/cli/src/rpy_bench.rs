@@ -1,0 +1,298 @@
+//! `colloidsim bench rpy`: the RPY mobility's direct product beside pystokes, PSE per product
+//! and per Brownian displacement, and a Brownian-dynamics step with PSE against a free-draining
+//! step of the `bench bd` system. The cases live in `colloidsim_hydro::bench`.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use colloidsim_md::hydro::bench::{
+    PYSTOKES_SCRIPT, RADIUS, box_edge, median, random_system, time_direct, time_pse,
+};
+use std::io::Write;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+/// Arguments of `colloidsim bench rpy`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Particle numbers of the direct product (and pystokes).
+    #[arg(long, value_delimiter = ',', default_value = "1000,2000,5000")]
+    pub sizes: Vec<usize>,
+    /// Particle numbers of PSE.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,3000,10000,30000,100000"
+    )]
+    pub pse_sizes: Vec<usize>,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Repetitions; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+    /// Volume fraction of the random systems.
+    #[arg(long, default_value_t = 0.1)]
+    pub phi: f64,
+    /// PSE tolerance.
+    #[arg(long, default_value_t = 1e-3)]
+    pub tolerance: f64,
+    /// Particles of the Brownian-dynamics step comparison (the `bench bd` system).
+    #[arg(long, default_value_t = 25_000)]
+    pub bd_n: usize,
+    /// Python interpreter that can import pystokes.
+    #[arg(long, default_value = "python3")]
+    pub python: String,
+    /// Do not run pystokes.
+    #[arg(long)]
+    pub no_pystokes: bool,
+    /// Parts to run: direct, pse, bd.
+    #[arg(long, value_delimiter = ',', default_value = "direct,pse,bd")]
+    pub parts: Vec<String>,
+}
+
+/// Positions and forces of one benchmark system.
+type System = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
+/// Run pystokes on the same systems; `None` (with the reason printed) when it cannot run.
+fn pystokes(a: &BenchArgs, systems: &[System]) -> Option<serde_json::Value> {
+    let cases: Vec<serde_json::Value> = systems
+        .iter()
+        .map(|(p, f)| {
+            serde_json::json!({"n": p.len(), "pos": p.as_flattened(), "force": f.as_flattened()})
+        })
+        .collect();
+    let req = serde_json::json!({
+        "radius": RADIUS, "viscosity": 1.0, "repeats": a.repeats.max(1), "cases": cases
+    });
+    let child = Command::new(&a.python)
+        .args(["-c", PYSTOKES_SCRIPT])
+        .env("OMP_NUM_THREADS", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn();
+    let mut child = match child {
+        Ok(c) => c,
+        Err(e) => {
+            println!("# pystokes: cannot start {} ({e}); not compared", a.python);
+            return None;
+        }
+    };
+    if let Some(mut stdin) = child.stdin.take() {
+        let _ = stdin.write_all(req.to_string().as_bytes());
+    }
+    let out = match child.wait_with_output() {
+        Ok(o) => o,
+        Err(e) => {
+            println!("# pystokes: {e}; not compared");
+            return None;
+        }
+    };
+    let v: serde_json::Value = match serde_json::from_slice(&out.stdout) {
+        Ok(v) => v,
+        Err(_) => {
+            println!(
+                "# pystokes: the Python run failed ({}); not compared",
+                String::from_utf8_lossy(&out.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("no output")
+            );
+            return None;
+        }
+    };
+    if let Some(e) = v.get("error") {
+        println!("# pystokes: {e} (pip install pystokes); not compared");
+        return None;
+    }
+    Some(v)
+}
+
+/// `colloidsim bench rpy`.
+pub fn bench(a: &BenchArgs) -> Result<()> {
+    let reps = a.repeats.max(1);
+    println!(
+        "# colloidsim bench rpy: spheres of radius {RADIUS}, viscosity 1, random positions at phi = {}, random forces; median of {reps}",
+        a.phi
+    );
+    let part = |p: &str| a.parts.iter().any(|x| x == p);
+    if part("direct") {
+        direct(a, reps)?;
+    }
+    if part("pse") {
+        pse(a, reps)?;
+    }
+    if part("bd") {
+        bd_step(a, reps)?;
+    }
+    Ok(())
+}
+
+/// The direct product beside pystokes.
+fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
+    println!(
+        "## direct RPY product M F (free space, non-overlapping spheres), beside pystokes.unbounded.Rbm.mobilityTT (OMP_NUM_THREADS=1); speed-ups of medians (and of minima)"
+    );
+    // Non-overlapping spheres (pystokes has only the r >= 2a branch of the tensor).
+    let systems = a
+        .sizes
+        .iter()
+        .map(|&n| -> Result<System> {
+            let l = box_edge(n, a.phi);
+            let sbox = colloidsim_md::SimBox::cube(l);
+            let pos = colloidsim_md::init::random_in_box(n, 2.0 * RADIUS, &sbox, 1, 0)?;
+            Ok((pos, random_system(n, l, 1).1))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut ours = Vec::new();
+    for (p, f) in &systems {
+        for &t in &a.threads {
+            let (timing, u) = time_direct(p, f, t, reps);
+            ours.push((timing, u));
+        }
+    }
+    let peer = if a.no_pystokes {
+        None
+    } else {
+        pystokes(a, &systems)
+    };
+    println!(
+        "code\tN\tthreads\tseconds\tmin_seconds\tns_per_pair\tspeed-up_vs_pystokes\tof_minima\trel_diff_vs_pystokes"
+    );
+    for (timing, u) in &ours {
+        let case = peer.as_ref().and_then(|v| {
+            v["cases"]
+                .as_array()?
+                .iter()
+                .find(|c| c["n"].as_u64() == Some(timing.n as u64))
+                .cloned()
+        });
+        let (speed, speed_min, diff) = match &case {
+            Some(c) => {
+                let s = c["median_s"].as_f64().unwrap_or(f64::NAN);
+                let smin = c["min_s"].as_f64().unwrap_or(f64::NAN);
+                let v: Vec<f64> = c["velocity"]
+                    .as_array()
+                    .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
+                    .unwrap_or_default();
+                let (mut d2, mut w2) = (0.0, 0.0);
+                for (x, y) in u.as_flattened().iter().zip(&v) {
+                    d2 += (x - y) * (x - y);
+                    w2 += y * y;
+                }
+                (
+                    format!("{:.2}", s / timing.seconds),
+                    format!("{:.2}", smin / timing.min_seconds),
+                    format!("{:.2e}", (d2 / w2).sqrt()),
+                )
+            }
+            None => ("-".into(), "-".into(), "-".into()),
+        };
+        println!(
+            "colloidsim\t{}\t{}\t{:.4e}\t{:.4e}\t{:.3}\t{speed}\t{speed_min}\t{diff}",
+            timing.n, timing.threads, timing.seconds, timing.min_seconds, timing.ns_per_pair
+        );
+    }
+    if let Some(v) = &peer {
+        for c in v["cases"].as_array().into_iter().flatten() {
+            println!(
+                "pystokes-{}\t{}\t1\t{:.4e}\t{:.4e}\t{:.3}\t1.00\t1.00\t0",
+                v["version"].as_str().unwrap_or("?"),
+                c["n"],
+                c["median_s"].as_f64().unwrap_or(f64::NAN),
+                c["min_s"].as_f64().unwrap_or(f64::NAN),
+                c["median_s"].as_f64().unwrap_or(f64::NAN) * 1e9
+                    / (c["n"].as_f64().unwrap_or(1.0)).powi(2)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// PSE per product and per displacement.
+fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
+    println!(
+        "## PSE (xi = 0.5/a, tolerance {}) per product and per Brownian displacement (new positions + dt M F + sqrt(2 kT dt) M^1/2 z); shares of the displacement",
+        a.tolerance
+    );
+    println!(
+        "N\tthreads\tL\tgrid\tsupport\tr_cut\tneighbours\tproduct_s\tstep_s\tfft\tspread\tkernel_noise\tinterp\treal+lanczos\tsetup\tlanczos_iters\tbytes_per_particle"
+    );
+    for &n in &a.pse_sizes {
+        for &t in &a.threads {
+            let p = time_pse(n, a.phi, a.tolerance, t, reps)
+                .with_context(|| format!("PSE at N = {n}"))?;
+            let s = |x: f64| format!("{:.1}%", 100.0 * x / p.step_total);
+            println!(
+                "{n}\t{t}\t{:.2}\t{}\t{}\t{:.3}\t{:.1}\t{:.4e}\t{:.4e}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.1}\t{:.0}",
+                p.box_length,
+                p.geometry.grid,
+                p.geometry.support,
+                p.geometry.r_cut,
+                p.neighbours,
+                p.product,
+                p.step,
+                s(p.times.fft),
+                s(p.times.spread),
+                s(p.times.kernel),
+                s(p.times.interpolate),
+                s(p.times.real),
+                s(p.times.setup),
+                p.times.lanczos_iterations as f64 / reps as f64,
+                p.bytes_per_particle
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A BD+RPY step against a free-draining step of the `bench bd` system.
+fn bd_step(a: &BenchArgs, reps: usize) -> Result<()> {
+    println!(
+        "## Brownian dynamics step, N = {}, phi = {} (the bench bd system: WCA, friction 1, dt = 1e-4): free draining vs RPY by PSE",
+        a.bd_n, a.phi
+    );
+    println!(
+        "# the two engines alternate (one free-draining run of 200 steps, then one RPY step, {reps} times); minima are the least disturbed by other load"
+    );
+    println!(
+        "threads\tfree_draining_s\tfd_min_s\trpy_pse_s\trpy_min_s\tratio_of_medians\tratio_of_minima\tfft_share"
+    );
+    for &t in &a.threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .context("thread pool")?;
+        let row = pool.install(|| -> Result<[f64; 5]> {
+            let mut fd = colloidsim_md::bench::wca_periodic(a.bd_n, a.phi, 1e-4, 1)?;
+            let mut hi =
+                colloidsim_md::bench::wca_periodic_rpy(a.bd_n, a.phi, 1e-4, 1, a.tolerance)?;
+            fd.run(100)?;
+            hi.run(2)?;
+            if let Some(p) = hi.mobility_mut().pse_mut() {
+                p.reset_times();
+            }
+            let (mut tf, mut th) = (Vec::new(), Vec::new());
+            for _ in 0..reps {
+                let s = Instant::now();
+                fd.run(200)?;
+                tf.push(s.elapsed().as_secs_f64() / 200.0);
+                let s = Instant::now();
+                hi.run(1)?;
+                th.push(s.elapsed().as_secs_f64());
+            }
+            let total: f64 = th.iter().sum();
+            let fft = hi.mobility().pse().map_or(0.0, |p| p.times().fft);
+            let (mf, mh) = (median(&mut tf), median(&mut th));
+            Ok([mf, tf[0], mh, th[0], fft / total])
+        })?;
+        let [mf, f0, mh, h0, share] = row;
+        println!(
+            "{t}\t{mf:.4e}\t{f0:.4e}\t{mh:.4e}\t{h0:.4e}\t{:.1}\t{:.1}\t{:.1}%",
+            mh / mf,
+            h0 / f0,
+            100.0 * share
+        );
+    }
+    Ok(())
+}

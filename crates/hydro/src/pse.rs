@@ -1,0 +1,1258 @@
+//! Positively split Ewald (PSE): the RPY mobility of monodisperse spheres in a periodic cube,
+//! after Fiore, Balboa Usabiaga, Donev & Swan, J. Chem. Phys. 146, 124116 (2017).
+//!
+//! **Split.** In Fourier space the RPY tensor is `sinc^2(ka) (I − k̂k̂) / (eta k^2)` (the
+//! Stokeslet averaged over two sphere surfaces; both branches of [`crate::rpy`] follow from
+//! it). Hasimoto's splitting function `H(k) = (1 + k^2/(4 xi^2)) exp(−k^2/(4 xi^2))` divides it
+//! into two positive definite parts, `M = M^w + M^r`:
+//!
+//! - wave space: `M^w` with kernel `b(k) (I − k̂k̂)`, `b(k) = sinc^2(ka) H(k) / (eta k^2)`,
+//!   summed over `k = 2 pi m / L`, `m != 0` (zero mean flow), by the spectral Ewald method:
+//!   forces spread to a grid with Gaussians of variance `sigma^2`, a real FFT, the kernel
+//!   `b(k) exp(sigma^2 k^2)` (the two Gaussians' transforms taken out), the inverse FFT and
+//!   the same Gaussian for the velocities (quadrature weight `h^3`). The Brownian part of the
+//!   wave space is drawn exactly in Fourier space: `sqrt(b) (I − k̂k̂) W` with complex Gaussian
+//!   `W` of variance V per mode (Hermitian-symmetric), through the same inverse FFT and
+//!   interpolation, so its covariance is `M^w` exactly (the operators are the same).
+//! - real space: `M^r(r) = M^RPY(r) − M^w_free(r)` (short ranged, like `exp(−xi^2 r^2)`), where
+//!   `M^w_free(r) = A_w(r) I + B_w(r) r̂r̂` is the free-space transform of the wave kernel,
+//!   `A_w = 1/(2 pi^2 eta) int_0^inf sinc^2(ka) H(k) [j0(kr) − j1(kr)/(kr)] dk`,
+//!   `B_w = 1/(2 pi^2 eta) int_0^inf sinc^2(ka) H(k) j2(kr) dk` (`j_n` spherical Bessel
+//!   functions), tabulated once by Gauss–Legendre quadrature and interpolated (cubic) — the
+//!   RPY part is evaluated exactly, so the kink at `r = 2a` needs no table. Pairs within the
+//!   cut-off `r_c` are kept in neighbour lists (cells of edge `>= r_c`, nearest image); the
+//!   Brownian part is the Lanczos square root of `M^r` ([`crate::lanczos`]).
+//!
+//! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 3 eps`,
+//! `x = K^2/(4 xi^2)`; grid spacing `h <= pi / K` (n points per axis, the next even 2-3-5-smooth
+//! size); Gaussian `sigma = (h / pi) sqrt(ln(1/e_s))` (aliasing `exp(−pi^2 sigma^2 / h^2) = e_s`,
+//! `e_s = 2 eps`), support: the fewest points `P` per axis that cover the half-width
+//! `w = sigma sqrt(2 ln(1/e_s))` on both sides of any particle (`P = 2m` reaches `(m − 1) h`,
+//! `P = 2m + 1` centred on the nearest point `(m − 1/2) h`); real-space cut-off `r_c`: beyond it `|A_r|, |B_r| < 0.2 eps mu0`.
+//! The shares were set by measurement: against Beenakker's Ewald sum the error of the product
+//! is set by the real-space cut-off and lies between 0.15 and 0.6 of the tolerance
+//! (`tests/pse.rs`, docs/hydrodynamics.md).
+//!
+//! **Determinism.** Spreading is a gather per grid plane (each plane sums the particles whose
+//! support reaches it, in a fixed order), interpolation a sum per particle, the FFT lines are
+//! independent, neighbour lists are in a fixed order, and the noise is keyed by (seed, step,
+//! particle) and (seed, step, grid line): results do not depend on the thread count.
+
+use crate::fft3::{C64, Fft3};
+use crate::lanczos::{Lanczos, LanczosParams, SqrtReport};
+use crate::noise::{GRID_KEY, NoiseKey, fill_particle_noise};
+use crate::params::check_lanczos;
+use crate::rpy::rpy;
+use crate::{HydroError, Mobility};
+use colloidsim_core::ParamError;
+use colloidsim_core::rng::{Purpose, Ziggurat, stream};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Threshold of the Fourier cut-off, relative to the tolerance.
+const FOURIER_SHARE: f64 = 3.0;
+/// Threshold of the Gaussian's aliasing and truncation, relative to the tolerance.
+const SUPPORT_SHARE: f64 = 2.0;
+/// Threshold of the real-space cut-off, relative to the tolerance (the real-space truncation
+/// dominates the error: measured against Beenakker's sum, the error is proportional to this
+/// share and nearly independent of the other two).
+const REAL_SHARE: f64 = 0.2;
+
+/// What PSE is asked for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PseParams {
+    /// Sphere radius a.
+    pub radius: f64,
+    /// Solvent viscosity eta.
+    pub viscosity: f64,
+    /// Edge L of the periodic cube (centred on the origin).
+    pub box_length: f64,
+    /// Splitting parameter xi (1 / length; the paper: 0.5 / a).
+    pub splitting: f64,
+    /// Relative tolerance of the product and of the real-space Lanczos noise.
+    pub tolerance: f64,
+    /// Lanczos iteration limit.
+    pub max_iterations: usize,
+}
+
+impl PseParams {
+    /// The paper's setting: `xi = 0.5 / a`, tolerance 1e-3, 200 Lanczos iterations at most.
+    pub fn paper(radius: f64, viscosity: f64, box_length: f64) -> Self {
+        Self {
+            radius,
+            viscosity,
+            box_length,
+            splitting: 0.5 / radius,
+            tolerance: 1e-3,
+            max_iterations: 200,
+        }
+    }
+}
+
+/// Grid and cut-offs chosen from [`PseParams`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PseGeometry {
+    /// Grid points per axis.
+    pub grid: usize,
+    /// Grid spacing h = L / grid.
+    pub spacing: f64,
+    /// Fourier cut-off K the grid resolves.
+    pub k_cut: f64,
+    /// Width sigma of the spreading Gaussian.
+    pub sigma: f64,
+    /// Gaussian support: points per axis.
+    pub support: usize,
+    /// Real-space cut-off r_c.
+    pub r_cut: f64,
+    /// Fraction `4 xi^2 sigma^2` of the Gaussian split into the spreading (Fiore's eta, <= 1).
+    pub gaussian_fraction: f64,
+}
+
+/// Even 2-3-5-smooth size at least `n`.
+fn fft_size(n: usize) -> usize {
+    let mut m = n.max(2);
+    loop {
+        let mut r = m;
+        for p in [2, 3, 5] {
+            while r.is_multiple_of(p) {
+                r /= p;
+            }
+        }
+        if r == 1 && m.is_multiple_of(2) {
+            return m;
+        }
+        m += 1;
+    }
+}
+
+/// `x` with `(1 + x) e^(−x) = eps` (x > 1), by bisection.
+fn hasimoto_cut(eps: f64) -> f64 {
+    let (mut lo, mut hi) = (1.0f64, 200.0f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if (1.0 + mid) * (-mid).exp() > eps {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre polynomial).
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// `(j0(x) − j1(x)/x, j2(x))`, by series below x = 0.3.
+fn bessel_pair(x: f64) -> (f64, f64) {
+    if x < 0.3 {
+        let x2 = x * x;
+        let j0 = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)));
+        let j1x = 1.0 / 3.0 - x2 / 30.0 + x2 * x2 / 840.0 - x2 * x2 * x2 / 45360.0
+            + x2 * x2 * x2 * x2 / 3991680.0;
+        let j2 = x2 / 15.0 - x2 * x2 / 210.0 + x2 * x2 * x2 / 7560.0 - x2 * x2 * x2 * x2 / 498960.0;
+        (j0 - j1x, j2)
+    } else {
+        let (s, c) = x.sin_cos();
+        let j0 = s / x;
+        let j1 = s / (x * x) - c / x;
+        let j2 = (3.0 / (x * x) - 1.0) * s / x - 3.0 * c / (x * x);
+        (j0 - j1 / x, j2)
+    }
+}
+
+/// `sin(x) / x`.
+fn sinc(x: f64) -> f64 {
+    if x.abs() < 1e-4 {
+        1.0 - x * x / 6.0
+    } else {
+        x.sin() / x
+    }
+}
+
+/// `A_w(r)`, `B_w(r)` of the free-space wave-space tensor on a uniform grid in r, with
+/// cubic interpolation.
+#[derive(Debug, Clone)]
+struct WaveTable {
+    dr: f64,
+    a: Vec<f64>,
+    b: Vec<f64>,
+}
+
+impl WaveTable {
+    fn build(radius: f64, eta: f64, xi: f64, r_max: f64) -> Self {
+        let dr = radius.min(1.0 / xi) / 64.0;
+        let m = (r_max / dr).ceil() as usize + 4;
+        // H(k) < 1e-19 beyond k = 14 xi.
+        let k_max = 14.0 * xi;
+        let width = (PI / (2.0 * r_max.max(2.0 * radius)))
+            .min(PI / (4.0 * radius))
+            .min(xi);
+        let panels = (k_max / width).ceil() as usize;
+        let gl = gauss_legendre(16);
+        let hw = 0.5 * k_max / panels as f64;
+        let nodes: Vec<(f64, f64)> = (0..panels)
+            .flat_map(|p| {
+                let mid = (2 * p + 1) as f64 * hw;
+                gl.iter().map(move |&(x, w)| (mid + hw * x, hw * w))
+            })
+            .map(|(k, w)| {
+                let q = k * k / (4.0 * xi * xi);
+                let s = sinc(k * radius);
+                (k, w * s * s * (1.0 + q) * (-q).exp())
+            })
+            .collect();
+        let pre = 1.0 / (2.0 * PI * PI * eta);
+        let (a, b): (Vec<f64>, Vec<f64>) = (0..m)
+            .into_par_iter()
+            .map(|i| {
+                let r = i as f64 * dr;
+                let (mut sa, mut sb) = (0.0, 0.0);
+                for &(k, w) in &nodes {
+                    let (p, q) = bessel_pair(k * r);
+                    sa += w * p;
+                    sb += w * q;
+                }
+                (pre * sa, pre * sb)
+            })
+            .unzip();
+        Self { dr, a, b }
+    }
+
+    /// `(A_w(r), B_w(r))`, 4-point Lagrange interpolation (B_w even in r, A_w too).
+    fn eval(&self, r: f64) -> (f64, f64) {
+        let t = r / self.dr;
+        let i = (t.floor() as usize).clamp(1, self.a.len() - 3);
+        let u = t - i as f64;
+        // Nodes i-1, i, i+1, i+2 at offsets -1, 0, 1, 2.
+        let w = [
+            -u * (u - 1.0) * (u - 2.0) / 6.0,
+            (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0,
+            -(u + 1.0) * u * (u - 2.0) / 2.0,
+            (u + 1.0) * u * (u - 1.0) / 6.0,
+        ];
+        let idx = |k: usize| {
+            // Reflect across r = 0 (both functions are even in r).
+            (i + k) as isize - 1
+        };
+        let (mut a, mut b) = (0.0, 0.0);
+        for (k, wk) in w.iter().enumerate() {
+            let j = idx(k).unsigned_abs();
+            a += wk * self.a[j];
+            b += wk * self.b[j];
+        }
+        (a, b)
+    }
+}
+
+/// Seconds spent in the parts of PSE since the last [`Pse::reset_times`] (for benchmarks).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct PseTimes {
+    /// Forward and inverse 3D FFTs.
+    pub fft: f64,
+    /// Spreading forces to the grid.
+    pub spread: f64,
+    /// The wave-space kernel and Fourier noise.
+    pub kernel: f64,
+    /// Interpolating velocities from the grid.
+    pub interpolate: f64,
+    /// Real-space products (including those of the Lanczos iterations).
+    pub real: f64,
+    /// Neighbour lists, pair tensors and Gaussian weights (`set_positions`).
+    pub setup: f64,
+    /// Lanczos iterations.
+    pub lanczos_iterations: u64,
+}
+
+/// One real-space pair of a neighbour list: `M^r_ij = a I + b e e^T`.
+#[derive(Debug, Clone, Copy, Default)]
+struct Entry {
+    j: u32,
+    a: f64,
+    b: f64,
+    e: [f64; 3],
+}
+
+/// Positively split Ewald RPY mobility in a periodic cube.
+pub struct Pse {
+    params: PseParams,
+    geom: PseGeometry,
+    n: usize,
+    mu0: f64,
+    /// Real-space self term `mu0 − A_w(0)`.
+    self_real: f64,
+    table: WaveTable,
+    // Positions wrapped into the box.
+    pos: Vec<[f64; 3]>,
+    // Cell list of the real-space part.
+    n_cells: usize,
+    cell_of: Vec<u32>,
+    cell_start: Vec<u32>,
+    cell_order: Vec<u32>,
+    /// Verlet skin of the candidate lists.
+    skin: f64,
+    /// Positions at the last candidate build.
+    reference: Vec<[f64; 3]>,
+    /// Row `i` of the candidates and of the entries starts at `offsets[i]`.
+    offsets: Vec<usize>,
+    candidates: Vec<u32>,
+    /// The first `counts[r]` entries of row r are the pairs within the cut-off; an entry's
+    /// `j` is the neighbour's row.
+    entries: Vec<Entry>,
+    counts: Vec<u32>,
+    /// Particle of each row, and row of each particle (cell order at the last candidate build).
+    row_particle: Vec<u32>,
+    row_of: Vec<u32>,
+    /// Forces and velocities of the real-space product in row order.
+    f_rows: Vec<f64>,
+    u_rows: Vec<f64>,
+    // Gaussian spreading: first grid index per axis and P weights per axis per particle.
+    base: Vec<[u32; 3]>,
+    weights: Vec<f64>,
+    /// Sort key of each particle: first grid plane and row of its support, `z g + y`.
+    plane_key: Vec<u32>,
+    plane_start: Vec<u32>,
+    /// Particles by sort key (spreading and interpolation visit them in this order, so that
+    /// consecutive particles touch nearby grid rows).
+    plane_order: Vec<u32>,
+    /// Position of each particle in `plane_order`.
+    slot_of: Vec<u32>,
+    /// Interpolated velocities in `plane_order`.
+    sorted: Vec<[f64; 3]>,
+    // Grids: real `[z][y][x]`, one shared half spectrum, full spectra `[ky][kx][kz]`.
+    fft: Fft3,
+    real: [Vec<f64>; 3],
+    spec: Vec<C64>,
+    work: [Vec<C64>; 3],
+    /// `b(k) exp(sigma^2 k^2)` per mode of `work` (0 at k = 0 and at the Nyquist planes).
+    kernel: Vec<f64>,
+    /// k components per index along an axis (`None`: the Nyquist index).
+    kvec: Vec<Option<f64>>,
+    /// Noise of the kx = 0 plane `[ky][kz]`, three complex components.
+    plane_noise: Vec<[C64; 3]>,
+    lanczos: Lanczos,
+    noise: Vec<[f64; 3]>,
+    scratch: Vec<[f64; 3]>,
+    times: PseTimes,
+}
+
+impl std::fmt::Debug for Pse {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pse")
+            .field("params", &self.params)
+            .field("geometry", &self.geom)
+            .field("n", &self.n)
+            .finish()
+    }
+}
+
+impl Pse {
+    /// Set up for `n` spheres: choose the grid and cut-offs, tabulate the real-space
+    /// functions, plan the FFTs. Errors name the scenario key at fault.
+    pub fn new(n: usize, params: PseParams) -> Result<Self, HydroError> {
+        let p = params;
+        colloidsim_core::param::positive("system.diameter", p.radius)?;
+        colloidsim_core::param::positive("system.viscosity", p.viscosity)?;
+        colloidsim_core::param::positive("system.box_length", p.box_length)?;
+        if !(p.splitting.is_finite() && p.splitting > 0.0) {
+            return Err(ParamError::new(
+                "hydrodynamics.splitting",
+                format!("must be a finite number > 0, got {}", p.splitting),
+            )
+            .into());
+        }
+        check_lanczos(&LanczosParams {
+            tolerance: p.tolerance,
+            max_iterations: p.max_iterations,
+        })?;
+        let (a, xi, l, eps) = (p.radius, p.splitting, p.box_length, p.tolerance);
+        if l < 4.0 * a {
+            return Err(ParamError::new(
+                "system.box_length",
+                format!(
+                    "the periodic box {l} must be at least 4 radii ({})",
+                    4.0 * a
+                ),
+            )
+            .into());
+        }
+        let mu0 = 1.0 / (6.0 * PI * p.viscosity * a);
+        // Fourier side.
+        let k_cut = 2.0 * xi * hasimoto_cut(FOURIER_SHARE * eps).sqrt();
+        let ln = (1.0 / (SUPPORT_SHARE * eps)).ln();
+        let mut grid = fft_size((k_cut * l / PI).ceil() as usize);
+        let support = |grid: usize| {
+            let h = l / grid as f64;
+            let sigma = h / PI * ln.sqrt();
+            let w = sigma * (2.0 * ln).sqrt();
+            // Fewest points whose worst-placed particle still has w covered on both sides:
+            // 2m points reach (m - 1) h, 2m + 1 points (m - 1/2) h.
+            let pts = (2..).find(|&p: &usize| {
+                let m = (p / 2) as f64;
+                (if p % 2 == 0 { m - 1.0 } else { m - 0.5 }) * h >= w
+            });
+            (h, sigma, pts.expect("finite support"))
+        };
+        let (mut h, mut sigma, mut pts) = support(grid);
+        if pts > grid {
+            grid = fft_size(pts);
+            (h, sigma, pts) = support(grid);
+        }
+        let frac = 4.0 * xi * xi * sigma * sigma;
+        debug_assert!(frac <= 1.0 + 1e-12, "Gaussian fraction {frac}");
+        if grid > 1024 {
+            return Err(ParamError::new(
+                "hydrodynamics.splitting",
+                format!(
+                    "xi = {xi} needs a {grid}^3 grid for a box of edge {l} ({:.1} GiB); \
+                     lower the splitting",
+                    60.0 * (grid as f64).powi(3) / (1u64 << 30) as f64
+                ),
+            )
+            .into());
+        }
+        // Real side: the table reaches where exp(-xi^2 r^2) < 1e-18.
+        let r_max = (4.0 * a).max(6.5 / xi);
+        let table = WaveTable::build(a, p.viscosity, xi, r_max);
+        let self_real = mu0 - table.a[0];
+        let mut r_cut = 0.0;
+        for i in (0..table.a.len() - 3).rev() {
+            let r = i as f64 * table.dr;
+            let t = rpy(r, a, p.viscosity);
+            let (aw, bw) = table.eval(r);
+            if (t.a - aw).abs().max((t.b - bw).abs()) > REAL_SHARE * eps * mu0 {
+                r_cut = r + table.dr;
+                break;
+            }
+        }
+        if r_cut >= 0.5 * l {
+            return Err(ParamError::new(
+                "hydrodynamics.splitting",
+                format!(
+                    "xi = {xi} gives a real-space cut-off {r_cut:.4} beyond half the box ({}); \
+                     raise the splitting to at least {:.4} or enlarge the box",
+                    0.5 * l,
+                    xi * r_cut / (0.49 * l)
+                ),
+            )
+            .into());
+        }
+        let geom = PseGeometry {
+            grid,
+            spacing: h,
+            k_cut,
+            sigma,
+            support: pts,
+            r_cut,
+            gaussian_fraction: frac,
+        };
+        let fft = Fft3::new(grid);
+        let nh = grid / 2 + 1;
+        let kvec: Vec<Option<f64>> = (0..grid)
+            .map(|m| {
+                let f = if m < grid / 2 {
+                    m as isize
+                } else {
+                    m as isize - grid as isize
+                };
+                (2 * m != grid).then(|| 2.0 * PI * f as f64 / l)
+            })
+            .collect();
+        let mut kernel = vec![0.0; grid * nh * grid];
+        kernel
+            .par_chunks_mut(nh * grid)
+            .enumerate()
+            .for_each(|(ky, plane)| {
+                for kx in 0..nh {
+                    for kz in 0..grid {
+                        plane[kx * grid + kz] = match (kvec[kx], kvec[ky], kvec[kz]) {
+                            (Some(x), Some(y), Some(z)) if kx + ky + kz > 0 => {
+                                let k2 = x * x + y * y + z * z;
+                                let q = k2 / (4.0 * xi * xi);
+                                let s = sinc(k2.sqrt() * a);
+                                s * s * (1.0 + q) * (sigma * sigma * k2 - q).exp()
+                                    / (p.viscosity * k2)
+                            }
+                            _ => 0.0,
+                        };
+                    }
+                }
+            });
+        let n3 = grid * grid * grid;
+        let len = fft.spectrum_len();
+        // Skin of the candidate lists: a tenth of the cut-off, less where the box is tight.
+        let skin = (0.1 * r_cut).min(0.5 * (0.5 * l - r_cut)).max(0.0);
+        let n_cells = ((l / (r_cut + skin)).floor() as usize).max(1);
+        Ok(Self {
+            params,
+            geom,
+            n,
+            mu0,
+            self_real,
+            table,
+            pos: vec![[0.0; 3]; n],
+            n_cells,
+            cell_of: vec![0; n],
+            cell_start: vec![0; n_cells.pow(3) + 1],
+            cell_order: vec![0; n],
+            skin,
+            reference: Vec::new(),
+            offsets: vec![0; n + 1],
+            candidates: Vec::new(),
+            entries: Vec::new(),
+            counts: vec![0; n],
+            row_particle: (0..n as u32).collect(),
+            row_of: (0..n as u32).collect(),
+            f_rows: vec![0.0; 3 * n],
+            u_rows: vec![0.0; 3 * n],
+            base: vec![[0; 3]; n],
+            weights: vec![0.0; 3 * pts * n],
+            plane_key: vec![0; n],
+            plane_start: vec![0; grid * grid + 1],
+            slot_of: vec![0; n],
+            sorted: vec![[0.0; 3]; n],
+            plane_order: vec![0; n],
+            fft,
+            real: [vec![0.0; n3], vec![0.0; n3], vec![0.0; n3]],
+            spec: vec![C64::default(); len],
+            work: [
+                vec![C64::default(); len],
+                vec![C64::default(); len],
+                vec![C64::default(); len],
+            ],
+            kernel,
+            kvec,
+            plane_noise: vec![[C64::default(); 3]; grid * grid],
+            lanczos: Lanczos::default(),
+            noise: vec![[0.0; 3]; n],
+            scratch: vec![[0.0; 3]; n],
+            times: PseTimes::default(),
+        })
+    }
+
+    /// Time spent in each part since the last reset.
+    pub fn times(&self) -> &PseTimes {
+        &self.times
+    }
+
+    /// Zero the timers.
+    pub fn reset_times(&mut self) {
+        self.times = PseTimes::default();
+    }
+
+    /// The chosen grid and cut-offs.
+    pub fn geometry(&self) -> &PseGeometry {
+        &self.geom
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &PseParams {
+        &self.params
+    }
+
+    /// Real-space neighbour pairs within the cut-off (both directions).
+    pub fn pairs(&self) -> usize {
+        self.counts.iter().map(|&c| c as usize).sum()
+    }
+
+    /// Candidate lists: for each particle, the others within `r_cut + skin` (cell list, each
+    /// row sorted by index), kept until a particle has moved more than half the skin.
+    fn build_candidates(&mut self) {
+        let (n, l, nc) = (self.n, self.params.box_length, self.n_cells);
+        let range = self.geom.r_cut + self.skin;
+        let cell = |x: f64| (((x / l + 0.5) * nc as f64) as usize).min(nc - 1);
+        for (c, p) in self.cell_of.iter_mut().zip(&self.pos) {
+            *c = ((cell(p[2]) * nc + cell(p[1])) * nc + cell(p[0])) as u32;
+        }
+        counting_sort(&self.cell_of, &mut self.cell_start, &mut self.cell_order);
+        let cells = Cells {
+            pos: &self.pos,
+            cell_of: &self.cell_of,
+            cell_start: &self.cell_start,
+            cell_order: &self.cell_order,
+            nc,
+            l,
+            rc2: range * range,
+        };
+        // Rows are stored in cell order (row r holds particle cell_order[r]), so that a row's
+        // neighbours lie close in memory; within a row the neighbours stay in increasing
+        // particle index, which fixes the order of the sums whatever the storage.
+        let perm = &self.cell_order;
+        let mut off = std::mem::take(&mut self.offsets);
+        off[1..].par_iter_mut().enumerate().for_each(|(r, c)| {
+            let mut k = 0;
+            cells.visit(perm[r] as usize, &mut |_, _, _| k += 1);
+            *c = k;
+        });
+        off[0] = 0;
+        for i in 0..n {
+            off[i + 1] += off[i];
+        }
+        self.candidates.resize(off[n], 0);
+        self.entries.resize(off[n], Entry::default());
+        for_row_chunks(&off, &mut self.candidates, |lo, hi, out| {
+            let base = off[lo];
+            for r in lo..hi {
+                let row = &mut out[off[r] - base..off[r + 1] - base];
+                let mut k = 0;
+                cells.visit(perm[r] as usize, &mut |j, _, _| {
+                    row[k] = j;
+                    k += 1;
+                });
+                row.sort_unstable();
+            }
+        });
+        self.offsets = off;
+        self.reference.clone_from(&self.pos);
+        self.row_particle.clone_from(&self.cell_order);
+        for (r, &p) in self.row_particle.iter().enumerate() {
+            self.row_of[p as usize] = r as u32;
+        }
+    }
+
+    /// The real-space pair tensors of the pairs within the cut-off, each row in increasing
+    /// index (a function of the positions alone, whenever the candidates were built).
+    fn build_real_space(&mut self) {
+        let l = self.params.box_length;
+        let lim = 0.25 * self.skin * self.skin;
+        let (pos, reference) = (&self.pos, &self.reference);
+        let moved = reference.len() != pos.len()
+            || pos.par_iter().zip(reference.par_iter()).any(|(p, q)| {
+                let d = [0, 1, 2].map(|k| {
+                    let d = p[k] - q[k];
+                    d - l * (d / l).round()
+                });
+                d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim
+            });
+        if moved {
+            self.build_candidates();
+        }
+        let rc2 = self.geom.r_cut * self.geom.r_cut;
+        let (a, eta, table) = (self.params.radius, self.params.viscosity, &self.table);
+        let (pos, off, cand) = (&self.pos, &self.offsets, &self.candidates);
+        let (row_particle, row_of) = (&self.row_particle, &self.row_of);
+        let counts = &mut self.counts;
+        let mut rows: Vec<(usize, usize, &mut [Entry], &mut [u32])> = Vec::new();
+        for_row_chunks_collect(off, &mut self.entries, counts, &mut rows);
+        rows.into_par_iter().for_each(|(lo, hi, out, count)| {
+            let base = off[lo];
+            for r in lo..hi {
+                let xi = pos[row_particle[r] as usize];
+                let mut k = off[r] - base;
+                for &j in &cand[off[r]..off[r + 1]] {
+                    let xj = pos[j as usize];
+                    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                    for c in d.iter_mut() {
+                        if *c >= 0.5 * l {
+                            *c -= l;
+                        } else if *c < -0.5 * l {
+                            *c += l;
+                        }
+                    }
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if r2 < rc2 {
+                        let r = r2.sqrt();
+                        let t = rpy(r, a, eta);
+                        let (aw, bw) = table.eval(r);
+                        out[k] = Entry {
+                            j: row_of[j as usize],
+                            a: t.a - aw,
+                            b: t.b - bw,
+                            e: d.map(|x| x / r),
+                        };
+                        k += 1;
+                    }
+                }
+                count[r - lo] = (k - (off[r] - base)) as u32;
+            }
+        });
+    }
+
+    /// Gaussian weights and grid bases of every particle, and their order by first plane.
+    fn build_spreading(&mut self) {
+        let (g, pts) = (self.geom.grid, self.geom.support);
+        let (h, l, sigma) = (self.geom.spacing, self.params.box_length, self.geom.sigma);
+        let norm = 1.0 / (2.0 * PI * sigma * sigma).sqrt();
+        let c = -0.5 / (sigma * sigma);
+        // Odd supports centre on the nearest grid point, even ones on the cell.
+        let (half, shift) = ((pts as isize - 1) / 2, if pts % 2 == 1 { 0.5 } else { 0.0 });
+        self.base
+            .par_iter_mut()
+            .zip(self.weights.par_chunks_mut(3 * pts))
+            .zip(self.pos.par_iter())
+            .for_each(|((base, w), x)| {
+                for k in 0..3 {
+                    let s = (x[k] + 0.5 * l) / h;
+                    let i0 = (s + shift).floor() as isize - half;
+                    base[k] = i0.rem_euclid(g as isize) as u32;
+                    for m in 0..pts {
+                        let d = ((i0 + m as isize) as f64 - s) * h;
+                        w[k * pts + m] = norm * (c * d * d).exp();
+                    }
+                }
+            });
+        for (o, b) in self.plane_key.iter_mut().zip(&self.base) {
+            *o = b[2] * g as u32 + b[1];
+        }
+        counting_sort(
+            &self.plane_key,
+            &mut self.plane_start,
+            &mut self.plane_order,
+        );
+        for (k, &j) in self.plane_order.iter().enumerate() {
+            self.slot_of[j as usize] = k as u32;
+        }
+    }
+
+    /// Spread the forces `f` onto the three real grids (a gather per plane).
+    fn spread(&mut self, f: &[[f64; 3]]) {
+        let (g, pts) = (self.geom.grid, self.geom.support);
+        let (base, weights) = (&self.base, &self.weights);
+        let (start, order) = (&self.plane_start, &self.plane_order);
+        let [gx, gy, gz] = &mut self.real;
+        gx.par_chunks_mut(g * g)
+            .zip(gy.par_chunks_mut(g * g))
+            .zip(gz.par_chunks_mut(g * g))
+            .enumerate()
+            .for_each(|(p, ((px, py), pz))| {
+                px.iter_mut().for_each(|v| *v = 0.0);
+                py.iter_mut().for_each(|v| *v = 0.0);
+                pz.iter_mut().for_each(|v| *v = 0.0);
+                for m in 0..pts {
+                    let b = (p + g * pts - m) % g;
+                    for &j in &order[start[b * g] as usize..start[(b + 1) * g] as usize] {
+                        let j = j as usize;
+                        let w = &weights[3 * pts * j..3 * pts * (j + 1)];
+                        let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
+                        let fz = f[j].map(|c| c * wz[m]);
+                        let [bx, by, _] = base[j];
+                        for (iy, &wyv) in wy.iter().enumerate() {
+                            let row = (by as usize + iy) % g * g;
+                            let c = fz.map(|c| c * wyv);
+                            for_row(bx as usize, pts, g, |x, ix| {
+                                let wv = wx[ix];
+                                px[row + x] += c[0] * wv;
+                                py[row + x] += c[1] * wv;
+                                pz[row + x] += c[2] * wv;
+                            });
+                        }
+                    }
+                }
+            });
+    }
+
+    /// `out_i (+)= h^3 sum_g u(x_g) g(x_g − x_i)` from the three real grids (particles in the
+    /// sorted order, then scattered back).
+    fn interpolate(&mut self, out: &mut [[f64; 3]], add: bool) {
+        let (g, pts, h) = (self.geom.grid, self.geom.support, self.geom.spacing);
+        let h3 = h * h * h;
+        let [gx, gy, gz] = &self.real;
+        let (weights, base, order) = (&self.weights, &self.base, &self.plane_order);
+        self.sorted
+            .par_iter_mut()
+            .zip(order.par_iter())
+            .with_min_len(64)
+            .for_each(|(o, &j)| {
+                let j = j as usize;
+                let w = &weights[3 * pts * j..3 * pts * (j + 1)];
+                let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
+                let [bx, by, bz] = base[j];
+                let mut u = [0.0; 3];
+                for (iz, &wzv) in wz.iter().enumerate() {
+                    let plane = (bz as usize + iz) % g * g * g;
+                    for (iy, &wyv) in wy.iter().enumerate() {
+                        let row = plane + (by as usize + iy) % g * g;
+                        let mut s = [0.0; 3];
+                        for_row(bx as usize, pts, g, |x, ix| {
+                            let wv = wx[ix];
+                            s[0] += gx[row + x] * wv;
+                            s[1] += gy[row + x] * wv;
+                            s[2] += gz[row + x] * wv;
+                        });
+                        let c = wzv * wyv;
+                        for k in 0..3 {
+                            u[k] += c * s[k];
+                        }
+                    }
+                }
+                *o = u.map(|c| h3 * c);
+            });
+        let (sorted, slot_of) = (&self.sorted, &self.slot_of);
+        out.par_iter_mut()
+            .zip(slot_of.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &k)| {
+                let v = sorted[k as usize];
+                for c in 0..3 {
+                    o[c] = if add { o[c] + v[c] } else { v[c] };
+                }
+            });
+    }
+
+    /// The wave-space pass: `out (+)= dt M^w f + scale (M^w)^(1/2) W` (either part optional).
+    fn wave(
+        &mut self,
+        f: Option<(&[[f64; 3]], f64)>,
+        noise: Option<(NoiseKey, f64)>,
+        out: &mut [[f64; 3]],
+        add: bool,
+    ) {
+        let (g, l) = (self.geom.grid, self.params.box_length);
+        let nh = g / 2 + 1;
+        let vol = l * l * l;
+        let h = self.geom.spacing;
+        let det = if let Some((f, dt)) = f {
+            let t = Instant::now();
+            self.spread(f);
+            let t1 = Instant::now();
+            self.times.spread += (t1 - t).as_secs_f64();
+            for c in 0..3 {
+                self.fft
+                    .forward(&mut self.real[c], &mut self.spec, &mut self.work[c]);
+            }
+            self.times.fft += t1.elapsed().as_secs_f64();
+            h * h * h / vol * dt
+        } else {
+            0.0
+        };
+        let (key, amp) = match noise {
+            Some((key, scale)) => (Some(key), scale / vol.sqrt()),
+            None => (None, 0.0),
+        };
+        let t0 = Instant::now();
+        if let Some(key) = key {
+            self.plane_noise_fill(key);
+        }
+        let (kernel, kvec, pn) = (&self.kernel, &self.kvec, &self.plane_noise);
+        let zig = Ziggurat::get();
+        let [wx, wy, wz] = &mut self.work;
+        wx.par_chunks_mut(nh * g)
+            .zip(wy.par_chunks_mut(nh * g))
+            .zip(wz.par_chunks_mut(nh * g))
+            .enumerate()
+            .for_each(|(ky, ((px, py), pz))| {
+                let kyv = kvec[ky].unwrap_or(0.0);
+                for kx in 0..nh {
+                    let kxv = kvec[kx].unwrap_or(0.0);
+                    let mut rng = key.map(|key| {
+                        stream(
+                            key.seed,
+                            key.step,
+                            Purpose::Noise,
+                            GRID_KEY | key.key0 | (ky * nh + kx) as u64,
+                        )
+                    });
+                    for kz in 0..g {
+                        let i = kx * g + kz;
+                        let b = kernel[i + ky * nh * g];
+                        let kzv = kvec[kz].unwrap_or(0.0);
+                        let k = [kxv, kyv, kzv];
+                        let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+                        let project = |v: [C64; 3]| {
+                            if k2 == 0.0 {
+                                return [C64::default(); 3];
+                            }
+                            let kv = (v[0] * k[0] + v[1] * k[1] + v[2] * k[2]) / k2;
+                            [v[0] - kv * k[0], v[1] - kv * k[1], v[2] - kv * k[2]]
+                        };
+                        let mut u = [C64::default(); 3];
+                        if det != 0.0 {
+                            let pf = project([px[i], py[i], pz[i]]);
+                            let s = det * b;
+                            u = pf.map(|c| c * s);
+                        }
+                        if let Some(rng) = rng.as_mut() {
+                            let mut w = [C64::default(); 3];
+                            let r = std::f64::consts::FRAC_1_SQRT_2;
+                            for c in w.iter_mut() {
+                                *c = C64::new(r * zig.sample(rng), r * zig.sample(rng));
+                            }
+                            if kx == 0 {
+                                w = pn[ky * g + kz];
+                            }
+                            let pw = project(w);
+                            let s = amp * b.sqrt();
+                            for c in 0..3 {
+                                u[c] += pw[c] * s;
+                            }
+                        }
+                        px[i] = u[0];
+                        py[i] = u[1];
+                        pz[i] = u[2];
+                    }
+                }
+            });
+        let t1 = Instant::now();
+        self.times.kernel += (t1 - t0).as_secs_f64();
+        for c in 0..3 {
+            self.fft
+                .inverse(&mut self.work[c], &mut self.spec, &mut self.real[c]);
+        }
+        let t2 = Instant::now();
+        self.times.fft += (t2 - t1).as_secs_f64();
+        self.interpolate(out, add);
+        self.times.interpolate += t2.elapsed().as_secs_f64();
+    }
+
+    /// The Hermitian-symmetric noise of the kx = 0 plane: each pair `(ky, kz)`, `(−ky, −kz)`
+    /// takes the draws of its first member (in storage order) and their conjugate.
+    fn plane_noise_fill(&mut self, key: NoiseKey) {
+        let (g, nh) = (self.geom.grid, self.geom.grid / 2 + 1);
+        let zig = Ziggurat::get();
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        self.plane_noise
+            .par_chunks_mut(g)
+            .enumerate()
+            .for_each(|(ky, line)| {
+                let mut rng = stream(
+                    key.seed,
+                    key.step,
+                    Purpose::Noise,
+                    GRID_KEY | key.key0 | (ky * nh) as u64,
+                );
+                for w in line.iter_mut() {
+                    for c in w.iter_mut() {
+                        *c = C64::new(r * zig.sample(&mut rng), r * zig.sample(&mut rng));
+                    }
+                }
+            });
+        for ky in 0..g {
+            for kz in 0..g {
+                let (py, pz) = ((g - ky) % g, (g - kz) % g);
+                if (py, pz) < (ky, kz) {
+                    self.plane_noise[ky * g + kz] = self.plane_noise[py * g + pz].map(|c| c.conj());
+                }
+            }
+        }
+    }
+
+    /// `out (+)= M^r f`: the forces gathered into row (cell) order, the rows summed there,
+    /// the velocities gathered back.
+    fn real_product(&mut self, f: &[f64], out: &mut [f64], add: bool) {
+        let (offsets, entries, s) = (&self.offsets, &self.entries, self.self_real);
+        let (counts, row_particle, row_of) = (&self.counts, &self.row_particle, &self.row_of);
+        let (f_rows, u_rows) = (&mut self.f_rows, &mut self.u_rows);
+        f_rows
+            .par_chunks_mut(3)
+            .zip(row_particle.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &p)| o.copy_from_slice(&f[3 * p as usize..3 * p as usize + 3]));
+        let f_rows = &*f_rows;
+        u_rows
+            .par_chunks_mut(3)
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(r, o)| {
+                let mut u = [
+                    s * f_rows[3 * r],
+                    s * f_rows[3 * r + 1],
+                    s * f_rows[3 * r + 2],
+                ];
+                for e in &entries[offsets[r]..offsets[r] + counts[r] as usize] {
+                    let j = e.j as usize;
+                    let fj = [f_rows[3 * j], f_rows[3 * j + 1], f_rows[3 * j + 2]];
+                    let ef = e.b * (e.e[0] * fj[0] + e.e[1] * fj[1] + e.e[2] * fj[2]);
+                    for k in 0..3 {
+                        u[k] += e.a * fj[k] + ef * e.e[k];
+                    }
+                }
+                o.copy_from_slice(&u);
+            });
+        let u_rows = &*u_rows;
+        out.par_chunks_mut(3)
+            .zip(row_of.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &r)| {
+                let u = &u_rows[3 * r as usize..3 * r as usize + 3];
+                for k in 0..3 {
+                    o[k] = if add { o[k] + u[k] } else { u[k] };
+                }
+            });
+    }
+
+    /// `out = scale (M^r)^(1/2) z(key)` by Lanczos.
+    fn real_noise(
+        &mut self,
+        key: NoiseKey,
+        scale: f64,
+        out: &mut [[f64; 3]],
+    ) -> Result<SqrtReport, HydroError> {
+        fill_particle_noise(key, &mut self.noise);
+        let mut lanczos = std::mem::take(&mut self.lanczos);
+        let lp = LanczosParams {
+            tolerance: self.params.tolerance,
+            max_iterations: self.params.max_iterations,
+        };
+        let noise = std::mem::take(&mut self.noise);
+        let t = Instant::now();
+        let rep = lanczos.sqrt_times(
+            &lp,
+            noise.as_flattened(),
+            |v, w| self.real_product(v, w, false),
+            out.as_flattened_mut(),
+        );
+        self.times.real += t.elapsed().as_secs_f64();
+        self.lanczos = lanczos;
+        self.noise = noise;
+        if let Ok(r) = &rep {
+            self.times.lanczos_iterations += r.iterations as u64;
+        }
+        let rep = rep.map_err(|source| HydroError::Lanczos {
+            step: key.step,
+            source,
+        })?;
+        out.iter_mut().flatten().for_each(|x| *x *= scale);
+        Ok(rep)
+    }
+}
+
+/// The cell list of the real-space part.
+struct Cells<'a> {
+    pos: &'a [[f64; 3]],
+    cell_of: &'a [u32],
+    cell_start: &'a [u32],
+    cell_order: &'a [u32],
+    nc: usize,
+    l: f64,
+    rc2: f64,
+}
+
+impl Cells<'_> {
+    /// Call `f(j, x_i − x_j, r^2)` (nearest image) for the particles `j != i` within the
+    /// cut-off, in a fixed order: the 27 cells around i's (all particles when there are fewer
+    /// than 3 cells per axis), a cell's particles in index order.
+    #[inline(always)]
+    fn visit<F: FnMut(u32, [f64; 3], f64) + ?Sized>(&self, i: usize, f: &mut F) {
+        let (nc, l, rc2, pos) = (self.nc, self.l, self.rc2, self.pos);
+        let xi = pos[i];
+        let mut pair = |j: u32| {
+            let xj = pos[j as usize];
+            let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            for c in d.iter_mut() {
+                // Positions lie in [-L/2, L/2): one shift at most.
+                if *c >= 0.5 * l {
+                    *c -= l;
+                } else if *c < -0.5 * l {
+                    *c += l;
+                }
+            }
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if r2 < rc2 && j as usize != i {
+                f(j, d, r2);
+            }
+        };
+        if nc < 3 {
+            (0..pos.len() as u32).for_each(&mut pair);
+            return;
+        }
+        let c = self.cell_of[i] as usize;
+        let (cx, cy, cz) = (c % nc, (c / nc) % nc, c / (nc * nc));
+        for dz in [nc - 1, 0, 1] {
+            for dy in [nc - 1, 0, 1] {
+                let row = (((cz + dz) % nc) * nc + (cy + dy) % nc) * nc;
+                for dx in [nc - 1, 0, 1] {
+                    let k = row + (cx + dx) % nc;
+                    let (lo, hi) = (self.cell_start[k] as usize, self.cell_start[k + 1] as usize);
+                    for &j in &self.cell_order[lo..hi] {
+                        pair(j);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Run `f(lo, hi, rows)` in parallel over chunks of rows `lo..hi` of a CSR array `data` with
+/// row offsets `off` (`rows` = the chunk's part of `data`).
+fn for_row_chunks<T: Send>(
+    off: &[usize],
+    data: &mut [T],
+    f: impl Fn(usize, usize, &mut [T]) + Sync + Send,
+) {
+    const CH: usize = 256;
+    let n = off.len() - 1;
+    let mut rest = data;
+    let mut chunks = Vec::with_capacity(n.div_ceil(CH));
+    for c in 0..n.div_ceil(CH) {
+        let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
+        let (head, tail) = rest.split_at_mut(off[hi] - off[lo]);
+        chunks.push((lo, hi, head));
+        rest = tail;
+    }
+    chunks
+        .into_par_iter()
+        .for_each(|(lo, hi, rows)| f(lo, hi, rows));
+}
+
+/// The chunks of [`for_row_chunks`] of a CSR array and of a per-row array, collected.
+fn for_row_chunks_collect<'a, T, U>(
+    off: &[usize],
+    data: &'a mut [T],
+    per_row: &'a mut [U],
+    out: &mut Vec<(usize, usize, &'a mut [T], &'a mut [U])>,
+) {
+    const CH: usize = 256;
+    let n = off.len() - 1;
+    let (mut rest, mut rest_row) = (data, per_row);
+    for c in 0..n.div_ceil(CH) {
+        let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
+        let (head, tail) = rest.split_at_mut(off[hi] - off[lo]);
+        let (rh, rt) = rest_row.split_at_mut(hi - lo);
+        out.push((lo, hi, head, rh));
+        rest = tail;
+        rest_row = rt;
+    }
+}
+
+/// Visit the `pts` grid columns from `bx` (periodic in `g`) as `(column, offset)`, in two
+/// contiguous runs when the support wraps.
+#[inline(always)]
+fn for_row(bx: usize, pts: usize, g: usize, mut f: impl FnMut(usize, usize)) {
+    let first = pts.min(g - bx);
+    for ix in 0..first {
+        f(bx + ix, ix);
+    }
+    for ix in first..pts {
+        f((bx + ix) % g, ix);
+    }
+}
+
+/// Counting sort of `keys` (values < `start.len() − 1`): `order` lists the indices by key,
+/// ascending index within a key; `start[k]..start[k + 1]` is key k's range.
+fn counting_sort(keys: &[u32], start: &mut [u32], order: &mut [u32]) {
+    start.iter_mut().for_each(|s| *s = 0);
+    for &k in keys {
+        start[k as usize + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    // `start[k]` is used as the next free slot of key k, then restored.
+    for (i, &k) in keys.iter().enumerate() {
+        let s = &mut start[k as usize];
+        order[*s as usize] = i as u32;
+        *s += 1;
+    }
+    for k in (1..start.len()).rev() {
+        start[k] = start[k - 1];
+    }
+    start[0] = 0;
+}
+
+impl Mobility for Pse {
+    fn len(&self) -> usize {
+        self.n
+    }
+
+    fn set_positions(&mut self, pos: &[[f64; 3]]) -> Result<(), HydroError> {
+        if pos.len() != self.n {
+            return Err(HydroError::Invalid(format!(
+                "{} positions for {} particles",
+                pos.len(),
+                self.n
+            )));
+        }
+        let l = self.params.box_length;
+        for (i, (q, p)) in self.pos.iter_mut().zip(pos).enumerate() {
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(HydroError::Invalid(format!(
+                    "particle {i} has a non-finite position"
+                )));
+            }
+            *q = p.map(|x| {
+                let y = x - l * (x / l + 0.5).floor();
+                // Rounding can leave y at +L/2.
+                if y >= 0.5 * l { y - l } else { y }
+            });
+        }
+        let t = Instant::now();
+        self.build_real_space();
+        self.build_spreading();
+        self.times.setup += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn apply(&mut self, f: &[[f64; 3]], out: &mut [[f64; 3]]) {
+        self.wave(Some((f, 1.0)), None, out, false);
+        let t = Instant::now();
+        self.real_product(f.as_flattened(), out.as_flattened_mut(), true);
+        self.times.real += t.elapsed().as_secs_f64();
+    }
+
+    fn brownian(
+        &mut self,
+        key: NoiseKey,
+        scale: f64,
+        out: &mut [[f64; 3]],
+    ) -> Result<SqrtReport, HydroError> {
+        let rep = self.real_noise(key, scale, out)?;
+        self.wave(None, Some((key, scale)), out, true);
+        Ok(rep)
+    }
+
+    fn displacement(
+        &mut self,
+        f: &[[f64; 3]],
+        dt: f64,
+        kt: f64,
+        key: NoiseKey,
+        out: &mut [[f64; 3]],
+    ) -> Result<SqrtReport, HydroError> {
+        let scale = (2.0 * kt * dt).sqrt();
+        let rep = self.real_noise(key, scale, out)?;
+        self.wave(Some((f, dt)), Some((key, scale)), out, true);
+        let t = Instant::now();
+        let mut u = std::mem::take(&mut self.scratch);
+        self.real_product(f.as_flattened(), u.as_flattened_mut(), false);
+        for (o, u) in out.iter_mut().zip(&u) {
+            for k in 0..3 {
+                o[k] += dt * u[k];
+            }
+        }
+        self.scratch = u;
+        self.times.real += t.elapsed().as_secs_f64();
+        Ok(rep)
+    }
+
+    fn stokes_mobility(&self, _: usize) -> f64 {
+        self.mu0
+    }
+
+    fn bytes(&self) -> usize {
+        let n = self.n;
+        8 * (3 * self.real[0].len()
+            + self.kernel.len()
+            + self.weights.len()
+            + self.table.a.len() * 2)
+            + 16 * (self.spec.len() + 3 * self.work[0].len())
+            + 48 * self.plane_noise.len()
+            + 48 * self.entries.capacity()
+            + 8 * (self.offsets.len())
+            + n * (24 + 12 + 4 * 4 + 2 * 24)
+            + 4 * (self.cell_start.len() + self.plane_start.len())
+            + self.fft.bytes()
+            + self.lanczos.bytes()
+    }
+}

@@ -1,0 +1,275 @@
+//! Validation of positively split Ewald against Beenakker's Ewald sum, Hasimoto's
+//! self-mobility and fluctuation–dissipation.
+
+use colloidsim_hydro::ewald::{beenakker_matrix, hasimoto, hasimoto_rpy};
+use colloidsim_hydro::{HydroError, Mobility, NoiseKey, Pse, PseParams};
+use std::f64::consts::PI;
+
+/// Uniform random positions in the cube of edge `l` (overlaps allowed) and random forces, from
+/// a small linear congruential generator (fixed seeds).
+fn random_config(n: usize, l: f64, seed: u64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let pos = (0..n)
+        .map(|_| [next(), next(), next()].map(|u| (u - 0.5) * l))
+        .collect();
+    let f = (0..n)
+        .map(|_| [next(), next(), next()].map(|u| 2.0 * u - 1.0))
+        .collect();
+    (pos, f)
+}
+
+fn matvec(m: &[f64], f: &[[f64; 3]]) -> Vec<f64> {
+    let n3 = 3 * f.len();
+    let x = f.as_flattened();
+    (0..n3)
+        .map(|r| (0..n3).map(|c| m[r * n3 + c] * x[c]).sum())
+        .collect()
+}
+
+fn rel_err(u: &[[f64; 3]], want: &[f64]) -> f64 {
+    let (mut d2, mut w2) = (0.0, 0.0);
+    for (a, b) in u.as_flattened().iter().zip(want) {
+        d2 += (a - b) * (a - b);
+        w2 += b * b;
+    }
+    (d2 / w2).sqrt()
+}
+
+#[test]
+fn pse_matches_beenakker_at_the_requested_tolerance() {
+    let (a, eta) = (0.5, 1.0);
+    for (n, l, seed) in [(40, 8.0, 1), (80, 9.0, 2), (25, 11.0, 3)] {
+        let (pos, f) = random_config(n, l, seed);
+        let want = matvec(&beenakker_matrix(&pos, a, eta, l, PI.sqrt() / l), &f);
+        let mut prev = f64::INFINITY;
+        for tol in [1e-2, 1e-3, 1e-4, 1e-5] {
+            let mut p = PseParams::paper(a, eta, l);
+            p.tolerance = tol;
+            let mut m = Pse::new(n, p).unwrap();
+            m.set_positions(&pos).unwrap();
+            let mut u = vec![[0.0; 3]; n];
+            m.apply(&f, &mut u);
+            let err = rel_err(&u, &want);
+            eprintln!(
+                "N {n} L {l} tol {tol:e}: error {err:.3e} {:?}",
+                m.geometry()
+            );
+            assert!(err < tol, "N {n}, L {l}, tolerance {tol}: error {err}");
+            assert!(err < prev, "the error falls as the tolerance tightens");
+            prev = err;
+        }
+    }
+}
+
+#[test]
+fn pse_matches_beenakker_for_other_splittings() {
+    // A small dense box needs a larger splitting (the real-space cut-off must stay below L/2);
+    // a smaller one moves work to real space.
+    let (a, eta) = (0.5, 1.0);
+    for (n, l, xi, seed) in [(60, 6.0, 1.5, 2), (30, 12.0, 0.7, 4)] {
+        let (pos, f) = random_config(n, l, seed);
+        let want = matvec(&beenakker_matrix(&pos, a, eta, l, PI.sqrt() / l), &f);
+        for tol in [1e-2, 1e-3, 1e-4] {
+            let mut p = PseParams::paper(a, eta, l);
+            p.tolerance = tol;
+            p.splitting = xi;
+            let mut m = Pse::new(n, p).unwrap();
+            m.set_positions(&pos).unwrap();
+            let mut u = vec![[0.0; 3]; n];
+            m.apply(&f, &mut u);
+            let err = rel_err(&u, &want);
+            assert!(
+                err < tol,
+                "N {n}, L {l}, xi {xi}, tolerance {tol}: error {err}"
+            );
+        }
+    }
+}
+
+#[test]
+fn single_sphere_self_mobility_follows_hasimoto() {
+    let (a, eta) = (0.5, 1.0);
+    let mu0 = 1.0 / (6.0 * PI * eta * a);
+    for l_over_a in [10.0, 16.0, 25.0, 40.0] {
+        let l = l_over_a * a;
+        for tol in [1e-3, 1e-5] {
+            let mut p = PseParams::paper(a, eta, l);
+            p.tolerance = tol;
+            if l_over_a < 15.0 {
+                // The paper's xi = 0.5 / a needs a box above 15 radii at tolerance 1e-5.
+                p.splitting = 1.0 / a;
+            }
+            let mut m = Pse::new(1, p).unwrap();
+            m.set_positions(&[[0.123, -0.4, 1.7]]).unwrap();
+            let mut u = [[0.0; 3]];
+            for k in 0..3 {
+                let mut f = [[0.0; 3]];
+                f[0][k] = 1.0;
+                m.apply(&f, &mut u);
+                let mu = u[0][k] / mu0;
+                if k == 0 {
+                    eprintln!(
+                        "L/a {l_over_a} tol {tol:e}: mu/mu0 {mu:.7} Hasimoto {:.7} (RPY terms {:.7})",
+                        hasimoto(a, l),
+                        hasimoto_rpy(a, l)
+                    );
+                }
+                // Hasimoto's series with its (a/L)^6 term (beyond RPY: 27.4 (a/L)^6 <= 2.7e-5).
+                let x = a / l;
+                assert!(
+                    (mu - hasimoto(a, l)).abs() < tol + 27.4 * x.powi(6),
+                    "L/a {l_over_a}, tol {tol}: mu/mu0 {mu} vs {}",
+                    hasimoto(a, l)
+                );
+                assert!(
+                    (mu - hasimoto_rpy(a, l)).abs() < tol,
+                    "L/a {l_over_a}, tol {tol}: mu/mu0 {mu} vs {}",
+                    hasimoto_rpy(a, l)
+                );
+                for q in 0..3 {
+                    if q != k {
+                        assert!(u[0][q].abs() < tol * mu0, "off-diagonal {}", u[0][q]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+mod common;
+
+#[test]
+fn pse_noise_covariance_is_2_kt_dt_m() {
+    // Four spheres (two overlapping) in a small box: wave and real space both matter.
+    let (a, eta, l) = (0.5, 1.0, 6.0);
+    let pos = [
+        [0.0, 0.0, 0.0],
+        [0.7, 0.2, -0.1],
+        [-1.5, 1.0, 0.4],
+        [1.2, -2.3, 2.6],
+    ];
+    let mut p = PseParams::paper(a, eta, l);
+    p.splitting = 1.5;
+    let mut m = Pse::new(4, p).unwrap();
+    m.set_positions(&pos).unwrap();
+    let (worst, mean2) = common::fdt_deviation(&mut m, 12_000, 1.0, 0.02);
+    // 78 entries: max of 78 standard normals beyond 4.5 with probability 5e-4.
+    assert!(worst < 4.5, "largest deviation {worst} standard errors");
+    assert!((mean2 - 1.0).abs() < 0.5, "mean squared deviation {mean2}");
+}
+
+#[test]
+fn pse_step_does_not_depend_on_the_thread_count_and_is_a_function_of_the_positions() {
+    let (a, eta, l) = (0.5, 1.0, 14.0);
+    let (pos, f) = random_config(300, l, 9);
+    let key = NoiseKey {
+        seed: 5,
+        step: 77,
+        key0: 3 << 32,
+    };
+    let run = |threads: usize, shift: f64| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let mut m = Pse::new(300, PseParams::paper(a, eta, l)).unwrap();
+                // Another periodic image of every particle: the same state.
+                let p: Vec<[f64; 3]> = pos.iter().map(|x| x.map(|c| c + shift)).collect();
+                m.set_positions(&p).unwrap();
+                let mut u = vec![[0.0; 3]; 300];
+                m.displacement(&f, 1e-3, 1.0, key, &mut u).unwrap();
+                u
+            })
+    };
+    let one = run(1, 0.0);
+    assert_eq!(one, run(2, 0.0));
+    assert_eq!(one, run(3, 0.0));
+    let moved = run(2, l);
+    for (x, y) in one.iter().flatten().zip(moved.iter().flatten()) {
+        assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused_naming_the_key() {
+    let key = |p: PseParams| match Pse::new(10, p) {
+        Err(HydroError::Param(e)) => e.key,
+        other => panic!("{other:?}"),
+    };
+    let ok = PseParams::paper(0.5, 1.0, 10.0);
+    assert_eq!(
+        key(PseParams {
+            splitting: 0.2,
+            ..ok
+        }),
+        "hydrodynamics.splitting"
+    );
+    assert_eq!(
+        key(PseParams {
+            splitting: -1.0,
+            ..ok
+        }),
+        "hydrodynamics.splitting"
+    );
+    assert_eq!(
+        key(PseParams {
+            tolerance: 0.5,
+            ..ok
+        }),
+        "hydrodynamics.tolerance"
+    );
+    assert_eq!(
+        key(PseParams {
+            box_length: 1.5,
+            ..ok
+        }),
+        "system.box_length"
+    );
+    let e = Pse::new(
+        10,
+        PseParams {
+            splitting: 0.2,
+            ..ok
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("raise the splitting"), "{e}");
+}
+
+#[test]
+fn pse_state_is_a_function_of_the_current_positions_whatever_the_history() {
+    // The real-space candidate lists are kept between small moves; the result must not
+    // depend on when they were built.
+    let (a, eta, l) = (0.5, 1.0, 12.0);
+    let (pos0, f) = random_config(200, l, 21);
+    let pos1: Vec<[f64; 3]> = pos0
+        .iter()
+        .enumerate()
+        .map(|(i, x)| x.map(|c| c + 0.01 * ((i % 7) as f64 - 3.0)))
+        .collect();
+    let key = NoiseKey {
+        seed: 2,
+        step: 9,
+        key0: 0,
+    };
+    let mut u1 = vec![[0.0; 3]; 200];
+    let mut m1 = Pse::new(200, PseParams::paper(a, eta, l)).unwrap();
+    m1.set_positions(&pos0).unwrap();
+    m1.set_positions(&pos1).unwrap();
+    m1.displacement(&f, 1e-3, 1.0, key, &mut u1).unwrap();
+    let mut u2 = vec![[0.0; 3]; 200];
+    let mut m2 = Pse::new(200, PseParams::paper(a, eta, l)).unwrap();
+    m2.set_positions(&pos1).unwrap();
+    m2.displacement(&f, 1e-3, 1.0, key, &mut u2).unwrap();
+    assert_eq!(u1, u2);
+}

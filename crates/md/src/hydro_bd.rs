@@ -1,0 +1,310 @@
+//! Brownian dynamics with hydrodynamic interactions (Ermak & McCammon 1978):
+//!
+//! `x(t + dt) = x + M F dt + sqrt(2 kT dt) M^(1/2) xi`,
+//!
+//! with the mobility M of `colloidsim_hydro` (free draining, RPY by direct free-space sums, or
+//! RPY by positively split Ewald in the periodic box). No drift term `kT div M dt`: these
+//! mobilities are divergence-free. The forces are those of the free-draining engine
+//! ([`crate::brownian`]): a pair potential on a full Verlet list ([`NeighborList`]) plus an
+//! external field.
+//!
+//! **Determinism and restarts.** Particles stay in input order; the noise of particle `i` at
+//! step `n` is keyed by (seed, n, replica, i) ([`colloidsim_hydro::noise`]); each particle's
+//! pair forces are summed over its neighbours in increasing index, and pairs beyond the
+//! cut-off add exact zeros, so the force does not depend on when the list was built. A step is
+//! therefore a pure function of the positions (with their image counts) and the step number:
+//! a checkpoint of those restarts bitwise, for any number of threads. The mobility sees the
+//! unwrapped positions `x + image L` (the free-space method needs them; PSE wraps them itself).
+
+use crate::neighbor::{BoxTooSmall, NeighborList};
+use crate::potential::{External, Pair};
+use crate::state::{Particles, SimBox};
+use colloidsim_hydro::{HydroError, Mobility, NoiseKey};
+use rayon::prelude::*;
+
+/// Parameters of the hydrodynamic Brownian integrator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HydroBdParams {
+    /// Thermal energy kT.
+    pub kt: f64,
+    /// Time step.
+    pub dt: f64,
+    /// Seed of the noise streams.
+    pub seed: u32,
+    /// Independent replica of the same seed (noise keys `replica * 2^32 + particle block`).
+    pub replica: u32,
+    /// Verlet skin of the pair-force list.
+    pub skin: f64,
+    /// A step whose deterministic displacement `|F| dt / (6 pi eta a)` exceeds this fraction of
+    /// the particle's diameter stops the run (the time step is too large for the potential).
+    pub max_drift: f64,
+}
+
+impl HydroBdParams {
+    /// Defaults: kT = 1, skin 0.3, max_drift 0.2, replica 0.
+    pub fn new(dt: f64, seed: u32) -> Self {
+        Self {
+            kt: 1.0,
+            dt,
+            seed,
+            replica: 0,
+            skin: 0.3,
+            max_drift: 0.2,
+        }
+    }
+}
+
+/// Why a hydrodynamic Brownian run stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HydroBdError {
+    /// The time step is too large for the forces.
+    #[error(
+        "blow-up at step {step} (t = {time}): particle {particle} would move {drift:.4} (diameter {diameter}) \
+         in one step under a force {force:.4e}; the time step is too large for the WCA core — reduce run.dt"
+    )]
+    BlowUp {
+        /// Step.
+        step: u64,
+        /// Time.
+        time: f64,
+        /// Lowest-index offending particle.
+        particle: usize,
+        /// Magnitude of its force.
+        force: f64,
+        /// Its free-draining deterministic displacement.
+        drift: f64,
+        /// Its diameter.
+        diameter: f64,
+    },
+    /// The mobility failed (e.g. a Lanczos square root that did not converge; names the step).
+    #[error("hydrodynamics: {0}")]
+    Hydro(#[from] HydroError),
+    /// Box too small for the neighbour list.
+    #[error(transparent)]
+    BoxTooSmall(#[from] BoxTooSmall),
+    /// Inconsistent input.
+    #[error("invalid particle data: {0}")]
+    Invalid(String),
+}
+
+/// A Brownian dynamics simulation with pair potential `P`, external field `E` and mobility `M`.
+pub struct HydroBrownian<P: Pair, E: External, M: Mobility> {
+    particles: Particles,
+    /// Periodic box.
+    pub sbox: SimBox,
+    /// Pair potential.
+    pub pair: P,
+    /// External field.
+    pub external: E,
+    mobility: M,
+    params: HydroBdParams,
+    /// Current step (time = step * dt).
+    pub step: u64,
+    nlist: NeighborList,
+    key: Vec<u32>,
+    forces: Vec<[f64; 3]>,
+    unwrapped: Vec<[f64; 3]>,
+    disp: Vec<[f64; 3]>,
+    last_iterations: usize,
+}
+
+impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
+    /// A simulation of `particles` at `step` with the mobility `mobility` (for as many
+    /// particles). A checkpoint is the particles (positions and image counts) and the step.
+    pub fn new(
+        particles: Particles,
+        sbox: SimBox,
+        pair: P,
+        external: E,
+        mobility: M,
+        params: HydroBdParams,
+        step: u64,
+    ) -> Result<Self, HydroBdError> {
+        particles.check().map_err(HydroBdError::Invalid)?;
+        let n = particles.len();
+        if mobility.len() != n {
+            return Err(HydroBdError::Invalid(format!(
+                "a mobility for {} particles given {n} particles",
+                mobility.len()
+            )));
+        }
+        if !(params.dt.is_finite() && params.dt > 0.0) {
+            return Err(HydroBdError::Invalid(format!(
+                "time step {} must be > 0",
+                params.dt
+            )));
+        }
+        if !(params.skin.is_finite() && params.skin >= 0.0) {
+            return Err(HydroBdError::Invalid(format!(
+                "skin {} must be >= 0",
+                params.skin
+            )));
+        }
+        let mut particles = particles;
+        for (p, img) in particles.pos.iter_mut().zip(particles.image.iter_mut()) {
+            sbox.wrap(p, img);
+        }
+        let mut s = Self {
+            nlist: NeighborList::new(pair.r_cut_max(), params.skin),
+            particles,
+            sbox,
+            pair,
+            external,
+            mobility,
+            params,
+            step,
+            key: (0..n as u32).collect(),
+            forces: vec![[0.0; 3]; n],
+            unwrapped: vec![[0.0; 3]; n],
+            disp: vec![[0.0; 3]; n],
+            last_iterations: 0,
+        };
+        s.nlist.build(&s.sbox, &s.particles.pos, &s.key)?;
+        Ok(s)
+    }
+
+    /// Particles in input order (positions wrapped, image counts kept).
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+
+    /// The mobility.
+    pub fn mobility(&self) -> &M {
+        &self.mobility
+    }
+
+    /// The mobility (mutable: e.g. to read and reset timers).
+    pub fn mobility_mut(&mut self) -> &mut M {
+        &mut self.mobility
+    }
+
+    /// The mobility, giving up the engine (e.g. to hand it to a restarted engine).
+    pub fn into_mobility(self) -> M {
+        self.mobility
+    }
+
+    /// Integrator parameters.
+    pub fn params(&self) -> &HydroBdParams {
+        &self.params
+    }
+
+    /// Current time `step * dt`.
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.params.dt
+    }
+
+    /// Lanczos iterations of the last step's square root.
+    pub fn last_lanczos_iterations(&self) -> usize {
+        self.last_iterations
+    }
+
+    /// Forces on the particles at the current positions and time (into the engine's buffer).
+    fn compute_forces(&mut self) {
+        let t = self.time();
+        let p = &self.particles;
+        let (pair, external, sbox, nlist) = (&self.pair, &self.external, &self.sbox, &self.nlist);
+        self.forces
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(i, f)| {
+                let xi = p.pos[i];
+                let mut s = external.force(xi, t);
+                for &j in nlist.neighbors(i) {
+                    let j = j as usize;
+                    let xj = p.pos[j];
+                    let d = sbox.min_image([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    let fr = pair.force_over_r(
+                        r2,
+                        p.typeid[i],
+                        p.typeid[j],
+                        p.diameter[i],
+                        p.diameter[j],
+                    );
+                    for k in 0..3 {
+                        s[k] += fr * d[k];
+                    }
+                }
+                *f = s;
+            });
+    }
+
+    /// Forces on the particles at the current positions and time, in input order.
+    pub fn forces(&mut self) -> &[[f64; 3]] {
+        self.compute_forces();
+        &self.forces
+    }
+
+    /// Advance `n` steps (on a worker of the thread pool, as the free-draining engine).
+    pub fn run(&mut self, n: u64) -> Result<(), HydroBdError> {
+        rayon::scope(|_| (0..n).try_for_each(|_| self.advance()))
+    }
+
+    /// Advance one step.
+    pub fn advance(&mut self) -> Result<(), HydroBdError> {
+        let step = self.step;
+        let p = self.params;
+        if self.nlist.needs_rebuild(&self.sbox, &self.particles.pos) {
+            self.nlist
+                .build(&self.sbox, &self.particles.pos, &self.key)?;
+        }
+        self.compute_forces();
+        // The time step must resolve the forces (free-draining drift as the yardstick).
+        let (forces, mobility, diameter) = (&self.forces, &self.mobility, &self.particles.diameter);
+        let bad = forces
+            .par_iter()
+            .enumerate()
+            .with_min_len(1024)
+            .find_first(|(i, f)| {
+                let f2 = f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+                let drift = f2.sqrt() * mobility.stokes_mobility(*i) * p.dt;
+                // NaN forces count as a blow-up too.
+                drift.is_nan() || drift > p.max_drift * diameter[*i]
+            });
+        if let Some((i, f)) = bad {
+            let force = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+            return Err(HydroBdError::BlowUp {
+                step,
+                time: self.time(),
+                particle: i,
+                force,
+                drift: force * self.mobility.stokes_mobility(i) * p.dt,
+                diameter: self.particles.diameter[i],
+            });
+        }
+        for ((u, x), img) in self
+            .unwrapped
+            .iter_mut()
+            .zip(&self.particles.pos)
+            .zip(&self.particles.image)
+        {
+            *u = self.sbox.unwrap(*x, *img);
+        }
+        self.mobility.set_positions(&self.unwrapped)?;
+        let key = NoiseKey {
+            seed: p.seed,
+            step,
+            key0: (p.replica as u64) << 32,
+        };
+        let rep = self
+            .mobility
+            .displacement(&self.forces, p.dt, p.kt, key, &mut self.disp)?;
+        self.last_iterations = rep.iterations;
+        let sbox = self.sbox;
+        self.particles
+            .pos
+            .par_iter_mut()
+            .zip(self.particles.image.par_iter_mut())
+            .zip(self.disp.par_iter())
+            .with_min_len(1024)
+            .for_each(|((x, img), d)| {
+                for k in 0..3 {
+                    x[k] += d[k];
+                }
+                sbox.wrap(x, img);
+            });
+        self.step += 1;
+        Ok(())
+    }
+}
