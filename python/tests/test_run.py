@@ -99,10 +99,12 @@ def test_overrides_meet_the_same_validation_as_the_cli(tmp_path, cli):
     p = cli("run", path, "--set", "run.dt=-1", "--out", tmp_path / "cli", check=False)
     assert p.returncode != 0
     with pytest.raises(colloidsim.ColloidsimError) as e:
-        colloidsim.run(path, out=tmp_path / "py", overrides={"run.dt": -1.0})
+        colloidsim.run(path, out=tmp_path / "py", overrides=["run.dt=-1"])
     # The same message as the CLI's (after its "error: " prefix).
     assert str(e.value) == p.stderr.strip().removeprefix("error: ")
     assert "run.dt" in str(e.value)
+    with pytest.raises(colloidsim.ColloidsimError, match=r"run.dt: must be a finite number > 0, got -1.0"):
+        colloidsim.run(path, out=tmp_path / "py", overrides={"run.dt": -1.0})
     # Nothing was written for bad input.
     assert not (tmp_path / "py").exists()
     with pytest.raises(colloidsim.ColloidsimError, match="observe.nonsense|unknown field"):
