@@ -22,6 +22,17 @@ impl ParamError {
     }
 }
 
+/// A number as messages show it: as written for ordinary sizes, in exponent form when huge
+/// or tiny (`1e300`, not three hundred digits).
+pub fn show(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-5..1e16).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// `value` must be finite and > 0.
 pub fn positive(key: &str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value > 0.0 {
@@ -29,7 +40,7 @@ pub fn positive(key: &str, value: f64) -> Result<f64, ParamError> {
     } else {
         Err(ParamError::new(
             key,
-            format!("must be a finite number > 0, got {value}"),
+            format!("must be a finite number > 0, got {}", show(value)),
         ))
     }
 }
@@ -41,7 +52,7 @@ pub fn non_negative(key: &str, value: f64) -> Result<f64, ParamError> {
     } else {
         Err(ParamError::new(
             key,
-            format!("must be a finite number >= 0, got {value}"),
+            format!("must be a finite number >= 0, got {}", show(value)),
         ))
     }
 }
@@ -53,7 +64,7 @@ pub fn finite(key: &str, value: f64) -> Result<f64, ParamError> {
     } else {
         Err(ParamError::new(
             key,
-            format!("must be a finite number, got {value}"),
+            format!("must be a finite number, got {}", show(value)),
         ))
     }
 }
@@ -65,7 +76,12 @@ pub fn in_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<f64, ParamErr
     } else {
         Err(ParamError::new(
             key,
-            format!("must lie in [{lo}, {hi}], got {value}"),
+            format!(
+                "must lie in [{}, {}], got {}",
+                show(lo),
+                show(hi),
+                show(value)
+            ),
         ))
     }
 }
@@ -95,5 +111,16 @@ mod tests {
         assert!(non_negative("x", 0.0).is_ok());
         assert!(in_range("x", 1.5, 0.0, 1.0).is_err());
         assert!(at_least("n", 0, 1).is_err());
+        assert_eq!(show(1e300), "1e300");
+        assert_eq!(show(-1.0), "-1");
+        assert_eq!(show(0.25), "0.25");
+        assert_eq!(show(3e-9), "3e-9");
+        assert!(
+            positive("x", 1e300).is_ok()
+                && finite("x", f64::INFINITY)
+                    .unwrap_err()
+                    .message
+                    .ends_with("got inf")
+        );
     }
 }

@@ -35,8 +35,7 @@ pub enum RodsError {
     /// The solver stopped before the residual reached the tolerance.
     #[error(
         "rods equilibrium did not converge: residual {residual:.3e} (max-norm of the structure \
-         equation in ln rho form) after {iterations} iterations, tolerance {tolerance:.1e}; \
-         raise max_iterations or the tolerance{}",
+         equation in ln rho form) after {iterations} iterations, tolerance {tolerance:.1e}{}",
         jam_hint(*min_vacancy)
     )]
     NotConverged {
@@ -63,7 +62,7 @@ fn jam_hint(min_vacancy: f64) -> String {
              residual to about 1e-16 / min(1 - eta); lower the density or the potential amplitude"
         )
     } else {
-        String::new()
+        "; a coarser grid (colloidsim theory --dx) converges faster".into()
     }
 }
 
@@ -352,16 +351,16 @@ impl RodsProblem {
             )
             .into());
         }
-        if intervals > 1e9 {
-            return Err(ParamError::new(
-                "dx",
-                format!(
-                    "too many grid points ({intervals}); use dx >= {}",
-                    span * 1e-9
-                ),
-            )
-            .into());
-        }
+        // The solve keeps about 2 (anderson_memory + 4) arrays of the grid (the retry's longer
+        // history counted): refuse a grid the machine cannot hold before allocating it.
+        let bytes = intervals * 8.0 * 2.0 * (self.anderson_memory.max(40) as f64 + 4.0);
+        colloidsim_core::resources::ensure_fits(
+            "dx",
+            &format!(
+                "the theory grid of {intervals:e} points (spacing {dx_eff:.3e}; a larger --dx makes it smaller)"
+            ),
+            bytes,
+        )?;
         let mut n = ratio.floor();
         let mut f = ratio - n;
         if f > 1.0 - 1e-9 {

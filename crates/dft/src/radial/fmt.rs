@@ -96,6 +96,15 @@ impl Rosenfeld {
         let a = 0.5 * diameter;
         let n = grid.len();
         let bw = (2.0 * a / dr).ceil() as usize + 2;
+        // Four weight bands of n x bw, and as much again for the DDFT's kernels and scratch:
+        // refused before they are allocated when the machine cannot hold them.
+        colloidsim_core::resources::ensure_fits(
+            "theory.dr",
+            &format!(
+                "the FMT weights of {n} cells x {bw} (grid spacing {dr:.3e}; a larger --dx makes them smaller)"
+            ),
+            8.0 * 8.0 * n as f64 * bw as f64,
+        )?;
         let faces = grid.faces();
         let mut j0 = vec![0; n];
         let mut w3 = vec![0.0; n * bw];

@@ -520,6 +520,14 @@ impl DpdScenario {
         };
         let sbox = SimBox::new(l);
         let vc = 4.0 / 3.0 * PI * radius.powi(3);
+        // Memory before the counts become integers (a cast saturates) and anything is
+        // allocated: about 600 B per bead (state, forces, Verlet lists at density 3, copies).
+        let beads = sbox.volume() * (phi / vc + density * (1.0 - phi));
+        colloidsim_core::resources::ensure_fits(
+            "system.box_length",
+            &format!("{beads:.3e} beads (density x box volume)"),
+            600.0 * beads,
+        )?;
         let colloids = (phi * sbox.volume() / vc).round() as usize;
         let free = sbox.volume() * (1.0 - phi);
         let solvent = (density * free).round() as usize;
