@@ -485,7 +485,13 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
 fn open_trajectory(out: &OutputDir, append: bool) -> Result<hoomd_gsd::hoomd::HoomdGsdFile> {
     let path = out.join("trajectory.gsd");
     Ok(if append && path.exists() {
-        hoomd_gsd::hoomd::HoomdGsdFile::open(&path)?
+        colloidsim_md::gsd::quietly(|| hoomd_gsd::hoomd::HoomdGsdFile::open(&path))
+            .map_err(|_| {
+                anyhow::anyhow!(
+                    "{}: damaged GSD file: its index names data past the end of the file (truncated?)",
+                    path.display()
+                )
+            })??
     } else {
         hoomd_gsd::hoomd::HoomdGsdFile::create(&path)?
     })
@@ -764,9 +770,29 @@ fn equilibrium_counterpart(
         return Ok(None);
     }
     let bins = sc.observe.density.as_ref().map_or(100, |d| d.bins);
+    // Beside a run the theory is a companion: it must not cost more than the run.
+    let span = match c.boundary {
+        Boundary::Periodic => r.period,
+        Boundary::Walls => c.length,
+    };
+    let points = span / default_dx(r);
+    if points > MAX_COMPANION_POINTS {
+        bail!(
+            "its grid would have {points:.2e} points (more than {MAX_COMPANION_POINTS:e} beside a run); compute it with colloidsim theory SCENARIO --dx {:.2e}",
+            span / MAX_COMPANION_POINTS
+        );
+    }
     let eq = solve_theory(r, dx)?;
     let b = eq.bin_average(bins, r.period)?;
     Ok(Some((b, r.pair.sticky.is_none())))
+}
+
+/// Largest grid of the exact theory written beside a run.
+const MAX_COMPANION_POINTS: f64 = 2e6;
+
+/// The theory's default grid spacing: 200 points per rod, at least 2000 per period.
+fn default_dx(r: &Resolved) -> f64 {
+    (r.config.sigma / 200.0).min(r.period / 2000.0)
 }
 
 fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
@@ -780,7 +806,7 @@ fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
         Some(s) => RodInteraction::Sticky { gamma: s.gamma },
         None => RodInteraction::Hard,
     };
-    let dx = dx.unwrap_or((c.sigma / 200.0).min(r.period / 2000.0));
+    let dx = dx.unwrap_or(default_dx(r));
     let problem = RodsProblem::new(c.sigma, n / c.length, domain)
         .with_dx(dx)
         .with_potential(BetaPotential::from_field(&r.field, c.kt))
