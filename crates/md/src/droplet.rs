@@ -23,6 +23,9 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
+/// Fewest steps a drying run may take.
+pub const MIN_DRYING_STEPS: u64 = 100;
+
 /// Highest initial volume fraction accepted: random insertion of hard spheres in a sphere.
 pub const MAX_PHI0: f64 = 0.3;
 /// Highest final mean volume fraction accepted (random close packing).
@@ -428,6 +431,15 @@ impl DropletScenario {
             it.stiffness.unwrap_or(50.0 * kt / (d * d)),
         )?;
         let range = positive("interface.range", it.range.unwrap_or(0.5 * d))?;
+        if range > r0 {
+            return Err(ParamError::new(
+                "interface.range",
+                format!(
+                    "{} is more than the initial droplet radius R0 = {r0:.4}: the harmonic part of the interface must be thinner than the droplet",
+                    colloidsim_core::param::show(range)
+                ),
+            ));
+        }
         let offset = in_range("interface.offset", it.offset.unwrap_or(-0.5 * d), -r0, r0)?;
         if r_end + offset <= 0.0 {
             return Err(ParamError::new(
@@ -448,6 +460,29 @@ impl DropletScenario {
             ));
         }
         let steps = (steps as u64).max(1);
+        // The drying must be resolved in time, and its last step must still have a droplet.
+        if steps < MIN_DRYING_STEPS {
+            return Err(ParamError::new(
+                if dr.peclet.is_some() {
+                    "drying.peclet"
+                } else {
+                    "run.dt"
+                },
+                format!(
+                    "the droplet would dry in {steps} steps of run.dt = {dt:.3e} (at least {MIN_DRYING_STEPS} are needed to follow it); lower drying.peclet or run.dt"
+                ),
+            ));
+        }
+        let r_last_sq = r0 * r0 - alpha * (steps as f64 * dt) / (4.0 * PI);
+        if r_last_sq.is_nan() || r_last_sq <= 0.0 {
+            return Err(ParamError::new(
+                "run.dt",
+                format!(
+                    "the last step ends at t = {:.4e}, after the droplet has vanished (t = {t_dry:.4e}); use a smaller run.dt",
+                    steps as f64 * dt
+                ),
+            ));
+        }
         let skin = in_range(
             "run.skin",
             self.run.skin.unwrap_or(0.6 * d),
@@ -472,7 +507,7 @@ impl DropletScenario {
             .map(|f| (f * steps as f64).round() as u64)
             .collect();
 
-        Ok(DropletParams {
+        let params = DropletParams {
             seed,
             replicas,
             particles,
@@ -499,7 +534,18 @@ impl DropletScenario {
             profile_steps,
             trajectory_every: self.observe.trajectory.every,
             initial: s.initial.clone(),
-        })
+        };
+        // Memory before anything is allocated: about 400 B per particle (state, lists,
+        // copies), 24 B per neighbour cell of the box, the profile sums.
+        let cells = (params.box_edge() / (2f64.powf(1.0 / 6.0) * d + skin)).powi(3);
+        let bytes =
+            400.0 * particles as f64 + 24.0 * cells + 8.0 * (bins * p.fractions.len()) as f64;
+        colloidsim_core::resources::ensure_fits(
+            "system.particles",
+            &format!("{particles} colloids in a box of {cells:.3e} neighbour cells"),
+            bytes,
+        )?;
+        Ok(params)
     }
 }
 
@@ -674,6 +720,14 @@ impl DropletParams {
                     return Err(DropletError::Initial(format!(
                         "{}: particle {i} lies outside the initial droplet (|r| > R0 + offset + range = {limit:.4})",
                         path.display()
+                    )));
+                }
+                // The droplet holds one species (type 0, diameter system.diameter).
+                if let Some(i) = p.typeid.iter().position(|&t| t != 0) {
+                    return Err(DropletError::Initial(format!(
+                        "{}: particle {i} has typeid {}, but a droplet holds one type of particle (typeid 0)",
+                        path.display(),
+                        p.typeid[i]
                     )));
                 }
                 p.diameter.iter_mut().for_each(|d| *d = self.diameter);

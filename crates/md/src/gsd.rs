@@ -89,10 +89,7 @@ impl GsdWriter {
 
     /// Open an existing file to append frames (restarts).
     pub fn append(path: &Path) -> Result<Self, GsdError> {
-        let file = GsdFile::open(path, Mode::Write).map_err(|e| GsdError::Open {
-            path: path.to_path_buf(),
-            message: chain(&e),
-        })?;
+        let file = open_checked(path, Mode::Write)?;
         Ok(Self {
             file,
             path: path.to_path_buf(),
@@ -261,10 +258,33 @@ pub fn frame_count(path: &Path) -> Result<u64, GsdError> {
 }
 
 fn open_read(path: &Path) -> Result<GsdFile, GsdError> {
-    GsdFile::open(path, Mode::Read).map_err(|e| GsdError::Open {
+    open_checked(path, Mode::Read)
+}
+
+/// Run `f`, turning a panic into `Err` without printing it (the panic hook is silenced for the
+/// call). For the GSD reader, which asserts on some damaged files (a chunk that reaches past
+/// the end of a truncated file) where it should report.
+pub fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    std::panic::set_hook(hook);
+    r
+}
+
+/// Open a GSD file, refusing a damaged one with a message naming it (never a panic).
+pub fn open_checked(path: &Path, mode: Mode) -> Result<GsdFile, GsdError> {
+    let open = |message: String| GsdError::Open {
         path: path.to_path_buf(),
-        message: format!("not a readable GSD file: {}", chain(&e)),
-    })
+        message,
+    };
+    match quietly(|| GsdFile::open(path, mode)) {
+        Ok(Ok(f)) => Ok(f),
+        Ok(Err(e)) => Err(open(format!("not a readable GSD file: {}", chain(&e)))),
+        Err(_) => Err(open(
+            "damaged GSD file: its index names data past the end of the file (truncated?)".into(),
+        )),
+    }
 }
 
 /// Read frame `frame` (default: the last) of a GSD file.

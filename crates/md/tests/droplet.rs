@@ -77,7 +77,12 @@ fn drying_keeps_every_particle_inside_the_interface_range() {
 
 #[test]
 fn too_large_a_time_step_is_reported_with_step_and_particle() {
-    let p = DropletScenario::from_toml(&scenario("dt = 0.5"))
+    // A slow drying (enough steps of dt = 0.05 to be accepted) of a dense droplet, whose WCA
+    // cores a step of 0.05 d^2/D0 cannot resolve.
+    let text = scenario("dt = 0.05")
+        .replace("phi0 = 0.1", "phi0 = 0.3")
+        .replace("peclet = 10", "peclet = 0.1");
+    let p = DropletScenario::from_toml(&text)
         .unwrap()
         .validate()
         .unwrap();
@@ -86,6 +91,12 @@ fn too_large_a_time_step_is_reported_with_step_and_particle() {
         Err(e @ BdError::BlowUp { .. }) => assert!(e.to_string().contains("run.dt")),
         other => panic!("expected a blow-up, got {other:?}"),
     }
+    // A drying too fast for the step is refused before it starts, naming the key.
+    let e = DropletScenario::from_toml(&scenario("dt = 0.5"))
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert_eq!(e.key, "drying.peclet", "{e}");
 }
 
 #[test]

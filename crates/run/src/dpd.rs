@@ -50,6 +50,8 @@ impl Method for DpdMethod {
 
     fn check(&self, src: &Source) -> Result<Checked> {
         let (_, s) = resolve(src, None)?;
+        // What `run` does before it starts: build the system.
+        s.build().with_context(|| src.label())?;
         Ok(Checked {
             resolved: describe(&s),
             warnings: s.warnings.clone(),

@@ -16,7 +16,7 @@ use colloidsim_core::output::OutputDir;
 use colloidsim_md::droplet::DropletSim;
 use colloidsim_md::gsd::{self, GsdWriter};
 use colloidsim_md::{BdParams, DropletParams, DropletScenario, LennardJones};
-use hoomd_gsd::file_layer::{GsdFile, Mode};
+use hoomd_gsd::file_layer::Mode;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
@@ -56,6 +56,8 @@ impl Method for DropletBd {
 
     fn check(&self, src: &Source) -> Result<Checked> {
         let (_, p) = resolve(src, None)?;
+        // What `run` does before it starts: set up replica 0 (reading system.initial).
+        p.build_replica(0).with_context(|| src.label())?;
         Ok(Checked {
             resolved: serde_json::to_value(&p)?,
             warnings: Vec::new(),
@@ -655,8 +657,7 @@ pub(crate) fn trim_trajectory(
     let tmp = path.with_extension("gsd.trim");
     let _ = std::fs::remove_file(&tmp);
     {
-        let file = GsdFile::open(path, Mode::Read)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let file = gsd::open_checked(path, Mode::Read)?;
         let mut w = GsdWriter::create_new(&tmp)?;
         if velocities {
             w = w.with_velocities();
