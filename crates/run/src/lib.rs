@@ -10,6 +10,7 @@ pub mod checkpoint;
 pub mod control;
 mod driver;
 pub mod engine;
+pub mod extrapolate;
 pub mod keys;
 pub mod method;
 pub mod plot;
@@ -23,6 +24,7 @@ mod theory_droplet;
 pub use control::{Control, Progress, Silent};
 pub use driver::{resume, run};
 pub use engine::Engine;
+pub use extrapolate::{ExtrapolateOptions, extrapolate};
 pub use method::{Checked, Finished, Method};
 pub use scenario::Scenario;
 
