@@ -7,6 +7,7 @@ use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
+use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_bcd::forces::{ExternalForce, NoPair, PairForce};
@@ -67,12 +68,19 @@ impl Method for BcdMethod {
         &self,
         src: &Source,
         seed: u64,
-        _out: &OutputDir,
+        out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
         let sc = parse(src)?;
         let r = resolve(src, &sc, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if sc.observe.trajectory.is_some() {
+            let path = out.join("trajectory.gsd");
+            saved.digest.verify(&path)?;
+            if path.exists() {
+                trim_trajectory(&path, saved.frames, r.config.length, r.config.sigma)?;
+            }
+        }
         session(sc, r, Some(saved))
     }
 
@@ -123,17 +131,19 @@ fn build<P: PairForce + Clone + Send + 'static>(
     saved: Option<Saved>,
 ) -> Result<Box<dyn Session>> {
     let field = r.engine_field.clone();
-    let (bcd, obs, frames) = match saved {
+    let (bcd, obs, frames, digest) = match saved {
         Some(s) => (
             Bcd::from_state(r.config.clone(), s.state, field, pair)?.with_integrator(r.integrator),
             s.observers,
             s.frames,
+            s.digest,
         ),
         None => (
             Bcd::new(r.config.clone(), r.initial.clone(), field, pair)?
                 .with_integrator(r.integrator),
             observers(&sc, &r),
             0,
+            FrameDigest::default(),
         ),
     };
     let triggers = Triggers::of(&sc, &r);
@@ -146,6 +156,7 @@ fn build<P: PairForce + Clone + Send + 'static>(
         bcd,
         obs,
         frames,
+        digest,
         gsd: None,
         triggers,
         msd_due,
@@ -213,6 +224,8 @@ struct Saved {
     observers: Observers,
     /// Frames in trajectory.gsd.
     frames: u64,
+    /// CRC-32 of those frames, checked before a restart appends to the file.
+    digest: FrameDigest,
 }
 
 fn observers(sc: &Scenario, r: &Resolved) -> Observers {
@@ -286,6 +299,7 @@ struct BcdSession<P: PairForce> {
     bcd: Bcd<Field, P>,
     obs: Observers,
     frames: u64,
+    digest: FrameDigest,
     gsd: Option<hoomd_gsd::hoomd::HoomdGsdFile>,
     triggers: Triggers,
     /// The next sampled step the MSD uses (from [`Msd::next_due`], kept between samples).
@@ -371,7 +385,13 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         if let (Some(g), Some(e)) = (self.gsd.as_mut(), t.trajectory)
             && s.is_multiple_of(e)
         {
-            write_frame(g, &self.bcd)?;
+            write_frame(
+                g,
+                self.bcd.steps(),
+                self.bcd.config().length,
+                self.bcd.config().sigma,
+                self.bcd.positions(),
+            )?;
             self.frames += 1;
         }
         Ok(())
@@ -456,11 +476,16 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
         Ok(())
     }
 
-    fn save(&mut self, _out: &OutputDir) -> Result<Vec<u8>> {
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.gsd.is_some() {
+            self.digest
+                .extend(&out.join("trajectory.gsd"), self.frames)?;
+        }
         Ok(bincode::serialize(&Saved {
             state: self.bcd.state().clone(),
             observers: self.obs.clone(),
             frames: self.frames,
+            digest: self.digest,
         })?)
     }
 
@@ -497,26 +522,62 @@ fn open_trajectory(out: &OutputDir, append: bool) -> Result<hoomd_gsd::hoomd::Ho
     })
 }
 
-/// One GSD frame in the HOOMD schema: rods on the x axis of a 2D box of size L x L, positions
-/// wrapped into [-L/2, L/2); the unwrapped positions go to `log/particles/x_unwrapped`.
-fn write_frame<E, P>(g: &mut hoomd_gsd::hoomd::HoomdGsdFile, bcd: &Bcd<E, P>) -> Result<()>
-where
-    E: ExternalForce,
-    P: PairForce,
-{
-    let c = bcd.config();
-    let l = c.length;
-    let x = bcd.positions();
-    g.append_frame(bcd.steps())?
+/// Name of the unwrapped rod positions in a BCD trajectory frame.
+const X_UNWRAPPED: &str = "particles/x_unwrapped";
+
+/// One GSD frame in the HOOMD schema: rods (diameter `sigma`) on the x axis of a 2D box of size
+/// L x L, positions wrapped into [-L/2, L/2); the unwrapped positions `x` go to
+/// `log/particles/x_unwrapped`.
+fn write_frame(
+    g: &mut hoomd_gsd::hoomd::HoomdGsdFile,
+    step: u64,
+    l: f64,
+    sigma: f64,
+    x: &[f64],
+) -> Result<()> {
+    g.append_frame(step)?
         .configuration_dimensions(hoomd_gsd::hoomd::Dimensions::Two)?
         .configuration_box([l, l, 0.0, 0.0, 0.0, 0.0])?
         .particles_position(x.iter().map(|&xi| {
             let w = (xi + 0.5 * l).rem_euclid(l) - 0.5 * l;
             [w, 0.0, 0.0].into()
         }))?
-        .particles_diameter(x.iter().map(|_| c.sigma))?
-        .log_scalars("particles/x_unwrapped", x.iter().copied())?
+        .particles_diameter(x.iter().map(|_| sigma))?
+        .log_scalars(X_UNWRAPPED, x.iter().copied())?
         .end()?;
+    Ok(())
+}
+
+/// Keep the first `frames` frames of a BCD trajectory (a run killed after its last checkpoint
+/// may have written more), rewritten from their steps and unwrapped positions exactly as
+/// [`write_frame`] wrote them, so that the continuation appends where the checkpoint stood.
+fn trim_trajectory(path: &std::path::Path, frames: u64, l: f64, sigma: f64) -> Result<()> {
+    use colloidsim_md::gsd::open_checked;
+    use hoomd_gsd::file_layer::Mode;
+    let file = open_checked(path, Mode::Read)?;
+    if file.n_frames() == frames {
+        return Ok(());
+    }
+    let tmp = path.with_extension("gsd.trim");
+    let _ = std::fs::remove_file(&tmp);
+    {
+        let mut g = hoomd_gsd::hoomd::HoomdGsdFile::create(&tmp)?;
+        let log = format!("log/{X_UNWRAPPED}");
+        for k in 0..frames {
+            let e = |e: hoomd_gsd::file_layer::ReadError| {
+                anyhow::anyhow!("{}: frame {k}: {e}", path.display())
+            };
+            let step = file
+                .iter_scalars::<u64>(k, "configuration/step")
+                .map_err(e)?
+                .next()
+                .with_context(|| format!("{}: frame {k}: no step", path.display()))?;
+            let x: Vec<f64> = file.iter_scalars::<f64>(k, &log).map_err(e)?.collect();
+            write_frame(&mut g, step, l, sigma, &x)?;
+        }
+        g.sync_all()?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
     Ok(())
 }
 

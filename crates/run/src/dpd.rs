@@ -7,6 +7,7 @@ use crate::droplet::{flat, trim_trajectory};
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
+use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
@@ -92,13 +93,9 @@ impl Method for DpdMethod {
             ck.sync_every,
         )?;
         let traj = out.join("trajectory.gsd");
+        ck.obs.digest.verify(&traj)?;
         if traj.exists() {
             trim_trajectory(&traj, ck.obs.frames, &["time_tau"], true)?;
-        } else if ck.obs.frames > 0 {
-            bail!(
-                "trajectory.gsd is missing (the checkpoint expects {} frames)",
-                ck.obs.frames
-            );
         }
         // Restoring builds the lists the interrupted run built at this step: count them once.
         let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
@@ -376,7 +373,12 @@ impl Session for DpdSession {
         Ok(())
     }
 
-    fn save(&mut self, _out: &OutputDir) -> Result<Vec<u8>> {
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.s.observe.trajectory_every > 0 {
+            self.obs
+                .digest
+                .extend(&out.join("trajectory.gsd"), self.obs.frames)?;
+        }
         let ck = Checkpoint {
             sync_every: self.sync_every,
             step: self.sim.step,
@@ -528,6 +530,8 @@ struct Observed {
     monitor: Vec<(u64, f64)>,
     /// Frames in trajectory.gsd.
     frames: u64,
+    /// CRC-32 of those frames, checked before a restart appends to the file.
+    digest: FrameDigest,
 }
 
 /// `(time, Thermo)` rows through a serialisable mirror of [`Thermo`].

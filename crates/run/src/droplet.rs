@@ -9,6 +9,7 @@ use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
 use crate::theory_droplet::profile_name;
+use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
@@ -91,13 +92,16 @@ impl Method for DropletBd {
         }
         let sim = restore_replica(out, &p, &saved)?;
         let traj = out.join("trajectory.gsd");
-        if saved.replica == 0 && p.trajectory_every > 0 && traj.exists() {
-            trim_trajectory(
-                &traj,
-                saved.acc.frames,
-                &["droplet/radius", "droplet/time"],
-                false,
-            )?;
+        if p.trajectory_every > 0 {
+            saved.acc.digest.verify(&traj)?;
+            if traj.exists() {
+                trim_trajectory(
+                    &traj,
+                    saved.acc.frames,
+                    &["droplet/radius", "droplet/time"],
+                    false,
+                )?;
+            }
         }
         Ok(Box::new(DropletSession::new(
             p,
@@ -144,6 +148,8 @@ struct Accum {
     builds: u64,
     /// Frames in trajectory.gsd.
     frames: u64,
+    /// CRC-32 of those frames, checked before a restart appends to the file.
+    digest: FrameDigest,
     /// Checkpoints written so far (alternates the GSD file name).
     checkpoints: u64,
 }
@@ -160,6 +166,7 @@ impl Accum {
             outside_final: 0,
             builds: 0,
             frames: 0,
+            digest: FrameDigest::default(),
             checkpoints: 0,
         }
     }
@@ -489,6 +496,11 @@ impl Session for DropletSession {
     /// driver) `checkpoint.bin` naming it, then [`Session::after_save`] removes the older one:
     /// a run killed at any point leaves a consistent checkpoint.
     fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.p.trajectory_every > 0 {
+            self.acc
+                .digest
+                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        }
         self.acc.checkpoints += 1;
         let name = format!("checkpoint-{}.gsd", self.acc.checkpoints % 2);
         let old = format!("checkpoint-{}.gsd", (self.acc.checkpoints + 1) % 2);

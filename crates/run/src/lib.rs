@@ -15,6 +15,7 @@ pub mod keys;
 pub mod method;
 pub mod plot;
 pub mod scenario;
+pub mod trajectory;
 
 mod bcd;
 mod dpd;

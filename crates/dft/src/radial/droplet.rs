@@ -71,7 +71,11 @@ impl DropletSetup {
         }
         let r_end = schedule.radius(self.t_end)?;
         let phi_end = mean_volume_fraction(self.particles, self.diameter, r_end);
-        if phi_end > CLOSE_PACKING {
+        // A particle run that stops at close packing has its last output up to one time step
+        // later (a relative excess of 3 alpha dt / (8 pi R^2): 2e-4 for the examples, 8e-4 for
+        // a droplet of 200): allow 1 %, so that the theory accepts every scenario the run
+        // accepts. (The functional itself is regular there; it diverges at a local packing 1.)
+        if phi_end > CLOSE_PACKING * 1.01 {
             return Err(ParamError::new(
                 "drying.final_volume_fraction",
                 format!(
