@@ -488,7 +488,8 @@ impl Scenario {
                 let f = self.initial.file.as_ref().ok_or_else(|| {
                     ParamError::new("initial.file", "placement = \"file\" needs a file name")
                 })?;
-                let x = read_column(&base.join(f), "x", "initial.file")?;
+                let path = base.join(f);
+                let x = read_column(&path, "x", "initial.file")?;
                 if x.len() != s.particles {
                     return Err(ParamError::new(
                         "initial.file",
@@ -500,7 +501,7 @@ impl Scenario {
                         ),
                     ));
                 }
-                init::from_positions(&config, x)?
+                init::from_positions(&config, x).map_err(naming(&path))?
             }
             p => {
                 return Err(ParamError::new(
@@ -736,11 +737,9 @@ impl Scenario {
         if let Some(t) = &p.table {
             let path = base.join(t);
             let (x, u) = read_pair(&path, ("x", "U"), "potential.table")?;
-            terms.push(FieldTerm::Tabulated(PeriodicSpline::new(
-                "potential.table",
-                x,
-                u,
-            )?));
+            terms.push(FieldTerm::Tabulated(
+                PeriodicSpline::new("potential.table", x, u).map_err(naming(&path))?,
+            ));
         }
         param::finite("potential.drive", p.drive)?;
         Ok(ExternalField {
@@ -763,8 +762,9 @@ impl Scenario {
             .transpose()?;
         let table = match &i.table {
             Some(t) => {
-                let (r, f) = read_pair(&base.join(t), ("r", "f"), "interaction.table")?;
-                Some(TabulatedPair::new(r, f, sigma)?)
+                let path = base.join(t);
+                let (r, f) = read_pair(&path, ("r", "f"), "interaction.table")?;
+                Some(TabulatedPair::new(r, f, sigma).map_err(naming(&path))?)
             }
             None => None,
         };
@@ -782,6 +782,18 @@ impl Scenario {
             table,
             range,
         })
+    }
+}
+
+/// An error about the content of an input file, with the file named first.
+fn naming(path: &Path) -> impl Fn(ParamError) -> ParamError + '_ {
+    move |e| {
+        let file = path.display().to_string();
+        if e.message.contains(&file) {
+            e
+        } else {
+            ParamError::new(e.key, format!("{file}: {}", e.message))
+        }
     }
 }
 

@@ -232,3 +232,114 @@ fn damaged_checkpoints_are_refused_by_the_restart() {
     std::fs::write(&ck, &good).unwrap();
     colloidsim_run::resume(&out, None, None, &Control::default()).unwrap();
 }
+
+/// Lines of a CSV table a hostile user (or a damaged disk) gives: numbers of every kind,
+/// missing or extra fields, text, nothing.
+fn csv_line() -> impl Strategy<Value = String> {
+    let number = prop_oneof![
+        (-5.0f64..15.0).prop_map(|x| x.to_string()),
+        Just("nan".to_string()),
+        Just("inf".to_string()),
+        Just("-inf".to_string()),
+        Just("1e300".to_string()),
+        Just("-1e-320".to_string()),
+        Just("0".to_string()),
+        Just(String::new()),
+        Just("x".to_string()),
+        "[ -~]{0,6}",
+    ];
+    proptest::collection::vec(number, 0..4).prop_map(|v| v.join(","))
+}
+
+/// Contents of an input table: a header the reader expects (or not) and hostile lines, or
+/// raw bytes.
+fn csv_file() -> impl Strategy<Value = Vec<u8>> {
+    let header = prop_oneof![
+        Just("x,U"),
+        Just("r,f"),
+        Just("x"),
+        Just("U,x"),
+        Just(""),
+        Just("# comment"),
+    ];
+    prop_oneof![
+        (header, proptest::collection::vec(csv_line(), 0..12)).prop_map(|(h, lines)| format!(
+            "{h}\n{}\n",
+            lines.join("\n")
+        )
+        .into_bytes()),
+        proptest::collection::vec(any::<u8>(), 0..200),
+    ]
+}
+
+/// Scenarios reading a table: a periodic potential, a pair force, initial positions.
+const TABLE_SCENARIOS: [&str; 3] = [
+    r#"method = "bcd"
+[system]
+length = 10.0
+particles = 4
+diameter = 0.5
+[potential]
+table = "table.csv"
+[run]
+dt = 1e-4
+time = 0.001
+[observe]
+density = { bins = 10 }
+"#,
+    r#"method = "bcd"
+[system]
+length = 10.0
+particles = 4
+diameter = 0.5
+[interaction]
+table = "table.csv"
+[run]
+dt = 1e-4
+time = 0.001
+[observe]
+density = { bins = 10 }
+"#,
+    r#"method = "bcd"
+[system]
+length = 10.0
+particles = 4
+diameter = 0.5
+[initial]
+placement = "file"
+file = "table.csv"
+[run]
+dt = 1e-4
+time = 0.001
+[observe]
+density = { bins = 10 }
+"#,
+];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// Every CSV input of a scenario (potential and pair tables, initial positions): a clean
+    /// error naming the file, or a valid run; never a panic.
+    #[test]
+    fn hostile_input_tables_are_refused_or_run_never_panic(
+        which in 0..TABLE_SCENARIOS.len(),
+        content in csv_file(),
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("table.csv"), &content).unwrap();
+        let Ok(sc) = Scenario::from_toml(TABLE_SCENARIOS[which], dir.path()) else {
+            return Ok(());
+        };
+        match colloidsim_run::check(&sc) {
+            Err(e) => {
+                let msg = format!("{e:#}");
+                prop_assert!(msg.contains("table.csv"), "the error names the file: {msg}");
+            }
+            Ok(_) => {
+                let mut e = colloidsim_run::engine(&sc, None).unwrap();
+                let _ = e.step(10);
+            }
+        }
+    }
+}
