@@ -23,6 +23,10 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
+/// The interface potential must reach this many kT within a droplet radius beyond the wall
+/// (a Boltzmann factor of 2e-9: no colloid leaves).
+pub const HOLD_KT: f64 = 20.0;
+
 /// Fewest steps a drying run may take.
 pub const MIN_DRYING_STEPS: u64 = 100;
 
@@ -441,6 +445,30 @@ impl DropletScenario {
             ));
         }
         let offset = in_range("interface.offset", it.offset.unwrap_or(-0.5 * d), -r0, r0)?;
+        // The interface must hold the colloids: V = k s^2 / 2 up to the range, then linear
+        // with force k * range; the distance beyond the wall where V reaches
+        // HOLD_KT kT must be smaller than the droplet (else the colloids leave it, and the
+        // continuum theory's domain grows without bound).
+        let hold = HOLD_KT * kt;
+        let reach = if hold <= 0.5 * stiffness * range * range {
+            (2.0 * hold / stiffness).sqrt()
+        } else {
+            range + (hold - 0.5 * stiffness * range * range) / (stiffness * range)
+        };
+        if reach > r0 {
+            return Err(ParamError::new(
+                "interface.stiffness",
+                format!(
+                    "{} (with interface.range = {}) does not hold the colloids: the interface \
+                     potential reaches {HOLD_KT} kT only {reach:.3} beyond the wall, more than \
+                     the droplet radius R0 = {r0:.4}; use at least stiffness * range = {:.3} \
+                     (the default is 50 kT/d^2 with range d/2)",
+                    colloidsim_core::param::show(stiffness),
+                    colloidsim_core::param::show(range),
+                    hold / (r0 - 0.5 * range)
+                ),
+            ));
+        }
         if r_end + offset <= 0.0 {
             return Err(ParamError::new(
                 "interface.offset",

@@ -136,3 +136,20 @@ fn replicas_differ_and_initial_configuration_is_inside() {
         "{e}"
     );
 }
+
+#[test]
+fn an_interface_too_soft_to_hold_the_colloids_is_refused() {
+    // 20 kT are reached 20.25 d beyond the wall at k = 2 kT/d^2 (range d/2), more than R0.
+    let soft = scenario("").replace("[run]", "[interface]\nstiffness = 2.0\n[run]");
+    let e = DropletScenario::from_toml(&soft)
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert_eq!(e.key, "interface.stiffness", "{e}");
+    assert!(e.to_string().contains("does not hold"), "{e}");
+    // The default (50 kT/d^2) holds them within about a diameter.
+    DropletScenario::from_toml(&scenario(""))
+        .unwrap()
+        .validate()
+        .unwrap();
+}
