@@ -5,7 +5,10 @@ use colloidsim_md::mpcd::measure::PoiseuilleProbe;
 use colloidsim_md::mpcd::{Acceleration, Confinement, Srd, SrdParams, theory};
 
 fn main() {
-    let a: Vec<f64> = std::env::args().skip(1).map(|s| s.parse().unwrap()).collect();
+    let a: Vec<f64> = std::env::args()
+        .skip(1)
+        .map(|s| s.parse().unwrap())
+        .collect();
     let get = |i: usize, d: f64| a.get(i).copied().unwrap_or(d);
     let (l, steps, g0) = (get(0, 16.0), get(1, 6000.0) as u64, get(2, 0.05));
     let mut p = SrdParams::standard(7);
@@ -20,7 +23,10 @@ fn main() {
     let relax = rho / (th.total() * k * k);
     let equil = ((5.0 * relax / p.tau).ceil() as u64).min(steps / 2);
     let mut srd = Srd::new(p, SimBox::cube(l), &Confinement::None, 0.0).unwrap();
-    let acc = Acceleration::CosineX { amplitude: g0, wavenumber: k };
+    let acc = Acceleration::CosineX {
+        amplitude: g0,
+        wavenumber: k,
+    };
     let mut probe = PoiseuilleProbe::new(g0, k, rho, ((steps - equil) / 20).max(1));
     for s in 0..steps {
         let t = (s + 1) as f64 * p.tau;
@@ -30,9 +36,23 @@ fn main() {
             let amp = PoiseuilleProbe::amplitude_of(&srd, k);
             srd.rescale_about(|x| [amp * (k * x[2]).cos(), 0.0, 0.0]);
         }
-        if s >= equil { probe.sample(&srd); }
+        if s >= equil {
+            probe.sample(&srd);
+        }
     }
     let (eta, se) = probe.viscosity();
-    println!("L {l} M {} alpha {} tau {} thermostat {}: eta = {eta:.4} +- {se:.4}; theory {:.4} (kin {:.4} col {:.4}); ratio {:.4} +- {:.4}; T = {:.4}, A = {:.4}",
-        p.density, p.angle.to_degrees(), p.tau, p.thermostat, th.total(), th.kinetic, th.collisional, eta / th.total(), se / th.total(), srd.temperature(), probe.flow.mean());
+    println!(
+        "L {l} M {} alpha {} tau {} thermostat {}: eta = {eta:.4} +- {se:.4}; theory {:.4} (kin {:.4} col {:.4}); ratio {:.4} +- {:.4}; T = {:.4}, A = {:.4}",
+        p.density,
+        p.angle.to_degrees(),
+        p.tau,
+        p.thermostat,
+        th.total(),
+        th.kinetic,
+        th.collisional,
+        eta / th.total(),
+        se / th.total(),
+        srd.temperature(),
+        probe.flow.mean()
+    );
 }

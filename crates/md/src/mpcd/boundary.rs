@@ -87,7 +87,9 @@ impl Confinement {
     pub fn volume(&self, t: f64, l: [f64; 3]) -> f64 {
         match *self {
             Confinement::None => l[0] * l[1] * l[2],
-            Confinement::Sphere { law, .. } => 4.0 / 3.0 * std::f64::consts::PI * law.radius(t).powi(3),
+            Confinement::Sphere { law, .. } => {
+                4.0 / 3.0 * std::f64::consts::PI * law.radius(t).powi(3)
+            }
             Confinement::Slab { half_width, .. } => l[0] * l[1] * 2.0 * half_width,
         }
     }
@@ -175,7 +177,11 @@ pub fn bounce_sphere(
         let b = x[0] * v[0] + x[1] * v[1] + x[2] * v[2] - r1 * speed;
         let disc = (b * b - a * c).max(0.0);
         let denom = b + disc.sqrt();
-        let s = if denom > 0.0 { (c / denom).min(left) } else { left };
+        let s = if denom > 0.0 {
+            (c / denom).min(left)
+        } else {
+            left
+        };
         let xc = [x[0] - v[0] * s, x[1] - v[1] * s, x[2] - v[2] * s];
         let rc = (xc[0] * xc[0] + xc[1] * xc[1] + xc[2] * xc[2]).sqrt();
         let n = if rc > 0.0 {
@@ -287,11 +293,17 @@ mod tests {
             }
             // It streamed on from the crossing point for the rest of the step.
             for k in 0..3 {
-                assert!((x[k] - (xc[k] + v[k] * (dt - tc))).abs() < 1e-9, "{kind:?} {k}");
+                assert!(
+                    (x[k] - (xc[k] + v[k] * (dt - tc))).abs() < 1e-9,
+                    "{kind:?} {k}"
+                );
             }
             // A particle that stays inside is untouched.
             let (mut xi, mut vi) = ([0.1, 0.2, 0.3], [1.0, 1.0, 1.0]);
-            assert_eq!(bounce_sphere(&mut xi, &mut vi, r1, speed, dt, kind).count, 0);
+            assert_eq!(
+                bounce_sphere(&mut xi, &mut vi, r1, speed, dt, kind).count,
+                0
+            );
             assert_eq!(vi, [1.0, 1.0, 1.0]);
         }
     }
@@ -301,8 +313,8 @@ mod tests {
         // At rest just inside a wall that moves in faster than the particle: the crossing root
         // with A = v.v - V^2 < 0.
         let (dt, speed, r1) = (0.1, -2.0, 5.0);
-        let mut x = [0.0, 0.0, 5.1];
-        let mut v = [0.0, 0.0, 0.05];
+        let x = [0.0, 0.0, 5.1];
+        let v = [0.0, 0.0, 0.05];
         for kind in [WallKind::Slip, WallKind::NoSlip] {
             let (mut xx, mut vv) = (x, v);
             let b = bounce_sphere(&mut xx, &mut vv, r1, speed, dt, kind);
@@ -311,10 +323,13 @@ mod tests {
             // Relative normal velocity reversed: v' - V = -(v - V) along z.
             assert!((vv[2] - speed + (0.05 - speed)).abs() < 1e-12, "{vv:?}");
         }
-        // And the slab.
+        // And the slab (static): a slow particle that starts just inside.
+        let mut x = [0.0, 0.0, 4.999 + 0.05 * dt];
+        let mut v = [0.0, 0.0, 0.05];
         let b = bounce_slab(&mut x, &mut v, 5.0, dt, WallKind::NoSlip);
         assert_eq!(b.count, 1);
         assert!(x[2] <= 5.0 && v[2] == -0.05);
+        assert!((x[2] - (5.0 - 0.004)).abs() < 1e-12, "{x:?}");
     }
 
     #[test]

@@ -31,8 +31,8 @@
 //! `f64`s in `AtomicU64`s ([`SharedVectors`]), whose relaxed loads and stores are plain moves;
 //! every slot belongs to one cell, so no two threads touch it. Every `sort_every` collisions
 //! the arrays are permuted into cell order, one component at a time through a scratch array
-//! (12 bytes), in parallel. In all about 54 bytes per particle at density 5
-//! ([`Srd::bytes_per_particle`]); nothing is allocated per step (except for cells with more
+//! (4 + 8 bytes), in parallel. In all 54 bytes per particle ([`Srd::bytes_per_particle`])
+//! and 8 per cell, 55.6 bytes per particle at density 5; nothing is allocated per step (except for cells with more
 //! than [`CELL_CAPACITY`] members, which are rare).
 
 use super::boundary::{Confinement, WallKind};
@@ -93,9 +93,11 @@ impl SrdParams {
 }
 
 /// A body force per unit mass on the solvent, integrated exactly over each free flight: the
-/// velocity change `dv` of the flight is applied half before and half after streaming (so the
-/// position moves by `(v + dv/2) tau`, exact for both forces, which do not depend on `x` and do
-/// not act along `z`; a reflection within the flight makes it approximate).
+/// velocity change `dv` of the flight is applied half before and half after streaming, so the
+/// position moves by `(v + dv/2) tau` (exact for the uniform force; for the cosine force, which
+/// acts along `x` and varies along `z` only, the velocity change is exact and the displacement
+/// along `x` is off by a term of relative order `(k v_z tau)^2`; a reflection within the flight
+/// makes both approximate).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Acceleration {
     /// None.
@@ -305,7 +307,7 @@ impl Grid {
             let r = q.round();
             if !(r >= 1.0 && (q - r).abs() <= 1e-9 * q.max(1.0)) || r > 1e6 {
                 return Err(MpcdError::Invalid(format!(
-                    "box edge {} is not a whole number of cells of edge {a} (edge / a = {q})",
+                    "box edge {} must be a whole number (1 to 10^6) of solvent cells of edge {a} (edge / cell = {q})",
                     sbox.l[k]
                 )));
             }
@@ -704,7 +706,8 @@ impl Srd {
     }
 
     /// Bytes held per solvent particle by the per-particle arrays: positions (12), velocities
-    /// (24), rank (2), cell list (4) and the storage sort's scratch (12).
+    /// (24), rank (2), cell list (4) and the storage sort's scratch (one component: 4 + 8).
+    /// The cells add [`Self::bytes_per_cell`] each (1.6 bytes per particle at density 5).
     pub fn bytes_per_particle() -> usize {
         3 * std::mem::size_of::<u32>()
             + 3 * std::mem::size_of::<AtomicU64>()
@@ -1106,10 +1109,8 @@ impl Srd {
         (0..n).into_par_iter().with_min_len(4096).for_each(|i| {
             let (x, v) = (self.position(i), self.vel.get(i));
             let f = flow(x);
-            self.vel.set(
-                i,
-                std::array::from_fn(|k| f[k] + scale * (v[k] - f[k])),
-            );
+            self.vel
+                .set(i, std::array::from_fn(|k| f[k] + scale * (v[k] - f[k])));
         });
     }
 
@@ -1156,24 +1157,25 @@ impl Buffers {
     }
 }
 
+/// Every parameter at its edge; the message names the key and its allowed range.
 fn check_params(p: &SrdParams) -> Result<(), MpcdError> {
-    for (what, v) in [
-        ("cell edge", p.cell),
+    for (key, v) in [
+        ("cell", p.cell),
         ("density", p.density),
-        ("collision time", p.tau),
+        ("tau", p.tau),
         ("kT", p.kt),
         ("mass", p.mass),
     ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(MpcdError::Invalid(format!(
-                "{what} must be a finite number > 0, got {v}"
+                "solvent {key} = {v} must be a finite number > 0"
             )));
         }
     }
     if !(p.angle > 0.0 && p.angle <= std::f64::consts::PI) {
         return Err(MpcdError::Invalid(format!(
-            "rotation angle must lie in (0, pi], got {}",
-            p.angle
+            "solvent angle = {} degrees must lie in (0, 180]",
+            p.angle.to_degrees()
         )));
     }
     Ok(())
@@ -1213,8 +1215,19 @@ fn collide_cell(
     let total = ns + ne + nv_max;
     if total <= CELL_CAPACITY {
         collide_in(
-            members, vel, emb_vel, emb_mass, rule, conf, cut_corner, t, zig, rng,
-            &mut buf.slots, &mut buf.v, &mut buf.m,
+            members,
+            vel,
+            emb_vel,
+            emb_mass,
+            rule,
+            conf,
+            cut_corner,
+            t,
+            zig,
+            rng,
+            &mut buf.slots,
+            &mut buf.v,
+            &mut buf.m,
         )
     } else {
         let mut slots = vec![0u32; total];
@@ -1394,4 +1407,322 @@ pub fn rotation(n: [f64; 3], cos: f64, sin: f64) -> [[f64; 3]; 3] {
             cos + c1 * n[2] * n[2],
         ],
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::potential::SphereAreaLaw;
+
+    /// `steps` streaming steps and collisions of `srd` (no walls unless `conf`).
+    fn run(srd: &mut Srd, steps: u64, conf: &Confinement, accel: &Acceleration) {
+        for _ in 0..steps {
+            let t = (srd.step() + 1) as f64 * srd.params().tau;
+            srd.stream(t, conf, accel).unwrap();
+            srd.collide(t, conf, None);
+        }
+    }
+
+    /// Velocities uniform in `[-c, c)` per component plus `drift` (not Maxwell–Boltzmann:
+    /// kurtosis 9/5), positions uniform.
+    fn uniform_solvent(p: SrdParams, l: f64, c: f64, drift: [f64; 3]) -> Srd {
+        let n = (p.density * l * l * l) as usize;
+        let mut rng = draw(p.seed, 0, Draw::Solvent, 1 << 40);
+        let pos: Vec<[f64; 3]> = (0..n)
+            .map(|_| std::array::from_fn(|_| (rng.random::<f64>() - 0.5) * l))
+            .collect();
+        let mut vel: Vec<[f64; 3]> = (0..n)
+            .map(|_| std::array::from_fn(|_| c * (2.0 * rng.random::<f64>() - 1.0)))
+            .collect();
+        // Remove the sample mean, then add the drift.
+        let mean: [f64; 3] =
+            std::array::from_fn(|k| vel.iter().map(|v| v[k]).sum::<f64>() / n as f64);
+        for v in &mut vel {
+            for k in 0..3 {
+                v[k] += drift[k] - mean[k];
+            }
+        }
+        Srd::from_state(p, SimBox::cube(l), &pos, &vel, 0).unwrap()
+    }
+
+    /// Mean, variance and kurtosis of the velocity components about their means.
+    fn moments(srd: &Srd) -> ([f64; 3], f64, f64) {
+        let v = srd.velocities();
+        let n = v.len() as f64;
+        let mean: [f64; 3] = std::array::from_fn(|k| v.iter().map(|x| x[k]).sum::<f64>() / n);
+        let (mut m2, mut m4) = (0.0, 0.0);
+        for x in &v {
+            for k in 0..3 {
+                let d = x[k] - mean[k];
+                m2 += d * d;
+                m4 += d * d * d * d;
+            }
+        }
+        let (m2, m4) = (m2 / (3.0 * n), m4 / (3.0 * n));
+        (mean, m2, m4 / (m2 * m2))
+    }
+
+    #[test]
+    fn parameters_out_of_range_are_rejected_naming_the_key_and_range() {
+        let ok = SrdParams::standard(1);
+        let sbox = SimBox::cube(4.0);
+        let bad = |f: &dyn Fn(&mut SrdParams)| {
+            let mut p = ok;
+            f(&mut p);
+            Srd::new(p, sbox, &Confinement::None, 0.0)
+                .unwrap_err()
+                .to_string()
+        };
+        for (key, set) in [
+            (
+                "density",
+                &(|p: &mut SrdParams| p.density = 0.0) as &dyn Fn(&mut SrdParams),
+            ),
+            ("density", &|p: &mut SrdParams| p.density = -5.0),
+            ("density", &|p: &mut SrdParams| p.density = f64::NAN),
+            ("tau", &|p: &mut SrdParams| p.tau = 0.0),
+            ("tau", &|p: &mut SrdParams| p.tau = f64::INFINITY),
+            ("kT", &|p: &mut SrdParams| p.kt = -1.0),
+            ("mass", &|p: &mut SrdParams| p.mass = 0.0),
+            ("cell", &|p: &mut SrdParams| p.cell = f64::NAN),
+        ] {
+            let msg = bad(set);
+            assert!(
+                msg.contains(&format!("solvent {key} = ")) && msg.contains("> 0"),
+                "{msg}"
+            );
+        }
+        for angle in [0.0, -10.0, 180.001, f64::NAN] {
+            let msg = bad(&|p: &mut SrdParams| p.angle = angle.to_radians());
+            assert!(
+                msg.contains("solvent angle = ") && msg.contains("(0, 180]"),
+                "{msg}"
+            );
+        }
+        // The edges of the range are accepted.
+        let mut p = ok;
+        p.angle = std::f64::consts::PI;
+        assert!(Srd::new(p, sbox, &Confinement::None, 0.0).is_ok());
+        p.angle = 1e-6;
+        assert!(Srd::new(p, sbox, &Confinement::None, 0.0).is_ok());
+        // A box that is not a whole number of cells.
+        let msg = Srd::new(ok, SimBox::cube(4.5), &Confinement::None, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("whole number") && msg.contains("4.5"), "{msg}");
+    }
+
+    /// Every position lies in the shifted cell that `cell_of` names, and the shifts of
+    /// successive collisions cover `[-a/2, a/2)` uniformly.
+    #[test]
+    fn the_shifted_grid_puts_each_particle_in_its_cell() {
+        let mut p = SrdParams::standard(3);
+        p.cell = 0.5;
+        let srd = Srd::new(p, SimBox::new([4.0, 3.0, 5.0]), &Confinement::None, 0.0).unwrap();
+        let grid = *srd.grid();
+        assert_eq!(grid.n, [8, 6, 10]);
+        let mut mean = [0.0; 3];
+        let steps = 2000;
+        for step in 0..steps {
+            let s = srd.shift(step);
+            for k in 0..3 {
+                assert!(s[k] >= -0.25 && s[k] < 0.25, "{s:?}");
+                mean[k] += s[k] / steps as f64;
+            }
+            if step < 20 {
+                for i in 0..srd.len() {
+                    let x = srd.position(i);
+                    let lo = grid.corner(srd.cell_of(x, step), s);
+                    for k in 0..3 {
+                        // The offset from the corner, wrapped into [0, L).
+                        let d = (x[k] - lo[k]).rem_euclid(grid.l[k]);
+                        assert!(d < p.cell * (1.0 + 1e-9), "{x:?} {lo:?} {k}");
+                    }
+                }
+            }
+        }
+        // Uniform on [-a/2, a/2): mean 0 with standard error a / sqrt(12 steps) = 3.2e-3.
+        for m in mean {
+            assert!(m.abs() < 0.013, "{mean:?}");
+        }
+    }
+
+    /// Without the thermostat a collision conserves momentum and energy exactly: after many
+    /// steps both agree with the start to round-off, while the velocities have decorrelated.
+    #[test]
+    fn collisions_conserve_momentum_and_energy_without_the_thermostat() {
+        let mut p = SrdParams::standard(11);
+        p.thermostat = false;
+        let mut srd = uniform_solvent(p, 8.0, 1.7, [0.3, -0.2, 0.1]);
+        let v0 = srd.velocities();
+        let (p0, e0) = (srd.momentum(), srd.kinetic_energy());
+        run(&mut srd, 45, &Confinement::None, &Acceleration::None);
+        let (p1, e1) = (srd.momentum(), srd.kinetic_energy());
+        for k in 0..3 {
+            // |P| ~ 800; round-off ~1e-16 per particle and collision.
+            assert!((p1[k] - p0[k]).abs() < 1e-10, "{p0:?} {p1:?}");
+        }
+        assert!((e1 / e0 - 1.0).abs() < 1e-12, "{e0} {e1}");
+        // The collisions did act: the velocity of a particle has forgotten its start (the
+        // storage sorts permute the slots, so compare the distributions' kurtosis instead of
+        // slot by slot): uniform 1.8 relaxes to Gaussian 3.
+        let k0 = {
+            let s = Srd::from_state(p, *srd.sbox(), &srd.positions(), &v0, 0).unwrap();
+            moments(&s).2
+        };
+        let (_, _, k1) = moments(&srd);
+        assert!((k0 - 1.8).abs() < 0.05, "{k0}");
+        // Standard error of the kurtosis of 3 N Gaussian samples: sqrt(24 / 3N) = 0.032.
+        assert!((k1 - 3.0).abs() < 0.15, "{k1}");
+    }
+
+    /// The cell thermostat brings velocities that start uniform at kT = 2 to the
+    /// Maxwell–Boltzmann distribution at kT = 1: the temperature within its statistical error,
+    /// the kurtosis 3, and a chi-square test of the histogram of the components against the
+    /// normal distribution.
+    #[test]
+    fn the_thermostat_gives_maxwell_boltzmann_velocities_at_kt() {
+        let mut p = SrdParams::standard(5);
+        p.kt = 1.0;
+        // Uniform in [-c, c): variance c^2 / 3 = 2.
+        let mut srd = uniform_solvent(p, 12.0, 6f64.sqrt(), [0.0; 3]);
+        run(&mut srd, 30, &Confinement::None, &Acceleration::None);
+        let n = srd.len() as f64;
+        let t = srd.temperature();
+        // Standard error of the kinetic temperature of N particles: kT sqrt(2 / (3 N)) = 0.0088.
+        let se = (2.0 / (3.0 * n)).sqrt();
+        assert!((t - 1.0).abs() < 4.0 * se, "T = {t} (se {se})");
+        let (mean, var, kurt) = moments(&srd);
+        assert!((var - 1.0).abs() < 4.0 * se, "{var}");
+        for m in mean {
+            // The start has no mean velocity and the thermostat keeps the cells' momenta.
+            assert!(m.abs() < 1e-10, "{mean:?}");
+        }
+        assert!((kurt - 3.0).abs() < 0.12, "kurtosis {kurt}");
+        // 24 bins equally probable under N(0, kT/m), chi-square with 23 degrees of freedom:
+        // 49.7 is its 0.1 % point.
+        let bins = 24;
+        let edges: Vec<f64> = (1..bins)
+            .map(|j| inverse_normal_cdf(j as f64 / bins as f64))
+            .collect();
+        let mut counts = vec![0f64; bins];
+        for v in srd.velocities() {
+            for c in v {
+                counts[edges.partition_point(|&e| e < c)] += 1.0;
+            }
+        }
+        let expect = 3.0 * n / bins as f64;
+        let chi2: f64 = counts.iter().map(|c| (c - expect).powi(2) / expect).sum();
+        assert!(chi2 < 49.7, "chi2 = {chi2}, {counts:?}");
+    }
+
+    /// The standard normal quantile by bisection on `erfc` (tests only).
+    fn inverse_normal_cdf(q: f64) -> f64 {
+        let cdf = |x: f64| 0.5 * erfc(-x / std::f64::consts::SQRT_2);
+        let (mut lo, mut hi) = (-10.0, 10.0);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if cdf(mid) < q { lo = mid } else { hi = mid }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// `erfc` to 1.2e-7 (Numerical Recipes' Chebyshev fit; tests only).
+    fn erfc(x: f64) -> f64 {
+        let z = x.abs();
+        let t = 1.0 / (1.0 + 0.5 * z);
+        let r = t
+            * (-z * z - 1.26551223
+                + t * (1.00002368
+                    + t * (0.37409196
+                        + t * (0.09678418
+                            + t * (-0.18628806
+                                + t * (0.27886807
+                                    + t * (-1.13520398
+                                        + t * (1.48851587
+                                            + t * (-0.82215223 + t * 0.17087277)))))))))
+                .exp();
+        if x >= 0.0 { r } else { 2.0 - r }
+    }
+
+    /// The same run on 1 and on 2 threads gives the same bits: bulk with the cosine drive and
+    /// storage sorts, and between no-slip walls with embedded particles and virtual particles.
+    #[test]
+    fn results_do_not_depend_on_the_thread_count() {
+        let l = 16.0;
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    let p = SrdParams::standard(21);
+                    let mut bulk = Srd::new(p, SimBox::cube(l), &Confinement::None, 0.0).unwrap();
+                    bulk.set_sort_every(4);
+                    let accel = Acceleration::CosineX {
+                        amplitude: 0.1,
+                        wavenumber: 2.0 * std::f64::consts::PI / l,
+                    };
+                    run(&mut bulk, 9, &Confinement::None, &accel);
+                    let slab = Confinement::Slab {
+                        half_width: 6.3,
+                        kind: WallKind::NoSlip,
+                    };
+                    let mut walled = Srd::new(p, SimBox::cube(l), &slab, 0.0).unwrap();
+                    let emb_pos: Vec<[f64; 3]> = (0..50)
+                        .map(|j| [0.3 * j as f64, -0.2 * j as f64, 0.1 * j as f64 - 2.5])
+                        .collect();
+                    let mut emb_vel = vec![[0.5, 0.0, -0.5]; 50];
+                    let emb_mass = vec![5.0; 50];
+                    let mut virt = 0;
+                    for _ in 0..7 {
+                        let t = (walled.step() + 1) as f64 * p.tau;
+                        walled
+                            .stream(t, &slab, &Acceleration::Uniform([0.1, 0.0, 0.0]))
+                            .unwrap();
+                        let emb = Embedded {
+                            pos: &emb_pos,
+                            vel: &mut emb_vel,
+                            mass: &emb_mass,
+                        };
+                        virt += walled.collide(t, &slab, Some(emb)).virtual_particles;
+                    }
+                    assert!(virt > 0);
+                    (
+                        bulk.raw_positions(),
+                        bulk.velocities(),
+                        walled.raw_positions(),
+                        walled.velocities(),
+                        emb_vel,
+                    )
+                })
+        };
+        let (a, b) = (on(1), on(2));
+        let bits =
+            |v: &[[f64; 3]]| -> Vec<[u64; 3]> { v.iter().map(|x| x.map(f64::to_bits)).collect() };
+        assert_eq!(a.0, b.0);
+        assert_eq!(bits(&a.1), bits(&b.1));
+        assert_eq!(a.2, b.2);
+        assert_eq!(bits(&a.3), bits(&b.3));
+        assert_eq!(bits(&a.4), bits(&b.4));
+        // The collisions did change the embedded particles' velocities.
+        assert_ne!(bits(&a.4), bits(&[[0.5, 0.0, -0.5]; 50]));
+    }
+
+    /// The solvent of a droplet fills the sphere only, at the density.
+    #[test]
+    fn a_droplet_solvent_fills_the_sphere() {
+        let law = SphereAreaLaw {
+            r0: 5.0,
+            alpha: 0.0,
+        };
+        let conf = Confinement::Sphere {
+            law,
+            kind: WallKind::Slip,
+        };
+        let srd = Srd::new(SrdParams::standard(2), SimBox::cube(12.0), &conf, 0.0).unwrap();
+        let expect = 5.0 * 4.0 / 3.0 * std::f64::consts::PI * 125.0;
+        assert_eq!(srd.len(), expect.round() as usize);
+        assert!(srd.positions().iter().all(|x| conf.inside(*x, 0.0)));
+    }
 }

@@ -66,22 +66,36 @@ mod tests {
     use super::*;
 
     #[test]
-    fn standard_solvent_has_the_usual_viscosity() {
-        // Density 5, 130 degrees, tau = 0.1: eta = 0.304 + 3.657 = 3.96 (the value quoted for
-        // this solvent throughout the MPCD literature).
+    fn viscosity_and_diffusion_follow_the_formulas() {
+        // Density 5, 130 degrees, tau = 0.1, by hand: cos = -0.642788, cos(260) = -0.173648,
+        // M - 1 + e^-M = 4.006738; eta_kin = 0.5 (25 / (4.006738 * 5.632872) - 1/2) = 0.30385,
+        // eta_col = 1.642788 * 4.006738 / 1.8 = 3.65679; 3.9606 in all (the value quoted for
+        // this solvent in the MPCD literature, 3.96).
         let v = viscosity(&SrdParams::standard(1));
-        assert!((v.kinetic - 0.3039).abs() < 5e-4, "{v:?}");
-        assert!((v.collisional - 3.6574).abs() < 5e-4, "{v:?}");
-        assert!((v.total() - 3.961).abs() < 1e-3);
-        // tau = 1, 90 degrees, M = 10: eta_kin = 10 (50 / (9 * 6) - 1/2) = 4.259.
+        assert!((v.kinetic - 0.30385).abs() < 2e-5, "{v:?}");
+        assert!((v.collisional - 3.65679).abs() < 2e-5, "{v:?}");
+        assert!((v.total() - 3.9606).abs() < 1e-4);
+        // tau = 1, 90 degrees, M = 10: 4 - 2 cos - 2 cos(2 alpha) = 6.
         let mut p = SrdParams::standard(1);
         p.tau = 1.0;
         p.angle = std::f64::consts::FRAC_PI_2;
         p.density = 10.0;
+        let f = 9.0 + (-10f64).exp();
         let v = viscosity(&p);
-        assert!((v.kinetic - 10.0 * (50.0 / (fluctuation(10.0) * 6.0) - 0.5)).abs() < 1e-12);
-        assert!((v.collisional - fluctuation(10.0) / 18.0).abs() < 1e-12);
+        assert!((v.kinetic - 10.0 * (50.0 / (f * 6.0) - 0.5)).abs() < 1e-12);
+        assert!((v.collisional - f / 18.0).abs() < 1e-12);
+        // Scaling: eta_kin ~ n kT tau, eta_col ~ m / (a tau) at fixed M.
+        p.kt = 2.0;
+        p.mass = 3.0;
+        let w = viscosity(&p);
+        assert!((w.kinetic / v.kinetic - 2.0).abs() < 1e-12);
+        assert!((w.collisional / v.collisional - 3.0).abs() < 1e-12);
         assert!((hasimoto(1.0, 10.0) - (1.0 - 0.2837297 + 4.18879e-3)).abs() < 1e-6);
-        assert!(self_diffusion(&SrdParams::standard(1)) > 0.0);
+        // D = (kT tau / 2m)(3 M / ((1 - cos) f) - 1): standard 0.05 (15 / (1.642788 * 4.006738) - 1).
+        let d = self_diffusion(&SrdParams::standard(1));
+        assert!(
+            (d - 0.05 * (15.0 / (1.642788 * 4.006738) - 1.0)).abs() < 1e-6,
+            "{d}"
+        );
     }
 }
