@@ -332,6 +332,110 @@ mod tests {
         assert!((x[2] - (5.0 - 0.004)).abs() < 1e-12, "{x:?}");
     }
 
+    /// Many random crossings of a shrinking, a static and a growing sphere: every particle
+    /// ends inside, at the distance from the crossing point that the rest of the step gives,
+    /// and with the relative velocity reflected (its magnitude kept; slip: tangential part
+    /// kept; no-slip: reversed).
+    #[test]
+    fn random_crossings_of_a_moving_sphere_obey_the_reflection_laws() {
+        use rand::RngExt;
+        let mut rng = colloidsim_core::rng::stream(9, 0, colloidsim_core::rng::Purpose::Moves, 0);
+        let (dt, r1) = (0.1, 4.0);
+        let mut single = 0;
+        for trial in 0..20_000 {
+            let speed = [-1.5, 0.0, 0.8][trial % 3];
+            let kind = if trial % 2 == 0 {
+                WallKind::Slip
+            } else {
+                WallKind::NoSlip
+            };
+            let r0 = r1 - speed * dt;
+            // Start inside the sphere of the start of the step, near its wall.
+            let dir = {
+                let d: [f64; 3] = std::array::from_fn(|_| rng.random::<f64>() - 0.5);
+                let n = dot(d, d).sqrt();
+                d.map(|x| x / n)
+            };
+            let x0 = dir.map(|x| x * r0 * (1.0 - 0.1 * rng.random::<f64>()));
+            let v0: [f64; 3] = std::array::from_fn(|_| 20.0 * (rng.random::<f64>() - 0.5));
+            let (mut x, mut v) = (x0, v0);
+            for k in 0..3 {
+                x[k] += v[k] * dt;
+            }
+            let b = bounce_sphere(&mut x, &mut v, r1, speed, dt, kind);
+            assert!(!b.stuck);
+            assert!(dot(x, x).sqrt() <= r1 * (1.0 + 1e-12), "{trial}: {x:?}");
+            if b.count != 1 {
+                continue;
+            }
+            single += 1;
+            // Crossing by bisection on g(t) = |x0 + v0 t| - (r0 + speed t), inside at t = 0.
+            let g = |t: f64| {
+                let p = [x0[0] + v0[0] * t, x0[1] + v0[1] * t, x0[2] + v0[2] * t];
+                dot(p, p).sqrt() - (r0 + speed * t)
+            };
+            let (mut lo, mut hi) = (0.0, dt);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if g(mid) < 0.0 { lo = mid } else { hi = mid }
+            }
+            let tc = 0.5 * (lo + hi);
+            let xc = [x0[0] + v0[0] * tc, x0[1] + v0[1] * tc, x0[2] + v0[2] * tc];
+            let n = xc.map(|c| c / dot(xc, xc).sqrt());
+            let wall = n.map(|c| speed * c);
+            let rel_in = [v0[0] - wall[0], v0[1] - wall[1], v0[2] - wall[2]];
+            let rel_out = [v[0] - wall[0], v[1] - wall[1], v[2] - wall[2]];
+            let tol = 1e-7 * (1.0 + dot(v0, v0).sqrt());
+            assert!((dot(rel_out, rel_out).sqrt() - dot(rel_in, rel_in).sqrt()).abs() < tol);
+            assert!((dot(rel_out, n) + dot(rel_in, n)).abs() < tol, "{trial}");
+            for k in 0..3 {
+                let (ti, to) = (
+                    rel_in[k] - dot(rel_in, n) * n[k],
+                    rel_out[k] - dot(rel_out, n) * n[k],
+                );
+                match kind {
+                    WallKind::Slip => assert!((to - ti).abs() < tol, "{trial}"),
+                    WallKind::NoSlip => assert!((to + ti).abs() < tol, "{trial}"),
+                }
+                assert!((x[k] - (xc[k] + v[k] * (dt - tc))).abs() < 1e-7, "{trial}");
+            }
+        }
+        // Many trials crossed exactly once (about a third).
+        assert!(single > 3_000, "{single}");
+    }
+
+    /// Through [`Confinement::stream`], the wall speed is the mean of the area law over the
+    /// step: a particle at rest just inside a shrinking droplet is hit and moves with twice
+    /// the wall's velocity (no-slip) or its normal velocity reversed about it (slip).
+    #[test]
+    fn the_drying_droplet_wall_pushes_a_resting_particle_inward() {
+        let law = SphereAreaLaw {
+            r0: 6.0,
+            alpha: 40.0,
+        };
+        let (t1, dt) = (2.0, 0.1);
+        let (ra, rb) = (law.radius(t1 - dt), law.radius(t1));
+        let speed = (rb - ra) / dt;
+        assert!(speed < 0.0);
+        for kind in [WallKind::Slip, WallKind::NoSlip] {
+            let conf = Confinement::Sphere { law, kind };
+            let mut x = [0.0, 0.5 * (ra + rb), 0.0];
+            let mut v = [0.0; 3];
+            let b = conf.stream(&mut x, &mut v, t1, dt);
+            assert_eq!(b.count, 1);
+            assert!(conf.inside(x, t1));
+            // Hit halfway through the step: v' = 2 V n either way (no tangential motion).
+            assert!(
+                (v[1] - 2.0 * speed).abs() < 1e-12 && v[0] == 0.0 && v[2] == 0.0,
+                "{v:?}"
+            );
+            assert!(
+                (x[1] - (0.5 * (ra + rb) + v[1] * 0.5 * dt)).abs() < 1e-9,
+                "{x:?}"
+            );
+        }
+    }
+
     #[test]
     fn slab_walls_reflect_slip_and_no_slip() {
         let conf = |kind| Confinement::Slab {
