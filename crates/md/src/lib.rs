@@ -10,6 +10,7 @@ pub mod droplet;
 pub mod gsd;
 pub mod hydro_bd;
 pub mod init;
+pub mod mpcd;
 pub mod neighbor;
 pub mod potential;
 pub mod state;
