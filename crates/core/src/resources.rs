@@ -6,12 +6,12 @@ use crate::ParamError;
 
 /// Memory this process may plan to use: `MemAvailable` of /proc/meminfo (Linux; else 8 GiB),
 /// or less when the process's address space is limited (`ulimit -v`: the limit less what is
-/// mapped already). `COLLOIDSIM_MEMORY_LIMIT` (bytes) overrides it (tests; batch systems with
-/// their own limit).
+/// mapped already). `COLLOIDSIM_MEMORY_LIMIT` (bytes, or with a suffix K, M, G, T of powers of
+/// 1024: `4G`) overrides it (tests; batch systems with their own limit).
 pub fn available_memory() -> f64 {
     if let Some(v) = std::env::var("COLLOIDSIM_MEMORY_LIMIT")
         .ok()
-        .and_then(|v| v.trim().parse::<f64>().ok())
+        .and_then(|v| parse_bytes(&v))
     {
         return v;
     }
@@ -35,6 +35,21 @@ pub fn available_memory() -> f64 {
 }
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// `4096`, `512M`, `4G`, `4GiB`, `1.5T` as bytes.
+fn parse_bytes(text: &str) -> Option<f64> {
+    let t = text.trim();
+    let t = t.strip_suffix("iB").or_else(|| t.strip_suffix('B')).unwrap_or(t);
+    let (number, scale) = match t.chars().last()? {
+        'K' | 'k' => (&t[..t.len() - 1], 1024.0),
+        'M' | 'm' => (&t[..t.len() - 1], 1024.0 * 1024.0),
+        'G' | 'g' => (&t[..t.len() - 1], GIB),
+        'T' | 't' => (&t[..t.len() - 1], 1024.0 * GIB),
+        _ => (t, 1.0),
+    };
+    let v = number.trim().parse::<f64>().ok()? * scale;
+    (v.is_finite() && v >= 0.0).then_some(v)
+}
 
 /// Bytes as a person reads them.
 pub fn human(bytes: f64) -> String {
@@ -93,5 +108,17 @@ mod tests {
         assert!(ensure_fits("k", "x", f64::INFINITY).is_err());
         assert!(ensure_fits("k", "x", f64::NAN).is_err());
         assert_eq!(human(1536.0), "1.5 KiB");
+    }
+
+    #[test]
+    fn memory_limits_are_read_with_their_unit() {
+        assert_eq!(parse_bytes("4096"), Some(4096.0));
+        assert_eq!(parse_bytes("512M"), Some(512.0 * 1024.0 * 1024.0));
+        assert_eq!(parse_bytes(" 4G "), Some(4.0 * GIB));
+        assert_eq!(parse_bytes("4GiB"), Some(4.0 * GIB));
+        assert_eq!(parse_bytes("1.5T"), Some(1.5 * 1024.0 * GIB));
+        for bad in ["", "G", "-1G", "four", "nan", "infG"] {
+            assert_eq!(parse_bytes(bad), None, "{bad}");
+        }
     }
 }
