@@ -1,21 +1,13 @@
 //! The direct method: the RPY mobility in an unbounded fluid by O(N^2) matrix-free products,
 //! and free draining.
 //!
-//! Positions and forces are kept as structure of arrays, and pairs go through [`LANES`]
-//! independent accumulators (consecutive `j` in consecutive lanes, the vectorised inner loop:
-//! both branches of the tensor computed and selected, no branch), added in a fixed order. The
-//! self term is the `r = 0` limit of the overlapping branch (`mu0 I`), so no pair is skipped.
-//!
-//! **Equal radii: each pair once.** `M_ij = M_ji`, so the product `U_i = sum_j M_ij F_j` is
-//! summed over tiles of [`BLOCK`] x [`BLOCK`] particles `(I, J)`, `I <= J`: an off-diagonal tile
-//! evaluates each pair tensor once and adds `M_ij F_j` to row i and `M_ij F_i` to row j (half the
-//! pair evaluations of a row-by-row product; the square root and division of a pair dominate
-//! its cost); a diagonal tile sums its rows. The tiles are dealt round-robin to [`PARTIALS`]
-//! partial sums (a fixed number, whatever the thread count), each summing its tiles in a fixed
-//! order, in parallel; `U` is the sum of the partials in a fixed order. The particles are
-//! padded to whole blocks by dummies far away with zero force, which add exact zeros.
-//! **Unequal radii:** one row per particle, rows in parallel. Either way the product is the
-//! same for any number of threads. Nothing is allocated per product.
+//! A product `U_i = sum_j M_ij F_j` is one row per particle, rows in parallel (rayon). A row
+//! sums its pairs in a fixed order: positions and forces are kept as structure of arrays, and
+//! the pairs go through [`LANES`] independent accumulators (consecutive `j` in consecutive
+//! lanes, the vectorised inner loop: both branches of the tensor computed and selected, no
+//! branch), added in a fixed order at the end. So each row — and the product — is the same
+//! for any number of threads. The self term is the `r = 0` limit of the overlapping branch
+//! (`mu0 I`), so no pair is skipped. Nothing is allocated per product.
 //!
 //! The Brownian displacement is `scale M^(1/2) z` by the Lanczos square root
 //! ([`crate::lanczos`]), one product per iteration.
@@ -30,14 +22,6 @@ use std::f64::consts::PI;
 pub const LANES: usize = 8;
 /// Rows per parallel work item.
 const ROWS: usize = 8;
-/// Particles per tile edge of the symmetric product (a multiple of [`LANES`]).
-pub const BLOCK: usize = 64;
-/// Partial sums of the symmetric product (work items; fixed, so that the sum does not depend
-/// on the thread count).
-pub const PARTIALS: usize = 32;
-/// Position of the padding dummies: far from any sphere, so that their pair tensors are
-/// finite and their zero forces add exact zeros.
-const FAR: f64 = 1e30;
 
 /// Default largest N of the direct method.
 pub const DEFAULT_MAX_DIRECT: usize = 20_000;
@@ -51,24 +35,17 @@ enum Radii {
     Each(Vec<f64>),
 }
 
-/// Positions and radii as structure of arrays, and the force components of a product (equal
-/// radii: padded to whole [`BLOCK`]s with dummies at [`FAR`] and zero force).
+/// Positions and radii as structure of arrays, and the force components of a product.
 #[derive(Debug, Clone)]
 struct Kernel {
     eta: f64,
     radii: Radii,
-    /// Particles (without the padding).
-    n: usize,
     x: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
     fx: Vec<f64>,
     fy: Vec<f64>,
     fz: Vec<f64>,
-    /// Tiles `(I, J)`, `I <= J`, of the symmetric product, in their order of summation.
-    tiles: Vec<(u32, u32)>,
-    /// Partial sums of the symmetric product: [`PARTIALS`] x 3 x padded length.
-    partial: Vec<f64>,
 }
 
 /// One lane of the monodisperse pair kernel, in units of `mu0`: `(A, B / r^2)` of
@@ -123,50 +100,27 @@ fn zuk_lane(r2: f64, ai: f64, aj: f64) -> (f64, f64) {
 
 impl Kernel {
     fn len(&self) -> usize {
-        self.n
+        self.x.len()
     }
 
-    /// `n` particles: equal radii padded to whole blocks.
-    fn new(n: usize, radii: Radii, eta: f64) -> Self {
-        let (pad, tiles) = match radii {
-            Radii::Equal(_) => {
-                let blocks = n.div_ceil(BLOCK);
-                let tiles = (0..blocks as u32)
-                    .flat_map(|i| (i..blocks as u32).map(move |j| (i, j)))
-                    .collect();
-                (blocks * BLOCK, tiles)
-            }
-            Radii::Each(_) => (n, Vec::new()),
-        };
-        let far = vec![FAR; pad];
-        let zeros = vec![0.0; pad];
-        let partial = if tiles.is_empty() {
-            Vec::new()
-        } else {
-            vec![0.0; PARTIALS * 3 * pad]
-        };
-        Self {
-            eta,
-            radii,
-            n,
-            x: far.clone(),
-            y: far.clone(),
-            z: far,
-            fx: zeros.clone(),
-            fy: zeros.clone(),
-            fz: zeros,
-            tiles,
-            partial,
-        }
-    }
-
-    /// `U_i` of particle `i` from the forces in `fx, fy, fz` (physical units), unequal radii.
+    /// `U_i` of particle `i` from the forces in `fx, fy, fz` (physical units).
     #[inline(always)]
-    fn row(&self, i: usize, radii: &[f64]) -> [f64; 3] {
+    fn row(&self, i: usize) -> [f64; 3] {
         let p = [self.x[i], self.y[i], self.z[i]];
-        let ai = radii[i];
-        let u = self.row_sum(p, radii, |r2, aj| zuk_lane(r2, ai, aj));
-        u.map(|c| c / (8.0 * PI * self.eta))
+        match &self.radii {
+            Radii::Equal(a) => {
+                let (a, inv_a, four_a2) = (*a, 1.0 / *a, 4.0 * a * a);
+                let mu0 = 1.0 / (6.0 * PI * self.eta * a);
+                // The radii slice is not read by this lane function: pass any of length N.
+                let u = self.row_sum(p, &self.x, |r2, _| mono_lane(r2, a, inv_a, four_a2));
+                u.map(|c| c * mu0)
+            }
+            Radii::Each(r) => {
+                let ai = r[i];
+                let u = self.row_sum(p, r, |r2, aj| zuk_lane(r2, ai, aj));
+                u.map(|c| c / (8.0 * PI * self.eta))
+            }
+        }
     }
 
     /// `sum_j (A_j F_j + B_j d_j (d_j . F_j))` over all j, `(A, B) = lane(r2, a_j)`, in
@@ -225,120 +179,12 @@ impl Kernel {
     }
 
     /// `out = M f` (`f` already in `fx, fy, fz`).
-    fn product(&mut self, out: &mut [[f64; 3]]) {
-        let radii = match &self.radii {
-            Radii::Equal(a) => return self.symmetric_product(*a, out),
-            Radii::Each(r) => r,
-        };
-        let k = &*self;
+    fn product(&self, out: &mut [[f64; 3]]) {
         out.par_chunks_mut(ROWS).enumerate().for_each(|(c, o)| {
-            for (j, u) in o.iter_mut().enumerate() {
-                *u = k.row(c * ROWS + j, radii);
+            for (k, u) in o.iter_mut().enumerate() {
+                *u = self.row(c * ROWS + k);
             }
         });
-    }
-
-    /// `out = M f` for equal radii `a`, each pair once (module docs).
-    fn symmetric_product(&mut self, a: f64, out: &mut [[f64; 3]]) {
-        let pad = self.x.len();
-        let mut partial = std::mem::take(&mut self.partial);
-        let k = &*self;
-        partial
-            .par_chunks_mut(3 * pad)
-            .enumerate()
-            .for_each(|(p, buf)| {
-                buf.fill(0.0);
-                let (ux, rest) = buf.split_at_mut(pad);
-                let (uy, uz) = rest.split_at_mut(pad);
-                for &(bi, bj) in k.tiles.iter().skip(p).step_by(PARTIALS) {
-                    k.tile(a, bi as usize, bj as usize, [ux, uy, uz]);
-                }
-            });
-        let mu0 = 1.0 / (6.0 * PI * self.eta * a);
-        let partial_ref = &partial;
-        out.par_chunks_mut(ROWS).enumerate().for_each(|(c, o)| {
-            for (r, u) in o.iter_mut().enumerate() {
-                let i = c * ROWS + r;
-                let mut s = [0.0; 3];
-                for buf in partial_ref.chunks_exact(3 * pad) {
-                    for q in 0..3 {
-                        s[q] += buf[q * pad + i];
-                    }
-                }
-                *u = s.map(|v| v * mu0);
-            }
-        });
-        self.partial = partial;
-    }
-
-    /// Tile `(bi, bj)` of the symmetric product, in units of `mu0`, added to `u`: row sums over
-    /// block `bj` for the rows of block `bi`, and for `bi < bj` also the transposed
-    /// contributions to the rows of block `bj` (the same pair tensors).
-    #[inline(always)]
-    fn tile(&self, a: f64, bi: usize, bj: usize, u: [&mut [f64]; 3]) {
-        const L: usize = LANES;
-        let (inv_a, four_a2) = (1.0 / a, 4.0 * a * a);
-        let (i0, j0) = (bi * BLOCK, bj * BLOCK);
-        let block =
-            |v: &Vec<f64>| -> [f64; BLOCK] { v[j0..j0 + BLOCK].try_into().expect("whole blocks") };
-        let (xj, yj, zj) = (block(&self.x), block(&self.y), block(&self.z));
-        let (fxj, fyj, fzj) = (block(&self.fx), block(&self.fy), block(&self.fz));
-        // Contributions to the rows of block bj.
-        let mut tj = [[0.0f64; BLOCK]; 3];
-        let [ux, uy, uz] = u;
-        for i in i0..i0 + BLOCK {
-            let p = [self.x[i], self.y[i], self.z[i]];
-            let fi = [self.fx[i], self.fy[i], self.fz[i]];
-            let mut acc = [[0.0f64; L]; 3];
-            if bi == bj {
-                for c in 0..BLOCK / L {
-                    for l in 0..L {
-                        let j = c * L + l;
-                        let d = [p[0] - xj[j], p[1] - yj[j], p[2] - zj[j]];
-                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        let (aa, bb) = mono_lane(r2, a, inv_a, four_a2);
-                        let df = bb * (d[0] * fxj[j] + d[1] * fyj[j] + d[2] * fzj[j]);
-                        acc[0][l] += aa * fxj[j] + df * d[0];
-                        acc[1][l] += aa * fyj[j] + df * d[1];
-                        acc[2][l] += aa * fzj[j] + df * d[2];
-                    }
-                }
-            } else {
-                for c in 0..BLOCK / L {
-                    for l in 0..L {
-                        let j = c * L + l;
-                        let d = [p[0] - xj[j], p[1] - yj[j], p[2] - zj[j]];
-                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        let (aa, bb) = mono_lane(r2, a, inv_a, four_a2);
-                        let df = bb * (d[0] * fxj[j] + d[1] * fyj[j] + d[2] * fzj[j]);
-                        acc[0][l] += aa * fxj[j] + df * d[0];
-                        acc[1][l] += aa * fyj[j] + df * d[1];
-                        acc[2][l] += aa * fzj[j] + df * d[2];
-                        let dg = bb * (d[0] * fi[0] + d[1] * fi[1] + d[2] * fi[2]);
-                        tj[0][j] += aa * fi[0] + dg * d[0];
-                        tj[1][j] += aa * fi[1] + dg * d[1];
-                        tj[2][j] += aa * fi[2] + dg * d[2];
-                    }
-                }
-            }
-            let row = acc.map(|c| {
-                let mut s = [0.0; L / 2];
-                for l in 0..L / 2 {
-                    s[l] = c[l] + c[l + L / 2];
-                }
-                (s[0] + s[2]) + (s[1] + s[3])
-            });
-            ux[i] += row[0];
-            uy[i] += row[1];
-            uz[i] += row[2];
-        }
-        if bi != bj {
-            for j in 0..BLOCK {
-                ux[j0 + j] += tj[0][j];
-                uy[j0 + j] += tj[1][j];
-                uz[j0 + j] += tj[2][j];
-            }
-        }
     }
 
     fn load_forces(&mut self, f: &[[f64; 3]]) {
@@ -412,8 +258,18 @@ impl DirectRpy {
             )));
         }
         crate::params::check_lanczos(&params)?;
+        let zeros = vec![0.0; n];
         Ok(Self {
-            kernel: Kernel::new(n, radii, eta),
+            kernel: Kernel {
+                eta,
+                radii,
+                x: zeros.clone(),
+                y: zeros.clone(),
+                z: zeros.clone(),
+                fx: zeros.clone(),
+                fy: zeros.clone(),
+                fz: zeros,
+            },
             lanczos: Lanczos::default(),
             params,
             noise: vec![[0.0; 3]; n],
@@ -525,13 +381,7 @@ impl Mobility for DirectRpy {
             Radii::Equal(_) => 0,
             Radii::Each(r) => 8 * r.len(),
         };
-        let k = &self.kernel;
-        6 * 8 * k.x.len()
-            + 8 * k.partial.len()
-            + 8 * k.tiles.len()
-            + 2 * 24 * n
-            + radii
-            + self.lanczos.bytes()
+        6 * 8 * n + 2 * 24 * n + radii + self.lanczos.bytes()
     }
 }
 
@@ -716,24 +566,6 @@ mod tests {
                 }
             }
         }
-    }
-
-    #[test]
-    fn symmetric_tiles_equal_the_pair_formulas() {
-        // 150 equal spheres: three tiles per row (the last one padded), dense enough for
-        // overlaps; every pair is evaluated once and used for both rows.
-        let n = 150;
-        let pos = config(n, 7.0, 5);
-        let (a, eta) = (0.5, 1.3);
-        let mut m = DirectRpy::new(n, a, eta, LanczosParams::default(), 1000).unwrap();
-        m.set_positions(&pos).unwrap();
-        let got = dense_matrix(&mut m);
-        let want = reference(&pos, &vec![a; n], eta);
-        let scale = 1.0 / (6.0 * PI * eta * a);
-        for (g, w) in got.iter().zip(&want) {
-            assert!((g - w).abs() < 1e-14 * scale, "{g} vs {w}");
-        }
-        assert!(want.iter().filter(|w| w.abs() > 0.5 * scale).count() > 3 * n);
     }
 
     #[test]
