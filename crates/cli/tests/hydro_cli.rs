@@ -1,6 +1,8 @@
 //! End-to-end tests of `colloidsim run` with hydrodynamics: droplets with RPY (direct and PSE)
-//! and the bulk method `bd` restart bitwise after an interrupt or a kill, and a Lanczos square
-//! root that does not converge stops the run through the failure path, naming the step.
+//! restart bitwise after an interrupt or a kill (checked to fail when the checkpoint rounds the
+//! positions to single precision), a Lanczos square root that does not converge stops the run
+//! through the failure path, naming the step, and bad `[hydrodynamics]` input is refused before
+//! anything is written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
