@@ -210,3 +210,78 @@ fn bad_hydrodynamics_are_refused_before_anything_is_written() {
         assert!(!out.exists(), "{change}: the output folder was created");
     }
 }
+
+/// A static droplet (`drying.peclet = 0`) with RPY: the radius stays R0, and the mean of the
+/// profiles after the start is written with its standard error; Pe < 0, and Pe = 0 with a final
+/// volume fraction (never reached), are refused naming the key.
+const STATIC: &str = r#"
+method = "droplet-bd"
+seed = 2
+[system]
+particles = 64
+phi0 = 0.2
+[drying]
+peclet = 0
+duration = 4.0
+[run]
+dt = 1.885e-3
+[observe]
+profile = { bins = 8, fractions = [0, 0.25, 0.5, 0.75, 1.0] }
+[hydrodynamics]
+model = "rpy"
+"#;
+
+#[test]
+fn a_static_droplet_with_rpy_keeps_its_radius_and_writes_the_mean_profile() {
+    let (_tmp, _sc, a) = complete("static", STATIC);
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("summary.json")).unwrap()).unwrap();
+    let par = &summary["parameters"];
+    assert_eq!(par["hydrodynamics"]["method"], "direct");
+    assert_eq!(summary["final_radius"], par["r0"]);
+    assert_eq!(par["r_end"], par["r0"]);
+    let mean = std::fs::read_to_string(a.join("profile_mean.csv")).unwrap();
+    let mut lines = mean.lines();
+    assert_eq!(lines.next(), Some("r,phi,err"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 8);
+    assert!(
+        rows.iter()
+            .all(|r| r[1] >= 0.0 && r[2].is_finite() && r[2] >= 0.0)
+    );
+    // The mean of the four later profiles, bin by bin.
+    let later: Vec<Vec<f64>> = ["0.25", "0.50", "0.75", "1.00"]
+        .iter()
+        .map(|f| {
+            std::fs::read_to_string(a.join(format!("profile_{f}.csv")))
+                .unwrap()
+                .lines()
+                .skip(1)
+                .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+                .collect()
+        })
+        .collect();
+    for (b, r) in rows.iter().enumerate() {
+        let m = later.iter().map(|p| p[b]).sum::<f64>() / 4.0;
+        assert!((r[1] - m).abs() < 1e-12, "bin {b}: {} vs {m}", r[1]);
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    for (change, key) in [
+        ("peclet = -1", "drying.peclet"),
+        (
+            "peclet = 0\nfinal_volume_fraction = 0.3",
+            "drying.final_volume_fraction",
+        ),
+    ] {
+        let text_ = STATIC.replace("peclet = 0\nduration = 4.0", change);
+        let sc = tmp.path().join("bad.toml");
+        std::fs::write(&sc, &text_).unwrap();
+        let out = tmp.path().join("never");
+        let o = run(&[p("run"), &sc, p("--out"), &out], &[]);
+        assert!(!o.status.success());
+        assert!(text(&o).contains(key), "{change}: {}", text(&o));
+        assert!(!out.exists());
+    }
+}
