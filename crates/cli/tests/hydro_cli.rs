@@ -41,7 +41,8 @@ model = "rpy"
 method = "direct"
 "#;
 
-/// 100 colloids with RPY by PSE in a box of two droplet diameters, 50 steps.
+/// 100 colloids with RPY by PSE in a box of two droplet diameters, 100 steps (main refuses
+/// fewer than 100 drying steps).
 const PSE: &str = r#"
 method = "droplet-bd"
 seed = 5
@@ -50,7 +51,7 @@ particles = 100
 phi0 = 0.05
 [drying]
 peclet = 10
-duration = 0.2
+duration = 0.4
 [run]
 dt = 0.004
 [observe]
