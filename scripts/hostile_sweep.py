@@ -48,7 +48,7 @@ for ex in examples:
                 tally[(cmd[0], str(rc))] = tally.get((cmd[0], str(rc)), 0) + 1
                 bad = rc not in (0, 1)
                 warn = rc == 0 and "warning" in (p.stderr if rc != "timeout" else "")
-                if bad or (cmd[0] == "run" and rc == 0):
+                if bad or cmd[0] == "run":
                     results.append((tag, cmd[0], rc, err[0][:200]))
                     print(tag, cmd[0], rc, err[0][:160], flush=True)
                 if rc != 0: break  # check refused: do not run

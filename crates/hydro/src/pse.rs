@@ -368,11 +368,24 @@ impl std::fmt::Debug for Pse {
     }
 }
 
-impl Pse {
-    /// Set up for `n` spheres: choose the grid and cut-offs, tabulate the real-space
-    /// functions, plan the FFTs. Errors name the scenario key at fault.
-    pub fn new(n: usize, params: PseParams) -> Result<Self, HydroError> {
-        let p = params;
+impl PseGeometry {
+    /// Choose the grid and cut-offs for `params` (everything [`Pse::new`] checks, without
+    /// allocating the grids): errors name the scenario key at fault.
+    pub fn new(params: &PseParams) -> Result<Self, HydroError> {
+        Ok(Self::with_table(params)?.0)
+    }
+
+    /// Bytes of the grids and spectra a [`Pse`] of this geometry holds (three real grids,
+    /// four half spectra of complex numbers, the kernel), besides about 0.3 kB per particle.
+    pub fn grid_bytes(&self) -> usize {
+        let g = self.grid;
+        let half = g * g * (g / 2 + 1);
+        8 * (3 * g * g * g + half) + 16 * 4 * half
+    }
+
+    /// The geometry, the tabulated wave-space functions and the real-space self term.
+    fn with_table(params: &PseParams) -> Result<(Self, WaveTable, f64), HydroError> {
+        let p = *params;
         colloidsim_core::param::positive("system.diameter", p.radius)?;
         colloidsim_core::param::positive("system.viscosity", p.viscosity)?;
         colloidsim_core::param::positive("system.box_length", p.box_length)?;
@@ -468,6 +481,19 @@ impl Pse {
             r_cut,
             gaussian_fraction: frac,
         };
+        Ok((geom, table, self_real))
+    }
+}
+
+impl Pse {
+    /// Set up for `n` spheres: choose the grid and cut-offs ([`PseGeometry::new`]), tabulate the
+    /// real-space functions, plan the FFTs. Errors name the scenario key at fault.
+    pub fn new(n: usize, params: PseParams) -> Result<Self, HydroError> {
+        let p = params;
+        let (geom, table, self_real) = PseGeometry::with_table(&p)?;
+        let (a, xi, l) = (p.radius, p.splitting, p.box_length);
+        let mu0 = 1.0 / (6.0 * PI * p.viscosity * a);
+        let (grid, sigma, pts, r_cut) = (geom.grid, geom.sigma, geom.support, geom.r_cut);
         let fft = Fft3::new(grid);
         let nh = grid / 2 + 1;
         let kvec: Vec<Option<f64>> = (0..grid)

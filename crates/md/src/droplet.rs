@@ -17,7 +17,8 @@ use colloidsim_core::ParamError;
 use colloidsim_core::param::{at_least, in_range, positive};
 use colloidsim_hydro::direct::DEFAULT_MAX_DIRECT;
 use colloidsim_hydro::{
-    AnyMobility, DirectRpy, FreeDraining, HydroMethod, HydroModel, HydroParams, Pse, PseParams,
+    AnyMobility, DirectRpy, FreeDraining, HydroMethod, HydroModel, HydroParams,
+    HydrodynamicsSection, Pse, PseGeometry, PseParams,
 };
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -61,6 +62,9 @@ pub struct DropletScenario {
     /// Observables.
     #[serde(default)]
     pub observe: ObserveSection,
+    /// Hydrodynamic interactions (absent: free draining, the engine of [`DropletSim`]).
+    #[serde(default)]
+    pub hydrodynamics: Option<HydrodynamicsSection>,
 }
 
 fn default_seed() -> u64 {
@@ -100,11 +104,13 @@ fn one() -> f64 {
     1.0
 }
 
-/// `[drying]`: `R(t) = sqrt(R0^2 - alpha t / (4 pi))`.
+/// `[drying]`: `R(t) = sqrt(R0^2 - alpha t / (4 pi))`. `peclet = 0` with `duration`: a static
+/// droplet (fixed R = R0), for equilibrium profiles.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DryingSection {
-    /// Peclet number `Pe = R |dR/dt| / D0` (default 10); give this or `alpha`.
+    /// Peclet number `Pe = R |dR/dt| / D0` (default 10; 0: a static droplet); give this or
+    /// `alpha`.
     #[serde(default)]
     pub peclet: Option<f64>,
     /// Rate of loss of surface area `alpha = -dA/dt` (length^2 / time); give this or `peclet`.
@@ -157,6 +163,19 @@ pub struct ObserveSection {
     /// GSD trajectory of the first replica.
     #[serde(default)]
     pub trajectory: TrajectorySection,
+    /// Cross-section of the first replica's last frame: a slab through the centre.
+    #[serde(default)]
+    pub cross_section: Option<CrossSectionSection>,
+}
+
+/// `[observe.cross_section]`: the particles of replica 0's last frame whose centres lie in the
+/// slab `|z| < width / 2` through the droplet's centre (`cross_section.csv`, `.png`).
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CrossSectionSection {
+    /// Slab thickness (length; default d).
+    #[serde(default)]
+    pub width: Option<f64>,
 }
 
 /// `[observe.profile]`.
@@ -251,6 +270,16 @@ pub struct DropletParams {
     pub trajectory_every: u64,
     /// Initial configuration file, if any.
     pub initial: Option<PathBuf>,
+    /// Hydrodynamics, when the scenario has a `[hydrodynamics]` table (otherwise free draining
+    /// by [`DropletSim`], and the key is absent from the resolved parameters).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hydrodynamics: Option<HydroParams>,
+    /// Grid and cut-offs of PSE (`hydrodynamics.method = "pse"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pse: Option<PseGeometry>,
+    /// Slab thickness of the cross-section of replica 0's last frame (`observe.cross_section`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cross_section: Option<f64>,
 }
 
 impl DropletParams {
@@ -264,6 +293,19 @@ impl DropletParams {
     /// Mean volume fraction `N d^3 / (8 R^3)` at radius `r`.
     pub fn volume_fraction_at_radius(&self, r: f64) -> f64 {
         self.particles as f64 * self.diameter.powi(3) / (8.0 * r.powi(3))
+    }
+
+    /// A static droplet (`drying.peclet = 0`): the radius stays R0.
+    pub fn is_static(&self) -> bool {
+        self.alpha == 0.0
+    }
+
+    /// Does a replica run with a hydrodynamic mobility ([`Self::build_hydro_replica`]), rather
+    /// than the free-draining engine ([`Self::build_replica`])?
+    pub fn has_hydrodynamics(&self) -> bool {
+        self.hydrodynamics
+            .as_ref()
+            .is_some_and(|h| h.model == HydroModel::Rpy)
     }
 }
 
@@ -377,10 +419,29 @@ impl DropletScenario {
                 (a / (8.0 * PI * d0), a)
             }
             (pe, None) => {
-                let pe = positive("drying.peclet", pe.unwrap_or(10.0))?;
+                let pe = pe.unwrap_or(10.0);
+                if !(pe.is_finite() && pe >= 0.0) {
+                    return Err(ParamError::new(
+                        "drying.peclet",
+                        format!("must be a finite number >= 0 (0: a static droplet), got {pe}"),
+                    ));
+                }
                 (pe, 8.0 * PI * pe * d0)
             }
         };
+        let fixed = alpha == 0.0;
+        if fixed && dr.duration.is_none() {
+            let key = if dr.final_volume_fraction.is_some() {
+                "drying.final_volume_fraction"
+            } else {
+                "drying.duration"
+            };
+            return Err(ParamError::new(
+                key,
+                "a static droplet (drying.peclet = 0) keeps its volume fraction: give drying.duration \
+                 (the time to run) instead of drying.final_volume_fraction",
+            ));
+        }
         // R(t)^2 = R0^2 - alpha t / (4 pi).
         let t_dry = 4.0 * PI * r0 * r0 / alpha; // time at which R^2 = 0
         let (t_end, r_end) = match (dr.final_volume_fraction, dr.duration) {
@@ -518,6 +579,12 @@ impl DropletScenario {
             5.0 * d,
         )?;
 
+        let hydrodynamics = self
+            .hydrodynamics
+            .as_ref()
+            .map(|h| h.validate(particles, 0.5 * d, false))
+            .transpose()?;
+
         let p = &self.observe.profile;
         let bins = at_least("observe.profile.bins", p.bins, 1)?;
         if p.fractions.is_empty() {
@@ -534,8 +601,21 @@ impl DropletScenario {
             .iter()
             .map(|f| (f * steps as f64).round() as u64)
             .collect();
+        let cross_section = self
+            .observe
+            .cross_section
+            .as_ref()
+            .map(|c| {
+                in_range(
+                    "observe.cross_section.width",
+                    c.width.unwrap_or(d),
+                    1e-3 * d,
+                    2.0 * r0,
+                )
+            })
+            .transpose()?;
 
-        let params = DropletParams {
+        let mut params = DropletParams {
             seed,
             replicas,
             particles,
@@ -562,6 +642,9 @@ impl DropletScenario {
             profile_steps,
             trajectory_every: self.observe.trajectory.every,
             initial: s.initial.clone(),
+            hydrodynamics,
+            pse: None,
+            cross_section,
         };
         // Memory before anything is allocated: about 400 B per particle (state, lists,
         // copies), 24 B per neighbour cell of the box, the profile sums.
@@ -573,6 +656,7 @@ impl DropletScenario {
             &format!("{particles} colloids in a box of {cells:.3e} neighbour cells"),
             bytes,
         )?;
+        params.pse = params.check_hydrodynamics()?;
         Ok(params)
     }
 }
@@ -654,6 +738,80 @@ final_volume_fraction = 0.5
         assert_eq!(
             err_key(&PAPER.replace("[drying]", "[run]\ndt = 0\n[drying]")),
             "run.dt"
+        );
+    }
+
+    #[test]
+    fn a_static_droplet_keeps_its_radius_and_needs_a_duration() {
+        let text = PAPER.replace(
+            "peclet = 10\nfinal_volume_fraction = 0.5",
+            "peclet = 0\nduration = 50.0",
+        );
+        let p = DropletScenario::from_toml(&text)
+            .unwrap()
+            .validate()
+            .unwrap();
+        assert!(p.is_static() && p.alpha == 0.0);
+        assert_eq!(p.radius_at(p.t_end), p.r0);
+        assert_eq!((p.r_end, p.phi_end), (p.r0, p.phi0));
+        assert_eq!(p.steps, (50.0 / p.dt).ceil() as u64);
+        assert!(p.interface().radius.radius(40.0) == p.r0);
+        // Pe = 0 cannot reach a final volume fraction.
+        assert_eq!(
+            err_key(&PAPER.replace("peclet = 10", "peclet = 0")),
+            "drying.final_volume_fraction"
+        );
+        assert_eq!(
+            err_key(&PAPER.replace("peclet = 10\nfinal_volume_fraction = 0.5", "peclet = 0")),
+            "drying.duration"
+        );
+    }
+
+    #[test]
+    fn hydrodynamics_are_checked_against_the_droplet() {
+        let with = |h: &str| format!("{PAPER}[hydrodynamics]\n{h}\n");
+        let p = DropletScenario::from_toml(&with("model = \"rpy\""))
+            .unwrap()
+            .validate()
+            .unwrap();
+        // 6250 particles: PSE by default, in a box of two droplet diameters.
+        let h = p.hydrodynamics.as_ref().unwrap();
+        assert_eq!(h.method, Some(HydroMethod::Pse));
+        assert!(p.has_hydrodynamics());
+        let g = p.pse.unwrap();
+        assert!((g.spacing * g.grid as f64 - 4.0 * p.r0).abs() < 1e-9);
+        // Free draining named explicitly: the free-draining engine.
+        let p = DropletScenario::from_toml(&with("model = \"free-draining\""))
+            .unwrap()
+            .validate()
+            .unwrap();
+        assert!(!p.has_hydrodynamics() && p.pse.is_none());
+        // A box too small for the droplet, a splitting whose cut-off exceeds half the box.
+        assert_eq!(
+            err_key(
+                &with("model = \"rpy\"\nmethod = \"pse\"\nbox_factor = 1.2").replace("6250", "300")
+            ),
+            "hydrodynamics.box_factor"
+        );
+        assert_eq!(
+            err_key(&with("model = \"rpy\"\nmethod = \"pse\"\nsplitting = 0.02")),
+            "hydrodynamics.splitting"
+        );
+        assert_eq!(
+            err_key(&with("model = \"rpy\"\ntolerance = 0.5")),
+            "hydrodynamics.tolerance"
+        );
+        // Too many particles for the direct method: refused, suggesting PSE with its memory.
+        let big = with("model = \"rpy\"\nmethod = \"direct\"").replace("6250", "30000");
+        let e = DropletScenario::from_toml(&big)
+            .unwrap()
+            .validate()
+            .unwrap_err();
+        assert_eq!(e.key, "hydrodynamics.method");
+        let m = e.to_string();
+        assert!(
+            m.contains("at most 20000") && m.contains("\"pse\"") && m.contains("GiB"),
+            "{m}"
         );
     }
 }
@@ -815,6 +973,74 @@ impl DropletParams {
         Ok(l)
     }
 
+    /// The PSE parameters of a periodic box of edge `l` with the settings of `hydro`.
+    fn pse_params(&self, hydro: &HydroParams, l: f64) -> PseParams {
+        PseParams {
+            radius: 0.5 * self.diameter,
+            viscosity: self.viscosity,
+            box_length: l,
+            splitting: hydro.splitting,
+            tolerance: hydro.tolerance,
+            max_iterations: hydro.max_iterations,
+        }
+    }
+
+    /// Check that the hydrodynamics fit the droplet before anything is built: the direct
+    /// method's particle limit (the error suggests PSE with the memory it would need) and, for
+    /// PSE, the box ([`Self::hydro_box_edge`]) and its grid and cut-offs ([`PseGeometry`],
+    /// returned).
+    fn check_hydrodynamics(&self) -> Result<Option<PseGeometry>, ParamError> {
+        let Some(h) = self
+            .hydrodynamics
+            .as_ref()
+            .filter(|h| h.model == HydroModel::Rpy)
+        else {
+            return Ok(None);
+        };
+        let as_param = |e: colloidsim_hydro::HydroError| match e {
+            colloidsim_hydro::HydroError::Param(p) => p,
+            other => ParamError::new("hydrodynamics", other.to_string()),
+        };
+        match h.method {
+            Some(HydroMethod::Pse) => {
+                let l = self.hydro_box_edge(h)?;
+                PseGeometry::new(&self.pse_params(h, l))
+                    .map(Some)
+                    .map_err(as_param)
+            }
+            _ => {
+                let n = self.particles;
+                if n <= DEFAULT_MAX_DIRECT {
+                    return Ok(None);
+                }
+                let nf = n as f64;
+                let gib = |b: f64| b / (1u64 << 30) as f64;
+                let pse = h.box_factor * 2.0 * self.r0;
+                let alternative = PseGeometry::new(&self.pse_params(h, pse))
+                    .map(|g| {
+                        format!(
+                            "; method = \"pse\" (a periodic box of box_factor = {} droplet diameters, \
+                             O(N log N)) would need a {}^3 grid, about {:.2} GiB",
+                            h.box_factor,
+                            g.grid,
+                            gib(g.grid_bytes() as f64 + 4.1e3 * nf)
+                        )
+                    })
+                    .unwrap_or_else(|e| format!("; method = \"pse\" is the alternative ({e})"));
+                Err(ParamError::new(
+                    "hydrodynamics.method",
+                    format!(
+                        "\"direct\" takes at most {DEFAULT_MAX_DIRECT} particles, got {n}: each product \
+                         costs N^2 = {:.2e} pair tensors (about 8 per step), and a stored 3N x 3N matrix \
+                         would need {:.1} GiB{alternative}",
+                        nf * nf,
+                        gib(72.0 * nf * nf)
+                    ),
+                ))
+            }
+        }
+    }
+
     /// Set up replica `replica` at step 0 with the mobility of `hydro` (free draining, RPY by
     /// direct free-space sums, or RPY by PSE in a periodic box of `box_factor` droplet
     /// diameters), noise keyed by the replica.
@@ -823,33 +1049,6 @@ impl DropletParams {
         replica: u32,
         hydro: &HydroParams,
     ) -> Result<HydroDropletSim, DropletError> {
-        let l = self.hydro_box_edge(hydro)?;
-        let particles = self.initial_particles(replica)?;
-        let n = particles.len();
-        let a = 0.5 * self.diameter;
-        let mobility = match (hydro.model, hydro.method) {
-            (HydroModel::FreeDraining, _) => AnyMobility::FreeDraining(
-                FreeDraining::new(&vec![a; n], self.viscosity).map_err(HydroBdError::from)?,
-            ),
-            (HydroModel::Rpy, Some(HydroMethod::Pse)) => AnyMobility::Pse(Box::new(
-                Pse::new(
-                    n,
-                    PseParams {
-                        radius: a,
-                        viscosity: self.viscosity,
-                        box_length: l,
-                        splitting: hydro.splitting,
-                        tolerance: hydro.tolerance,
-                        max_iterations: hydro.max_iterations,
-                    },
-                )
-                .map_err(HydroBdError::from)?,
-            )),
-            (HydroModel::Rpy, _) => AnyMobility::Direct(Box::new(
-                DirectRpy::new(n, a, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)
-                    .map_err(HydroBdError::from)?,
-            )),
-        };
         let params = HydroBdParams {
             kt: self.kt,
             dt: self.dt,
@@ -858,6 +1057,34 @@ impl DropletParams {
             skin: self.skin,
             max_drift: 0.2,
         };
+        self.restart_hydro_replica(self.initial_particles(replica)?, hydro, params, 0)
+    }
+
+    /// A replica with hydrodynamics at `step` from its particles (positions and image counts,
+    /// in input order: the whole state of [`HydroBrownian`]) and integrator parameters; it
+    /// continues bitwise as the run that saved them.
+    pub fn restart_hydro_replica(
+        &self,
+        particles: Particles,
+        hydro: &HydroParams,
+        params: HydroBdParams,
+        step: u64,
+    ) -> Result<HydroDropletSim, DropletError> {
+        let l = self.hydro_box_edge(hydro)?;
+        let n = particles.len();
+        let a = 0.5 * self.diameter;
+        let mobility = match (hydro.model, hydro.method) {
+            (HydroModel::FreeDraining, _) => AnyMobility::FreeDraining(
+                FreeDraining::new(&vec![a; n], self.viscosity).map_err(HydroBdError::from)?,
+            ),
+            (HydroModel::Rpy, Some(HydroMethod::Pse)) => AnyMobility::Pse(Box::new(
+                Pse::new(n, self.pse_params(hydro, l)).map_err(HydroBdError::from)?,
+            )),
+            (HydroModel::Rpy, _) => AnyMobility::Direct(Box::new(
+                DirectRpy::new(n, a, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)
+                    .map_err(HydroBdError::from)?,
+            )),
+        };
         Ok(HydroBrownian::new(
             particles,
             SimBox::cube(l),
@@ -865,7 +1092,7 @@ impl DropletParams {
             self.interface(),
             mobility,
             params,
-            0,
+            step,
         )?)
     }
 }

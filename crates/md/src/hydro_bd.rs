@@ -198,13 +198,31 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
         self.last_iterations
     }
 
+    /// Neighbour-list builds so far.
+    pub fn neighbor_builds(&self) -> u64 {
+        self.nlist.builds()
+    }
+
     /// Forces on the particles at the current positions and time (into the engine's buffer).
     fn compute_forces(&mut self) {
+        let mut f = std::mem::take(&mut self.forces);
+        self.forces_into(&mut f);
+        self.forces = f;
+    }
+
+    /// The systematic (pair and external) forces at the current positions and time, in input
+    /// order, without touching the engine's buffers.
+    pub fn systematic_forces(&self) -> Vec<[f64; 3]> {
+        let mut f = vec![[0.0; 3]; self.particles.len()];
+        self.forces_into(&mut f);
+        f
+    }
+
+    fn forces_into(&self, out: &mut [[f64; 3]]) {
         let t = self.time();
         let p = &self.particles;
         let (pair, external, sbox, nlist) = (&self.pair, &self.external, &self.sbox, &self.nlist);
-        self.forces
-            .par_iter_mut()
+        out.par_iter_mut()
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, f)| {

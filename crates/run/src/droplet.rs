@@ -1,22 +1,25 @@
-//! The drying droplet (`method = "droplet-bd"`): free-draining Brownian dynamics of WCA
-//! spheres in a shrinking harmonic interface, replicas one after the other, radial
-//! volume-fraction profiles at fractions of the drying time; `theory` is the radial FMT DDFT
-//! ([`crate::theory_droplet`]).
+//! The drying droplet (`method = "droplet-bd"`): Brownian dynamics of WCA spheres in a
+//! shrinking (or, with `drying.peclet = 0`, static) harmonic interface, free draining by the
+//! free-draining engine or with RPY hydrodynamics (`[hydrodynamics]`: direct free-space sums or
+//! PSE in a periodic box), replicas one after the other, radial volume-fraction profiles at
+//! fractions of the drying time; `theory` is the radial FMT DDFT ([`crate::theory_droplet`]).
 
 use crate::checkpoint::{Envelope, file_crc};
 use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, picture};
+use crate::plot::{Disc, Scale, Series, cross_section, line_plot, picture};
 use crate::theory_droplet::profile_name;
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::droplet::DropletSim;
+use colloidsim_md::droplet::{DropletSim, HydroDropletSim};
 use colloidsim_md::gsd::{self, GsdWriter};
-use colloidsim_md::{BdParams, DropletParams, DropletScenario, LennardJones};
+use colloidsim_md::{
+    BdParams, DropletParams, DropletScenario, HydroBdParams, LennardJones, Particles, SimBox,
+};
 use hoomd_gsd::file_layer::Mode;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -48,7 +51,7 @@ impl Method for DropletBd {
     }
 
     fn about(&self) -> &'static str {
-        "a drying droplet of hard-sphere colloids, free-draining Brownian dynamics, beside its FMT DDFT"
+        "a drying (or static) droplet of hard-sphere colloids, Brownian dynamics free draining or with RPY hydrodynamics, beside its FMT DDFT"
     }
 
     fn docs(&self) -> &'static str {
@@ -68,7 +71,7 @@ impl Method for DropletBd {
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
         let (_, p) = resolve(src, seed)?;
         // Set up replica 0 before the output folder is created: bad input leaves nothing.
-        let sim = p.build_replica(0)?;
+        let sim = Replica::build(&p, 0)?;
         let acc = Accum::new(&p);
         Ok(Box::new(DropletSession::new(p, acc, 0, Some((sim, 0)))))
     }
@@ -125,7 +128,7 @@ impl Method for DropletBd {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let (_, p) = resolve(src, seed)?;
-        let sim = p.build_replica(0)?;
+        let sim = Replica::build(&p, 0)?;
         Ok(Box::new(BdEngine { sim }))
     }
 }
@@ -189,18 +192,47 @@ struct Engine {
 }
 
 impl Engine {
-    fn of(s: &DropletSim, builds: u64) -> Self {
-        let b = s.params();
-        Self {
-            kt: b.kt,
-            viscosity: b.viscosity,
-            dt: b.dt,
-            seed: b.seed,
-            replica: b.replica,
-            skin: b.skin,
-            sort_every: b.sort_every,
-            max_drift: b.max_drift,
-            builds,
+    fn of(s: &Replica, builds: u64) -> Self {
+        match s {
+            Replica::Free(s) => {
+                let b = s.params();
+                Self {
+                    kt: b.kt,
+                    viscosity: b.viscosity,
+                    dt: b.dt,
+                    seed: b.seed,
+                    replica: b.replica,
+                    skin: b.skin,
+                    sort_every: b.sort_every,
+                    max_drift: b.max_drift,
+                    builds,
+                }
+            }
+            Replica::Hydro(s) => {
+                let b = s.params();
+                Self {
+                    kt: b.kt,
+                    viscosity: 0.0,
+                    dt: b.dt,
+                    seed: b.seed,
+                    replica: b.replica,
+                    skin: b.skin,
+                    sort_every: 0,
+                    max_drift: b.max_drift,
+                    builds,
+                }
+            }
+        }
+    }
+
+    fn hydro_params(&self) -> HydroBdParams {
+        HydroBdParams {
+            kt: self.kt,
+            dt: self.dt,
+            seed: self.seed,
+            replica: self.replica,
+            skin: self.skin,
+            max_drift: self.max_drift,
         }
     }
 
@@ -238,7 +270,7 @@ fn restore_replica(
     out: &OutputDir,
     p: &DropletParams,
     saved: &Saved,
-) -> Result<Option<(DropletSim, u64)>> {
+) -> Result<Option<(Replica, u64)>> {
     let Some((name, crc, engine)) = &saved.state else {
         return Ok(None);
     };
@@ -250,10 +282,13 @@ fn restore_replica(
             path.display()
         );
     }
-    let f = gsd::read_frame(&path, None)?;
+    let mut f = gsd::read_frame(&path, None)?;
+    // The hydrodynamic engine's state is its exact positions and images; the free-draining
+    // engine's also holds its storage order and list reference positions.
+    let hydro = p.hydrodynamics.as_ref().filter(|_| p.has_hydrodynamics());
     if f.step != saved.step
         || !f.exact
-        || f.list.is_none()
+        || f.list.is_none() != hydro.is_some()
         || engine.replica as usize != saved.replica
     {
         bail!(
@@ -263,19 +298,130 @@ fn restore_replica(
             saved.step
         );
     }
-    let sim = DropletSim::restart(
-        f.particles,
-        f.sbox,
-        LennardJones::wca(p.kt, p.diameter),
-        p.interface(),
-        engine.params(),
-        f.step,
-        f.list.as_ref(),
-    )
-    .with_context(|| format!("restart from {}", path.display()))?;
+    // GSD stores diameters in single precision: every colloid has the scenario's.
+    f.particles.diameter.fill(p.diameter);
+    let sim = match hydro {
+        None => Replica::Free(Box::new(
+            DropletSim::restart(
+                f.particles,
+                f.sbox,
+                LennardJones::wca(p.kt, p.diameter),
+                p.interface(),
+                engine.params(),
+                f.step,
+                f.list.as_ref(),
+            )
+            .with_context(|| format!("restart from {}", path.display()))?,
+        )),
+        Some(h) => Replica::hydro(
+            p.restart_hydro_replica(f.particles, h, engine.hydro_params(), f.step)
+                .with_context(|| format!("restart from {}", path.display()))?,
+        ),
+    };
     // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
     let builds = engine.builds.saturating_sub(sim.neighbor_builds());
     Ok(Some((sim, builds)))
+}
+
+/// A running droplet replica: the free-draining engine (bitwise the engine of every
+/// free-draining run), or Brownian dynamics with a hydrodynamic mobility.
+enum Replica {
+    Free(Box<DropletSim>),
+    Hydro(Box<HydroDropletSim>),
+}
+
+impl Replica {
+    /// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
+    fn build(p: &DropletParams, replica: u32) -> Result<Self> {
+        Ok(match &p.hydrodynamics {
+            Some(h) if p.has_hydrodynamics() => Self::hydro(p.build_hydro_replica(replica, h)?),
+            _ => Self::Free(Box::new(p.build_replica(replica)?)),
+        })
+    }
+
+    fn hydro(s: HydroDropletSim) -> Self {
+        Self::Hydro(Box::new(s))
+    }
+
+    fn step(&self) -> u64 {
+        match self {
+            Self::Free(s) => s.step,
+            Self::Hydro(s) => s.step,
+        }
+    }
+
+    fn time(&self) -> f64 {
+        match self {
+            Self::Free(s) => s.time(),
+            Self::Hydro(s) => s.time(),
+        }
+    }
+
+    fn dt(&self) -> f64 {
+        match self {
+            Self::Free(s) => s.params().dt,
+            Self::Hydro(s) => s.params().dt,
+        }
+    }
+
+    fn sbox(&self) -> &SimBox {
+        match self {
+            Self::Free(s) => &s.sbox,
+            Self::Hydro(s) => &s.sbox,
+        }
+    }
+
+    /// The particles in the engine's order (for profiles, where the order does not matter).
+    fn particles(&self) -> &Particles {
+        match self {
+            Self::Free(s) => s.particles(),
+            Self::Hydro(s) => s.particles(),
+        }
+    }
+
+    /// The particles in input order, positions wrapped into the box.
+    fn snapshot(&self) -> Particles {
+        match self {
+            Self::Free(s) => s.snapshot(),
+            Self::Hydro(s) => s.particles().clone(),
+        }
+    }
+
+    fn neighbor_builds(&self) -> u64 {
+        match self {
+            Self::Free(s) => s.neighbor_builds(),
+            Self::Hydro(s) => s.neighbor_builds(),
+        }
+    }
+
+    /// Run `n` steps; the error says why the run cannot go on.
+    fn run(&mut self, n: u64) -> Result<(), String> {
+        match self {
+            Self::Free(s) => s.run(n).map_err(|e| e.to_string()),
+            Self::Hydro(s) => s.run(n).map_err(|e| e.to_string()),
+        }
+    }
+
+    /// The systematic forces at the current positions, in input order.
+    fn forces(&self) -> Vec<[f64; 3]> {
+        match self {
+            Self::Free(s) => s.forces(),
+            Self::Hydro(s) => s.systematic_forces(),
+        }
+    }
+
+    /// The checkpoint of this replica at its step into a new GSD file at `path`.
+    fn write_checkpoint(&self, path: &Path) -> Result<()> {
+        let mut w = GsdWriter::create_new(path)?;
+        match self {
+            Self::Free(s) => {
+                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?
+            }
+            Self::Hydro(s) => w.write_frame(s.step, &s.sbox, s.particles(), true, &[])?,
+        }
+        w.sync()?;
+        Ok(())
+    }
 }
 
 /// A droplet run: replicas one after the other.
@@ -285,7 +431,7 @@ struct DropletSession {
     /// The running replica (or the next one, when `sim` is `None`).
     rep: usize,
     /// The running replica and its neighbour-list builds before this session.
-    sim: Option<(DropletSim, u64)>,
+    sim: Option<(Replica, u64)>,
     /// Steps of a replica at which something is recorded (profiles, frames, the end).
     stops: Vec<u64>,
     /// Steps between a replica's regular checkpoints.
@@ -293,12 +439,14 @@ struct DropletSession {
     gsd: Option<GsdWriter>,
     /// The trajectory's path, once the folder is known.
     traj: Option<std::path::PathBuf>,
+    /// The output folder, once known (the cross-section is written when replica 0 ends).
+    folder: Option<std::path::PathBuf>,
     /// GSD file the previous checkpoint named, removed once the next one is in place.
     stale: Vec<String>,
 }
 
 impl DropletSession {
-    fn new(p: DropletParams, acc: Accum, rep: usize, sim: Option<(DropletSim, u64)>) -> Self {
+    fn new(p: DropletParams, acc: Accum, rep: usize, sim: Option<(Replica, u64)>) -> Self {
         let mut stops: Vec<u64> = p.profile_steps.clone();
         if p.trajectory_every > 0 {
             stops.extend((0..=p.steps).step_by(p.trajectory_every as usize));
@@ -316,6 +464,7 @@ impl DropletSession {
             ck_every,
             gsd: None,
             traj: None,
+            folder: None,
             stale: Vec::new(),
         }
     }
@@ -371,7 +520,7 @@ impl DropletSession {
         {
             w.write_frame(
                 ev,
-                &s.sbox,
+                s.sbox(),
                 &s.snapshot(),
                 false,
                 &[("droplet/radius", radius), ("droplet/time", t)],
@@ -392,7 +541,7 @@ impl Session for DropletSession {
     }
 
     fn position(&self) -> u64 {
-        self.rep as u64 * self.p.steps + self.sim.as_ref().map_or(0, |(s, _)| s.step)
+        self.rep as u64 * self.p.steps + self.sim.as_ref().map_or(0, |(s, _)| s.step())
     }
 
     fn seed(&self) -> u64 {
@@ -412,6 +561,9 @@ impl Session for DropletSession {
         profile("profile_")
             || [
                 "profiles.png",
+                "profile_mean.csv",
+                "cross_section.csv",
+                "cross_section.png",
                 "trajectory.gsd",
                 "checkpoint-0.gsd",
                 "checkpoint-1.gsd",
@@ -421,6 +573,7 @@ impl Session for DropletSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         self.traj = Some(out.join("trajectory.gsd"));
+        self.folder = Some(out.path().to_path_buf());
         if self.sim.is_some() {
             self.open_trajectory()?;
             if fresh && self.stops.first() == Some(&0) {
@@ -449,7 +602,7 @@ impl Session for DropletSession {
         let steps = self.p.steps;
         while self.position() < until {
             if self.sim.is_none() {
-                self.sim = Some((self.p.build_replica(self.rep as u32)?, 0));
+                self.sim = Some((Replica::build(&self.p, self.rep as u32)?, 0));
                 self.open_trajectory()?;
                 if self.stops.first() == Some(&0) {
                     self.record(0)?;
@@ -457,7 +610,7 @@ impl Session for DropletSession {
             }
             let local_until = until.min((self.rep as u64 + 1) * steps) - self.rep as u64 * steps;
             loop {
-                let step = self.sim.as_ref().map_or(0, |(s, _)| s.step);
+                let step = self.sim.as_ref().map_or(0, |(s, _)| s.step());
                 if step >= local_until {
                     break;
                 }
@@ -476,6 +629,12 @@ impl Session for DropletSession {
                 // The replica is complete.
                 if let Some(mut w) = self.gsd.take() {
                     w.sync()?;
+                }
+                if self.rep == 0
+                    && let (Some(width), Some(out), Some((s, _))) =
+                        (self.p.cross_section, &self.folder, &self.sim)
+                {
+                    write_cross_section(out, &self.p, s, width)?;
                 }
                 let (s, builds0) = self.sim.take().expect("a running replica");
                 self.acc.builds += builds0 + s.neighbor_builds();
@@ -509,10 +668,7 @@ impl Session for DropletSession {
             Some((s, builds)) => {
                 let path = out.join(&name);
                 let _ = std::fs::remove_file(&path);
-                let mut w = GsdWriter::create_new(&path)?;
-                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?;
-                w.sync()?;
-                drop(w);
+                s.write_checkpoint(&path)?;
                 let crc = file_crc(&path)?;
                 Some((name, crc, Engine::of(s, builds + s.neighbor_builds())))
             }
@@ -523,7 +679,7 @@ impl Session for DropletSession {
         };
         let saved = Saved {
             replica: self.rep,
-            step: self.sim.as_ref().map_or(0, |(s, _)| s.step),
+            step: self.sim.as_ref().map_or(0, |(s, _)| s.step()),
             state,
             acc: self.acc.clone(),
         };
@@ -587,13 +743,59 @@ impl Session for DropletSession {
                 points: false,
             })
             .collect();
+        let title = match (p.is_static(), mobility_label(p)) {
+            (false, None) => format!(
+                "Drying droplet, free-draining BD: N = {}, Pe = {}, {} replica(s)",
+                p.particles, p.peclet, p.replicas
+            ),
+            (false, Some(m)) => format!(
+                "Drying droplet, {m}: N = {}, Pe = {}, {} replica(s)",
+                p.particles, p.peclet, p.replicas
+            ),
+            (true, m) => format!(
+                "Static droplet, {}: N = {}, phi = {:.3}, {} replica(s)",
+                m.as_deref().unwrap_or("free-draining BD"),
+                p.particles,
+                p.phi0,
+                p.replicas
+            ),
+        };
+        if p.is_static() {
+            // Every profile after the start samples the same equilibrium: their mean, with the
+            // standard error from their scatter (profiles taken further apart than the
+            // relaxation time are independent).
+            let later: Vec<usize> = (0..drawn.len())
+                .filter(|&k| p.profile_steps[drawn[k]] > 0)
+                .collect();
+            if later.len() >= 2 {
+                let m = later.len() as f64;
+                let bins = means[later[0]].len();
+                let (mut mean, mut err) = (vec![0.0; bins], vec![0.0; bins]);
+                for b in 0..bins {
+                    let v: Vec<f64> = later.iter().map(|&k| means[k][b]).collect();
+                    let mu = v.iter().sum::<f64>() / m;
+                    let var = v.iter().map(|x| (x - mu).powi(2)).sum::<f64>() / (m - 1.0);
+                    mean[b] = mu;
+                    err[b] = (var / m).sqrt();
+                }
+                let r = &r_axes[drawn[later[0]]];
+                out.write_table(
+                    "profile_mean.csv",
+                    &[("r", r), ("phi", &mean), ("err", &err)],
+                )?;
+                files.push("profile_mean.csv".into());
+            }
+        }
+        if p.cross_section.is_some() && out.join("cross_section.csv").exists() {
+            files.push("cross_section.csv".into());
+            if out.join("cross_section.png").exists() {
+                files.push("cross_section.png".into());
+            }
+        }
         picture(
             line_plot(
                 &out.join("profiles.png"),
-                &format!(
-                    "Drying droplet, free-draining BD: N = {}, Pe = {}, {} replica(s)",
-                    p.particles, p.peclet, p.replicas
-                ),
+                &title,
                 "r / R(t)",
                 "volume fraction phi(r)",
                 &series,
@@ -644,6 +846,65 @@ impl Session for DropletSession {
             warnings,
         })
     }
+}
+
+/// What moves the particles, for titles: `None` for free draining.
+fn mobility_label(p: &DropletParams) -> Option<String> {
+    use colloidsim_md::hydro::HydroMethod;
+    let h = p.hydrodynamics.as_ref().filter(|_| p.has_hydrodynamics())?;
+    Some(match h.method {
+        Some(HydroMethod::Pse) => format!("BD + RPY (PSE, box {} droplet diameters)", h.box_factor),
+        _ => "BD + RPY (free space)".to_string(),
+    })
+}
+
+/// The cross-section of a replica at its end: the particles whose centres lie within
+/// `width / 2` of the plane z = 0 through the droplet's centre, as `cross_section.csv`
+/// (columns `x,y,z,r`: centre and distance from the droplet's centre) and `cross_section.png`
+/// (the circles where the slab's mid-plane cuts the spheres, inside the circle of R(t)).
+fn write_cross_section(dir: &Path, p: &DropletParams, s: &Replica, width: f64) -> Result<()> {
+    let out = OutputDir::reopen(dir)?;
+    let radius = p.radius_at(s.time());
+    let a = 0.5 * p.diameter;
+    let snap = s.snapshot();
+    let mut cols: [Vec<f64>; 4] = Default::default();
+    let mut discs = Vec::new();
+    for x in &snap.pos {
+        if x[2].abs() < 0.5 * width {
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            for (c, v) in cols.iter_mut().zip([x[0], x[1], x[2], r]) {
+                c.push(v);
+            }
+            // The section of the sphere by z = 0 (a sphere cut off-centre by the slab still
+            // shows as a small disc).
+            let rc = (a * a - x[2] * x[2]).max(0.04 * a * a).sqrt();
+            discs.push(Disc {
+                x: x[0],
+                y: x[1],
+                r: rc,
+                colour: usize::from(r > radius - p.diameter),
+            });
+        }
+    }
+    out.write_table(
+        "cross_section.csv",
+        &[
+            ("x", &cols[0]),
+            ("y", &cols[1]),
+            ("z", &cols[2]),
+            ("r", &cols[3]),
+        ],
+    )?;
+    let title = format!(
+        "{}: slab |z| < {} at t = {:.1} (R = {:.2}), replica 0",
+        mobility_label(p).unwrap_or_else(|| "free-draining BD".into()),
+        0.5 * width,
+        s.time(),
+        radius
+    );
+    // A picture that cannot be drawn leaves the table; the run goes on.
+    let _ = cross_section(&out.join("cross_section.png"), &title, &discs, radius);
+    Ok(())
 }
 
 /// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
@@ -710,7 +971,7 @@ pub(crate) fn trim_trajectory(
 
 /// Replica 0 of a droplet scenario, stepped by hand.
 struct BdEngine {
-    sim: DropletSim,
+    sim: Replica,
 }
 
 /// Flatten `[x, y, z]` rows.
@@ -729,16 +990,16 @@ impl crate::Engine for BdEngine {
         self.sim.particles().len()
     }
     fn step(&mut self, steps: u64) -> Result<()> {
-        Ok(self.sim.run(steps)?)
+        self.sim.run(steps).map_err(anyhow::Error::msg)
     }
     fn steps(&self) -> u64 {
-        self.sim.step
+        self.sim.step()
     }
     fn time(&self) -> f64 {
         self.sim.time()
     }
     fn dt(&self) -> f64 {
-        self.sim.params().dt
+        self.sim.dt()
     }
     fn positions(&self) -> Vec<f64> {
         flat(&self.sim.snapshot().pos)
@@ -750,6 +1011,6 @@ impl crate::Engine for BdEngine {
         Ok(flat(&self.sim.forces()))
     }
     fn box_lengths(&self) -> Vec<f64> {
-        self.sim.sbox.l.to_vec()
+        self.sim.sbox().l.to_vec()
     }
 }

@@ -591,7 +591,7 @@ pub static DROPLET: &[Spec] = &[
         "-",
         "required",
         OneOf(&["droplet-bd"]),
-        "free-draining Brownian dynamics of a drying droplet",
+        "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics",
     ),
     key(
         "seed",
@@ -673,9 +673,10 @@ pub static DROPLET: &[Spec] = &[
         "drying.peclet",
         "-",
         "10",
-        Positive,
-        "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha",
-    ),
+        NonNegative,
+        "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha. 0: a static droplet (R = R0), for equilibrium profiles",
+    )
+    .also("0 needs drying.duration"),
     key(
         "drying.alpha",
         "length^2 / time",
@@ -774,6 +775,73 @@ pub static DROPLET: &[Spec] = &[
         "0",
         Integer(0, COUNT),
         "steps between frames (0: none)",
+    ),
+    key(
+        "observe.cross_section",
+        "-",
+        "none",
+        Table,
+        "a slab through the centre of replica 0's last frame: cross_section.csv (x,y,z,r) and cross_section.png",
+    ),
+    key(
+        "observe.cross_section.width",
+        "length",
+        "d",
+        Positive,
+        "slab thickness: centres with |z| < width / 2",
+    )
+    .also("in [0.001 d, 2 R0]"),
+    key(
+        "hydrodynamics",
+        "-",
+        "free draining",
+        Table,
+        "hydrodynamic interactions; without this table the free-draining engine runs",
+    ),
+    key(
+        "hydrodynamics.model",
+        "-",
+        "free-draining",
+        OneOf(&["free-draining", "rpy"]),
+        "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
+    ),
+    key(
+        "hydrodynamics.method",
+        "-",
+        "direct up to 2000 particles, pse above",
+        OneOf(&["direct", "pse"]),
+        "RPY in an unbounded fluid by direct O(N^2) sums, or periodic by positively split Ewald",
+    )
+    .also("model = \"rpy\" only; direct: at most 20000 particles"),
+    key(
+        "hydrodynamics.tolerance",
+        "-",
+        "1e-3",
+        LeftOpen(0.0, 0.1),
+        "relative error of the PSE product and of each Lanczos square root",
+    ),
+    key(
+        "hydrodynamics.splitting",
+        "1 / length",
+        "0.5 / a = 1 / d",
+        Positive,
+        "PSE splitting parameter xi",
+    )
+    .also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3"),
+    key(
+        "hydrodynamics.box_factor",
+        "droplet diameters",
+        "2",
+        Closed(1.2, 20.0),
+        "PSE: edge of the periodic box / initial droplet diameter 2 R0 (the paper: 2)",
+    )
+    .also("method = \"pse\" only; the box must hold the droplet, its interface and two neighbour ranges"),
+    key(
+        "hydrodynamics.max_iterations",
+        "-",
+        "200",
+        Integer(1, 1000),
+        "Lanczos iteration limit; reaching it stops the run naming the step",
     ),
 ];
 

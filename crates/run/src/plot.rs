@@ -169,6 +169,90 @@ fn draw_line_plot(
     Ok(())
 }
 
+/// One disc of a cross-section: centre and radius in data units, and which colour (an index
+/// into the palette).
+pub struct Disc {
+    /// Centre.
+    pub x: f64,
+    /// Centre.
+    pub y: f64,
+    /// Radius.
+    pub r: f64,
+    /// Colour index.
+    pub colour: usize,
+}
+
+/// Draw `discs` (e.g. the sections of spheres cut by a slab) inside a circle of radius `outline`
+/// centred on the origin, with equal scales on both axes, into a square PNG at `path`
+/// (600x600 px; drawn under a temporary name and renamed into place).
+pub fn cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.partial.png"));
+    let drawn = draw_cross_section(&tmp, title, discs, outline)
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
+    if drawn.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+}
+
+fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
+    register_font();
+    let reach = discs
+        .iter()
+        .map(|d| d.x.abs().max(d.y.abs()) + d.r)
+        .fold(outline, f64::max);
+    if !(reach.is_finite() && reach > 0.0) {
+        return Err(anyhow!("no finite data to draw"));
+    }
+    let e = |e| anyhow!("plot: {e}");
+    let lim = 1.05 * reach;
+    let root = BitMapBackend::new(path, (600, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(-lim..lim, -lim..lim)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x")
+        .y_desc("y")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(e)?;
+    let ring = |x: f64, y: f64, r: f64, k: usize| -> Vec<(f64, f64)> {
+        (0..k)
+            .map(|i| {
+                let t = 2.0 * std::f64::consts::PI * i as f64 / k as f64;
+                (x + r * t.cos(), y + r * t.sin())
+            })
+            .collect()
+    };
+    chart
+        .draw_series(discs.iter().map(|d| {
+            let c = COLOURS[d.colour % COLOURS.len()];
+            Polygon::new(ring(d.x, d.y, d.r, 24), c.mix(0.85).filled())
+        }))
+        .map_err(e)?;
+    let mut edge = ring(0.0, 0.0, outline, 360);
+    edge.push(edge[0]);
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            edge,
+            BLACK.stroke_width(2),
+        )))
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
 /// A picture is a companion of the data: when it cannot be drawn (say, no finite value), the
 /// run's tables stand and a warning says so; `name` joins `files` only when it was written.
 pub fn picture(

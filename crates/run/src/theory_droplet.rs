@@ -74,9 +74,11 @@ struct Written {
     phi: Vec<f64>,
 }
 
-/// `--hydrodynamics`: `free-draining` (default) or `rpy`.
-fn parse_hydrodynamics(h: Option<&str>) -> Result<Hydrodynamics> {
+/// `--hydrodynamics`: `free-draining` or `rpy`; by default the scenario's
+/// `hydrodynamics.model` (free draining without the table).
+fn parse_hydrodynamics(h: Option<&str>, p: &DropletParams) -> Result<Hydrodynamics> {
     match h {
+        None if p.has_hydrodynamics() => Ok(Hydrodynamics::Rpy),
         None | Some("free-draining") => Ok(Hydrodynamics::FreeDraining),
         Some("rpy") => Ok(Hydrodynamics::Rpy),
         Some(other) => bail!("--hydrodynamics must be free-draining or rpy, got '{other}'"),
@@ -85,11 +87,11 @@ fn parse_hydrodynamics(h: Option<&str>) -> Result<Hydrodynamics> {
 
 /// `colloidsim theory SCENARIO` for a drying droplet.
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
-    let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref())?;
     let dx = topts.dx;
     crate::keys::validate(&src.table()?, crate::keys::DROPLET).with_context(|| src.label())?;
     let sc = DropletScenario::from_toml(src.text()).map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let p = sc.validate().map_err(|e| anyhow!("{}: {e}", src.label()))?;
+    let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
     let dr = grid_spacing(&p, dx)?;
     // Output times of the BD run (`step * dt`, the last one up to dt past t_end), in ascending
     // order (fractions may be listed in any order).

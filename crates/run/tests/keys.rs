@@ -48,7 +48,7 @@ method = "droplet-bd"
 seed = 1
 replicas = 1
 [system]
-particles = 10
+particles = 100
 diameter = 1.0
 kT = 1.0
 viscosity = 1.0
@@ -67,6 +67,15 @@ bins = 50
 fractions = [0.0, 0.25, 0.5, 0.75, 1.0]
 [observe.trajectory]
 every = 0
+[observe.cross_section]
+width = 1.0
+[hydrodynamics]
+model = "rpy"
+method = "pse"
+tolerance = 1e-3
+splitting = 1.0
+box_factor = 2.0
+max_iterations = 200
 "#;
 
 const DPD: &str = r#"
