@@ -39,7 +39,10 @@ const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 /// `4096`, `512M`, `4G`, `4GiB`, `1.5T` as bytes.
 fn parse_bytes(text: &str) -> Option<f64> {
     let t = text.trim();
-    let t = t.strip_suffix("iB").or_else(|| t.strip_suffix('B')).unwrap_or(t);
+    let t = t
+        .strip_suffix("iB")
+        .or_else(|| t.strip_suffix('B'))
+        .unwrap_or(t);
     let (number, scale) = match t.chars().last()? {
         'K' | 'k' => (&t[..t.len() - 1], 1024.0),
         'M' | 'm' => (&t[..t.len() - 1], 1024.0 * 1024.0),
