@@ -562,6 +562,25 @@ impl DropletScenario {
                 ),
             ));
         }
+        // A step must not overshoot the interface's harmonic well: (D0 / kT) k dt < 1.
+        let kappa = d0 / kt * stiffness * dt;
+        if kappa >= 1.0 {
+            return Err(ParamError::new(
+                if it.stiffness.is_some() {
+                    "interface.stiffness"
+                } else {
+                    "run.dt"
+                },
+                format!(
+                    "an interface of stiffness {} is too stiff for run.dt = {}: D0 k dt / kT = \
+                     {kappa:.3e} >= 1, so a step overshoots the interface's well; use run.dt < \
+                     {:.3e} or a softer interface",
+                    colloidsim_core::param::show(stiffness),
+                    colloidsim_core::param::show(dt),
+                    kt / (d0 * stiffness)
+                ),
+            ));
+        }
         let r_last_sq = r0 * r0 - alpha * (steps as f64 * dt) / (4.0 * PI);
         if r_last_sq.is_nan() || r_last_sq <= 0.0 {
             return Err(ParamError::new(

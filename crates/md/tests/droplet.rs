@@ -147,6 +147,14 @@ fn an_interface_too_soft_to_hold_the_colloids_is_refused() {
         .unwrap_err();
     assert_eq!(e.key, "interface.stiffness", "{e}");
     assert!(e.to_string().contains("does not hold"), "{e}");
+    // So stiff that one step overshoots its well (D0 k dt / kT >= 1): refused too.
+    let stiff = scenario("dt = 1e-3").replace("[run]", "[interface]\nstiffness = 1e4\n[run]");
+    let e = DropletScenario::from_toml(&stiff)
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert_eq!(e.key, "interface.stiffness", "{e}");
+    assert!(e.to_string().contains("overshoots"), "{e}");
     // The default (50 kT/d^2) holds them within about a diameter.
     DropletScenario::from_toml(&scenario(""))
         .unwrap()
