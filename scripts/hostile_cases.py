@@ -196,6 +196,34 @@ def case_kill_restart_trajectory(method):
                f"exit {rc}, trajectories differ")
 
 
+def case_full_disk():
+    """A disk with room for the tables but not for a picture, then one without room for a
+    checkpoint (a small tmpfs; needs root)."""
+    mnt = tempfile.mkdtemp()
+    for size, tried in [("120k", "a full disk: room for the tables, not for `density.png`"),
+                        ("12k", "a full disk: no room for the next checkpoint")]:
+        if subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", mnt],
+                          capture_output=True).returncode != 0:
+            record(tried, True, "not tried here (mounting a small tmpfs needs root)")
+            continue
+        try:
+            rc, out = sh(["run", COSINE, "--out", "full", "--quiet"], mnt)
+            names = sorted(os.listdir(os.path.join(mnt, "full")))
+            partial = [n for n in names if "partial" in n]
+            if size == "120k":
+                s = json.load(open(os.path.join(mnt, "full", "summary.json")))
+                ok = (rc == 0 and "density.png" not in names and not partial
+                      and any("density.png not drawn" in w for w in s["warnings"]))
+                record(tried, ok, f"completed; no density.png, no partial file; summary.json "
+                       f"warns \"{s['warnings'][0][:80]}...\"")
+            else:
+                ok = rc == 1 and not partial and "No space left" in out
+                record(tried, ok, f"stops: \"{last_line(out)}\"; left {', '.join(names)} (the last checkpoint that fit, intact)")
+        finally:
+            subprocess.run(["umount", mnt])
+    os.rmdir(mnt)
+
+
 def main():
     d = tempfile.mkdtemp()
     try:
@@ -321,6 +349,7 @@ def main():
         rc, out = sh(["theory", "--help"], d)
         record("the non-convergence message names options that exist",
                "--dx" in out, "it advises `colloidsim theory --dx`, an option of `theory`")
+        case_full_disk()
     finally:
         shutil.rmtree(d, ignore_errors=True)
 
