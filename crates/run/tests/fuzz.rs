@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use std::path::Path;
 
 /// Small, fast scenarios of each method (the mutations start from these).
-const BASES: [(&str, &[Spec]); 4] = [
+const BASES: [(&str, &[Spec]); 6] = [
     (
         r#"method = "bcd"
 seed = 3
@@ -57,6 +57,40 @@ phi0 = 0.05
 [drying]
 peclet = 5.0
 final_volume_fraction = 0.06
+[observe.profile]
+bins = 10
+fractions = [0.0, 1.0]
+"#,
+        keys::DROPLET,
+    ),
+    (
+        r#"method = "droplet-bd"
+[system]
+particles = 30
+phi0 = 0.05
+[drying]
+peclet = 5.0
+final_volume_fraction = 0.06
+[hydrodynamics]
+model = "rpy"
+method = "direct"
+[observe.profile]
+bins = 10
+fractions = [0.0, 1.0]
+"#,
+        keys::DROPLET,
+    ),
+    (
+        r#"method = "droplet-bd"
+[system]
+particles = 30
+phi0 = 0.05
+[drying]
+peclet = 5.0
+final_volume_fraction = 0.06
+[hydrodynamics]
+model = "rpy"
+method = "pse"
 [observe.profile]
 bins = 10
 fractions = [0.0, 1.0]
@@ -341,5 +375,16 @@ proptest! {
                 let _ = e.step(10);
             }
         }
+    }
+}
+
+/// The mutations start from valid scenarios (else they would test nothing but the refusal).
+#[test]
+fn every_base_scenario_is_valid_and_steps() {
+    for (text, _) in BASES {
+        let sc = Scenario::from_toml(text, Path::new(".")).unwrap();
+        colloidsim_run::check(&sc).unwrap_or_else(|e| panic!("{e:#}\n{text}"));
+        let mut e = colloidsim_run::engine(&sc, None).unwrap();
+        e.step(3).unwrap();
     }
 }
