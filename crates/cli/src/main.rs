@@ -279,6 +279,20 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// `--threads N`: the global pool of N workers (default: all cores).
+fn thread_pool(threads: Option<usize>) -> Result<()> {
+    if let Some(n) = threads {
+        if n == 0 {
+            bail!("--threads must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot start the thread pool")?;
+    }
+    Ok(())
+}
+
 /// The error and its causes, `a: b: c`, each cause once (an error whose message already ends
 /// with its source's is not followed by it again).
 fn error_chain(e: &anyhow::Error) -> String {
@@ -350,15 +364,7 @@ fn run_cli() -> Result<()> {
             restart,
             overrides,
         } => {
-            if let Some(n) = threads {
-                if n == 0 {
-                    bail!("--threads must be at least 1");
-                }
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build_global()
-                    .context("cannot start the thread pool")?;
-            }
+            thread_pool(threads)?;
             let sc = path
                 .as_deref()
                 .map(|p| scenario(p, &overrides))
@@ -411,15 +417,7 @@ fn run_cli() -> Result<()> {
             threads,
             overrides,
         } => {
-            if let Some(n) = threads {
-                if n == 0 {
-                    bail!("--threads must be at least 1");
-                }
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build_global()
-                    .context("cannot start the thread pool")?;
-            }
+            thread_pool(threads)?;
             let sc = scenario(&path, &overrides)?;
             let opts = colloidsim_run::ExtrapolateOptions {
                 out,
