@@ -75,11 +75,12 @@ impl Method for BcdMethod {
         let r = resolve(src, &sc, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if sc.observe.trajectory.is_some() {
-            let path = out.join("trajectory.gsd");
-            saved.digest.verify(&path)?;
-            if path.exists() {
-                trim_trajectory(&path, saved.frames, r.config.length, r.config.sigma)?;
-            }
+            let (l, sigma) = (r.config.length, r.config.sigma);
+            saved
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, l, sigma)
+                })?;
         }
         session(sc, r, Some(saved))
     }

@@ -92,11 +92,11 @@ impl Method for DpdMethod {
             ck.step,
             ck.sync_every,
         )?;
-        let traj = out.join("trajectory.gsd");
-        ck.obs.digest.verify(&traj)?;
-        if traj.exists() {
-            trim_trajectory(&traj, ck.obs.frames, &["time_tau"], true)?;
-        }
+        ck.obs
+            .digest
+            .restore(&out.join("trajectory.gsd"), |path, frames| {
+                trim_trajectory(path, frames, &["time_tau"], true)
+            })?;
         // Restoring builds the lists the interrupted run built at this step: count them once.
         let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
         DpdSession::new(s, sim, ck.obs, builds0).map(|d| Box::new(d) as Box<dyn Session>)

@@ -94,17 +94,13 @@ impl Method for DropletBd {
             );
         }
         let sim = restore_replica(out, &p, &saved)?;
-        let traj = out.join("trajectory.gsd");
         if p.trajectory_every > 0 {
-            saved.acc.digest.verify(&traj)?;
-            if traj.exists() {
-                trim_trajectory(
-                    &traj,
-                    saved.acc.frames,
-                    &["droplet/radius", "droplet/time"],
-                    false,
-                )?;
-            }
+            saved
+                .acc
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, &["droplet/radius", "droplet/time"], false)
+                })?;
         }
         Ok(Box::new(DropletSession::new(
             p,

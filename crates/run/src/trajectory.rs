@@ -57,9 +57,19 @@ impl FrameDigest {
         Ok(())
     }
 
-    /// Before a restart appends to `path`: check that the file holds at least the frames this
-    /// digest covers and that they are the frames the checkpoint saw. The caller then drops
-    /// any frames written after the checkpoint.
+    /// Before a restart appends to `path`: [`Self::verify`] it, then let `trim` (the method's
+    /// own writer) keep only the first `self.frames` frames, dropping any a killed run wrote
+    /// after the checkpoint.
+    pub fn restore(&self, path: &Path, trim: impl FnOnce(&Path, u64) -> Result<()>) -> Result<()> {
+        self.verify(path)?;
+        if path.exists() {
+            trim(path, self.frames)?;
+        }
+        Ok(())
+    }
+
+    /// Check that `path` holds at least the frames this digest covers and that they are the
+    /// frames the checkpoint saw.
     pub fn verify(&self, path: &Path) -> Result<()> {
         if self.frames == 0 {
             return Ok(());
