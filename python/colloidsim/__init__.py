@@ -225,10 +225,12 @@ def theory(
     dx: Optional[float] = None,
     force: bool = False,
     hydrodynamics: Optional[str] = None,
+    pair: Optional[str] = None,
     threads: Optional[int] = None,
 ) -> Result:
     """The continuum counterpart of a scenario on the run's grid and file names (as
-    ``colloidsim theory``); ``out`` defaults to a new temporary folder."""
+    ``colloidsim theory``); ``out`` defaults to a new temporary folder. ``hydrodynamics``:
+    ``"free-draining"`` or ``"rpy"``; ``pair`` (RPY only): ``"dilute"`` or ``"trokhymchuk"``."""
     text, base, name, origin = _scenario(scenario)
     if out is None:
         out = tempfile.mkdtemp(prefix=f"colloidsim-{name}-theory-")
@@ -243,6 +245,7 @@ def theory(
             dx,
             force,
             hydrodynamics,
+            pair,
             threads,
         )
     )

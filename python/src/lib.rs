@@ -164,7 +164,7 @@ fn resume(
 
 /// The theory counterpart of a scenario; returns the report as JSON.
 #[pyfunction]
-#[pyo3(signature = (text, base, name, origin, overrides_json, out=None, dx=None, force=false, hydrodynamics=None, threads=None))]
+#[pyo3(signature = (text, base, name, origin, overrides_json, out=None, dx=None, force=false, hydrodynamics=None, pair=None, threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn theory(
     py: Python<'_>,
@@ -177,6 +177,7 @@ fn theory(
     dx: Option<f64>,
     force: bool,
     hydrodynamics: Option<String>,
+    pair: Option<String>,
     threads: Option<usize>,
 ) -> PyResult<String> {
     let sc = scenario(text, base, name, origin, overrides_json).map_err(to_py)?;
@@ -185,6 +186,7 @@ fn theory(
         dx,
         force,
         hydrodynamics,
+        pair,
     };
     let r = blocking(py, threads, |ctl| colloidsim_run::theory(&sc, &opts, ctl))?;
     Ok(report_json(&r))

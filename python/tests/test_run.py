@@ -71,6 +71,37 @@ def test_theory_equals_the_cli(example, tmp_path, cli):
     assert r.density.rho.shape == r.density.x.shape
 
 
+def test_theory_with_the_trokhymchuk_pair_correlation_equals_the_cli(tmp_path, cli):
+    scenario = {
+        "method": "droplet-bd",
+        "seed": 1,
+        "system": {"particles": 200, "phi0": 0.05},
+        "drying": {"peclet": 10, "final_volume_fraction": 0.3},
+        "run": {"dt": 0.004},
+        "observe": {"profile": {"bins": 10, "fractions": [0, 1.0]}},
+    }
+    path = tmp_path / "small.toml"
+    path.write_text(
+        'method = "droplet-bd"\nseed = 1\n[system]\nparticles = 200\nphi0 = 0.05\n'
+        "[drying]\npeclet = 10\nfinal_volume_fraction = 0.3\n[run]\ndt = 0.004\n"
+        "[observe]\nprofile = { bins = 10, fractions = [0, 1.0] }\n"
+    )
+    args = ("--hydrodynamics", "rpy", "--pair", "trokhymchuk", "--dx", "0.05")
+    cli("theory", path, "--out", tmp_path / "cli", *args)
+    r = colloidsim.theory(
+        path, out=tmp_path / "py", hydrodynamics="rpy", pair="trokhymchuk", dx=0.05
+    )
+    assert_same_outputs(tmp_path / "cli", tmp_path / "py")
+    assert r.summary["pair_correlation"] == "trokhymchuk"
+    assert r.summary["status"] == "ok"
+    d = colloidsim.theory(
+        scenario, out=tmp_path / "dict", hydrodynamics="rpy", pair="trokhymchuk", dx=0.05
+    )
+    assert (d.out / "profile_1.00.csv").read_bytes() == (r.out / "profile_1.00.csv").read_bytes()
+    with pytest.raises(colloidsim.ColloidsimError, match="--pair must be"):
+        colloidsim.theory(scenario, out=tmp_path / "bad", hydrodynamics="rpy", pair="py")
+
+
 def test_check_equals_the_cli(cli):
     path = EXAMPLES / "bcd/hard-rods-cosine.toml"
     out = cli("check", path, "--set", "run.dt=2e-4").stdout

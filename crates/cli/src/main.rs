@@ -104,6 +104,11 @@ enum Command {
         /// unphysical).
         #[arg(long)]
         hydrodynamics: Option<String>,
+        /// Droplet DDFT with `--hydrodynamics rpy` only: the pair correlation in the flux's
+        /// two-body density, `dilute` (default, `g = Theta(r - d)`) or `trokhymchuk`
+        /// (Trokhymchuk et al. 2005 at the mean local packing fraction).
+        #[arg(long)]
+        pair: Option<String>,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -392,6 +397,7 @@ fn run_cli() -> Result<()> {
             dx,
             force,
             hydrodynamics,
+            pair,
             overrides,
         } => {
             let sc = scenario(&path, &overrides)?;
@@ -402,6 +408,7 @@ fn run_cli() -> Result<()> {
                     dx,
                     force,
                     hydrodynamics,
+                    pair,
                 },
                 &control(false),
             )?;

@@ -40,6 +40,7 @@ fn main() {
         t_end: schedule.time_at_radius(r_end),
         dr,
         hydrodynamics: Hydrodynamics::FreeDraining,
+        pair: Default::default(),
     };
     let mut opts = DdftOptions::new(d0, 1.0);
     opts.dt_max = dt_max;

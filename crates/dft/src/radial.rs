@@ -9,7 +9,8 @@
 //! - [`equilibrium`]: equilibrium profile at fixed particle number (Picard + Anderson mixing).
 //! - [`ddft`]: implicit-Euler DDFT on spherical shells, free-draining or with pairwise RPY flux.
 //! - [`droplet`]: a drying droplet end to end (setup validation, equilibrium start, snapshots).
-//! - [`rpy`]: the dilute-limit radial RPY kernel of the hydrodynamic flux.
+//! - [`rpy`]: the radial RPY kernel of the hydrodynamic flux (dilute or Trokhymchuk pair correlation).
+//! - [`pair`]: bulk hard-sphere pair correlation `g(r; eta)` (Trokhymchuk et al. 2005).
 //! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
 //!
 //! ```no_run
@@ -26,6 +27,7 @@
 //!     t_end: schedule.time_at_radius(25.0 * 0.1f64.cbrt()),
 //!     dr: 0.01,
 //!     hydrodynamics: Hydrodynamics::FreeDraining,
+//!     pair: PairCorrelation::Dilute,
 //! };
 //! let times = [0.5 * setup.t_end, setup.t_end];
 //! let opts = DdftOptions::new(1.0, 1.0);
@@ -44,6 +46,7 @@ pub mod equilibrium;
 pub mod fmt;
 pub mod grid;
 pub mod interface;
+pub mod pair;
 pub mod rpy;
 
 pub use ddft::{Ddft, DdftOptions, Hydrodynamics, StepReport};
@@ -54,6 +57,7 @@ pub use equilibrium::{Equilibrium, EquilibriumOptions, solve_equilibrium};
 pub use fmt::Rosenfeld;
 pub use grid::RadialGrid;
 pub use interface::{DryingSchedule, HarmonicInterface};
+pub use rpy::{PairCorrelation, PairTable};
 
 use colloidsim_core::ParamError;
 use thiserror::Error;

@@ -26,6 +26,7 @@ fn drying(r0: f64, phi0: f64, phi_end: f64, dr: f64, hydro: Hydrodynamics) -> Dr
         t_end: schedule.time_at_radius(r_end),
         dr,
         hydrodynamics: hydro,
+        pair: Default::default(),
     }
 }
 

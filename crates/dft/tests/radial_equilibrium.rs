@@ -135,6 +135,7 @@ fn radial_very_dense_droplet_equilibrium_falls_back_to_ddft_relaxation() {
         t_end: 0.0,
         dr: 0.02,
         hydrodynamics: Hydrodynamics::FreeDraining,
+        pair: Default::default(),
     };
     let (grid, eq) = equilibrium_at(&setup, radius, &EquilibriumOptions::default()).unwrap();
     assert!(eq.residual < 1e-10);

@@ -59,6 +59,9 @@ pub struct TheoryOptions {
     pub force: bool,
     /// Droplet DDFT only: `free-draining` (default) or `rpy`.
     pub hydrodynamics: Option<String>,
+    /// Droplet DDFT with RPY only: the pair correlation of the flux, `dilute` (default) or
+    /// `trokhymchuk`.
+    pub pair: Option<String>,
 }
 
 /// What a finished run or theory solve produced.
@@ -122,6 +125,9 @@ pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Res
     let m = method::of(sc)?;
     if opts.hydrodynamics.is_some() && m.names()[0] != "droplet-bd" {
         anyhow::bail!("--hydrodynamics applies to droplet-bd scenarios only");
+    }
+    if opts.pair.is_some() && m.names()[0] != "droplet-bd" {
+        anyhow::bail!("--pair applies to droplet-bd scenarios only");
     }
     m.theory(sc, opts, ctl)
 }

@@ -17,8 +17,8 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow, bail};
 use colloidsim_core::output::{OutputDir, read_table};
 use colloidsim_dft::radial::{
-    DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError,
-    RadialGrid, Snapshot, bin_average, equilibrium_at, run_droplet,
+    DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
+    PairCorrelation, RadialError, RadialGrid, Snapshot, bin_average, equilibrium_at, run_droplet,
 };
 use colloidsim_md::droplet::{DropletParams, DropletScenario};
 
@@ -64,6 +64,7 @@ pub fn setup_from(p: &DropletParams, dr: f64) -> Result<DropletSetup> {
         t_end: p.t_end,
         dr,
         hydrodynamics: Hydrodynamics::FreeDraining,
+        pair: Default::default(),
     })
 }
 
@@ -85,6 +86,20 @@ fn parse_hydrodynamics(h: Option<&str>, p: &DropletParams) -> Result<Hydrodynami
     }
 }
 
+/// `--pair`: `dilute` (default) or `trokhymchuk`; only with the RPY flux.
+fn parse_pair(pair: Option<&str>, hydro: Hydrodynamics) -> Result<PairCorrelation> {
+    let parsed = match pair {
+        None | Some("dilute") => PairCorrelation::Dilute,
+        Some("trokhymchuk") => PairCorrelation::Trokhymchuk,
+        Some("trokhymchuk-n3") => PairCorrelation::TrokhymchukWeighted,
+        Some(other) => bail!("--pair must be dilute, trokhymchuk or trokhymchuk-n3, got '{other}'"),
+    };
+    if pair.is_some() && hydro != Hydrodynamics::Rpy {
+        bail!("--pair applies to the RPY flux only (--hydrodynamics rpy)");
+    }
+    Ok(parsed)
+}
+
 /// `colloidsim theory SCENARIO` for a drying droplet.
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
     let dx = topts.dx;
@@ -92,6 +107,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     let sc = DropletScenario::from_toml(src.text()).map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let p = sc.validate().map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
+    let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;
     // Output times of the BD run (`step * dt`, the last one up to dt past t_end), in ascending
     // order (fractions may be listed in any order).
@@ -102,6 +118,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     let setup = DropletSetup {
         t_end: times.last().copied().unwrap_or(0.0).max(p.t_end),
         hydrodynamics: hydro,
+        pair,
         ..setup_from(&p, dr)?
     };
     setup
@@ -176,12 +193,18 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         Err(e) => ("failed".to_string(), e.to_string()),
     };
     let outcome = result.as_ref().ok();
-    let summary = serde_json::json!({
+    let mut summary = serde_json::json!({
         "method": "droplet-bd",
         "engine": "theory: radial Rosenfeld FMT DDFT, implicit Euler",
         "hydrodynamics": match hydro {
             Hydrodynamics::FreeDraining => "free-draining",
-            Hydrodynamics::Rpy => "rpy (pairwise RPY flux, dilute pair correlation)",
+            Hydrodynamics::Rpy => match pair {
+                PairCorrelation::Dilute => "rpy (pairwise RPY flux, dilute pair correlation)",
+                PairCorrelation::Trokhymchuk =>
+                    "rpy (pairwise RPY flux, Trokhymchuk pair correlation at the mean local packing fraction)",
+                PairCorrelation::TrokhymchukWeighted =>
+                    "rpy (pairwise RPY flux, Trokhymchuk pair correlation at the mean weighted packing fraction n3)",
+            },
         },
         "software_version": env!("CARGO_PKG_VERSION"),
         "software": crate::software(),
@@ -207,13 +230,20 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         "profiles_written": written.iter().map(|w| profile_name(w.fraction)).collect::<Vec<_>>(),
         "wall_seconds": wall,
     });
+    if hydro == Hydrodynamics::Rpy {
+        summary["pair_correlation"] = pair.name().into();
+    }
     dir.write_json("summary.json", &summary)?;
     let mut files: Vec<String> = written.iter().map(|w| profile_name(w.fraction)).collect();
     let mut warnings = Vec::new();
     if !written.is_empty() {
         let tag = match hydro {
             Hydrodynamics::FreeDraining => "free-draining",
-            Hydrodynamics::Rpy => "RPY",
+            Hydrodynamics::Rpy => match pair {
+                PairCorrelation::Dilute => "RPY",
+                PairCorrelation::Trokhymchuk => "RPY, Trokhymchuk g",
+                PairCorrelation::TrokhymchukWeighted => "RPY, Trokhymchuk g at n3",
+            },
         };
         plot::picture(
             draw(Path::new(src.name()), &dir, &written, tag),

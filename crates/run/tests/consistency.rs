@@ -33,6 +33,7 @@ fn a_drying_to_close_packing_is_accepted_by_check_and_by_theory() {
             dx: Some(0.1),
             force: false,
             hydrodynamics: None,
+            pair: None,
         };
         let t = colloidsim_run::theory(&sc, &opts, &Control::default());
         assert_eq!(t.is_ok(), accepted, "theory at {phi}: {:?}", t.err());

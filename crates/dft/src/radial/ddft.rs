@@ -16,7 +16,7 @@
 use colloidsim_core::param;
 
 use super::anderson::Anderson;
-use super::rpy::RpyKernel;
+use super::rpy::{PairCorrelation, PairTable, RpyKernel};
 use super::{DryingSchedule, HarmonicInterface, RadialError, RadialGrid, Rosenfeld};
 
 /// Hydrodynamic approximation of the flux.
@@ -24,7 +24,7 @@ use super::{DryingSchedule, HarmonicInterface, RadialError, RadialGrid, Rosenfel
 pub enum Hydrodynamics {
     /// `M_ij = delta_ij / (6 pi eta a)`.
     FreeDraining,
-    /// Free-draining plus the pairwise RPY flux with the dilute pair correlation.
+    /// Free-draining plus the pairwise RPY flux (pair correlation: [`DdftOptions::pair`]).
     Rpy,
 }
 
@@ -47,6 +47,10 @@ pub struct DdftOptions {
     pub depth: usize,
     /// Hydrodynamic approximation.
     pub hydrodynamics: Hydrodynamics,
+    /// Pair correlation in the RPY flux's two-body density (Eq. 17); unused when free-draining.
+    pub pair: PairCorrelation,
+    /// Tabulation of the Trokhymchuk kernel (range, clamp).
+    pub pair_table: PairTable,
     /// Particles where the interface potential exceeds `eject_potential` (kT) count as ejected:
     /// no physical pressure of the compressed suspension reaches that far into the interface.
     pub eject_potential: f64,
@@ -69,6 +73,8 @@ impl DdftOptions {
             max_iterations: 40,
             depth: 6,
             hydrodynamics: Hydrodynamics::FreeDraining,
+            pair: PairCorrelation::Dilute,
+            pair_table: PairTable::default(),
             eject_potential: 40.0,
             eject_tolerance: 1e-6,
             potential_cutoff: 100.0,
@@ -176,7 +182,12 @@ impl Ddft {
         }
         let fmt = Rosenfeld::new(&grid, diameter)?;
         let rpy = match opts.hydrodynamics {
-            Hydrodynamics::Rpy => Some(RpyKernel::new(&grid, diameter)),
+            Hydrodynamics::Rpy => Some(RpyKernel::with_pair(
+                &grid,
+                diameter,
+                opts.pair,
+                opts.pair_table,
+            )?),
             Hydrodynamics::FreeDraining => None,
         };
         let particles = grid.integrate(rho0);
@@ -434,7 +445,12 @@ impl Ddft {
             for j in 0..m {
                 self.gcell[j] = -0.5 * (self.flux[j] + self.flux[j + 1]);
             }
-            k.velocities(&self.gcell, m, &mut self.u);
+            let local = if self.opts.pair.reads_n3() {
+                self.fmt.n3()
+            } else {
+                &self.x[..]
+            };
+            k.velocities(&self.gcell, local, m, &mut self.u);
             for f in 1..m {
                 self.delta[f] -= self.u[f] * dr;
             }

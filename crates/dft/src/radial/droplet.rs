@@ -7,7 +7,8 @@ use colloidsim_core::{ParamError, param};
 
 use super::{
     Ddft, DdftOptions, DryingSchedule, Equilibrium, EquilibriumOptions, HarmonicInterface,
-    Hydrodynamics, RadialError, RadialGrid, Rosenfeld, StepReport, solve_equilibrium,
+    Hydrodynamics, PairCorrelation, RadialError, RadialGrid, Rosenfeld, StepReport,
+    solve_equilibrium,
 };
 
 /// Random close packing: the largest mean volume fraction accepted.
@@ -34,6 +35,8 @@ pub struct DropletSetup {
     pub dr: f64,
     /// Hydrodynamic approximation.
     pub hydrodynamics: Hydrodynamics,
+    /// Pair correlation of the RPY flux (unused when free-draining).
+    pub pair: PairCorrelation,
 }
 
 /// Mean volume fraction `N d^3 / (8 R^3)`.
@@ -177,6 +180,7 @@ pub fn run_droplet(
     let mut opts = *opts;
     opts.d0 = setup.d0;
     opts.hydrodynamics = setup.hydrodynamics;
+    opts.pair = setup.pair;
     let mut ddft = Ddft::new(
         grid.clone(),
         setup.diameter,
