@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Static droplet equilibrium (the paper's Fig. 2a): BD radial profiles beside the radial
+Rosenfeld-FMT equilibrium of the same N, at mean volume fractions 0.05 to 0.5, in a droplet of
+R0 = 8 d (examples/droplet/static-equilibrium.toml).
+
+Usage: static_equilibrium.py COLLOIDSIM WORKDIR PICTURE.png [PHI ...]
+
+For phi <= 0.3 the static run starts from random insertion; above, the droplet is first dried
+slowly (Pe = 1) from phi = 0.25 to the target and the static run starts from its last frame
+(`system.initial`). BD: `profile_mean.csv` (the mean of the profiles after the first, with its
+standard error from their scatter); FMT: `colloidsim theory` of the same scenario
+(`equilibrium_1.00.csv`, same bins).
+"""
+import csv
+import os
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLE = os.path.join(HERE, "..", "examples", "droplet", "static-equilibrium.toml")
+R0 = 8.0
+
+
+def run(binary, *args):
+    subprocess.run([binary, *args], check=True)
+
+
+def table(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def main():
+    binary, work, picture = sys.argv[1], sys.argv[2], sys.argv[3]
+    phis = [float(x) for x in sys.argv[4:]] or [0.05, 0.1, 0.2, 0.3, 0.4, 0.5]
+    os.makedirs(work, exist_ok=True)
+    results = []
+    for phi in phis:
+        n = round(8 * phi * R0**3)
+        tag = f"phi{phi:.2f}"
+        sets = ["--set", f"system.particles={n}", "--set", f"system.phi0={phi}"]
+        if phi > 0.3:
+            dry = os.path.join(work, f"{tag}-dry")
+            run(binary, "run", EXAMPLE, "--out", dry, "--force", "--quiet",
+                "--set", f"system.particles={n}", "--set", "system.phi0=0.25",
+                "--set", "replicas=1", "--set", "drying.peclet=1",
+                "--set", f"drying.final_volume_fraction={phi}",
+                "--set", "observe.trajectory.every=2000",
+                "--set", "observe.profile.fractions=[0, 1.0]")
+            sets += ["--set", f"system.initial={os.path.abspath(os.path.join(dry, 'trajectory.gsd'))}"]
+        bd = os.path.join(work, f"{tag}-bd")
+        th = os.path.join(work, f"{tag}-theory")
+        run(binary, "run", EXAMPLE, "--out", bd, "--force", "--quiet", *sets)
+        run(binary, "theory", EXAMPLE, "--out", th, "--force", "--dx", "0.02", *sets)
+        results.append((phi, table(os.path.join(bd, "profile_mean.csv")),
+                        table(os.path.join(th, "equilibrium_1.00.csv"))))
+    cols = 3
+    rows = (len(results) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    for ax, (phi, bd, th) in zip(axes.flat, results):
+        ax.errorbar(bd["r"], bd["phi"], yerr=bd["err"], fmt="o", ms=3, label="BD (mean of profiles)")
+        ax.plot(th["r"], th["phi"], "-", label="Rosenfeld FMT equilibrium")
+        ax.set_title(f"mean phi = {phi}")
+        ax.set_xlabel("r / d")
+        ax.set_ylabel("phi (bin average)")
+    axes.flat[0].legend(fontsize=8)
+    for ax in list(axes.flat)[len(results):]:
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(picture, dpi=110)
+    print(f"wrote {picture}")
+
+
+if __name__ == "__main__":
+    main()
