@@ -6,13 +6,14 @@ R0 = 8 d (examples/droplet/static-equilibrium.toml).
 Usage: static_equilibrium.py COLLOIDSIM WORKDIR PICTURE.png [PHI ...]
 
 For phi <= 0.3 the static run starts from random insertion; above, the droplet is first dried
-slowly (Pe = 1) from phi = 0.25 to the target and the static run starts from its last frame
+slowly (Pe = 1) from phi = 0.25 to 1.06 x the target and the static run starts from its last frame
 (`system.initial`). BD: `profile_mean.csv` (the mean of the profiles after the first, with its
 standard error from their scatter); FMT: `colloidsim theory` of the same scenario
 (`equilibrium_1.00.csv`, same bins).
 """
 import csv
 import os
+import re
 import subprocess
 import sys
 
@@ -46,12 +47,18 @@ def main():
         tag = f"phi{phi:.2f}"
         sets = ["--set", f"system.particles={n}", "--set", f"system.phi0={phi}"]
         if phi > 0.3:
+            # The drying stage: the example with its duration replaced by the target.
             dry = os.path.join(work, f"{tag}-dry")
-            run(binary, "run", EXAMPLE, "--out", dry, "--force", "--quiet",
+            text = open(EXAMPLE).read()
+            text = re.sub(r"(?m)^peclet = .*$", "peclet = 1", text)
+            # A little beyond the target, so that the last frame lies within R0.
+            text = re.sub(r"(?m)^duration = .*$", f"final_volume_fraction = {1.06 * phi:.4f}", text)
+            scenario = os.path.join(work, f"{tag}-dry.toml")
+            with open(scenario, "w") as f:
+                f.write(text)
+            run(binary, "run", scenario, "--out", dry, "--force", "--quiet",
                 "--set", f"system.particles={n}", "--set", "system.phi0=0.25",
-                "--set", "replicas=1", "--set", "drying.peclet=1",
-                "--set", f"drying.final_volume_fraction={phi}",
-                "--set", "observe.trajectory.every=2000",
+                "--set", "replicas=1", "--set", "observe.trajectory.every=500",
                 "--set", "observe.profile.fractions=[0, 1.0]")
             sets += ["--set", f"system.initial={os.path.abspath(os.path.join(dry, 'trajectory.gsd'))}"]
         bd = os.path.join(work, f"{tag}-bd")

@@ -7,7 +7,7 @@
 
 use std::fmt::Write as _;
 
-use colloidsim_dft::radial::pair::TotalCorrelation;
+use colloidsim_dft::radial::pair::{TotalCorrelation, bulk_sedimentation};
 use colloidsim_dft::radial::rpy::PAIR_RANGE;
 
 fn main() {
@@ -38,16 +38,7 @@ fn main() {
         let kt = if phi == 0.0 {
             1.0
         } else {
-            let h = TotalCorrelation::new(phi).expect("eta");
-            let n = 100_000;
-            let dx = (PAIR_RANGE - 1.0) / n as f64;
-            let tail: f64 = (0..n)
-                .map(|i| {
-                    let x = 1.0 + (i as f64 + 0.5) * dx;
-                    x * h.h(x) * dx
-                })
-                .sum();
-            1.0 - 5.0 * phi + 12.0 * phi * tail
+            bulk_sedimentation(phi, PAIR_RANGE).expect("eta")
         };
         writeln!(s, "{phi:.2},{:.6},{kt:.6}", 1.0 - 5.0 * phi).unwrap();
     }

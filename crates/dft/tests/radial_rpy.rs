@@ -34,20 +34,9 @@ fn radial_hydrodynamic_flux_hinders_like_one_minus_five_phi() {
     assert!(u[1].abs() < u[f].abs());
 }
 
-/// `K = 1 + 12 phi int_1^range x h(x) dx - 5 phi` from the total correlation alone (bulk, far
-/// field: the angular mean of the RPY pair tensor along the force is `1 / (6 pi eta r)`).
+/// `K = 1 - 5 phi + 12 phi int_1^range x h(x) dx` from the total correlation alone.
 fn bulk_k(phi: f64, range: f64) -> f64 {
-    use colloidsim_dft::radial::pair::TotalCorrelation;
-    let h = TotalCorrelation::new(phi).unwrap();
-    let n = 200_000;
-    let dx = (range - 1.0) / n as f64;
-    let tail: f64 = (0..n)
-        .map(|k| {
-            let x = 1.0 + (k as f64 + 0.5) * dx;
-            x * h.h(x) * dx
-        })
-        .sum();
-    1.0 - 5.0 * phi + 12.0 * phi * tail
+    colloidsim_dft::radial::pair::bulk_sedimentation(phi, range).unwrap()
 }
 
 /// Trokhymchuk's `g`: far from the centre the kernel gives the bulk `K` of its `h`, at a node of

@@ -234,6 +234,22 @@ impl TotalCorrelation {
     }
 }
 
+/// Bulk sedimentation coefficient of the pairwise far-field RPY flux with this pair correlation
+/// kept to `range` diameters: `K = 1 - 5 eta + 12 eta int_1^range x h(x) dx` (the angular mean of
+/// the RPY pair tensor along the force is `1 / (6 pi eta_s r)`; `1 - 5 eta` is the excluded core).
+pub fn bulk_sedimentation(eta: f64, range: f64) -> Result<f64, ParamError> {
+    let h = TotalCorrelation::new(eta)?;
+    let n = 100_000;
+    let dx = (range - 1.0) / n as f64;
+    let tail: f64 = (0..n)
+        .map(|k| {
+            let x = 1.0 + (k as f64 + 0.5) * dx;
+            x * h.h(x) * dx
+        })
+        .sum();
+    Ok(1.0 - 5.0 * eta + 12.0 * eta * tail)
+}
+
 /// `h(x; eta)` (see [`TotalCorrelation`]).
 pub fn total_correlation(x: f64, eta: f64) -> Result<f64, ParamError> {
     Ok(TotalCorrelation::new(eta)?.h(x))
