@@ -413,6 +413,12 @@ pub struct HardSphereMc {
     tag: Vec<u32>,
     /// Grid offset of the current binning.
     offset: [f64; 3],
+    /// Per particle: its cell, its slot, its position relative to the cell's corner, and the
+    /// corner (scratch of the binning, kept to avoid allocating per sweep).
+    cell_of: Vec<u32>,
+    slot_of: Vec<u32>,
+    local: [Vec<f64>; 3],
+    corner: [Vec<f64>; 3],
 }
 
 /// Smallest cell side, in diameters (see [`HardSphereMc::new`]).
@@ -461,7 +467,7 @@ impl HardSphereMc {
         let n = positions.len();
         // Slots (3 coordinates, a tag) at the initial capacity, counts, particle arrays.
         let cap0 = 8usize;
-        let bytes = cells * (cap0 as f64 * 28.0 + 4.0) + n as f64 * 24.0;
+        let bytes = cells * (cap0 as f64 * 28.0 + 4.0) + n as f64 * 80.0;
         ensure_fits(
             "system",
             &format!("a grid of {nc}^3 Monte Carlo cells"),
@@ -483,6 +489,10 @@ impl HardSphereMc {
             slot: std::array::from_fn(|_| vec![0.0; nc_cells * cap0]),
             tag: vec![0; nc_cells * cap0],
             offset: [0.0; 3],
+            cell_of: vec![0; n],
+            slot_of: vec![0; n],
+            local: std::array::from_fn(|_| vec![0.0; n]),
+            corner: std::array::from_fn(|_| vec![0.0; n]),
         };
         mc.delta = mc.delta.min(mc.max_delta());
         let max = params.geometry.confinement(d);
@@ -632,35 +642,61 @@ impl HardSphereMc {
         self.offset = offset;
         let (l, s, nc) = (self.edge, self.side, self.nc);
         let pass = self.pass();
-        let locate = |x: f64, a: usize| -> (usize, f64) {
+        let locate = |x: f64, a: usize| -> (usize, f64, f64) {
             let mut t = x + 0.5 * l - offset[a];
             if t < 0.0 {
                 t += l;
             }
             let j = ((t / s) as usize).min(nc - 1);
             let u = (t - j as f64 * s).clamp(0.0, s);
-            (j, u)
+            (j, u, -0.5 * l + offset[a] + j as f64 * s)
         };
+        // In parallel: each particle's cell, its position relative to the cell's corner, and
+        // the corner (for the write-back).
+        let [px, py, pz] = &self.pos;
+        let [lx, ly, lz] = &mut self.local;
+        let [cx, cy, cz] = &mut self.corner;
+        self.cell_of
+            .par_iter_mut()
+            .zip(
+                lx.par_iter_mut()
+                    .zip(ly.par_iter_mut())
+                    .zip(lz.par_iter_mut()),
+            )
+            .zip(
+                cx.par_iter_mut()
+                    .zip(cy.par_iter_mut())
+                    .zip(cz.par_iter_mut()),
+            )
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, ((cell, ((ux, uy), uz)), ((ox, oy), oz)))| {
+                let (jx, x, cxx) = locate(px[i], 0);
+                let (jy, y, cyy) = locate(py[i], 1);
+                let (jz, z, czz) = locate(pz[i], 2);
+                *cell = pass.id([jx, jy, jz]) as u32;
+                (*ux, *uy, *uz) = (x, y, z);
+                (*ox, *oy, *oz) = (cxx, cyy, czz);
+            });
+        // Serially, in particle order: the slots.
         'retry: loop {
             self.count.fill(0);
             for a in &mut self.slot {
                 a.fill(EMPTY);
             }
             for i in 0..self.len() {
-                let (jx, ux) = locate(self.pos[0][i], 0);
-                let (jy, uy) = locate(self.pos[1][i], 1);
-                let (jz, uz) = locate(self.pos[2][i], 2);
-                let id = pass.id([jx, jy, jz]);
+                let id = self.cell_of[i] as usize;
                 let c = self.count[id] as usize;
                 if c == self.cap {
                     self.grow();
                     continue 'retry;
                 }
                 let k = id * self.cap + c;
-                self.slot[0][k] = ux;
-                self.slot[1][k] = uy;
-                self.slot[2][k] = uz;
+                for a in 0..3 {
+                    self.slot[a][k] = self.local[a][i];
+                }
                 self.tag[k] = i as u32;
+                self.slot_of[i] = k as u32;
                 self.count[id] += 1;
             }
             return;
@@ -677,23 +713,20 @@ impl HardSphereMc {
         self.tag.resize(total, 0);
     }
 
-    /// Write the slots back into the particle-order positions.
+    /// Write the slots back into the particle-order positions (in parallel).
     fn scatter(&mut self) {
-        let pass = self.pass();
-        let (l, s) = (self.edge, self.side);
-        let h3 = pass.half.pow(3);
-        for id in 0..self.count.len() {
-            let c = pass.coords(id / h3, id % h3);
-            for k in id * self.cap..id * self.cap + self.count[id] as usize {
-                let i = self.tag[k] as usize;
-                for a in 0..3 {
-                    let mut x = -0.5 * l + self.offset[a] + c[a] as f64 * s + self.slot[a][k];
-                    if x >= 0.5 * l {
-                        x -= l;
-                    }
-                    self.pos[a][i] = x;
-                }
-            }
+        let l = self.edge;
+        let slot_of = &self.slot_of;
+        for a in 0..3 {
+            let (slot, corner) = (&self.slot[a], &self.corner[a]);
+            self.pos[a]
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(i, x)| {
+                    let v = corner[i] + slot[slot_of[i] as usize];
+                    *x = if v >= 0.5 * l { v - l } else { v };
+                });
         }
     }
 
