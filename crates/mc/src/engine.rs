@@ -97,7 +97,7 @@ pub struct McParams {
 }
 
 /// Counts of one or more sweeps.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct SweepStats {
     /// Trial moves (N per sweep).
     pub trials: u64,

@@ -9,6 +9,7 @@
 //! - [`init`]: lattice starting configurations (melted by the warm-up).
 //! - [`observe`]: pair-distance and radial histograms, contact values extrapolated to contact,
 //!   block-average errors, the Carnahan–Starling reference.
+//! - [`scenario`]: the `method = "hs-mc"` scenario and its validation.
 //! - [`bench`]: trial moves per second (`colloidsim bench mc`).
 //!
 //! Conventions and validation numbers: docs/mc.md.
@@ -18,6 +19,7 @@ pub mod engine;
 pub mod geometry;
 pub mod init;
 pub mod observe;
+pub mod scenario;
 
 pub use engine::{HardSphereMc, McError, McParams, SweepStats};
 pub use geometry::Geometry;
