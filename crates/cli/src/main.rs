@@ -3,6 +3,7 @@
 
 mod bench_bcd;
 mod bench_bd;
+mod bench_mc;
 mod common;
 mod dpd_bench;
 mod rpy_bench;
@@ -175,6 +176,8 @@ enum BenchKind {
     Bcd(bench_bcd::BenchArgs),
     /// WCA Brownian dynamics, 25,000 particles at phi = 0.1 in a periodic box, beside LAMMPS.
     Bd(bench_bd::BenchArgs),
+    /// Hard-sphere Monte Carlo, 10,976 spheres at phi = 0.3 and 0.5, trial moves per second.
+    Mc(bench_mc::BenchArgs),
     /// Pure DPD water, 81,000 beads at density 3 (L = 30, dt = 0.04), beside LAMMPS.
     Dpd(dpd_bench::BenchArgs),
     /// RPY mobility: direct product beside pystokes, PSE from 10^3 to 10^5, BD+RPY step.
@@ -462,6 +465,7 @@ fn run_cli() -> Result<()> {
             BenchKind::Bcd(args) => bench_bcd::bench(&args),
             BenchKind::Bd(args) => bench_bd::bench(&args),
             BenchKind::Dpd(args) => dpd_bench::bench(&args),
+            BenchKind::Mc(args) => bench_mc::bench(&args),
             BenchKind::Rpy(args) => rpy_bench::bench(&args),
         },
     }

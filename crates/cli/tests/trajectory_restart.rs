@@ -60,8 +60,24 @@ msd_every = 20
 structure_every = 100
 "#;
 
+const MC: &str = r#"
+method = "hs-mc"
+seed = 3
+[system]
+geometry = "hard-wall"
+particles = 150
+radius = 4.0
+[mc]
+warmup_sweeps = 100
+sweeps = 400
+sample_every = 5
+blocks = 4
+[output]
+trajectory_every = 25
+"#;
+
 /// (scenario, step to kill at: after a checkpoint, with frames written since it).
-const CASES: [(&str, &str); 3] = [(BCD, "10500"), (DROPLET, "170"), (DPD, "235")];
+const CASES: [(&str, &str); 4] = [(BCD, "10500"), (DROPLET, "170"), (DPD, "235"), (MC, "235")];
 
 fn run(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));

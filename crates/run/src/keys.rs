@@ -1108,6 +1108,189 @@ pub static DPD: &[Spec] = &[
     ),
 ];
 
+/// The keys of `hs-mc` scenarios.
+pub static MC: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["hs-mc"]),
+        "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of the counter-based random streams (--seed overrides)",
+    ),
+    key("system", "-", "required", Table, "spheres and container"),
+    key(
+        "system.geometry",
+        "-",
+        "required",
+        OneOf(&["bulk", "hard-wall", "interface"]),
+        "periodic cube; hard spherical wall (centres within radius - d/2); the BD droplet's harmonic interface ([interface])",
+    ),
+    key(
+        "system.particles",
+        "-",
+        "from the other two",
+        Integer(1, 100_000_000),
+        "number of spheres N",
+    )
+    .also("give exactly two of particles, volume_fraction and box (bulk) or radius (droplet); at least 2 in bulk"),
+    key(
+        "system.volume_fraction",
+        "-",
+        "from the other two",
+        LeftOpen(0.0, 0.64),
+        "N pi d^3 / (6 L^3) in bulk, N d^3 / (8 R^3) in a droplet; at most random close packing",
+    ),
+    key("system.diameter", "length", "1", Positive, "sphere diameter d"),
+    key(
+        "system.radius",
+        "length",
+        "from the other two",
+        Positive,
+        "droplet radius R (hard-wall, interface)",
+    )
+    .also("above d/2; not with geometry = \"bulk\""),
+    key(
+        "system.box",
+        "length",
+        "from the other two",
+        Positive,
+        "edge L of the periodic cube (bulk)",
+    )
+    .also("at least 2 d; bulk only"),
+    key(
+        "system.kT",
+        "energy",
+        "1",
+        Positive,
+        "thermal energy (the interface's stiffness is in energy / length^2)",
+    ),
+    key(
+        "system.initial",
+        "-",
+        "FCC lattice",
+        Path,
+        "start from the last frame of this GSD file",
+    )
+    .also("N spheres, no overlap, centres inside the wall"),
+    key(
+        "interface",
+        "-",
+        "-",
+        Table,
+        "the harmonic interface, as droplet-bd's (geometry = \"interface\" only)",
+    ),
+    key(
+        "interface.stiffness",
+        "energy / length^2",
+        "50 kT / d^2",
+        Positive,
+        "spring constant k of V = k s^2 / 2, s = r - (R + offset)",
+    ),
+    key(
+        "interface.range",
+        "length",
+        "d / 2",
+        Positive,
+        "range of the harmonic part (linear beyond)",
+    ),
+    key(
+        "interface.offset",
+        "length",
+        "-d / 2",
+        Finite,
+        "wall position relative to R (-d/2: the surface touches R)",
+    )
+    .also("above -radius"),
+    key("mc", "-", "-", Table, "sweeps, warm-up and tuning"),
+    key(
+        "mc.sweeps",
+        "sweeps",
+        "10000",
+        Integer(1, COUNT),
+        "sampling sweeps (N trial moves each) after the warm-up",
+    ),
+    key(
+        "mc.warmup_sweeps",
+        "sweeps",
+        "2000",
+        Integer(0, COUNT),
+        "warm-up sweeps, delta tuned every tune_every, then frozen",
+    ),
+    key(
+        "mc.target_acceptance",
+        "-",
+        "0.3",
+        LeftOpen(0.0, 1.0),
+        "acceptance the warm-up tunes delta towards",
+    )
+    .also("below 1"),
+    key(
+        "mc.tune_every",
+        "sweeps",
+        "100",
+        Integer(1, COUNT),
+        "sweeps between tunings: delta *= acceptance / target (factor in [1/2, 2])",
+    ),
+    key(
+        "mc.sample_every",
+        "sweeps",
+        "10",
+        Integer(1, COUNT),
+        "sweeps between samples of the observables",
+    ),
+    key(
+        "mc.delta",
+        "length",
+        "d / 10",
+        Positive,
+        "initial half-width of the displacement cube (at most half a cell side)",
+    ),
+    key(
+        "mc.blocks",
+        "-",
+        "20",
+        Integer(2, 100_000),
+        "blocks of the sampling sweeps whose scatter gives the standard errors",
+    )
+    .also("at most sweeps / sample_every"),
+    key("output", "-", "-", Table, "observables and files"),
+    key(
+        "output.profile_bins",
+        "-",
+        "50",
+        Integer(1, 1_000_000),
+        "radial bins between 0 and R (droplets: profile_mean.csv)",
+    ),
+    key(
+        "output.gr_bins",
+        "-",
+        "200",
+        Integer(1, 1_000_000),
+        "bins of g(r) between 0 and gr_max (bulk: g_r.csv)",
+    ),
+    key("output.gr_max", "length", "L/2", Positive, "range of g(r)")
+        .also("at most L/2"),
+    key(
+        "output.trajectory_every",
+        "sweeps",
+        "0 (none)",
+        Integer(0, COUNT),
+        "sweeps between frames of trajectory.gsd",
+    ),
+];
+
+/// The keys of `hs-mc` scenarios, as listed.
+pub fn mc() -> Vec<Key> {
+    MC.iter().map(Key::from).collect()
+}
+
 /// The keys of `bcd` scenarios, as listed.
 pub fn bcd() -> Vec<Key> {
     BCD.iter().map(Key::from).collect()

@@ -20,6 +20,7 @@ pub mod trajectory;
 mod bcd;
 mod dpd;
 mod droplet;
+mod hs_mc;
 mod theory_droplet;
 
 pub use control::{Control, Progress, Silent};

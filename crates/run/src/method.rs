@@ -134,6 +134,7 @@ static METHODS: &[&dyn Method] = &[
     &crate::bcd::BcdMethod,
     &crate::droplet::DropletBd,
     &crate::dpd::DpdMethod,
+    &crate::hs_mc::HsMc,
 ];
 
 /// Every registered method.

@@ -122,9 +122,37 @@ structure_every = 1000
 gr_bins = 200
 "#;
 
+const MC: &str = r#"
+method = "hs-mc"
+seed = 1
+[system]
+geometry = "interface"
+particles = 100
+radius = 5.0
+diameter = 1.0
+kT = 1.0
+[interface]
+stiffness = 50.0
+range = 0.5
+offset = -0.5
+[mc]
+sweeps = 1000
+warmup_sweeps = 2000
+target_acceptance = 0.3
+tune_every = 100
+sample_every = 10
+delta = 0.1
+blocks = 20
+[output]
+profile_bins = 50
+gr_bins = 200
+gr_max = 3.0
+trajectory_every = 0
+"#;
+
 type Parse = fn(&str) -> Result<(), String>;
 
-fn methods() -> [(&'static str, &'static [Spec], Parse); 3] {
+fn methods() -> [(&'static str, &'static [Spec], Parse); 4] {
     [
         (BCD, keys::BCD, |t| {
             toml::from_str::<colloidsim_bcd::scenario::Scenario>(t)
@@ -138,6 +166,11 @@ fn methods() -> [(&'static str, &'static [Spec], Parse); 3] {
         }),
         (DPD, keys::DPD, |t| {
             colloidsim_md::dpd::scenario::DpdScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (MC, keys::MC, |t| {
+            colloidsim_mc::scenario::McScenario::from_toml(t)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         }),

@@ -1,0 +1,184 @@
+//! End-to-end tests of `colloidsim run` on hs-mc scenarios: killed and interrupted runs continue
+//! bitwise (every output file and summary.json the same), the examples are valid, and bad input
+//! is refused with the key and its range.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+mod common;
+use common::{assert_same_outputs, text};
+
+/// summary.json fields that depend on the session's timing.
+const VOLATILE: &[&str] = &["wall_seconds", "trial_moves_per_second"];
+
+/// 500 spheres at phi 0.3 in bulk, 500 warm-up and 600 sampling sweeps (checkpoints every 110).
+const BULK: &str = r#"
+method = "hs-mc"
+seed = 5
+[system]
+geometry = "bulk"
+particles = 500
+volume_fraction = 0.3
+[mc]
+warmup_sweeps = 500
+sweeps = 600
+sample_every = 5
+blocks = 6
+[output]
+gr_bins = 40
+trajectory_every = 50
+"#;
+
+/// 300 spheres in the BD droplet's harmonic interface, R = 5 d.
+const INTERFACE: &str = r#"
+method = "hs-mc"
+seed = 5
+[system]
+geometry = "interface"
+particles = 300
+radius = 5.0
+[interface]
+stiffness = 50.0
+[mc]
+warmup_sweeps = 500
+sweeps = 600
+sample_every = 5
+blocks = 6
+"#;
+
+fn run(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
+    c.current_dir(dir).args(args);
+    if args[0] == "run" {
+        c.arg("--quiet");
+    }
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().unwrap()
+}
+
+#[test]
+fn killed_and_interrupted_runs_continue_bitwise() {
+    for scenario in [BULK, INTERFACE] {
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path();
+        std::fs::write(d.join("s.toml"), scenario).unwrap();
+        let o = run(d, &["run", "s.toml", "--out", "a"], &[]);
+        assert!(o.status.success(), "{}", text(&o));
+        for (k, hook) in [
+            ("k", "COLLOIDSIM_KILL_AT_STEP"),
+            ("i", "COLLOIDSIM_INTERRUPT_AT_STEP"),
+        ] {
+            let o = run(d, &["run", "s.toml", "--out", k], &[(hook, "333")]);
+            assert!(!o.status.success(), "{hook}: {}", text(&o));
+            let o = run(d, &["run", "--restart", k], &[]);
+            assert!(o.status.success(), "{}", text(&o));
+            assert_same_outputs(&d.join("a"), &d.join(k), VOLATILE);
+        }
+        let s: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("a/summary.json")).unwrap()).unwrap();
+        let acc = s["acceptance"].as_f64().unwrap();
+        assert!((acc - 0.3).abs() < 0.05, "acceptance {acc} after tuning");
+        if scenario == BULK {
+            let z = &s["compressibility"];
+            let (v, e) = (
+                z["value"].as_f64().unwrap(),
+                z["standard_error"].as_f64().unwrap(),
+            );
+            assert!(e > 0.0 && (v - 3.9738).abs() < 5.0 * e, "Z {v} +- {e}");
+            assert!(d.join("a/g_r.csv").exists());
+        } else {
+            assert!(d.join("a/profile_mean.csv").exists());
+        }
+    }
+}
+
+#[test]
+fn the_examples_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/mc");
+    for name in ["bulk.toml", "droplet-static.toml"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let o = run(
+            tmp.path(),
+            &["check", root.join(name).to_str().unwrap()],
+            &[],
+        );
+        assert!(o.status.success(), "{name}: {}", text(&o));
+    }
+}
+
+/// Write a GSD frame with these positions (a starting configuration).
+fn gsd_with(path: &Path, pos: Vec<[f64; 3]>) {
+    use colloidsim_md::gsd::GsdWriter;
+    use colloidsim_md::{Particles, SimBox};
+    let mut w = GsdWriter::create_new(path).unwrap();
+    w.write_frame(
+        0,
+        &SimBox::cube(20.0),
+        &Particles::monodisperse(pos, 1.0),
+        true,
+        &[],
+    )
+    .unwrap();
+    w.sync().unwrap();
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_key_and_range() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let wall = |extra: &str, mc: &str| {
+        format!(
+            "method = \"hs-mc\"\n[system]\ngeometry = \"hard-wall\"\nradius = 4.0\n{extra}\n[mc]\nsweeps = 1000\n{mc}\n"
+        )
+    };
+    gsd_with(&d.join("overlap.gsd"), vec![[0.0; 3], [0.5, 0.0, 0.0]]);
+    gsd_with(&d.join("outside.gsd"), vec![[0.0; 3], [3.7, 0.0, 0.0]]);
+    let cases = [
+        (
+            wall("particles = 100", "target_acceptance = 1.0"),
+            "mc.target_acceptance",
+        ),
+        (
+            wall("particles = 100", "target_acceptance = 0.0"),
+            "mc.target_acceptance",
+        ),
+        (wall("volume_fraction = 0.7", ""), "system.volume_fraction"),
+        (wall("particles = 400", ""), "random close packing"),
+        (
+            wall("particles = 2\ninitial = \"overlap.gsd\"", ""),
+            "system.initial",
+        ),
+        (
+            wall("particles = 2\ninitial = \"outside.gsd\"", ""),
+            "beyond the allowed",
+        ),
+        (wall("particles = 100\nbox = 10.0", ""), "system.box"),
+        (
+            wall("particles = 100", "blocks = 200\nsample_every = 10"),
+            "mc.blocks",
+        ),
+        (
+            "method = \"hs-mc\"\n[system]\ngeometry = \"bulk\"\nparticles = 2\nbox = 1e7\n".into(),
+            "more than this machine can give",
+        ),
+        (
+            "method = \"hs-mc\"\n[system]\ngeometry = \"bulk\"\nparticles = 10\nbox = 1.5\n".into(),
+            "system.",
+        ),
+        (
+            wall("particles = 10\n[interface]\nstiffness = 5.0", ""),
+            "interface",
+        ),
+    ];
+    for (k, (scenario, want)) in cases.iter().enumerate() {
+        let name = format!("bad{k}.toml");
+        std::fs::write(d.join(&name), scenario).unwrap();
+        let o = run(d, &["check", &name], &[]);
+        let t = text(&o);
+        assert!(!o.status.success(), "{scenario}: accepted");
+        assert!(t.contains(want), "{scenario}: {t}");
+        assert!(!t.contains("panicked"), "{t}");
+    }
+}

@@ -1,0 +1,884 @@
+//! The hard-sphere NVT Monte Carlo engine: single-particle displacement moves on a checkerboard
+//! of cells.
+//!
+//! # Algorithm
+//!
+//! The periodic box (the bulk cube, or a cube around the droplet with [`Geometry::box_edge`]'s
+//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` even (at least 2).
+//! A sweep is:
+//!
+//! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the eight colours
+//!    `(ix mod 2, iy mod 2, iz mod 2)` from the stream `(seed, sweep, Moves, 0)`;
+//! 2. bin every particle (in particle order) into the shifted grid, storing its position
+//!    relative to its cell's corner;
+//! 3. for each colour in turn, every cell of that colour (concurrently, with rayon) makes as many
+//!    trial moves as it holds particles: pick one of its particles uniformly, displace it
+//!    uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre leaves the
+//!    cell, leaves the container, or overlaps any sphere, and (interface geometry) accept it
+//!    with the Metropolis probability `min(1, exp(-beta dV))`. Cells of one colour are a cell
+//!    apart, `s >= d`, so a sphere moving inside one can touch only spheres of its own cell and of
+//!    its 26 neighbours, which belong to other colours and stay fixed during the colour's pass;
+//! 4. write the positions back in particle order.
+//!
+//! This is the checkerboard scheme of Anderson, Jankowski, Grubb, Engel, Glotzer, J. Comput.
+//! Phys. 254, 27 (2013) (HOOMD-blue HPMC on GPUs). Each elementary move keeps detailed balance
+//! with respect to the hard-sphere Boltzmann distribution: with the grid fixed, the number of
+//! particles in a cell does not change during its pass, so the pick is symmetric; the
+//! displacement is symmetric; moves out of the cell are rejected in both directions. The sweep
+//! is a composition of such moves (balance holds), and the random offset and colour order make
+//! it ergodic. A sweep makes exactly N trial moves.
+//!
+//! Random numbers: cell `c` draws from the stream `(seed, sweep, Moves, 1 + c)`, so a run is a
+//! pure function of its seed and the result does not depend on the number of threads.
+//!
+//! Memory: positions live twice, in particle order (`pos`, structure of arrays) and in the cell
+//! slots (`slot`, fixed capacity per cell, colours stored one after another so that a colour's
+//! cells are one contiguous mutable range while the other colours are read-only). Nothing is
+//! allocated per move or per sweep (only when a cell overflows its capacity, which grows).
+
+use crate::geometry::Geometry;
+use colloidsim_core::ParamError;
+use colloidsim_core::param::{positive, show};
+use colloidsim_core::resources::ensure_fits;
+use colloidsim_core::rng::{Purpose, stream};
+use rand::Rng;
+use rayon::prelude::*;
+use thiserror::Error;
+
+/// Errors of the Monte Carlo engine.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum McError {
+    /// A parameter is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// Two spheres of the initial configuration overlap.
+    #[error(
+        "{key}: spheres {i} and {j} overlap (centre distance {distance:.6} < diameter {diameter}); a hard-sphere configuration needs every centre distance >= d"
+    )]
+    Overlap {
+        /// Scenario key of the configuration.
+        key: String,
+        /// First sphere.
+        i: usize,
+        /// Second sphere.
+        j: usize,
+        /// Their centre distance.
+        distance: f64,
+        /// The diameter.
+        diameter: f64,
+    },
+    /// A sphere of the initial configuration lies outside its container.
+    #[error(
+        "{key}: sphere {i} has its centre at distance {r:.6} from the droplet centre, beyond the allowed {max:.6} (hard wall: radius - d/2)"
+    )]
+    OutsideWall {
+        /// Scenario key of the configuration.
+        key: String,
+        /// The sphere.
+        i: usize,
+        /// Its centre distance.
+        r: f64,
+        /// The largest allowed centre distance.
+        max: f64,
+    },
+}
+
+/// Settings of [`HardSphereMc`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct McParams {
+    /// Sphere diameter d (length unit).
+    pub diameter: f64,
+    /// Container.
+    pub geometry: Geometry,
+    /// Seed of the random streams.
+    pub seed: u32,
+    /// Initial half-width of the trial displacement cube.
+    pub delta: f64,
+}
+
+/// Counts of one or more sweeps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SweepStats {
+    /// Trial moves (N per sweep).
+    pub trials: u64,
+    /// Accepted moves.
+    pub accepted: u64,
+    /// Moves rejected because the new centre left its cell.
+    pub left_cell: u64,
+}
+
+impl SweepStats {
+    /// Accepted / trials (0 for no trials).
+    pub fn acceptance(&self) -> f64 {
+        if self.trials == 0 {
+            0.0
+        } else {
+            self.accepted as f64 / self.trials as f64
+        }
+    }
+}
+
+impl std::ops::AddAssign for SweepStats {
+    fn add_assign(&mut self, o: Self) {
+        self.trials += o.trials;
+        self.accepted += o.accepted;
+        self.left_cell += o.left_cell;
+    }
+}
+
+/// Which neighbour cells a colour pass reads: the slots below and above the colour's range.
+#[derive(Clone, Copy)]
+struct Frozen<'a> {
+    below: [&'a [f64]; 3],
+    above: [&'a [f64]; 3],
+    /// First and one-past-last slot of the active colour.
+    lo: usize,
+    hi: usize,
+}
+
+impl<'a> Frozen<'a> {
+    /// Coordinates of the `n` particles of the (inactive) cell whose slots start at `base`.
+    #[inline(always)]
+    fn cell(&self, base: usize, n: usize) -> [&'a [f64]; 3] {
+        if base < self.lo {
+            self.below.map(|s| &s[base..base + n])
+        } else {
+            let b = base - self.hi;
+            self.above.map(|s| &s[b..b + n])
+        }
+    }
+}
+
+/// Everything a cell's pass needs apart from the slots (copied into each task).
+#[derive(Clone, Copy)]
+struct Pass {
+    d2: f64,
+    side: f64,
+    edge: f64,
+    nc: usize,
+    half: usize,
+    cap: usize,
+    delta: f64,
+    seed: u32,
+    sweep: u64,
+    offset: [f64; 3],
+    geometry: Geometry,
+    /// Squared largest centre distance from the droplet centre (infinite in bulk).
+    confine2: f64,
+}
+
+/// A uniform deviate in [0, 1) from 53 bits.
+#[inline(always)]
+fn unit(bits: u64) -> f64 {
+    (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// A uniform integer in `0..n` from 64 bits (multiply-shift; bias below n / 2^64).
+#[inline(always)]
+fn below(bits: u64, n: usize) -> usize {
+    ((bits as u128 * n as u128) >> 64) as usize
+}
+
+impl Pass {
+    /// Grid coordinates of cell `k` of colour `colour`.
+    #[inline(always)]
+    fn coords(&self, colour: usize, k: usize) -> [usize; 3] {
+        let h = self.half;
+        [
+            2 * (k % h) + (colour & 1),
+            2 * ((k / h) % h) + ((colour >> 1) & 1),
+            2 * (k / (h * h)) + (colour >> 2),
+        ]
+    }
+
+    /// Storage index of the cell at grid coordinates `c` (colour-major).
+    #[inline(always)]
+    fn id(&self, c: [usize; 3]) -> usize {
+        let h = self.half;
+        let colour = (c[0] & 1) | ((c[1] & 1) << 1) | ((c[2] & 1) << 2);
+        colour * h * h * h + ((c[2] >> 1) * h + (c[1] >> 1)) * h + (c[0] >> 1)
+    }
+
+    /// Position of the centre of the cell at grid coordinates `c` relative to the box centre
+    /// (minimum image).
+    #[inline(always)]
+    fn cell_centre(&self, c: [usize; 3]) -> [f64; 3] {
+        std::array::from_fn(|a| {
+            let mut x = -0.5 * self.edge + self.offset[a] + (c[a] as f64 + 0.5) * self.side;
+            if x >= 0.5 * self.edge {
+                x -= self.edge;
+            }
+            x
+        })
+    }
+
+    /// The trial moves of one row of active cells: the `h = nc/2` cells of colour `colour` with
+    /// row index `row` (`= kz h + ky`), whose slots are `own`; one random stream per row,
+    /// `(seed, sweep, Moves, 1 + colour h^2 + row)`. Returns (accepted, left their cell).
+    fn row_moves(
+        &self,
+        colour: usize,
+        row: usize,
+        own: [&mut [f64]; 3],
+        counts: &[u32],
+        frozen: &Frozen<'_>,
+    ) -> (u64, u64) {
+        let (h, nc, cap) = (self.half, self.nc, self.cap);
+        let first = colour * h * h * h + row * h;
+        if counts[first..first + h].iter().all(|&c| c == 0) {
+            return (0, 0);
+        }
+        let around = |i: usize| {
+            [
+                if i == 0 { nc - 1 } else { i - 1 },
+                i,
+                if i + 1 == nc { 0 } else { i + 1 },
+            ]
+        };
+        let ys = around(2 * (row % h) + ((colour >> 1) & 1));
+        let zs = around(2 * (row / h) + (colour >> 2));
+        let mut rng = stream(
+            self.seed,
+            self.sweep,
+            Purpose::Moves,
+            1 + (colour * h * h + row) as u64,
+        );
+        let [ox, oy, oz] = own;
+        let (mut accepted, mut left) = (0, 0);
+        for kx in 0..h {
+            let n = counts[first + kx] as usize;
+            if n == 0 {
+                continue;
+            }
+            let xs = around(2 * kx + (colour & 1));
+            let cell = kx * cap..(kx + 1) * cap;
+            let (a, l) = self.cell_moves(
+                [xs[1], ys[1], zs[1]],
+                [&xs, &ys, &zs],
+                [&mut ox[cell.clone()], &mut oy[cell.clone()], &mut oz[cell]],
+                n,
+                counts,
+                frozen,
+                &mut rng,
+            );
+            accepted += a;
+            left += l;
+        }
+        (accepted, left)
+    }
+
+    /// The trial moves of one active cell at grid coordinates `c` (`around`: the grid
+    /// coordinates below, at and above it along each axis, wrapped): as many as it holds
+    /// particles (`own`: its `cap` slots, positions relative to its corner, the `n` occupied
+    /// ones first and [`EMPTY`] beyond). Returns (accepted, left the cell).
+    ///
+    /// A move to `u` can touch only the neighbour cells within `d` of `u`: along each axis the
+    /// lower one when `u < d`, the upper one when `u > s - d` (with `s >= 2 d` about 7 of the
+    /// 27 cells). Each is scanned over all its slots (empty ones hold [`EMPTY`], far from
+    /// everything), a fixed-length loop that vectorises and never mispredicts its end.
+    #[inline(always)]
+    fn cell_moves(
+        &self,
+        c: [usize; 3],
+        around: [&[usize; 3]; 3],
+        own: [&mut [f64]; 3],
+        n: usize,
+        counts: &[u32],
+        frozen: &Frozen<'_>,
+        rng: &mut impl Rng,
+    ) -> (u64, u64) {
+        let [ox, oy, oz] = own;
+        let (s, cap, d) = (self.side, self.cap, self.d2.sqrt());
+        // Slots of the 27 cells around (index 9 dz + 3 dy + dx, own cell at 13), and whether
+        // each holds anyone.
+        let mut base = [0usize; 27];
+        let mut len = [0usize; 27];
+        for (dz, &jz) in around[2].iter().enumerate() {
+            for (dy, &jy) in around[1].iter().enumerate() {
+                for (dx, &jx) in around[0].iter().enumerate() {
+                    let j = self.id([jx, jy, jz]);
+                    base[9 * dz + 3 * dy + dx] = j * cap;
+                    // Whole vectors of eight: the slots up to the count rounded up.
+                    len[9 * dz + 3 * dy + dx] = (counts[j] as usize).next_multiple_of(8);
+                }
+            }
+        }
+        let centre = self.cell_centre(c);
+        let half_side = 0.5 * s;
+        let at =
+            |u: [f64; 3]| -> [f64; 3] { std::array::from_fn(|a| centre[a] + u[a] - half_side) };
+        let soft = matches!(self.geometry, Geometry::Interface { .. });
+        let (mut accepted, mut left) = (0u64, 0u64);
+        let range = |u: f64| (usize::from(u >= d), 1 + usize::from(u > s - d));
+        for _ in 0..n {
+            let p = below(rng.next_u64(), n);
+            let step = |b: u64| self.delta * (2.0 * unit(b) - 1.0);
+            let new = [
+                ox[p] + step(rng.next_u64()),
+                oy[p] + step(rng.next_u64()),
+                oz[p] + step(rng.next_u64()),
+            ];
+            if !new.iter().all(|&u| (0.0..s).contains(&u)) {
+                left += 1;
+                continue;
+            }
+            let r = at(new);
+            if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > self.confine2 {
+                continue;
+            }
+            // The own cell, without p itself.
+            let mut hit = false;
+            for q in 0..len[13] {
+                let (a, b, cc) = (new[0] - ox[q], new[1] - oy[q], new[2] - oz[q]);
+                hit |= (a * a + b * b + cc * cc < self.d2) & (q != p);
+            }
+            let (xr, yr, zr) = (range(new[0]), range(new[1]), range(new[2]));
+            'scan: for dz in zr.0..=zr.1 {
+                for dy in yr.0..=yr.1 {
+                    for dx in xr.0..=xr.1 {
+                        let k = 9 * dz + 3 * dy + dx;
+                        if hit {
+                            break 'scan;
+                        }
+                        if k == 13 || len[k] == 0 {
+                            continue;
+                        }
+                        let [x, y, z] = frozen.cell(base[k], len[k]);
+                        // The sphere's position relative to our corner is its own plus the
+                        // offset of its cell; move the offset to the trial position instead.
+                        let q = [
+                            new[0] - (dx as f64 - 1.0) * s,
+                            new[1] - (dy as f64 - 1.0) * s,
+                            new[2] - (dz as f64 - 1.0) * s,
+                        ];
+                        hit = any_within(x, y, z, q, self.d2);
+                    }
+                }
+            }
+            if hit {
+                continue;
+            }
+            if soft {
+                let du = self.geometry.beta_energy(r)
+                    - self.geometry.beta_energy(at([ox[p], oy[p], oz[p]]));
+                if du > 0.0 && unit(rng.next_u64()) >= (-du).exp() {
+                    continue;
+                }
+            }
+            ox[p] = new[0];
+            oy[p] = new[1];
+            oz[p] = new[2];
+            accepted += 1;
+        }
+        (accepted, left)
+    }
+}
+
+/// Coordinate of an empty slot: far from every position, so that fixed-length scans over all
+/// the slots of a cell never see it as a neighbour (its squared distances stay finite).
+pub(crate) const EMPTY: f64 = 1e30;
+
+/// Whether any of the points `(x, y, z)` (a cell's slots, a multiple of eight) lies closer
+/// than `sqrt(d2)` to `p`: a fixed-length, branch-free loop that vectorises.
+#[inline(always)]
+fn any_within(x: &[f64], y: &[f64], z: &[f64], p: [f64; 3], d2: f64) -> bool {
+    let mut hit = false;
+    for ((x, y), z) in x.iter().zip(y).zip(z) {
+        let (a, b, c) = (p[0] - x, p[1] - y, p[2] - z);
+        hit |= a * a + b * b + c * c < d2;
+    }
+    hit
+}
+
+/// Hard spheres in a [`Geometry`], moved by checkerboard Monte Carlo sweeps.
+#[derive(Debug, Clone)]
+pub struct HardSphereMc {
+    diameter: f64,
+    geometry: Geometry,
+    seed: u32,
+    delta: f64,
+    sweep: u64,
+    edge: f64,
+    nc: usize,
+    side: f64,
+    /// Positions in particle order, relative to the box (droplet) centre, in [-L/2, L/2).
+    pos: [Vec<f64>; 3],
+    /// Slots per cell.
+    cap: usize,
+    /// Particles per cell (storage order).
+    count: Vec<u32>,
+    /// Position relative to the cell's corner, per slot.
+    slot: [Vec<f64>; 3],
+    /// Particle index per slot.
+    tag: Vec<u32>,
+    /// Grid offset of the current binning.
+    offset: [f64; 3],
+    /// Per particle: its cell, its slot, its position relative to the cell's corner, and the
+    /// corner (scratch of the binning, kept to avoid allocating per sweep).
+    cell_of: Vec<u32>,
+    slot_of: Vec<u32>,
+    local: [Vec<f64>; 3],
+    corner: [Vec<f64>; 3],
+}
+
+/// Smallest cell side, in diameters (see [`HardSphereMc::new`]).
+const CELL_MIN: f64 = 2.0;
+
+/// Largest delta the tuner may choose, in cell sides (a larger cube always leaves the cell).
+const MAX_DELTA_PER_SIDE: f64 = 0.5;
+
+impl HardSphereMc {
+    /// Spheres at `positions` (relative to the box centre, or the droplet centre). Errors:
+    /// parameters out of range, overlaps, centres outside the container, a cell grid larger
+    /// than the memory (`key` names the configuration's scenario key in messages).
+    pub fn new(params: &McParams, positions: &[[f64; 3]], key: &str) -> Result<Self, McError> {
+        let d = positive("system.diameter", params.diameter)?;
+        positive("mc.delta", params.delta)?;
+        let edge = params.geometry.box_edge(d);
+        positive("system.box", edge)?;
+        if let Geometry::HardWall { radius } = params.geometry
+            && radius <= 0.5 * d
+        {
+            return Err(ParamError::new(
+                "system.radius",
+                format!("must exceed d/2 = {} (no room for a centre)", show(0.5 * d)),
+            )
+            .into());
+        }
+        if edge < 2.0 * d {
+            return Err(ParamError::new(
+                "system.box",
+                format!(
+                    "the periodic box edge must be at least 2 d = {}, got {}",
+                    show(2.0 * d),
+                    show(edge)
+                ),
+            )
+            .into());
+        }
+        // Cells of side >= 2 d (fewer, fuller cells: fewer moves leave their cell, and the
+        // gathered neighbours amortise over more moves); >= d in boxes shorter than 4 d.
+        let mut nc = (edge / (CELL_MIN * d)).floor() as usize;
+        nc -= nc % 2;
+        if nc < 2 {
+            nc = 2;
+        }
+        let cells = (nc as f64).powi(3);
+        let n = positions.len();
+        // Slots (3 coordinates, a tag) at the initial capacity, counts, particle arrays.
+        let cap0 = 8usize;
+        let bytes = cells * (cap0 as f64 * 28.0 + 4.0) + n as f64 * 80.0;
+        ensure_fits(
+            "system",
+            &format!("a grid of {nc}^3 Monte Carlo cells"),
+            bytes,
+        )?;
+        let nc_cells = nc * nc * nc;
+        let mut mc = Self {
+            diameter: d,
+            geometry: params.geometry,
+            seed: params.seed,
+            delta: params.delta,
+            sweep: 0,
+            edge,
+            nc,
+            side: edge / nc as f64,
+            pos: std::array::from_fn(|_| Vec::with_capacity(n)),
+            cap: cap0,
+            count: vec![0; nc_cells],
+            slot: std::array::from_fn(|_| vec![0.0; nc_cells * cap0]),
+            tag: vec![0; nc_cells * cap0],
+            offset: [0.0; 3],
+            cell_of: vec![0; n],
+            slot_of: vec![0; n],
+            local: std::array::from_fn(|_| vec![0.0; n]),
+            corner: std::array::from_fn(|_| vec![0.0; n]),
+        };
+        mc.delta = mc.delta.min(mc.max_delta());
+        let max = params.geometry.confinement(d);
+        for (i, p) in positions.iter().enumerate() {
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(
+                    ParamError::new(key, format!("sphere {i} has a non-finite position")).into(),
+                );
+            }
+            let mut q = *p;
+            if let Some(max) = max {
+                let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+                if r > max {
+                    return Err(McError::OutsideWall {
+                        key: key.into(),
+                        i,
+                        r,
+                        max,
+                    });
+                }
+            } else {
+                for x in &mut q {
+                    *x -= edge * (*x / edge + 0.5).floor();
+                    if *x >= 0.5 * edge {
+                        *x -= edge;
+                    }
+                }
+            }
+            for a in 0..3 {
+                mc.pos[a].push(q[a]);
+            }
+        }
+        mc.rebin([0.0; 3]);
+        if let Some((i, j, r)) = mc.first_overlap(0.0) {
+            return Err(McError::Overlap {
+                key: key.into(),
+                i,
+                j,
+                distance: r,
+                diameter: d,
+            });
+        }
+        Ok(mc)
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.pos[0].len()
+    }
+
+    /// Whether there are no spheres.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sphere diameter.
+    pub fn diameter(&self) -> f64 {
+        self.diameter
+    }
+
+    /// The container.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// Edge of the periodic box the cells tile.
+    pub fn box_edge(&self) -> f64 {
+        self.edge
+    }
+
+    /// Cell side s.
+    pub fn cell_side(&self) -> f64 {
+        self.side
+    }
+
+    /// Cells per box edge.
+    pub fn cells_per_edge(&self) -> usize {
+        self.nc
+    }
+
+    /// Current half-width of the trial displacement cube.
+    pub fn delta(&self) -> f64 {
+        self.delta
+    }
+
+    /// Largest delta allowed (half a cell side).
+    pub fn max_delta(&self) -> f64 {
+        MAX_DELTA_PER_SIDE * self.side
+    }
+
+    /// Set the displacement half-width (clamped to `(0, max_delta]`).
+    pub fn set_delta(&mut self, delta: f64) {
+        self.delta = delta.clamp(1e-12 * self.diameter, self.max_delta());
+    }
+
+    /// Sweeps done.
+    pub fn sweeps(&self) -> u64 {
+        self.sweep
+    }
+
+    /// Seed of the random streams.
+    pub fn seed(&self) -> u32 {
+        self.seed
+    }
+
+    /// Positions in particle order, relative to the box centre: `[x, y, z]`.
+    pub fn positions(&self) -> [&[f64]; 3] {
+        [&self.pos[0], &self.pos[1], &self.pos[2]]
+    }
+
+    /// Position of sphere `i`.
+    pub fn position(&self, i: usize) -> [f64; 3] {
+        [self.pos[0][i], self.pos[1][i], self.pos[2][i]]
+    }
+
+    /// Restore a saved state: positions (as returned by [`Self::positions`]), sweeps done and
+    /// delta; the next sweep continues bitwise as the saved run would have.
+    pub fn restore(&mut self, pos: [Vec<f64>; 3], sweeps: u64, delta: f64) {
+        assert!(pos.iter().all(|p| p.len() == self.len()));
+        self.pos = pos;
+        self.sweep = sweeps;
+        self.delta = delta;
+        self.rebin([0.0; 3]);
+    }
+
+    fn pass(&self) -> Pass {
+        let confine = self.geometry.confinement(self.diameter);
+        Pass {
+            d2: self.diameter * self.diameter,
+            side: self.side,
+            edge: self.edge,
+            nc: self.nc,
+            half: self.nc / 2,
+            cap: self.cap,
+            delta: self.delta,
+            seed: self.seed,
+            sweep: self.sweep,
+            offset: self.offset,
+            geometry: self.geometry,
+            confine2: confine.map_or(f64::INFINITY, |r| r * r),
+        }
+    }
+
+    /// Bin every particle into the grid shifted by `offset` (particle order), growing the cell
+    /// capacity when a cell overflows.
+    fn rebin(&mut self, offset: [f64; 3]) {
+        self.offset = offset;
+        let (l, s, nc) = (self.edge, self.side, self.nc);
+        let pass = self.pass();
+        let locate = |x: f64, a: usize| -> (usize, f64, f64) {
+            let mut t = x + 0.5 * l - offset[a];
+            if t < 0.0 {
+                t += l;
+            }
+            let j = ((t / s) as usize).min(nc - 1);
+            let u = (t - j as f64 * s).clamp(0.0, s);
+            (j, u, -0.5 * l + offset[a] + j as f64 * s)
+        };
+        // In parallel: each particle's cell, its position relative to the cell's corner, and
+        // the corner (for the write-back).
+        let [px, py, pz] = &self.pos;
+        let [lx, ly, lz] = &mut self.local;
+        let [cx, cy, cz] = &mut self.corner;
+        self.cell_of
+            .par_iter_mut()
+            .zip(
+                lx.par_iter_mut()
+                    .zip(ly.par_iter_mut())
+                    .zip(lz.par_iter_mut()),
+            )
+            .zip(
+                cx.par_iter_mut()
+                    .zip(cy.par_iter_mut())
+                    .zip(cz.par_iter_mut()),
+            )
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, ((cell, ((ux, uy), uz)), ((ox, oy), oz)))| {
+                let (jx, x, cxx) = locate(px[i], 0);
+                let (jy, y, cyy) = locate(py[i], 1);
+                let (jz, z, czz) = locate(pz[i], 2);
+                *cell = pass.id([jx, jy, jz]) as u32;
+                (*ux, *uy, *uz) = (x, y, z);
+                (*ox, *oy, *oz) = (cxx, cyy, czz);
+            });
+        // Serially, in particle order: the slots.
+        'retry: loop {
+            self.count.fill(0);
+            for a in &mut self.slot {
+                a.fill(EMPTY);
+            }
+            for i in 0..self.len() {
+                let id = self.cell_of[i] as usize;
+                let c = self.count[id] as usize;
+                if c == self.cap {
+                    self.grow();
+                    continue 'retry;
+                }
+                let k = id * self.cap + c;
+                for a in 0..3 {
+                    self.slot[a][k] = self.local[a][i];
+                }
+                self.tag[k] = i as u32;
+                self.slot_of[i] = k as u32;
+                self.count[id] += 1;
+            }
+            return;
+        }
+    }
+
+    /// Eight more slots per cell (a multiple of eight keeps the scans in whole vectors).
+    fn grow(&mut self) {
+        self.cap += 8;
+        let total = self.count.len() * self.cap;
+        for s in &mut self.slot {
+            s.resize(total, 0.0);
+        }
+        self.tag.resize(total, 0);
+    }
+
+    /// Write the slots back into the particle-order positions (in parallel).
+    fn scatter(&mut self) {
+        let l = self.edge;
+        let slot_of = &self.slot_of;
+        for a in 0..3 {
+            let (slot, corner) = (&self.slot[a], &self.corner[a]);
+            self.pos[a]
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(i, x)| {
+                    let v = corner[i] + slot[slot_of[i] as usize];
+                    *x = if v >= 0.5 * l { v - l } else { v };
+                });
+        }
+    }
+
+    /// One sweep: N trial moves (see the module documentation).
+    pub fn sweep(&mut self) -> SweepStats {
+        let mut rng = stream(self.seed, self.sweep, Purpose::Moves, 0);
+        let s = self.side;
+        let offset = [
+            s * unit(rng.next_u64()),
+            s * unit(rng.next_u64()),
+            s * unit(rng.next_u64()),
+        ];
+        let mut colours = [0usize, 1, 2, 3, 4, 5, 6, 7];
+        for i in (1..8).rev() {
+            colours.swap(i, below(rng.next_u64(), i + 1));
+        }
+        self.rebin(offset);
+        let pass = self.pass();
+        let h3 = pass.half.pow(3);
+        let cap = self.cap;
+        let span = h3 * cap;
+        let row = pass.half * cap;
+        let (mut accepted, mut left) = (0, 0);
+        let counts = &self.count;
+        for colour in colours {
+            let (lo, hi) = (colour * span, (colour + 1) * span);
+            let [sx, sy, sz] = &mut self.slot;
+            let (xb, rest) = sx.split_at_mut(lo);
+            let (xc, xa) = rest.split_at_mut(span);
+            let (yb, rest) = sy.split_at_mut(lo);
+            let (yc, ya) = rest.split_at_mut(span);
+            let (zb, rest) = sz.split_at_mut(lo);
+            let (zc, za) = rest.split_at_mut(span);
+            let frozen = Frozen {
+                below: [xb, yb, zb],
+                above: [xa, ya, za],
+                lo,
+                hi,
+            };
+            let (a, b) = xc
+                .par_chunks_mut(row)
+                .zip(yc.par_chunks_mut(row))
+                .zip(zc.par_chunks_mut(row))
+                .enumerate()
+                .with_min_len(4)
+                .map(|(k, ((x, y), z))| pass.row_moves(colour, k, [x, y, z], counts, &frozen))
+                .reduce(|| (0, 0), |p, q| (p.0 + q.0, p.1 + q.1));
+            accepted += a;
+            left += b;
+        }
+        self.scatter();
+        self.sweep += 1;
+        SweepStats {
+            trials: self.len() as u64,
+            accepted,
+            left_cell: left,
+        }
+    }
+
+    /// `sweeps` sweeps, with their summed counts.
+    pub fn run(&mut self, sweeps: u64) -> SweepStats {
+        let mut total = SweepStats::default();
+        for _ in 0..sweeps {
+            total += self.sweep();
+        }
+        total
+    }
+
+    /// Scale delta by `acceptance / target` (the factor clamped to [1/2, 2], delta to
+    /// `(0, max_delta]`): the warm-up's move-size tuning.
+    pub fn tune(&mut self, acceptance: f64, target: f64) {
+        let factor = (acceptance / target).clamp(0.5, 2.0);
+        self.set_delta(self.delta * factor);
+    }
+
+    /// Warm up for `sweeps` sweeps, tuning delta towards acceptance `target` every `every`
+    /// sweeps; returns the counts of the last tuning window. Delta is frozen afterwards (the
+    /// sampling sweeps keep detailed balance only with a fixed delta).
+    pub fn warm_up(&mut self, sweeps: u64, every: u64, target: f64) -> SweepStats {
+        let every = every.max(1);
+        let mut window = SweepStats::default();
+        for k in 1..=sweeps {
+            window += self.sweep();
+            if k % every == 0 {
+                self.tune(window.acceptance(), target);
+                if k < sweeps {
+                    window = SweepStats::default();
+                }
+            }
+        }
+        window
+    }
+
+    /// Visit every unordered pair with centre distance `r < rcut` once: `f(i, j, r^2)`.
+    /// `rcut` is clamped so that the cell stencil fits the box (at most `L/2`).
+    pub fn for_each_pair(&self, rcut: f64, mut f: impl FnMut(usize, usize, f64)) {
+        let pass = self.pass();
+        let (nc, s, cap) = (self.nc, self.side, self.cap);
+        let rcut = rcut.min(0.5 * self.edge);
+        let reach = ((rcut / s).ceil() as isize).max(1);
+        let rc2 = rcut * rcut;
+        let h3 = pass.half.pow(3);
+        for a in 0..self.count.len() {
+            let ca = pass.coords(a / h3, a % h3);
+            let na = self.count[a] as usize;
+            if na == 0 {
+                continue;
+            }
+            for dz in -reach..=reach {
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        let w = |c: usize, o: isize| (c as isize + o).rem_euclid(nc as isize);
+                        let b = pass.id([
+                            w(ca[0], dx) as usize,
+                            w(ca[1], dy) as usize,
+                            w(ca[2], dz) as usize,
+                        ]);
+                        if b < a {
+                            continue;
+                        }
+                        let sh = [dx as f64 * s, dy as f64 * s, dz as f64 * s];
+                        for p in a * cap..a * cap + na {
+                            let first = if a == b { p + 1 } else { b * cap };
+                            for q in first..b * cap + self.count[b] as usize {
+                                let r2 = (0..3)
+                                    .map(|k| {
+                                        let v = self.slot[k][p] - self.slot[k][q] - sh[k];
+                                        v * v
+                                    })
+                                    .sum::<f64>();
+                                if r2 < rc2 {
+                                    f(self.tag[p] as usize, self.tag[q] as usize, r2);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The first pair closer than `d (1 - tolerance)` (particle indices and distance), if any.
+    /// Positions are re-expressed relative to a new cell each sweep, so distances carry a
+    /// rounding error of a few ulp of the box edge; the checks of the tests allow 1e-12.
+    pub fn first_overlap(&self, tolerance: f64) -> Option<(usize, usize, f64)> {
+        let lim = self.diameter * (1.0 - tolerance);
+        let mut found = None;
+        self.for_each_pair(self.diameter, |i, j, r2| {
+            if found.is_none() && r2 < lim * lim {
+                found = Some((i.min(j), i.max(j), r2.sqrt()));
+            }
+        });
+        found
+    }
+}

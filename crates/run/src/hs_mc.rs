@@ -1,0 +1,597 @@
+//! Hard-sphere Monte Carlo (`method = "hs-mc"`, crate `colloidsim-mc`): a warm-up that tunes
+//! the move size, then sampling sweeps with delta frozen; in bulk g(r), the contact value and
+//! the compressibility factor with block-average errors; in a droplet the radial volume-fraction
+//! profile on droplet-bd's file names (and, with a hard wall, the exact virial sum rule at the
+//! wall). Checkpoints hold the positions exactly: a restart continues bitwise.
+
+use crate::checkpoint::Envelope;
+use crate::droplet::{flat, trim_trajectory};
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot, picture};
+use crate::trajectory::FrameDigest;
+use crate::{Scenario as Source, seed32};
+use anyhow::{Context, Result, bail};
+use colloidsim_core::output::OutputDir;
+use colloidsim_mc::observe::{
+    CONTACT_BINS, CONTACT_WINDOW, PairHistogram, RadialHistogram, bulk_contact, carnahan_starling,
+    carnahan_starling_contact, compressibility, contact_pairs, mean_and_error,
+    wall_contact_density,
+};
+use colloidsim_mc::scenario::{McRun, McScenario};
+use colloidsim_mc::{HardSphereMc, SweepStats};
+use colloidsim_md::gsd::{self, GsdWriter};
+use colloidsim_md::{Particles, SimBox};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::f64::consts::PI;
+
+/// Hard-sphere Monte Carlo scenarios.
+pub struct HsMc;
+
+/// Parse and validate a scenario (`system.initial` relative to the scenario's folder).
+fn resolve(src: &Source, seed: Option<u64>) -> Result<McRun> {
+    crate::keys::validate(&src.table()?, crate::keys::MC).with_context(|| src.label())?;
+    let mut sc = McScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        seed32(s)?;
+        sc.seed = s;
+    }
+    if let Some(init) = &sc.system.initial
+        && init.is_relative()
+    {
+        sc.system.initial = Some(src.base().join(init));
+    }
+    sc.validate().with_context(|| src.label())
+}
+
+/// The engine at the start: the last frame of `system.initial`, or an FCC lattice.
+fn build(p: &McRun) -> Result<HardSphereMc> {
+    let positions = match &p.initial {
+        Some(path) => {
+            let f = gsd::read_frame(path, None)
+                .with_context(|| format!("system.initial: {}", path.display()))?;
+            Some(f.particles.pos)
+        }
+        None => None,
+    };
+    Ok(p.engine(positions.as_deref(), "system.initial")?)
+}
+
+impl Method for HsMc {
+    fn names(&self) -> &'static [&'static str] {
+        &["hs-mc"]
+    }
+
+    fn about(&self) -> &'static str {
+        "hard-sphere Monte Carlo (NVT, checkerboard cells) in bulk, in a hard spherical wall or in the BD droplet's interface"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/mc.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let p = resolve(src, None)?;
+        build(&p).with_context(|| src.label())?;
+        Ok(Checked {
+            resolved: serde_json::to_value(&p)?,
+            warnings: Vec::new(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let p = resolve(src, seed)?;
+        let mc = build(&p).with_context(|| src.label())?;
+        let acc = Accum::new(&p, &mc);
+        Ok(Box::new(McSession::new(p, mc, acc)))
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let p = resolve(src, Some(seed))?;
+        let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if saved.pos.iter().any(|c| c.len() != p.particles) || saved.acc.blocks.len() != p.blocks {
+            bail!("checkpoint: its state does not fit the scenario");
+        }
+        let rows: Vec<[f64; 3]> = (0..p.particles)
+            .map(|i| [saved.pos[0][i], saved.pos[1][i], saved.pos[2][i]])
+            .collect();
+        let mut mc = p.engine(Some(&rows), "checkpoint.bin")?;
+        mc.restore(saved.pos, saved.sweeps, saved.delta);
+        if p.trajectory_every > 0 {
+            saved
+                .acc
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, &[], false)
+                })?;
+        }
+        Ok(Box::new(McSession::new(p, mc, saved.acc)))
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::mc()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let p = resolve(src, seed)?;
+        Ok(Box::new(McEngine { mc: build(&p)? }))
+    }
+}
+
+/// One block of the sampling sweeps: its histograms.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Block {
+    /// Pair distances next to contact.
+    contact: PairHistogram,
+    /// g(r) (bulk).
+    gr: Option<PairHistogram>,
+    /// Centre distances from the droplet centre over [0, R] (droplets).
+    profile: Option<RadialHistogram>,
+    /// Centre distances next to the hard wall (hard wall).
+    wall: Option<RadialHistogram>,
+}
+
+/// Everything a run accumulates, saved in every checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Accum {
+    /// Counts of the current tuning window (warm-up).
+    window: SweepStats,
+    /// Counts of the sampling sweeps.
+    sampling: SweepStats,
+    /// Delta at the end of the warm-up (frozen).
+    frozen_delta: Option<f64>,
+    blocks: Vec<Block>,
+    /// Frames in trajectory.gsd and their CRC-32.
+    frames: u64,
+    digest: FrameDigest,
+}
+
+impl Accum {
+    fn new(p: &McRun, mc: &HardSphereMc) -> Self {
+        let d = p.diameter;
+        let contact_max = d * (1.0 + CONTACT_WINDOW);
+        let rc = mc.geometry().confinement(d);
+        let block = Block {
+            contact: PairHistogram::new(d, contact_max, CONTACT_BINS),
+            gr: p
+                .is_bulk()
+                .then(|| PairHistogram::new(0.0, p.gr_max, p.gr_bins)),
+            profile: p
+                .radius
+                .map(|r| RadialHistogram::new(0.0, r, p.profile_bins)),
+            wall: (p.geometry == "hard-wall")
+                .then(|| {
+                    rc.map(|rc| RadialHistogram::new(rc - CONTACT_WINDOW * d, rc, CONTACT_BINS))
+                })
+                .flatten(),
+        };
+        Self {
+            window: SweepStats::default(),
+            sampling: SweepStats::default(),
+            frozen_delta: None,
+            blocks: vec![block; p.blocks],
+            frames: 0,
+            digest: FrameDigest::default(),
+        }
+    }
+}
+
+/// The method's part of `checkpoint.bin`: the exact positions, sweeps, delta and accumulators.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Saved {
+    sweeps: u64,
+    delta: f64,
+    pos: [Vec<f64>; 3],
+    acc: Accum,
+}
+
+/// A Monte Carlo run: warm-up sweeps, then sampling sweeps.
+struct McSession {
+    p: McRun,
+    mc: HardSphereMc,
+    acc: Accum,
+    gsd: Option<GsdWriter>,
+    traj: Option<std::path::PathBuf>,
+}
+
+impl McSession {
+    fn new(p: McRun, mc: HardSphereMc, acc: Accum) -> Self {
+        Self {
+            p,
+            mc,
+            acc,
+            gsd: None,
+            traj: None,
+        }
+    }
+
+    fn total(&self) -> u64 {
+        self.p.warmup_sweeps + self.p.sweeps
+    }
+
+    /// Observations after `sweep` sweeps: samples of the sampling part, trajectory frames.
+    fn record(&mut self, sweep: u64) -> Result<()> {
+        let p = &self.p;
+        if sweep > p.warmup_sweeps && (sweep - p.warmup_sweeps - 1).is_multiple_of(p.sample_every) {
+            // Sample k of the sampling part belongs to block k * blocks / sweeps.
+            let k = sweep - p.warmup_sweeps - 1;
+            let b = ((k as u128 * p.blocks as u128) / p.sweeps as u128) as usize;
+            let block = &mut self.acc.blocks[b.min(p.blocks - 1)];
+            block.contact.sample(&self.mc);
+            if let Some(h) = block.gr.as_mut() {
+                h.sample(&self.mc);
+            }
+            if let Some(h) = block.profile.as_mut() {
+                h.sample(&self.mc);
+            }
+            if let Some(h) = block.wall.as_mut() {
+                h.sample(&self.mc);
+            }
+        }
+        if let Some(w) = self.gsd.as_mut()
+            && sweep.is_multiple_of(p.trajectory_every)
+        {
+            let pos: Vec<[f64; 3]> = (0..self.mc.len()).map(|i| self.mc.position(i)).collect();
+            w.write_frame(
+                sweep,
+                &SimBox::cube(self.mc.box_edge()),
+                &Particles::monodisperse(pos, p.diameter),
+                false,
+                &[],
+            )?;
+            self.acc.frames += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Session for McSession {
+    fn label(&self) -> String {
+        "hs-mc".into()
+    }
+
+    fn total(&self) -> u64 {
+        McSession::total(self)
+    }
+
+    fn position(&self) -> u64 {
+        self.mc.sweeps()
+    }
+
+    fn seed(&self) -> u64 {
+        self.p.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::to_value(&self.p).unwrap_or_default()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        [
+            "g_r.csv",
+            "profile_mean.csv",
+            "profiles.png",
+            "g_r.png",
+            "trajectory.gsd",
+        ]
+        .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        let traj = out.join("trajectory.gsd");
+        if self.p.trajectory_every > 0 {
+            self.gsd = Some(if traj.exists() && !fresh {
+                GsdWriter::append(&traj)?
+            } else {
+                GsdWriter::create_new(&traj)?
+            });
+        }
+        self.traj = Some(traj);
+        if fresh {
+            self.record(0)?;
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        let total = McSession::total(self);
+        let every = (total / 10).max(1);
+        let next = (self.position() / every + 1) * every;
+        (next < total).then_some(next)
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        let p = self.p.clone();
+        while self.mc.sweeps() < until.min(self.total()) {
+            let s = self.mc.sweep();
+            let done = self.mc.sweeps();
+            if done <= p.warmup_sweeps {
+                self.acc.window += s;
+                if done.is_multiple_of(p.tune_every) {
+                    self.mc
+                        .tune(self.acc.window.acceptance(), p.target_acceptance);
+                    self.acc.window = SweepStats::default();
+                }
+                if done == p.warmup_sweeps {
+                    self.acc.frozen_delta = Some(self.mc.delta());
+                }
+            } else {
+                self.acc.sampling += s;
+            }
+            self.record(done)?;
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.p.trajectory_every > 0 {
+            self.flush()?;
+            self.acc
+                .digest
+                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        }
+        let [x, y, z] = self.mc.positions();
+        let saved = Saved {
+            sweeps: self.mc.sweeps(),
+            delta: self.mc.delta(),
+            pos: [x.to_vec(), y.to_vec(), z.to_vec()],
+            acc: self.acc.clone(),
+        };
+        Ok(bincode::serialize(&saved)?)
+    }
+
+    fn finish(
+        mut self: Box<Self>,
+        out: &OutputDir,
+        wall_s: f64,
+        _failure: Option<&str>,
+    ) -> Result<Finished> {
+        self.flush()?;
+        let p = &self.p;
+        let d = p.diameter;
+        let n = self.mc.len();
+        let mut files = Vec::new();
+        let mut warnings = Vec::new();
+        let blocks: Vec<&Block> = self
+            .acc
+            .blocks
+            .iter()
+            .filter(|b| b.contact.samples() > 0)
+            .collect();
+        let mut summary = json!({
+            "software": crate::software(),
+            "method": "hs-mc",
+            "seed": p.seed,
+            "parameters": p,
+            "sweeps": self.mc.sweeps(),
+            "trial_moves": self.acc.sampling.trials,
+            "acceptance": self.acc.sampling.acceptance(),
+            "left_cell_fraction": self.acc.sampling.left_cell as f64 / self.acc.sampling.trials.max(1) as f64,
+            "delta": self.acc.frozen_delta.unwrap_or(self.mc.delta()),
+            "cell_side": self.mc.cell_side(),
+            "blocks": blocks.len(),
+            "samples": blocks.iter().map(|b| b.contact.samples()).sum::<u64>(),
+            "wall_seconds": wall_s,
+            "trial_moves_per_second": (self.mc.sweeps() * n as u64) as f64 / wall_s.max(1e-9),
+            "threads": rayon::current_num_threads(),
+            "trajectory_frames": self.acc.frames,
+        });
+        let value_error = |v: &[f64]| {
+            let (m, e) = mean_and_error(v);
+            json!({ "value": m, "standard_error": e })
+        };
+        if p.is_bulk() {
+            let volume = self.mc.box_edge().powi(3);
+            let contact: Vec<f64> = blocks
+                .iter()
+                .map(|b| bulk_contact(&b.contact, n, volume, d))
+                .collect();
+            let z: Vec<f64> = contact
+                .iter()
+                .map(|&g| compressibility(p.volume_fraction, n, g))
+                .collect();
+            summary["contact_value"] = value_error(&contact);
+            summary["compressibility"] = value_error(&z);
+            summary["carnahan_starling"] = json!({
+                "compressibility": carnahan_starling(p.volume_fraction),
+                "contact_value": carnahan_starling_contact(p.volume_fraction),
+            });
+            let per_block: Vec<Vec<f64>> = blocks
+                .iter()
+                .filter_map(|b| b.gr.as_ref().map(|h| h.pair_correlation(n, volume)))
+                .collect();
+            if let Some(h) = blocks.first().and_then(|b| b.gr.as_ref()) {
+                let r = h.centres();
+                let (g, err) = columns(&per_block, r.len());
+                out.write_table("g_r.csv", &[("r", &r), ("g", &g), ("err", &err)])?;
+                files.push("g_r.csv".into());
+                let title = format!(
+                    "Hard spheres, Monte Carlo: N = {n}, phi = {:.3}, Z = {:.4}",
+                    p.volume_fraction,
+                    summary["compressibility"]["value"]
+                        .as_f64()
+                        .unwrap_or(f64::NAN)
+                );
+                let series = [Series {
+                    label: "g(r)",
+                    x: &r,
+                    y: &g,
+                    points: false,
+                }];
+                picture(
+                    line_plot(
+                        &out.join("g_r.png"),
+                        &title,
+                        "r / d",
+                        "g(r)",
+                        &series,
+                        Scale::Linear,
+                    ),
+                    "g_r.png",
+                    &mut files,
+                    &mut warnings,
+                );
+            }
+        } else {
+            let vol = PI / 6.0 * d.powi(3);
+            let per_block: Vec<Vec<f64>> = blocks
+                .iter()
+                .filter_map(|b| {
+                    b.profile
+                        .as_ref()
+                        .map(|h| h.density().iter().map(|rho| rho * vol).collect())
+                })
+                .collect();
+            if let Some(h) = blocks.first().and_then(|b| b.profile.as_ref()) {
+                let r = h.centres();
+                let (phi, err) = columns(&per_block, r.len());
+                out.write_table(
+                    "profile_mean.csv",
+                    &[("r", &r), ("phi", &phi), ("err", &err)],
+                )?;
+                files.push("profile_mean.csv".into());
+                let radius = p.radius.unwrap_or(1.0);
+                let x: Vec<f64> = r.iter().map(|v| v / radius).collect();
+                let title = format!(
+                    "Static droplet, hard-sphere MC ({}): N = {n}, phi = {:.3}",
+                    p.geometry, p.volume_fraction
+                );
+                let series = [Series {
+                    label: "equilibrium",
+                    x: &x,
+                    y: &phi,
+                    points: false,
+                }];
+                picture(
+                    line_plot(
+                        &out.join("profiles.png"),
+                        &title,
+                        "r / R",
+                        "volume fraction phi(r)",
+                        &series,
+                        Scale::Linear,
+                    ),
+                    "profiles.png",
+                    &mut files,
+                    &mut warnings,
+                );
+            }
+            if let Some(rc) = self
+                .mc
+                .geometry()
+                .confinement(d)
+                .filter(|_| p.geometry == "hard-wall")
+            {
+                // 4 pi Rc^3 rho(Rc) = 3 N + d n_c (docs/mc.md), per block.
+                let wall: Vec<f64> = blocks
+                    .iter()
+                    .filter_map(|b| b.wall.as_ref())
+                    .map(|h| 4.0 * PI * rc.powi(3) * wall_contact_density(h, rc))
+                    .collect();
+                let virial: Vec<f64> = blocks
+                    .iter()
+                    .map(|b| 3.0 * n as f64 + d * contact_pairs(&b.contact, d))
+                    .collect();
+                let ratio: Vec<f64> = wall.iter().zip(&virial).map(|(a, b)| a / b - 1.0).collect();
+                let contact: Vec<f64> = blocks
+                    .iter()
+                    .filter_map(|b| b.wall.as_ref())
+                    .map(|h| wall_contact_density(h, rc))
+                    .collect();
+                summary["wall_contact_density"] = value_error(&contact);
+                summary["wall_sum_rule"] = json!({
+                    "wall": value_error(&wall),
+                    "virial": value_error(&virial),
+                    "relative_difference": value_error(&ratio),
+                });
+            }
+        }
+        if self.acc.frames > 0 {
+            files.push("trajectory.gsd".into());
+        }
+        summary["warnings"] = json!(warnings);
+        let message = format!(
+            "{} sweeps of {n} hard spheres ({}) in {wall_s:.1} s ({:.3e} trial moves/s), acceptance {:.3}; outputs in {}",
+            self.mc.sweeps(),
+            p.geometry,
+            (self.mc.sweeps() * n as u64) as f64 / wall_s.max(1e-9),
+            self.acc.sampling.acceptance(),
+            out.path().display()
+        );
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+/// Mean and standard error per bin over blocks.
+fn columns(per_block: &[Vec<f64>], bins: usize) -> (Vec<f64>, Vec<f64>) {
+    (0..bins)
+        .map(|b| {
+            let v: Vec<f64> = per_block.iter().map(|x| x[b]).collect();
+            let (m, e) = mean_and_error(&v);
+            (m, if e.is_finite() { e } else { 0.0 })
+        })
+        .unzip()
+}
+
+/// The engine of a scenario, stepped by hand (a step is a sweep, without tuning).
+struct McEngine {
+    mc: HardSphereMc,
+}
+
+impl crate::Engine for McEngine {
+    fn method(&self) -> &str {
+        "hs-mc"
+    }
+    fn dimensions(&self) -> usize {
+        3
+    }
+    fn particles(&self) -> usize {
+        self.mc.len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        self.mc.run(steps);
+        Ok(())
+    }
+    fn steps(&self) -> u64 {
+        self.mc.sweeps()
+    }
+    fn time(&self) -> f64 {
+        self.mc.sweeps() as f64
+    }
+    fn dt(&self) -> f64 {
+        1.0
+    }
+    fn positions(&self) -> Vec<f64> {
+        let pos: Vec<[f64; 3]> = (0..self.mc.len()).map(|i| self.mc.position(i)).collect();
+        flat(&pos)
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// Hard spheres exert no systematic force away from contact: zeros.
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(vec![0.0; 3 * self.mc.len()])
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        vec![self.mc.box_edge(); 3]
+    }
+}
