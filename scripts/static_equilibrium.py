@@ -6,7 +6,7 @@ R0 = 8 d (examples/droplet/static-equilibrium.toml).
 Usage: static_equilibrium.py COLLOIDSIM WORKDIR PICTURE.png [PHI ...]
 
 For phi <= 0.3 the static run starts from random insertion; above, the droplet is first dried
-slowly (Pe = 1) from phi = 0.25 to 1.06 x the target and the static run starts from its last frame
+slowly (Pe = 1) from phi = 0.25 to 1.06 x the target in a stiffer interface (500 kT/d^2) and the static run starts from its last frame
 (`system.initial`). BD: `profile_mean.csv` (the mean of the profiles after the first, with its
 standard error from their scatter); FMT: `colloidsim theory` of the same scenario
 (`equilibrium_1.00.csv`, same bins).
@@ -52,7 +52,10 @@ def main():
             text = open(EXAMPLE).read()
             text = re.sub(r"(?m)^peclet = .*$", "peclet = 1", text)
             # A little beyond the target, so that the last frame lies within R0.
+            # A little beyond the target and with a stiffer interface, so that the last frame
+            # lies within R0 + offset + range of the static run.
             text = re.sub(r"(?m)^duration = .*$", f"final_volume_fraction = {1.06 * phi:.4f}", text)
+            text = re.sub(r"(?m)^stiffness = .*$", "stiffness = 500.0", text)
             scenario = os.path.join(work, f"{tag}-dry.toml")
             with open(scenario, "w") as f:
                 f.write(text)
