@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
-"""Static droplet equilibrium (the paper's Fig. 2a): BD radial profiles beside the radial
-Rosenfeld-FMT equilibrium of the same N, at mean volume fractions 0.05 to 0.5, in a droplet of
-R0 = 8 d (examples/droplet/static-equilibrium.toml).
+"""Static droplet equilibrium (the paper's Fig. 2a): BD and hard-sphere Monte Carlo radial
+profiles beside the radial Rosenfeld-FMT equilibrium of the same N, at mean volume fractions 0.05
+to 0.5, in a droplet of R0 = 8 d (examples/droplet/static-equilibrium.toml; the MC samples the
+same harmonic interface, method = "hs-mc" with geometry = "interface").
 
-Usage: static_equilibrium.py COLLOIDSIM WORKDIR PICTURE.png [PHI ...]
+Usage: static_equilibrium.py COLLOIDSIM WORKDIR PICTURE.png [--reuse] [PHI ...]
+
+--reuse keeps the runs whose summary.json is already in WORKDIR (to redraw the picture).
 
 For phi <= 0.3 the static run starts from random insertion; above, the droplet is first dried
 slowly (Pe = 1) from phi = 0.25 to 1.06 x the target in a stiffer interface (500 kT/d^2) and the static run starts from its last frame
@@ -27,7 +30,33 @@ EXAMPLE = os.path.join(HERE, "..", "examples", "droplet", "static-equilibrium.to
 R0 = 8.0
 
 
+REUSE = False
+
+MC = """method = "hs-mc"
+seed = 1
+[system]
+geometry = "interface"
+particles = {n}
+radius = {r0}
+diameter = 1.0
+[interface]
+stiffness = 50.0
+range = 0.5
+offset = -0.5
+[mc]
+sweeps = 20000
+warmup_sweeps = 2000
+sample_every = 20
+blocks = 20
+[output]
+profile_bins = 40
+"""
+
+
 def run(binary, *args):
+    out = args[args.index("--out") + 1]
+    if REUSE and os.path.exists(os.path.join(out, "summary.json")):
+        return
     subprocess.run([binary, *args], check=True)
 
 
@@ -38,8 +67,11 @@ def table(path):
 
 
 def main():
+    global REUSE
     binary, work, picture = sys.argv[1], sys.argv[2], sys.argv[3]
-    phis = [float(x) for x in sys.argv[4:]] or [0.05, 0.1, 0.2, 0.3, 0.4, 0.5]
+    rest = sys.argv[4:]
+    REUSE = "--reuse" in rest
+    phis = [float(x) for x in rest if x != "--reuse"] or [0.05, 0.1, 0.2, 0.3, 0.4, 0.5]
     os.makedirs(work, exist_ok=True)
     results = []
     for phi in phis:
@@ -68,14 +100,22 @@ def main():
         th = os.path.join(work, f"{tag}-theory")
         run(binary, "run", EXAMPLE, "--out", bd, "--force", "--quiet", *sets)
         run(binary, "theory", EXAMPLE, "--out", th, "--force", "--dx", "0.02", *sets)
+        mc_scenario = os.path.join(work, f"{tag}-mc.toml")
+        with open(mc_scenario, "w") as f:
+            f.write(MC.format(n=n, r0=R0))
+        mc = os.path.join(work, f"{tag}-mc")
+        run(binary, "run", mc_scenario, "--out", mc, "--force", "--quiet")
         results.append((phi, table(os.path.join(bd, "profile_mean.csv")),
+                        table(os.path.join(mc, "profile_mean.csv")),
                         table(os.path.join(th, "equilibrium_1.00.csv"))))
     cols = 3
     rows = (len(results) + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
-    for ax, (phi, bd, th) in zip(axes.flat, results):
-        ax.errorbar(bd["r"], bd["phi"], yerr=bd["err"], fmt="o", ms=3, label="BD (mean of profiles)")
-        ax.plot(th["r"], th["phi"], "-", label="Rosenfeld FMT equilibrium")
+    for ax, (phi, bd, mc, th) in zip(axes.flat, results):
+        ax.errorbar(bd["r"], bd["phi"], yerr=bd["err"], fmt="o", ms=3, label="BD (WCA)")
+        ax.errorbar(mc["r"], mc["phi"], yerr=mc["err"], fmt="s", ms=2.5, label="hard-sphere MC")
+        ax.plot(th["r"], th["phi"], "-", color="k", lw=1, label="Rosenfeld FMT equilibrium")
+        ax.set_ylim(0.0, 1.35 * max(th["phi"]))
         ax.set_title(f"mean phi = {phi}")
         ax.set_xlabel("r / d")
         ax.set_ylabel("phi (bin average)")
