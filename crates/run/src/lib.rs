@@ -22,6 +22,7 @@ mod dpd;
 mod droplet;
 mod hs_mc;
 mod theory_droplet;
+pub mod two_body;
 
 pub use control::{Control, Progress, Silent};
 pub use driver::{resume, run};
