@@ -44,6 +44,9 @@ warmup_sweeps = 500
 sweeps = 600
 sample_every = 5
 blocks = 6
+[output]
+rho2_r_bins = 5
+rho2_cos_bins = 4
 "#;
 
 fn run(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
@@ -89,7 +92,7 @@ fn killed_and_interrupted_runs_continue_bitwise() {
             assert!(e > 0.0 && (v - 3.9738).abs() < 5.0 * e, "Z {v} +- {e}");
             assert!(d.join("a/g_r.csv").exists());
         } else {
-            assert!(d.join("a/profile_mean.csv").exists());
+            assert!(d.join("a/profile_mean.csv").exists() && d.join("a/g2.csv").exists());
         }
     }
 }

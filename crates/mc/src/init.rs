@@ -103,3 +103,17 @@ pub fn fcc_in_sphere(n: usize, d: f64, radius: f64) -> Result<Vec<[f64; 3]>, McE
     sites.truncate(n);
     Ok(sites)
 }
+
+/// `positions` in a random order (Fisher–Yates on the stream `(seed, 0, Initial, 0)`): lattice
+/// sites come out sorted (by plane, or innermost first), and a particle's index would otherwise
+/// remember where it started long after the lattice has melted.
+pub fn shuffled(mut positions: Vec<[f64; 3]>, seed: u32) -> Vec<[f64; 3]> {
+    use colloidsim_core::rng::{Purpose, stream};
+    use rand::Rng;
+    let mut rng = stream(seed, 0, Purpose::Initial, 0);
+    for i in (1..positions.len()).rev() {
+        let j = ((rng.next_u64() as u128 * (i as u128 + 1)) >> 64) as usize;
+        positions.swap(i, j);
+    }
+    positions
+}

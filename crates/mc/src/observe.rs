@@ -253,6 +253,144 @@ pub fn compressibility(phi: f64, n: usize, contact: f64) -> f64 {
     1.0 + 4.0 * phi * (1.0 - 1.0 / n as f64) * contact
 }
 
+/// The two-body density in a droplet's symmetry coordinates: `rho2(r1, r2, cos theta)` with
+/// `r1 = |x1|`, `r2 = |x2|` and `theta` the angle between `x1` and `x2` (paper Sec. III.4, Fig. 7),
+/// on `r_bins` radial bins over `[0, r_max)` and `cos_bins` bins of `cos theta` over `[-1, 1]`.
+///
+/// Every unordered pair is counted once, in the order of its indices, as `H(a, b, c)`
+/// (`a`: bin of the lower index's `r`); [`PairDensity::rho2`] symmetrises. With
+/// `d^3 x1 d^3 x2 = (4 pi r1^2 dr1) (2 pi r2^2 dr2 dcos)` the estimate of a bin is
+/// `(H(a, b, c) + H(b, a, c)) / (samples V1(a) V2(b, c))`, `V1 = 4 pi / 3 (r_hi^3 - r_lo^3)`,
+/// `V2 = 2 pi / 3 (r_hi^3 - r_lo^3) dcos`, so that `sum rho2 V1 V2 = N (N - 1)` when every centre
+/// lies below `r_max`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PairDensity {
+    r_max: f64,
+    r_bins: usize,
+    cos_bins: usize,
+    counts: Vec<u64>,
+    samples: u64,
+}
+
+impl PairDensity {
+    /// An empty histogram.
+    pub fn new(r_max: f64, r_bins: usize, cos_bins: usize) -> Self {
+        let (r_bins, cos_bins) = (r_bins.max(1), cos_bins.max(1));
+        Self {
+            r_max,
+            r_bins,
+            cos_bins,
+            counts: vec![0; r_bins * r_bins * cos_bins],
+            samples: 0,
+        }
+    }
+
+    #[inline]
+    fn index(&self, a: usize, b: usize, c: usize) -> usize {
+        (a * self.r_bins + b) * self.cos_bins + c
+    }
+
+    /// Add every pair of the current configuration (all pairs: O(N^2)).
+    pub fn sample(&mut self, mc: &HardSphereMc) {
+        let [x, y, z] = mc.positions();
+        let n = x.len();
+        let (rb, cb) = (self.r_bins, self.cos_bins);
+        let r: Vec<f64> = (0..n)
+            .map(|i| (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt())
+            .collect();
+        let bin_r = |v: f64| ((v / self.r_max * rb as f64) as usize).min(rb);
+        for i in 0..n {
+            let a = bin_r(r[i]);
+            if a >= rb {
+                continue;
+            }
+            for j in i + 1..n {
+                let b = bin_r(r[j]);
+                if b >= rb {
+                    continue;
+                }
+                let dot = x[i] * x[j] + y[i] * y[j] + z[i] * z[j];
+                let cos = (dot / (r[i] * r[j]).max(f64::MIN_POSITIVE)).clamp(-1.0, 1.0);
+                let c = (((cos + 1.0) * 0.5 * cb as f64) as usize).min(cb - 1);
+                let k = self.index(a, b, c);
+                self.counts[k] += 1;
+            }
+        }
+        self.samples += 1;
+    }
+
+    /// Samples taken.
+    pub fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    /// Radial bin centres.
+    pub fn r_centres(&self) -> Vec<f64> {
+        let w = self.r_max / self.r_bins as f64;
+        (0..self.r_bins).map(|b| (b as f64 + 0.5) * w).collect()
+    }
+
+    /// `cos theta` bin centres.
+    pub fn cos_centres(&self) -> Vec<f64> {
+        let w = 2.0 / self.cos_bins as f64;
+        (0..self.cos_bins)
+            .map(|c| -1.0 + (c as f64 + 0.5) * w)
+            .collect()
+    }
+
+    /// Raw (unsymmetrised) count of bin `(a, b, c)`.
+    pub fn count(&self, a: usize, b: usize, c: usize) -> u64 {
+        self.counts[self.index(a, b, c)]
+    }
+
+    /// Volume `4 pi / 3 (r_hi^3 - r_lo^3)` of radial shell `a`.
+    pub fn shell(&self, a: usize) -> f64 {
+        let w = self.r_max / self.r_bins as f64;
+        4.0 * PI / 3.0 * (((a + 1) as f64 * w).powi(3) - (a as f64 * w).powi(3))
+    }
+
+    /// `rho2` per bin, index `(a r_bins + b) cos_bins + c` (symmetric in `a <-> b`).
+    pub fn rho2(&self) -> Vec<f64> {
+        let dcos = 2.0 / self.cos_bins as f64;
+        let mut out = vec![0.0; self.counts.len()];
+        for a in 0..self.r_bins {
+            for b in 0..self.r_bins {
+                let v = self.shell(a) * self.shell(b) * 0.5 * dcos;
+                for c in 0..self.cos_bins {
+                    let h = self.count(a, b, c) + self.count(b, a, c);
+                    out[self.index(a, b, c)] = h as f64 / (self.samples.max(1) as f64 * v);
+                }
+            }
+        }
+        out
+    }
+
+    /// `sum rho2 V1 V2` over all bins: `N (N - 1)` when every centre lies below `r_max`.
+    pub fn integral(&self, rho2: &[f64]) -> f64 {
+        let dcos = 2.0 / self.cos_bins as f64;
+        let mut total = 0.0;
+        for a in 0..self.r_bins {
+            for b in 0..self.r_bins {
+                let v = self.shell(a) * self.shell(b) * 0.5 * dcos;
+                for c in 0..self.cos_bins {
+                    total += rho2[self.index(a, b, c)] * v;
+                }
+            }
+        }
+        total
+    }
+
+    /// Radial bins.
+    pub fn r_bins(&self) -> usize {
+        self.r_bins
+    }
+
+    /// `cos theta` bins.
+    pub fn cos_bins(&self) -> usize {
+        self.cos_bins
+    }
+}
+
 /// Window next to contact over which contact values are extrapolated, in diameters.
 pub const CONTACT_WINDOW: f64 = 0.1;
 /// Bins in the contact window.

@@ -4,7 +4,7 @@
 
 use crate::engine::{HardSphereMc, McError, McParams};
 use crate::geometry::Geometry;
-use crate::init::{fcc_in_box, fcc_in_sphere};
+use crate::init::{fcc_in_box, fcc_in_sphere, shuffled};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{at_least, positive, show};
 use colloidsim_core::resources::ensure_fits;
@@ -166,6 +166,17 @@ pub struct OutputSection {
     /// Sweeps between frames of `trajectory.gsd` (0: none).
     #[serde(default)]
     pub trajectory_every: u64,
+    /// Radial bins of the two-body density `rho2(r1, r2, cos theta)` over [0, R] (droplets;
+    /// 0: not measured).
+    #[serde(default)]
+    pub rho2_r_bins: usize,
+    /// `cos theta` bins of the two-body density.
+    #[serde(default = "default_rho2_cos_bins")]
+    pub rho2_cos_bins: usize,
+}
+
+fn default_rho2_cos_bins() -> usize {
+    20
 }
 
 fn default_profile_bins() -> usize {
@@ -182,6 +193,8 @@ impl Default for OutputSection {
             gr_bins: default_gr_bins(),
             gr_max: None,
             trajectory_every: 0,
+            rho2_r_bins: 0,
+            rho2_cos_bins: default_rho2_cos_bins(),
         }
     }
 }
@@ -229,6 +242,8 @@ pub struct McRun {
     pub gr_max: f64,
     /// Sweeps between trajectory frames (0: none).
     pub trajectory_every: u64,
+    /// Two-body density bins (r, cos theta); `None`: not measured.
+    pub rho2_bins: Option<(usize, usize)>,
     /// Starting configuration file, if any.
     pub initial: Option<PathBuf>,
 }
@@ -419,9 +434,18 @@ impl McScenario {
                 ),
             ));
         }
+        at_least("output.rho2_cos_bins", o.rho2_cos_bins, 1)?;
+        let rho2_bins = (o.rho2_r_bins > 0).then_some((o.rho2_r_bins, o.rho2_cos_bins));
+        if bulk && rho2_bins.is_some() {
+            return Err(ParamError::new(
+                "output.rho2_r_bins",
+                "applies to the droplet geometries only (give 0 or leave it out in bulk)",
+            ));
+        }
+        let rho2_cells = rho2_bins.map_or(0.0, |(r, c)| (r * r * c) as f64);
         // Positions (particle order, scratch and slots), histograms of every block.
         let bytes = particles as f64 * 200.0
-            + m.blocks as f64 * 8.0 * (o.profile_bins + o.gr_bins + 100) as f64;
+            + m.blocks as f64 * 8.0 * ((o.profile_bins + o.gr_bins + 100) as f64 + rho2_cells);
         ensure_fits("system.particles", &format!("{particles} spheres"), bytes)?;
         Ok(McRun {
             seed,
@@ -444,6 +468,7 @@ impl McScenario {
             gr_bins: o.gr_bins,
             gr_max,
             trajectory_every: o.trajectory_every,
+            rho2_bins,
             initial: s.initial.clone(),
         })
     }
@@ -468,7 +493,8 @@ impl McRun {
         self.radius.is_none()
     }
 
-    /// The engine at `positions` (`key` names them in errors), or on an FCC lattice.
+    /// The engine at `positions` (`key` names them in errors), or on an FCC lattice (sites in
+    /// a random order).
     pub fn engine(
         &self,
         positions: Option<&[[f64; 3]]>,
@@ -492,17 +518,20 @@ impl McRun {
                 p
             }
             None => {
-                lattice = match self.radius {
-                    None => fcc_in_box(self.particles, self.diameter, self.box_edge)?,
-                    Some(_) => fcc_in_sphere(
-                        self.particles,
-                        self.diameter,
-                        geometry
-                            .confinement(self.diameter)
-                            .unwrap_or(0.0)
-                            .min(self.radius.unwrap_or(0.0) - 0.5 * self.diameter),
-                    )?,
-                };
+                lattice = shuffled(
+                    match self.radius {
+                        None => fcc_in_box(self.particles, self.diameter, self.box_edge)?,
+                        Some(_) => fcc_in_sphere(
+                            self.particles,
+                            self.diameter,
+                            geometry
+                                .confinement(self.diameter)
+                                .unwrap_or(0.0)
+                                .min(self.radius.unwrap_or(0.0) - 0.5 * self.diameter),
+                        )?,
+                    },
+                    self.seed,
+                );
                 &lattice
             }
         };

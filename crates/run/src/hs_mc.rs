@@ -14,8 +14,8 @@ use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::{
-    CONTACT_BINS, CONTACT_WINDOW, PairHistogram, RadialHistogram, bulk_contact, carnahan_starling,
-    carnahan_starling_contact, compressibility, contact_pairs, mean_and_error,
+    CONTACT_BINS, CONTACT_WINDOW, PairDensity, PairHistogram, RadialHistogram, bulk_contact,
+    carnahan_starling, carnahan_starling_contact, compressibility, contact_pairs, mean_and_error,
     wall_contact_density,
 };
 use colloidsim_mc::scenario::{McRun, McScenario};
@@ -136,6 +136,8 @@ struct Block {
     profile: Option<RadialHistogram>,
     /// Centre distances next to the hard wall (hard wall).
     wall: Option<RadialHistogram>,
+    /// The two-body density and the one-body density on its radial bins (droplets, optional).
+    rho2: Option<(PairDensity, RadialHistogram)>,
 }
 
 /// Everything a run accumulates, saved in every checkpoint.
@@ -171,6 +173,12 @@ impl Accum {
                     rc.map(|rc| RadialHistogram::new(rc - CONTACT_WINDOW * d, rc, CONTACT_BINS))
                 })
                 .flatten(),
+            rho2: p.radius.zip(p.rho2_bins).map(|(r, (nr, nc))| {
+                (
+                    PairDensity::new(r, nr, nc),
+                    RadialHistogram::new(0.0, r, nr),
+                )
+            }),
         };
         Self {
             window: SweepStats::default(),
@@ -234,6 +242,10 @@ impl McSession {
             if let Some(h) = block.wall.as_mut() {
                 h.sample(&self.mc);
             }
+            if let Some((h, rho)) = block.rho2.as_mut() {
+                h.sample(&self.mc);
+                rho.sample(&self.mc);
+            }
         }
         if let Some(w) = self.gsd.as_mut()
             && sweep.is_multiple_of(p.trajectory_every)
@@ -279,6 +291,7 @@ impl Session for McSession {
             "profile_mean.csv",
             "profiles.png",
             "g_r.png",
+            "g2.csv",
             "trajectory.gsd",
         ]
         .contains(&name)
@@ -489,6 +502,49 @@ impl Session for McSession {
                     &mut files,
                     &mut warnings,
                 );
+            }
+            if let Some((h0, _)) = blocks.first().and_then(|b| b.rho2.as_ref()) {
+                // rho2 and g2 = rho2 / (rho(r1) rho(r2)) per block, then mean and error.
+                let per_block: Vec<(Vec<f64>, Vec<f64>)> = blocks
+                    .iter()
+                    .filter_map(|b| b.rho2.as_ref())
+                    .map(|(h, rho)| {
+                        let r2 = h.rho2();
+                        let rho = rho.density();
+                        let (nr, nc) = (h.r_bins(), h.cos_bins());
+                        let g2 = (0..r2.len())
+                            .map(|k| {
+                                let (a, b) = (k / (nr * nc), (k / nc) % nr);
+                                let den = rho[a] * rho[b];
+                                if den > 0.0 { r2[k] / den } else { 0.0 }
+                            })
+                            .collect();
+                        (r2, g2)
+                    })
+                    .collect();
+                let cells = per_block[0].0.len();
+                let rho2s: Vec<Vec<f64>> = per_block.iter().map(|b| b.0.clone()).collect();
+                let g2s: Vec<Vec<f64>> = per_block.iter().map(|b| b.1.clone()).collect();
+                let (rho2, rho2_err) = columns(&rho2s, cells);
+                let (g2, g2_err) = columns(&g2s, cells);
+                let (rs, cs) = (h0.r_centres(), h0.cos_centres());
+                let (nr, nc) = (h0.r_bins(), h0.cos_bins());
+                let r1: Vec<f64> = (0..cells).map(|k| rs[k / (nr * nc)]).collect();
+                let r2: Vec<f64> = (0..cells).map(|k| rs[(k / nc) % nr]).collect();
+                let cos: Vec<f64> = (0..cells).map(|k| cs[k % nc]).collect();
+                out.write_table(
+                    "g2.csv",
+                    &[
+                        ("r1", &r1),
+                        ("r2", &r2),
+                        ("cos_theta", &cos),
+                        ("rho2", &rho2),
+                        ("rho2_err", &rho2_err),
+                        ("g2", &g2),
+                        ("g2_err", &g2_err),
+                    ],
+                )?;
+                files.push("g2.csv".into());
             }
             if let Some(rc) = self
                 .mc

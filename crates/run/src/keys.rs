@@ -1284,6 +1284,21 @@ pub static MC: &[Spec] = &[
         Integer(0, COUNT),
         "sweeps between frames of trajectory.gsd",
     ),
+    key(
+        "output.rho2_r_bins",
+        "-",
+        "0 (none)",
+        Integer(0, 10_000),
+        "radial bins over [0, R] of the two-body density rho2(r1, r2, cos theta) and g2 (g2.csv; all pairs, O(N^2) per sample)",
+    )
+    .also("droplets only"),
+    key(
+        "output.rho2_cos_bins",
+        "-",
+        "20",
+        Integer(1, 10_000),
+        "bins of cos theta over [-1, 1] of the two-body density",
+    ),
 ];
 
 /// The keys of `hs-mc` scenarios, as listed.

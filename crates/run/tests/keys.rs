@@ -148,6 +148,8 @@ profile_bins = 50
 gr_bins = 200
 gr_max = 3.0
 trajectory_every = 0
+rho2_r_bins = 4
+rho2_cos_bins = 20
 "#;
 
 type Parse = fn(&str) -> Result<(), String>;
