@@ -529,6 +529,15 @@ impl Session for McSession {
                 let (g2, g2_err) = columns(&g2s, cells);
                 let (rs, cs) = (h0.r_centres(), h0.cos_centres());
                 let (nr, nc) = (h0.r_bins(), h0.cos_bins());
+                // Eq. 17 on the same grid, at the blocks' mean density of each radial bin.
+                let rhos: Vec<Vec<f64>> = blocks
+                    .iter()
+                    .filter_map(|b| b.rho2.as_ref())
+                    .map(|(_, rho)| rho.density())
+                    .collect();
+                let (rho_mean, _) = columns(&rhos, nr);
+                let r_max = p.radius.context("g2 needs a droplet radius")?;
+                let eq = crate::two_body::eq17(r_max, nr, nc, d, &rho_mean)?;
                 let r1: Vec<f64> = (0..cells).map(|k| rs[k / (nr * nc)]).collect();
                 let r2: Vec<f64> = (0..cells).map(|k| rs[(k / nc) % nr]).collect();
                 let cos: Vec<f64> = (0..cells).map(|k| cs[k % nc]).collect();
@@ -542,9 +551,17 @@ impl Session for McSession {
                         ("rho2_err", &rho2_err),
                         ("g2", &g2),
                         ("g2_err", &g2_err),
+                        ("g2_eq17_dilute", &eq.dilute),
+                        ("g2_eq17_trokhymchuk", &eq.trokhymchuk),
                     ],
                 )?;
                 files.push("g2.csv".into());
+                picture(
+                    draw_g2(out, &rs, &cs, &rho_mean, &g2, &eq, d),
+                    "g2.png",
+                    &mut files,
+                    &mut warnings,
+                );
             }
             if let Some(rc) = self
                 .mc
@@ -598,6 +615,76 @@ impl Session for McSession {
 }
 
 /// Mean and standard error per bin over blocks.
+/// `g2.png` (the paper's Fig. 7): measured `g2` against Eq. 17 for pairs in one shell, against the
+/// pair distance `s = r sqrt(2 (1 - cos theta))` up to 4 d, in a shell a third of the way out and
+/// in the densest shell (the contact layer at the interface).
+fn draw_g2(
+    out: &OutputDir,
+    rs: &[f64],
+    cs: &[f64],
+    rho: &[f64],
+    g2: &[f64],
+    eq: &crate::two_body::Eq17,
+    diameter: f64,
+) -> Result<()> {
+    let (nr, nc) = (rs.len(), cs.len());
+    let dense = (0..nr)
+        .max_by(|&a, &b| rho[a].total_cmp(&rho[b]))
+        .unwrap_or(0);
+    let inner = nr / 3;
+    let mut data = Vec::new();
+    for (a, place) in [(inner, "inner"), (dense, "densest")] {
+        // Pair distances up to 4 d, where the structure is.
+        let near: Vec<usize> = (0..nc)
+            .filter(|&c| rs[a] * (2.0 * (1.0 - cs[c])).sqrt() <= 4.0 * diameter)
+            .collect();
+        let s: Vec<f64> = near
+            .iter()
+            .map(|&c| rs[a] * (2.0 * (1.0 - cs[c])).sqrt())
+            .collect();
+        let pick =
+            |v: &[f64]| -> Vec<f64> { near.iter().map(|&c| v[(a * nr + a) * nc + c]).collect() };
+        data.push((
+            format!("MC, {place} shell r = {:.2}", rs[a]),
+            format!("Eq. 17 Trokhymchuk, r = {:.2}", rs[a]),
+            format!("Eq. 17 dilute, r = {:.2}", rs[a]),
+            s,
+            pick(g2),
+            pick(&eq.trokhymchuk),
+            pick(&eq.dilute),
+        ));
+    }
+    let mut series = Vec::new();
+    for (l_mc, l_tk, l_dil, s, mc, tk, dil) in &data {
+        series.push(Series {
+            label: l_mc,
+            x: s,
+            y: mc,
+            points: true,
+        });
+        series.push(Series {
+            label: l_tk,
+            x: s,
+            y: tk,
+            points: false,
+        });
+        series.push(Series {
+            label: l_dil,
+            x: s,
+            y: dil,
+            points: false,
+        });
+    }
+    line_plot(
+        &out.path().join("g2.png"),
+        "Pair correlation in the droplet: Monte Carlo against Eq. 17",
+        "pair distance s",
+        "g2 (same shell)",
+        &series,
+        Scale::Linear,
+    )
+}
+
 fn columns(per_block: &[Vec<f64>], bins: usize) -> (Vec<f64>, Vec<f64>) {
     (0..bins)
         .map(|b| {

@@ -114,7 +114,10 @@ mod tests {
             .fold((0, 0.0), |m, v| if v.1 > m.1 { v } else { m });
         let cos = -1.0 + (c_max as f64 + 0.5) * 2.0 / nc as f64;
         let s = 6.125 * (2.0 * (1.0 - cos)).sqrt();
-        assert!(g_max > 1.5 && (1.0..1.3).contains(&s), "peak {g_max} at s = {s}");
+        assert!(
+            g_max > 1.5 && (1.0..1.3).contains(&s),
+            "peak {g_max} at s = {s}"
+        );
         // Opposite sides: s ~ 12 d.
         assert!((at(24, 24, 0) - 1.0).abs() < 1e-3);
         // A wrong number of densities is refused.
