@@ -15,6 +15,7 @@ use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::output::OutputDir;
+use colloidsim_md::brownian::Integrator;
 use colloidsim_md::droplet::{DropletSim, HydroDropletSim};
 use colloidsim_md::gsd::{self, GsdWriter};
 use colloidsim_md::{
@@ -183,6 +184,11 @@ struct Engine {
     skin: f64,
     sort_every: u64,
     max_drift: f64,
+    /// Free draining: Euler or Leimkuhler–Matthews (checkpoints written before the key
+    /// existed are Euler's). The Leimkuhler–Matthews deviates are not saved: the engine
+    /// draws them again from (seed, step, particle).
+    #[serde(default)]
+    integrator: Integrator,
     /// Neighbour-list builds of this replica so far.
     builds: u64,
 }
@@ -201,6 +207,7 @@ impl Engine {
                     skin: b.skin,
                     sort_every: b.sort_every,
                     max_drift: b.max_drift,
+                    integrator: b.integrator,
                     builds,
                 }
             }
@@ -215,6 +222,7 @@ impl Engine {
                     skin: b.skin,
                     sort_every: 0,
                     max_drift: b.max_drift,
+                    integrator: Integrator::Euler,
                     builds,
                 }
             }
@@ -242,6 +250,7 @@ impl Engine {
             skin: self.skin,
             sort_every: self.sort_every,
             max_drift: self.max_drift,
+            integrator: self.integrator,
         }
     }
 }
