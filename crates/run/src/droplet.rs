@@ -184,11 +184,6 @@ struct Engine {
     skin: f64,
     sort_every: u64,
     max_drift: f64,
-    /// Free draining: Euler or Leimkuhler–Matthews (checkpoints written before the key
-    /// existed are Euler's). The Leimkuhler–Matthews deviates are not saved: the engine
-    /// draws them again from (seed, step, particle).
-    #[serde(default)]
-    integrator: Integrator,
     /// Neighbour-list builds of this replica so far.
     builds: u64,
 }
@@ -207,7 +202,6 @@ impl Engine {
                     skin: b.skin,
                     sort_every: b.sort_every,
                     max_drift: b.max_drift,
-                    integrator: b.integrator,
                     builds,
                 }
             }
@@ -222,7 +216,6 @@ impl Engine {
                     skin: b.skin,
                     sort_every: 0,
                     max_drift: b.max_drift,
-                    integrator: Integrator::Euler,
                     builds,
                 }
             }
@@ -240,7 +233,11 @@ impl Engine {
         }
     }
 
-    fn params(&self) -> BdParams {
+    /// The free-draining engine's parameters with `integrator` (the scenario's
+    /// `run.integrator`: a restart runs the scenario it started with, so the checkpoint need not
+    /// hold it; nor the Leimkuhler–Matthews deviates, which the engine draws again from (seed,
+    /// step, particle)).
+    fn params(&self, integrator: Integrator) -> BdParams {
         BdParams {
             kt: self.kt,
             viscosity: self.viscosity,
@@ -250,7 +247,7 @@ impl Engine {
             skin: self.skin,
             sort_every: self.sort_every,
             max_drift: self.max_drift,
-            integrator: self.integrator,
+            integrator,
         }
     }
 }
@@ -312,7 +309,7 @@ fn restore_replica(
                 f.sbox,
                 LennardJones::wca(p.kt, p.diameter),
                 p.interface(),
-                engine.params(),
+                engine.params(p.integrator),
                 f.step,
                 f.list.as_ref(),
             )
