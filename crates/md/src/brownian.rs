@@ -30,7 +30,8 @@
 //!
 //! One step is two parallel passes and nothing is allocated: the pair forces slab by slab, then
 //! chunk by chunk the external force, the noise and the new positions (into a second buffer;
-//! the buffers are then swapped).
+//! the buffers are then swapped). Leimkuhler–Matthews draws its deviates `xi_{n+1}` in a third
+//! pass, by input index, before the positions.
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::BoxTooSmall;
