@@ -168,3 +168,32 @@ fn restart_refuses_without_checkpoint_changed_scenario_or_completed_run() {
     assert!(o.status.success());
     assert_same_outputs(&a, &b, VOLATILE);
 }
+
+/// With `run.integrator = "lm"` an interrupted or killed run continues bitwise too (the
+/// Leimkuhler–Matthews deviate kept between steps is drawn again at the restart), and the
+/// outputs differ from Euler's.
+#[test]
+fn leimkuhler_matthews_run_restarts_bitwise() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join("lm.toml");
+    std::fs::write(
+        &sc,
+        TINY.replace("dt = 0.004", "dt = 0.004\nintegrator = \"lm\""),
+    )
+    .unwrap();
+    let a = tmp.path().join("a");
+    assert!(run(&[p("run"), &sc, p("--out"), &a], &[]).status.success());
+    let (_euler, _, e) = setup();
+    assert!(files(&a)["profile_1.00.csv"] != files(&e)["profile_1.00.csv"]);
+    for (hook, at) in [
+        ("COLLOIDSIM_INTERRUPT_AT_STEP", "450"),
+        ("COLLOIDSIM_KILL_AT_STEP", "170"),
+    ] {
+        let b = tmp.path().join(format!("b{at}"));
+        let o = run(&[p("run"), &sc, p("--out"), &b], &[(hook, at)]);
+        assert!(!o.status.success());
+        let o = run(&[p("run"), &sc, p("--restart"), &b], &[]);
+        assert!(o.status.success());
+        assert_same_outputs(&a, &b, VOLATILE);
+    }
+}

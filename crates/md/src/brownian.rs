@@ -1,7 +1,8 @@
-//! Free-draining Brownian dynamics (Euler–Maruyama).
+//! Free-draining Brownian dynamics (Euler–Maruyama or Leimkuhler–Matthews, [`Integrator`]).
 //!
 //! `x(t + dt) = x + F / gamma_i dt + sqrt(2 kT dt / gamma_i) xi`, with Stokes friction
-//! `gamma_i = 3 pi eta d_i` from each particle's diameter.
+//! `gamma_i = 3 pi eta d_i` from each particle's diameter; Leimkuhler–Matthews replaces `xi_n`
+//! by `(xi_n + xi_{n+1}) / 2`.
 //!
 //! **Neighbours.** Particles are kept sorted by cell ([`crate::cells`]; cells at least the
 //! largest cut-off plus the skin wide, z-major) and every pair within that range is stored once,
@@ -22,11 +23,15 @@
 //! build (ties in a cell broken by input index), so a run is a pure function of its inputs:
 //! bitwise identical for any number of threads. A checkpoint that keeps the storage order and
 //! the positions of the last build ([`ListState`]) restarts bitwise identically.
+//! Leimkuhler–Matthews draws its deviates by particle instead (input index `i`: the stream
+//! (seed, n, replica, i / BLOCK)), so that `xi_n` of every particle is a function of (seed,
+//! n, i) alone and a restart draws it again rather than storing it.
 //! [`Brownian::snapshot`] returns the particles in input order.
 //!
 //! One step is two parallel passes and nothing is allocated: the pair forces slab by slab, then
 //! chunk by chunk the external force, the noise and the new positions (into a second buffer;
-//! the buffers are then swapped).
+//! the buffers are then swapped). Leimkuhler–Matthews draws its deviates `xi_{n+1}` in a third
+//! pass, by input index, before the positions.
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::BoxTooSmall;
@@ -38,6 +43,24 @@ use std::f64::consts::PI;
 
 /// Particles per parallel work item of the integration pass (a multiple of the noise block).
 const CHUNK: usize = 4 * BLOCK;
+
+/// How a step integrates the overdamped Langevin equation (`run.integrator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// Euler–Maruyama, `x_{n+1} = x_n + F(x_n) dt / gamma + sqrt(2 kT dt / gamma) xi_n`:
+    /// first order in dt for the stationary distribution.
+    #[default]
+    Euler,
+    /// Leimkuhler–Matthews, `x_{n+1} = x_n + F(x_n) dt / gamma + sqrt(2 kT dt / gamma)
+    /// (xi_n + xi_{n+1}) / 2` (Leimkuhler & Matthews, Appl. Math. Res. Express 2013;
+    /// Leimkuhler, Matthews & Tretyakov, Proc. R. Soc. A 470, 20140120 (2014)): second order
+    /// in dt for the stationary distribution, at one deviate per particle and step as Euler
+    /// (`xi_{n+1}` is kept for the next step). Free displacements over `k` steps have variance
+    /// `2 D dt (k - 1/2)` per axis: the MSD is low by a constant `D dt` per axis, its slope
+    /// (the diffusion coefficient) is not.
+    Lm,
+}
 /// Parameters of the Brownian integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BdParams {
@@ -60,10 +83,13 @@ pub struct BdParams {
     /// A step whose deterministic displacement `|F| dt / gamma` exceeds this fraction of the
     /// particle's diameter stops the run (the time step is too large for the potential).
     pub max_drift: f64,
+    /// Euler–Maruyama or Leimkuhler–Matthews.
+    pub integrator: Integrator,
 }
 
 impl BdParams {
-    /// Defaults: kT = 1, eta = 1, skin 0.3, lists rebuilt at least every 500 steps, max_drift 0.2.
+    /// Defaults: kT = 1, eta = 1, skin 0.3, lists rebuilt at least every 500 steps, max_drift 0.2,
+    /// Euler–Maruyama.
     pub fn new(dt: f64, seed: u32) -> Self {
         Self {
             kt: 1.0,
@@ -74,6 +100,7 @@ impl BdParams {
             skin: 0.3,
             sort_every: 500,
             max_drift: 0.2,
+            integrator: Integrator::Euler,
         }
     }
 }
@@ -175,6 +202,12 @@ pub struct Brownian<P: Pair, E: External> {
     scratch_f64: Vec<f64>,
     scratch_u32: Vec<u32>,
     scratch3: Vec<[f64; 3]>,
+    /// Leimkuhler–Matthews: the deviates `xi_n` and `xi_{n+1}` of every particle, by input
+    /// index (empty for Euler), and the step `n` whose deviates `lm_now` holds (`None`: draw
+    /// them from the stream before the next step).
+    lm_now: Vec<[f64; 3]>,
+    lm_next: Vec<[f64; 3]>,
+    lm_step: Option<u64>,
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
@@ -201,6 +234,26 @@ impl ChunkReport {
             },
         }
     }
+}
+
+/// Standard normal deviates `xi_n` of every particle at step `n` by input index, three per
+/// particle in the order x, y, z: the particles of block `b` (indices `b * BLOCK ..`) from the
+/// stream (seed, n, `Noise`, `replica * 2^32 + b`), blocks in parallel.
+fn fill_deviates(seed: u32, step: u64, key0: u64, out: &mut [[f64; 3]]) {
+    let zig = Ziggurat::get();
+    out.par_chunks_mut(BLOCK)
+        .enumerate()
+        .with_min_len(4)
+        .for_each(|(b, xi)| {
+            let mut rng = stream(seed, step, Purpose::Noise, key0 | b as u64);
+            for x in xi {
+                *x = [
+                    zig.sample(&mut rng),
+                    zig.sample(&mut rng),
+                    zig.sample(&mut rng),
+                ];
+            }
+        });
 }
 
 /// Pairs per batch of the pair-force pass.
@@ -450,7 +503,14 @@ impl<P: Pair, E: External> Brownian<P, E> {
             scratch_f64: Vec::new(),
             scratch_u32: Vec::new(),
             scratch3: Vec::new(),
+            lm_now: Vec::new(),
+            lm_next: Vec::new(),
+            lm_step: None,
         };
+        if params.integrator == Integrator::Lm {
+            s.lm_now = vec![[0.0; 3]; n];
+            s.lm_next = vec![[0.0; 3]; n];
+        }
         s.set_dt(params.dt);
         match list {
             None => s.sort_and_rebuild(),
@@ -530,6 +590,22 @@ impl<P: Pair, E: External> Brownian<P, E> {
             positions: self.particles.pos.clone(),
             images: self.particles.image.clone(),
         }
+    }
+
+    /// Integrate with `integrator` from the next step on. Leimkuhler–Matthews keeps two
+    /// deviates per particle (48 bytes); they are not part of the state: the next step draws
+    /// `xi_n` again from (seed, n, particle), so a restart continues bitwise.
+    pub fn with_integrator(mut self, integrator: Integrator) -> Self {
+        self.params.integrator = integrator;
+        let n = if integrator == Integrator::Lm {
+            self.particles.len()
+        } else {
+            0
+        };
+        self.lm_now = vec![[0.0; 3]; n];
+        self.lm_next = vec![[0.0; 3]; n];
+        self.lm_step = None;
+        self
     }
 
     /// Change the time step (the time origin stays at `step * dt`).
@@ -743,6 +819,17 @@ impl<P: Pair, E: External> Brownian<P, E> {
         if self.range > 0.0 {
             all_pair_forces(&mut self.slabs, &self.particles, &self.pair);
         }
+        // Leimkuhler–Matthews: xi_n (drawn by the previous step, or afresh after a restart)
+        // and xi_{n+1}, by input index.
+        let lm = self.params.integrator == Integrator::Lm;
+        if lm {
+            if self.lm_step != Some(step) {
+                fill_deviates(seed, step, key0, &mut self.lm_now);
+            }
+            fill_deviates(seed, step + 1, key0, &mut self.lm_next);
+            self.lm_step = Some(step);
+        }
+        let (lm_now, lm_next) = (&self.lm_now, &self.lm_next);
         let mut new_pos = std::mem::take(&mut self.new_pos);
         new_pos.resize(n, [0.0; 3]);
         let p = &self.particles;
@@ -767,6 +854,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
                         &ref_pos[lo..lo + m],
                     );
                     let mut rng = stream(seed, step, Purpose::Noise, key0 | (lo / BLOCK) as u64);
+                    let tags = &tag[lo..lo + m];
                     for k in 0..m {
                         let [drift_per_force, amp, limit2] = c[k];
                         let fp = pair_force.force(lo + k);
@@ -792,11 +880,22 @@ impl<P: Pair, E: External> Brownian<P, E> {
                                 ));
                             }
                         }
-                        let xi = [
-                            zig.sample(&mut rng),
-                            zig.sample(&mut rng),
-                            zig.sample(&mut rng),
-                        ];
+                        let xi = if lm {
+                            // (xi_n + xi_{n+1}) / 2 of this particle.
+                            let i = tags[k] as usize;
+                            let (a, b) = (lm_now[i], lm_next[i]);
+                            [
+                                0.5 * (a[0] + b[0]),
+                                0.5 * (a[1] + b[1]),
+                                0.5 * (a[2] + b[2]),
+                            ]
+                        } else {
+                            [
+                                zig.sample(&mut rng),
+                                zig.sample(&mut rng),
+                                zig.sample(&mut rng),
+                            ]
+                        };
                         let q = [
                             x[k][0] + drift[0] + amp * xi[0],
                             x[k][1] + drift[1] + amp * xi[1],
@@ -832,6 +931,11 @@ impl<P: Pair, E: External> Brownian<P, E> {
         std::mem::swap(&mut self.particles.pos, &mut new_pos);
         self.new_pos = new_pos;
         self.step += 1;
+        if lm {
+            // xi_{n+1} is the next step's xi_n.
+            std::mem::swap(&mut self.lm_now, &mut self.lm_next);
+            self.lm_step = Some(self.step);
+        }
         let every = self.params.sort_every;
         // NaN displacements (a run gone non-finite without a blow-up) fail every comparison:
         // the rebuild is skipped and the next step reports the blow-up.

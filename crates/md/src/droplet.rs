@@ -7,7 +7,7 @@
 //! drying time) or returns a [`ParamError`] naming the key and the allowed range. Both the
 //! particle engine (`colloidsim run`) and the radial DDFT (`colloidsim theory`) read it.
 
-use crate::brownian::{BdError, BdParams, Brownian};
+use crate::brownian::{BdError, BdParams, Brownian, Integrator};
 use crate::gsd::read_frame;
 use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::init::random_in_sphere;
@@ -151,6 +151,10 @@ pub struct RunSection {
     /// Verlet skin (length; default 0.6 d).
     #[serde(default)]
     pub skin: Option<f64>,
+    /// `"euler"` (Euler–Maruyama, the default) or `"lm"` (Leimkuhler–Matthews, free draining
+    /// only).
+    #[serde(default)]
+    pub integrator: Option<String>,
 }
 
 /// `[observe]`.
@@ -256,6 +260,8 @@ pub struct DropletParams {
     pub offset: f64,
     /// Time step.
     pub dt: f64,
+    /// Integrator of the free-draining engine ([`Integrator`]).
+    pub integrator: Integrator,
     /// Number of steps `ceil(t_end / dt)`.
     pub steps: u64,
     /// Verlet skin.
@@ -603,6 +609,30 @@ impl DropletScenario {
             .as_ref()
             .map(|h| h.validate(particles, 0.5 * d, false))
             .transpose()?;
+        let integrator = match self.run.integrator.as_deref() {
+            None | Some("euler") => Integrator::Euler,
+            Some("lm") => Integrator::Lm,
+            Some(other) => {
+                return Err(ParamError::new(
+                    "run.integrator",
+                    format!(
+                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
+                    ),
+                ));
+            }
+        };
+        if integrator == Integrator::Lm
+            && hydrodynamics
+                .as_ref()
+                .is_some_and(|h| h.model == HydroModel::Rpy)
+        {
+            return Err(ParamError::new(
+                "run.integrator",
+                "\"lm\" (Leimkuhler-Matthews) is for free draining only: with hydrodynamics.model = \
+                 \"rpy\" the noise is correlated through the mobility, which the scheme does not \
+                 cover; use run.integrator = \"euler\" or hydrodynamics.model = \"free-draining\"",
+            ));
+        }
 
         let p = &self.observe.profile;
         let bins = at_least("observe.profile.bins", p.bins, 1)?;
@@ -654,6 +684,7 @@ impl DropletScenario {
             range,
             offset,
             dt,
+            integrator,
             steps,
             skin,
             bins,
@@ -784,6 +815,40 @@ final_volume_fraction = 0.5
             err_key(&PAPER.replace("peclet = 10\nfinal_volume_fraction = 0.5", "peclet = 0")),
             "drying.duration"
         );
+    }
+
+    #[test]
+    fn the_integrator_is_euler_or_lm_and_lm_is_free_draining_only() {
+        let with = |run: &str, h: &str| format!("{PAPER}[run]\n{run}\n{h}");
+        let integrator = |text: &str| {
+            DropletScenario::from_toml(text)
+                .unwrap()
+                .validate()
+                .map(|p| p.integrator)
+        };
+        assert_eq!(integrator(PAPER), Ok(Integrator::Euler));
+        assert_eq!(
+            integrator(&with("integrator = \"euler\"", "")),
+            Ok(Integrator::Euler)
+        );
+        assert_eq!(
+            integrator(&with("integrator = \"lm\"", "")),
+            Ok(Integrator::Lm)
+        );
+        let free = "[hydrodynamics]\nmodel = \"free-draining\"";
+        assert_eq!(
+            integrator(&with("integrator = \"lm\"", free)),
+            Ok(Integrator::Lm)
+        );
+        assert_eq!(
+            err_key(&with("integrator = \"heun\"", "")),
+            "run.integrator"
+        );
+        let rpy = "[hydrodynamics]\nmodel = \"rpy\"";
+        let e = integrator(&with("integrator = \"lm\"", rpy)).unwrap_err();
+        assert_eq!(e.key, "run.integrator");
+        assert!(e.to_string().contains("rpy"), "{e}");
+        assert!(integrator(&with("integrator = \"euler\"", rpy)).is_ok());
     }
 
     #[test]
@@ -955,6 +1020,7 @@ impl DropletParams {
             skin: self.skin,
             sort_every: 500,
             max_drift: 0.2,
+            integrator: self.integrator,
         };
         Ok(Brownian::new(
             particles,

@@ -15,7 +15,7 @@ pub mod neighbor;
 pub mod potential;
 pub mod state;
 
-pub use brownian::{BdError, BdParams, Brownian};
+pub use brownian::{BdError, BdParams, Brownian, Integrator};
 pub use colloidsim_hydro as hydro;
 pub use dpd::{Dpd, DpdError, DpdParams};
 pub use droplet::{DropletParams, DropletScenario};

@@ -5,8 +5,8 @@
 use colloidsim_md::gsd::{GsdWriter, read_frame};
 use colloidsim_md::init::{random_in_box, random_in_sphere};
 use colloidsim_md::{
-    BdError, BdParams, Brownian, External, HarmonicInterface, LennardJones, NoExternal, NoPair,
-    Pair, Particles, SimBox, SphereAreaLaw,
+    BdError, BdParams, Brownian, External, HarmonicInterface, Integrator, LennardJones, NoExternal,
+    NoPair, Pair, Particles, SimBox, SphereAreaLaw,
 };
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -233,50 +233,59 @@ fn wca_system(n: usize, phi: f64, dt: f64, seed: u32) -> Brownian<LennardJones, 
 }
 
 /// Runs are bitwise identical for 1 and 2 threads, and a restart from a GSD checkpoint
-/// continues bitwise identically.
+/// continues bitwise identically, with either integrator (Leimkuhler–Matthews draws its kept
+/// deviate again at the restart).
 #[test]
 fn thread_count_and_restart_do_not_change_the_trajectory() {
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut sim = wca_system(3000, 0.2, 1e-4, 7);
-            sim.run(700).unwrap(); // includes a re-sort at step 500
-            sim.snapshot()
-        })
-    };
-    let one = run(1);
-    assert!(one == run(2), "1 and 2 threads differ");
-    assert!(one == run(3), "1 and 3 threads differ");
+    let mut last = Vec::new();
+    for integrator in [Integrator::Euler, Integrator::Lm] {
+        let system = |seed: u32| wca_system(3000, 0.2, 1e-4, seed).with_integrator(integrator);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut sim = system(7);
+                sim.run(700).unwrap(); // includes a re-sort at step 500
+                sim.snapshot()
+            })
+        };
+        let one = run(1);
+        assert!(one == run(2), "{integrator:?}: 1 and 2 threads differ");
+        assert!(one == run(3), "{integrator:?}: 1 and 3 threads differ");
 
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("checkpoint.gsd");
-    let mut sim = wca_system(3000, 0.2, 1e-4, 7);
-    sim.run(120).unwrap();
-    let mut w = GsdWriter::create_new(&path).unwrap();
-    w.write_checkpoint(sim.step, &sim.sbox, &sim.snapshot(), &sim.list_state(), &[])
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.gsd");
+        let mut sim = system(7);
+        sim.run(120).unwrap();
+        let mut w = GsdWriter::create_new(&path).unwrap();
+        w.write_checkpoint(sim.step, &sim.sbox, &sim.snapshot(), &sim.list_state(), &[])
+            .unwrap();
+        drop(w);
+        let f = read_frame(&path, None).unwrap();
+        assert_eq!(f.step, 120);
+        let mut again = Brownian::restart(
+            f.particles,
+            f.sbox,
+            LennardJones::wca(1.0, 1.0),
+            NoExternal,
+            *sim.params(),
+            f.step,
+            f.list.as_ref(),
+        )
         .unwrap();
-    drop(w);
-    let f = read_frame(&path, None).unwrap();
-    assert_eq!(f.step, 120);
-    let mut again = Brownian::restart(
-        f.particles,
-        f.sbox,
-        LennardJones::wca(1.0, 1.0),
-        NoExternal,
-        *sim.params(),
-        f.step,
-        f.list.as_ref(),
-    )
-    .unwrap();
-    again.run(580).unwrap();
-    assert!(again.snapshot() == one, "restart differs");
-    // A different seed does change it (the comparison can fail).
-    let mut other = wca_system(3000, 0.2, 1e-4, 8);
-    other.run(700).unwrap();
-    assert!(other.snapshot().pos != one.pos);
+        assert_eq!(again.params().integrator, integrator);
+        again.run(580).unwrap();
+        assert!(again.snapshot() == one, "{integrator:?}: restart differs");
+        // A different seed does change it (the comparison can fail).
+        let mut other = system(8);
+        other.run(700).unwrap();
+        assert!(other.snapshot().pos != one.pos);
+        last.push(one.pos);
+    }
+    // The integrators differ (Leimkuhler–Matthews is not Euler under another name).
+    assert!(last[0] != last[1]);
 }
 
 /// A time step far too large for the WCA core is detected, naming the step and the particle.

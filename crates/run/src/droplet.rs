@@ -15,6 +15,7 @@ use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::output::OutputDir;
+use colloidsim_md::brownian::Integrator;
 use colloidsim_md::droplet::{DropletSim, HydroDropletSim};
 use colloidsim_md::gsd::{self, GsdWriter};
 use colloidsim_md::{
@@ -232,7 +233,11 @@ impl Engine {
         }
     }
 
-    fn params(&self) -> BdParams {
+    /// The free-draining engine's parameters with `integrator` (the scenario's
+    /// `run.integrator`: a restart runs the scenario it started with, so the checkpoint need not
+    /// hold it; nor the Leimkuhler–Matthews deviates, which the engine draws again from (seed,
+    /// step, particle)).
+    fn params(&self, integrator: Integrator) -> BdParams {
         BdParams {
             kt: self.kt,
             viscosity: self.viscosity,
@@ -242,6 +247,7 @@ impl Engine {
             skin: self.skin,
             sort_every: self.sort_every,
             max_drift: self.max_drift,
+            integrator,
         }
     }
 }
@@ -303,7 +309,7 @@ fn restore_replica(
                 f.sbox,
                 LennardJones::wca(p.kt, p.diameter),
                 p.interface(),
-                engine.params(),
+                engine.params(p.integrator),
                 f.step,
                 f.list.as_ref(),
             )

@@ -739,6 +739,14 @@ pub static DROPLET: &[Spec] = &[
     )
     .also("at most 1e12 steps"),
     key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]"),
+    key(
+        "run.integrator",
+        "-",
+        "euler",
+        OneOf(&["euler", "lm"]),
+        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
+    )
+    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")"),
     key("observe", "-", "profiles", Table, "what to measure"),
     key(
         "observe.profile",
