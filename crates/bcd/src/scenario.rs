@@ -418,9 +418,7 @@ impl Scenario {
             }
         };
         let seed = seed_override.unwrap_or(self.seed);
-        let seed = u32::try_from(seed).map_err(|_| {
-            ParamError::new("seed", format!("must lie in [0, 4294967295], got {seed}"))
-        })?;
+        let seed = colloidsim_core::param::seed("seed", seed)?;
         let s = &self.system;
         let config = BcdConfig {
             length: s.length,

@@ -33,6 +33,12 @@ pub fn show(v: f64) -> String {
     }
 }
 
+/// A run's random seed: it keys 32-bit counter streams, so it must fit in a `u32`.
+pub fn seed(key: &str, value: u64) -> Result<u32, ParamError> {
+    u32::try_from(value)
+        .map_err(|_| ParamError::new(key, format!("must lie in [0, 4294967295], got {value}")))
+}
+
 /// `value` must be finite and > 0.
 pub fn positive(key: &str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value > 0.0 {

@@ -262,12 +262,7 @@ impl McScenario {
                 format!("must be \"hs-mc\", got \"{}\"", self.method),
             ));
         }
-        let seed = u32::try_from(self.seed).map_err(|_| {
-            ParamError::new(
-                "seed",
-                format!("must lie in [0, 4294967295], got {}", self.seed),
-            )
-        })?;
+        let seed = colloidsim_core::param::seed("seed", self.seed)?;
         let s = &self.system;
         let d = positive("system.diameter", s.diameter)?;
         let kt = positive("system.kT", s.kt)?;

@@ -335,12 +335,7 @@ impl DropletScenario {
                 format!("must be \"droplet-bd\", got \"{}\"", self.method),
             ));
         }
-        let seed = u32::try_from(self.seed).map_err(|_| {
-            ParamError::new(
-                "seed",
-                format!("must lie in [0, 4294967295], got {}", self.seed),
-            )
-        })?;
+        let seed = colloidsim_core::param::seed("seed", self.seed)?;
         let replicas = at_least("replicas", self.replicas, 1)?;
         let s = &self.system;
         let particles = at_least("system.particles", s.particles, 1)?;

@@ -146,6 +146,5 @@ pub fn engine(sc: &Scenario, seed: Option<u64>) -> anyhow::Result<Box<dyn Engine
 
 /// Validate a seed from the scenario or the caller: the counter-based streams take 32 bits.
 pub fn seed32(seed: u64) -> anyhow::Result<u32> {
-    u32::try_from(seed)
-        .map_err(|_| anyhow::anyhow!("seed: must lie in [0, 4294967295], got {seed}"))
+    Ok(colloidsim_core::param::seed("seed", seed)?)
 }

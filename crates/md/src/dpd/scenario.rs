@@ -381,12 +381,7 @@ impl DpdScenario {
                 format!("must be \"dpd\", got \"{}\"", self.method),
             ));
         }
-        let seed = u32::try_from(self.seed).map_err(|_| {
-            ParamError::new(
-                "seed",
-                format!("must lie in [0, 4294967295], got {}", self.seed),
-            )
-        })?;
+        let seed = colloidsim_core::param::seed("seed", self.seed)?;
         let mut warnings = Vec::new();
         let s = &self.system;
         let l = match (s.box_length, s.box_edges) {
