@@ -55,11 +55,12 @@ impl SimBox {
             if p[k] >= 0.5 * l || p[k] < -0.5 * l {
                 let n = (p[k] / l + 0.5).floor();
                 p[k] -= n * l;
-                image[k] += n as i32;
+                // Saturating: a blown-up position (stopped by the run's checks) must not panic.
+                image[k] = image[k].saturating_add(n as i32);
                 // Rounding can leave p exactly at +L/2.
                 if p[k] >= 0.5 * l {
                     p[k] -= l;
-                    image[k] += 1;
+                    image[k] = image[k].saturating_add(1);
                 }
             }
         }
