@@ -9,7 +9,9 @@
 //! that results depend neither on the number of threads nor on the order of the work.
 
 pub mod boundary;
+pub mod drying;
 pub mod measure;
+pub mod scenario;
 pub mod srd;
 pub mod theory;
 
