@@ -1309,6 +1309,353 @@ pub static MC: &[Spec] = &[
     ),
 ];
 
+/// The `[solvent]` keys of both MPCD methods (MPCD units).
+macro_rules! solvent_keys {
+    () => {
+        [
+            key(
+                "solvent",
+                "-",
+                "-",
+                Table,
+                "the SRD solvent (MPCD units: cell edge a, solvent mass m, kT)",
+            ),
+            key(
+                "solvent.density",
+                "particles / cell",
+                "5",
+                LeftOpen(0.0, 1000.0),
+                "mean particles per cell M",
+            ),
+            key(
+                "solvent.angle",
+                "degrees",
+                "130",
+                LeftOpen(0.0, 180.0),
+                "SRD rotation angle about a random axis per cell",
+            ),
+            key(
+                "solvent.tau",
+                "time",
+                "0.1",
+                Positive,
+                "collision time (the streaming step)",
+            ),
+            key("solvent.kT", "energy", "1", Positive, "thermal energy"),
+            key(
+                "solvent.mass",
+                "mass",
+                "1",
+                Positive,
+                "solvent particle mass m",
+            ),
+            key(
+                "solvent.cell",
+                "length",
+                "1",
+                Positive,
+                "collision cell edge a",
+            )
+            .also("every box edge a whole number of cells"),
+            key(
+                "solvent.thermostat",
+                "-",
+                "true",
+                Bool,
+                "cell-level Maxwell-Boltzmann thermostat (Huang et al. 2010)",
+            ),
+        ]
+    };
+}
+
+const SOLVENT: [Spec; 8] = solvent_keys!();
+
+/// The keys of `mpcd` scenarios.
+pub static MPCD: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["mpcd"]),
+        "SRD solvent in a periodic cube (docs/mpcd.md)",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of the counter-based random streams (--seed overrides)",
+    ),
+    SOLVENT[0],
+    SOLVENT[1],
+    SOLVENT[2],
+    SOLVENT[3],
+    SOLVENT[4],
+    SOLVENT[5],
+    SOLVENT[6],
+    SOLVENT[7],
+    key("system", "-", "required", Table, "the periodic box"),
+    key(
+        "system.box",
+        "length",
+        "required",
+        Positive,
+        "edge L of the periodic cube",
+    )
+    .also("a whole number of cells, 2 to 4096 of them"),
+    key("run", "-", "required", Table, "collisions"),
+    key(
+        "run.collisions",
+        "-",
+        "required",
+        Integer(1, COUNT),
+        "collisions in all (equilibration included)",
+    ),
+    key(
+        "run.equilibrate",
+        "-",
+        "6 flow relaxation times rho / (eta k^2) with [viscosity], else 100 (at most half the run)",
+        Integer(0, COUNT),
+        "collisions before sampling",
+    )
+    .also("below run.collisions"),
+    key(
+        "viscosity",
+        "-",
+        "absent: no drive",
+        Table,
+        "shear viscosity by periodic Poiseuille flow (body force g0 cos(2 pi z / L) along x)",
+    ),
+    key(
+        "viscosity.drive",
+        "force / mass",
+        "flow amplitude 0.25 sqrt(kT/m) by Kikuchi's viscosity",
+        Positive,
+        "drive amplitude g0",
+    )
+    .also("flow amplitude at most 0.6 sqrt(kT/m)"),
+    key(
+        "viscosity.blocks",
+        "-",
+        "10",
+        Integer(2, 10_000),
+        "blocks of the standard errors",
+    )
+    .also("at most the sampling collisions"),
+    key("observe", "-", "-", Table, "observables"),
+    key(
+        "observe.every",
+        "collisions",
+        "collisions / 200",
+        Integer(1, COUNT),
+        "rows of thermo.csv (temperature, flow amplitude, momentum)",
+    ),
+    key("observe.trajectory", "-", "-", Table, "GSD trajectory"),
+    key(
+        "observe.trajectory.every",
+        "collisions",
+        "0",
+        Integer(0, COUNT),
+        "collisions between frames (0: none)",
+    ),
+    key(
+        "observe.trajectory.solvent",
+        "-",
+        "false",
+        Bool,
+        "frames hold the solvent (type S, with velocities)",
+    )
+    .also("true when frames are written: a bulk solvent has no colloids"),
+];
+
+/// The keys of `droplet-mpcd` scenarios.
+pub static DROPLET_MPCD: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["droplet-mpcd"]),
+        "drying droplet of SRD solvent (docs/mpcd.md)",
+    ),
+    key(
+        "seed",
+        "-",
+        "1",
+        SEED,
+        "seed of the counter-based random streams (--seed overrides)",
+    ),
+    key(
+        "boundary",
+        "-",
+        "\"slip\"",
+        OneOf(&["none", "slip", "no-slip"]),
+        "the solvent at the moving sphere: none (fills the box, ignores it), slip or no-slip bounce-back",
+    ),
+    SOLVENT[0],
+    SOLVENT[1],
+    SOLVENT[2],
+    SOLVENT[3],
+    SOLVENT[4],
+    SOLVENT[5],
+    SOLVENT[6],
+    SOLVENT[7],
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "colloids, droplet and box",
+    ),
+    key(
+        "system.particles",
+        "-",
+        "0",
+        Integer(0, 0),
+        "colloids (0: a pure-solvent droplet)",
+    )
+    .also("colloids are not built yet"),
+    key(
+        "system.diameter",
+        "length",
+        "4",
+        Positive,
+        "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe",
+    ),
+    key(
+        "system.radius",
+        "length",
+        "required",
+        Positive,
+        "initial droplet radius R0",
+    )
+    .also("at least 2 cells"),
+    key(
+        "system.phi0",
+        "-",
+        "from radius",
+        LeftOpen(0.0, 0.3),
+        "initial colloid volume fraction N d^3 / (8 R0^3)",
+    )
+    .also("with colloids; not with system.radius"),
+    key(
+        "system.box",
+        "length",
+        "smallest whole number of cells >= 2 R0 + 4",
+        Positive,
+        "edge of the periodic box",
+    )
+    .also("at least 2 R0 + 4 cells, a whole number of cells"),
+    key(
+        "drying",
+        "-",
+        "-",
+        Table,
+        "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi)), as droplet-bd's",
+    ),
+    key(
+        "drying.peclet",
+        "-",
+        "10",
+        NonNegative,
+        "Pe = R |dR/dt| / D0 (0: a static droplet)",
+    )
+    .also("not with drying.alpha"),
+    key(
+        "drying.alpha",
+        "length^2 / time",
+        "8 pi Pe D0",
+        Positive,
+        "rate of loss of surface area",
+    ),
+    key(
+        "drying.final_volume_fraction",
+        "-",
+        "0.55 with colloids",
+        LeftOpen(0.0, 0.64),
+        "stop at this mean colloid volume fraction",
+    )
+    .also("with colloids; not with drying.duration"),
+    key(
+        "drying.duration",
+        "time",
+        "required without colloids",
+        Positive,
+        "stop after this time",
+    )
+    .also("R must stay above two cells"),
+    key("observe", "-", "-", Table, "observables"),
+    key(
+        "observe.every",
+        "collisions",
+        "collisions / 200",
+        Integer(1, COUNT),
+        "rows of thermo.csv (radius, solvent count, expected count, removed, bounced, temperature)",
+    ),
+    key("observe.profile", "-", "-", Table, "times of the profiles"),
+    key(
+        "observe.profile.bins",
+        "-",
+        "50",
+        Integer(1, 100_000),
+        "bins of the colloid volume-fraction profiles (with colloids)",
+    ),
+    key(
+        "observe.profile.fractions",
+        "-",
+        "[0.0, 0.25, 0.5, 0.75, 1.0]",
+        Numbers(0.0, 1.0, None),
+        "fractions of the drying time at which profiles are taken",
+    )
+    .also("increasing, distinct collisions"),
+    key(
+        "observe.solvent",
+        "-",
+        "-",
+        Table,
+        "solvent density and radial velocity against r / R(t)",
+    ),
+    key(
+        "observe.solvent.bins",
+        "-",
+        "20",
+        Integer(1, 10_000),
+        "bins over [0, R(t)]",
+    ),
+    key(
+        "observe.solvent.window",
+        "collisions",
+        "collisions / 10",
+        Integer(1, COUNT),
+        "each solvent profile averages this many collisions ending at its time (10 blocks for the errors)",
+    ),
+    key("observe.trajectory", "-", "-", Table, "GSD trajectory"),
+    key(
+        "observe.trajectory.every",
+        "collisions",
+        "0",
+        Integer(0, COUNT),
+        "collisions between frames (0: none)",
+    ),
+    key(
+        "observe.trajectory.solvent",
+        "-",
+        "false",
+        Bool,
+        "frames hold the solvent (type S, with velocities; log/radius)",
+    )
+    .also("true when frames are written without colloids"),
+];
+
+/// The keys of `mpcd` scenarios, as listed.
+pub fn mpcd() -> Vec<Key> {
+    MPCD.iter().map(Key::from).collect()
+}
+
+/// The keys of `droplet-mpcd` scenarios, as listed.
+pub fn droplet_mpcd() -> Vec<Key> {
+    DROPLET_MPCD.iter().map(Key::from).collect()
+}
+
 /// The keys of `hs-mc` scenarios, as listed.
 pub fn mc() -> Vec<Key> {
     MC.iter().map(Key::from).collect()
@@ -1469,7 +1816,7 @@ mod tests {
 
     #[test]
     fn every_path_is_listed_once_under_a_listed_table() {
-        for spec in [BCD, DROPLET, DPD] {
+        for spec in [BCD, DROPLET, DPD, MC, MPCD, DROPLET_MPCD] {
             for (i, s) in spec.iter().enumerate() {
                 assert!(
                     spec[..i].iter().all(|t| t.path != s.path),

@@ -21,6 +21,7 @@ mod bcd;
 mod dpd;
 mod droplet;
 mod hs_mc;
+mod mpcd;
 mod theory_droplet;
 pub mod two_body;
 

@@ -135,6 +135,8 @@ static METHODS: &[&dyn Method] = &[
     &crate::droplet::DropletBd,
     &crate::dpd::DpdMethod,
     &crate::hs_mc::HsMc,
+    &crate::mpcd::MpcdBulk,
+    &crate::mpcd::DropletMpcd,
 ];
 
 /// Every registered method.

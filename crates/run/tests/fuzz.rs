@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use std::path::Path;
 
 /// Small, fast scenarios of each method (the mutations start from these).
-const BASES: [(&str, &[Spec]); 6] = [
+const BASES: [(&str, &[Spec]); 8] = [
     (
         r#"method = "bcd"
 seed = 3
@@ -109,6 +109,31 @@ thermo_every = 5
 structure_every = 10
 "#,
         keys::DPD,
+    ),
+    (
+        r#"method = "mpcd"
+[system]
+box = 6.0
+[run]
+collisions = 20
+[viscosity]
+[observe.trajectory]
+every = 10
+solvent = true
+"#,
+        keys::MPCD,
+    ),
+    (
+        r#"method = "droplet-mpcd"
+boundary = "no-slip"
+[system]
+radius = 3.0
+[drying]
+duration = 5.0
+[observe.solvent]
+window = 5
+"#,
+        keys::DROPLET_MPCD,
     ),
 ];
 

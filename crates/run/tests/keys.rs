@@ -152,9 +152,68 @@ rho2_r_bins = 4
 rho2_cos_bins = 20
 "#;
 
+const MPCD: &str = r#"
+method = "mpcd"
+seed = 1
+[solvent]
+density = 5.0
+angle = 130.0
+tau = 0.1
+kT = 1.0
+mass = 1.0
+cell = 1.0
+thermostat = true
+[system]
+box = 8.0
+[run]
+collisions = 400
+equilibrate = 100
+[viscosity]
+drive = 0.01
+blocks = 10
+[observe]
+every = 10
+[observe.trajectory]
+every = 0
+solvent = false
+"#;
+
+const DROPLET_MPCD: &str = r#"
+method = "droplet-mpcd"
+seed = 1
+boundary = "slip"
+[solvent]
+density = 5.0
+angle = 130.0
+tau = 0.1
+kT = 1.0
+mass = 1.0
+cell = 1.0
+thermostat = true
+[system]
+particles = 0
+diameter = 4.0
+radius = 4.0
+box = 12.0
+[drying]
+peclet = 10.0
+duration = 10.0
+[observe]
+every = 10
+[observe.profile]
+bins = 50
+fractions = [0.0, 0.25, 0.5, 0.75, 1.0]
+[observe.solvent]
+bins = 20
+window = 10
+[observe.trajectory]
+every = 0
+solvent = false
+"#;
+
 type Parse = fn(&str) -> Result<(), String>;
 
-fn methods() -> [(&'static str, &'static [Spec], Parse); 4] {
+fn methods() -> [(&'static str, &'static [Spec], Parse); 6] {
     [
         (BCD, keys::BCD, |t| {
             toml::from_str::<colloidsim_bcd::scenario::Scenario>(t)
@@ -173,6 +232,16 @@ fn methods() -> [(&'static str, &'static [Spec], Parse); 4] {
         }),
         (MC, keys::MC, |t| {
             colloidsim_mc::scenario::McScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (MPCD, keys::MPCD, |t| {
+            colloidsim_md::mpcd::scenario::BulkScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (DROPLET_MPCD, keys::DROPLET_MPCD, |t| {
+            colloidsim_md::mpcd::scenario::DropletScenario::from_toml(t)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         }),

@@ -135,9 +135,12 @@ impl SolventProfile {
     }
 
     /// Per bin: `(r/R at the bin centre, number density, its standard error, mean radial
-    /// velocity, its standard error)`, the errors from the scatter of the block means (NaN
-    /// with fewer than two blocks that hold samples).
-    pub fn table(&self) -> Vec<[f64; 5]> {
+    /// velocity, its standard error)`, and the lag-1 correlation of consecutive block means
+    /// (pooled over the bins). The errors come from the scatter of the block means, widened by
+    /// `sqrt((1 + rho) / (1 - rho))` for a positive correlation `rho` (the factor of a
+    /// first-order autoregressive series: blocks shorter than the relaxation of the density
+    /// are not independent); NaN with fewer than two blocks holding samples.
+    pub fn table(&self) -> (Vec<[f64; 5]>, f64) {
         let bins = self.bins;
         let used: Vec<usize> = (0..self.samples.len())
             .filter(|&k| self.samples[k] > 0)
@@ -146,22 +149,42 @@ impl SolventProfile {
         let shell = |b: usize| {
             4.0 / 3.0 * PI * (((b + 1) as f64).powi(3) - (b as f64).powi(3)) / (bins as f64).powi(3)
         };
+        let density = |k: usize, b: usize| self.counts[k][b] / (shell(b) * self.r3[k]);
+        // Pooled lag-1 correlation of the density block means.
+        let (mut num, mut den) = (0.0, 0.0);
+        for b in 0..bins {
+            let v: Vec<f64> = used.iter().map(|&k| density(k, b)).collect();
+            let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            for k in 0..v.len() {
+                den += (v[k] - m).powi(2);
+                if k + 1 < v.len() {
+                    num += (v[k] - m) * (v[k + 1] - m);
+                }
+            }
+        }
+        let rho = if den > 0.0 && used.len() >= 3 {
+            num / den
+        } else {
+            0.0
+        };
+        let widen = if rho > 0.0 {
+            ((1.0 + rho) / (1.0 - rho).max(0.05)).sqrt()
+        } else {
+            1.0
+        };
         let stats = |v: &[f64]| {
             let m = v.len() as f64;
             let mean = v.iter().sum::<f64>() / m;
             let se = if v.len() >= 2 {
-                (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (m - 1.0) / m).sqrt()
+                widen * (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (m - 1.0) / m).sqrt()
             } else {
                 f64::NAN
             };
             (mean, se)
         };
-        (0..bins)
+        let rows = (0..bins)
             .map(|b| {
-                let dens: Vec<f64> = used
-                    .iter()
-                    .map(|&k| self.counts[k][b] / (shell(b) * self.r3[k]))
-                    .collect();
+                let dens: Vec<f64> = used.iter().map(|&k| density(k, b)).collect();
                 let vr: Vec<f64> = used
                     .iter()
                     .filter(|&&k| self.counts[k][b] > 0.0)
@@ -175,7 +198,8 @@ impl SolventProfile {
                 };
                 [(b as f64 + 0.5) / bins as f64, d, de, v, ve]
             })
-            .collect()
+            .collect();
+        (rows, rho)
     }
 }
 
@@ -251,7 +275,7 @@ mod tests {
                 srd.collide(t, &conf, None);
                 prof.sample(&srd, 7.0, k / 20);
             }
-            for row in prof.table() {
+            for row in prof.table().0 {
                 let [x, n, ne, v, ve] = row;
                 assert!(
                     (n - 5.0).abs() < 4.0 * ne && ne < 0.05 * 5.0,

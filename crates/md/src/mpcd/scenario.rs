@@ -108,6 +108,13 @@ impl SolventParams {
     }
 }
 
+/// Peak bytes of a solvent of `n` particles in `cells` cells: `Srd::new` holds the particles
+/// in `f64` before encoding them (about twice the 56 bytes per particle of a running engine).
+fn ensure_solvent_fits(key: &str, n: f64, cells: f64) -> Result<(), ParamError> {
+    let bytes = 112.0 * n + 8.0 * cells;
+    colloidsim_core::resources::ensure_fits(key, &format!("{n:e} solvent particles"), bytes)
+}
+
 /// Box edge `l` (key `key`) as a whole number of cells of edge `a`, at least `min` cells.
 fn box_edge(key: &str, l: f64, a: f64, min: usize) -> Result<f64, ParamError> {
     let l = positive(key, l)?;
@@ -169,7 +176,18 @@ pub struct ViscositySection {
     pub blocks: Option<u64>,
 }
 
-/// `[observe]` of either scenario.
+/// `[observe]` of a bulk scenario.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BulkObserve {
+    /// A row of `thermo.csv` every this many collisions (default: 200 rows over the run).
+    pub every: Option<u64>,
+    /// GSD trajectory.
+    #[serde(default)]
+    pub trajectory: TrajectorySection,
+}
+
+/// `[observe]` of a droplet scenario.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ObserveSection {
@@ -227,7 +245,7 @@ pub struct BulkScenario {
     pub viscosity: Option<ViscositySection>,
     /// Observables.
     #[serde(default)]
-    pub observe: ObserveSection,
+    pub observe: BulkObserve,
 }
 
 fn default_seed() -> u64 {
@@ -299,6 +317,7 @@ impl BulkScenario {
                 ),
             ));
         }
+        ensure_solvent_fits("system.box", particles, (l / srd.cell).powi(3))?;
         let collisions = self.run.collisions;
         if !(1..=1 << 53).contains(&collisions) {
             return Err(ParamError::new(
@@ -352,12 +371,6 @@ impl BulkScenario {
             ));
         }
         let o = &self.observe;
-        if o.profile.is_some() || o.solvent.is_some() {
-            return Err(ParamError::new(
-                "observe.profile",
-                "radial profiles belong to droplet-mpcd scenarios",
-            ));
-        }
         let t = &o.trajectory;
         if t.every > 0 && !t.solvent {
             return Err(ParamError::new(
@@ -679,6 +692,7 @@ impl DropletScenario {
                 format!("{solvent_particles:e} solvent particles: at most 2^31 - 1"),
             ));
         }
+        ensure_solvent_fits("system.box", solvent_particles, (l / a).powi(3))?;
         let o = &self.observe;
         let profile = o.profile.clone().unwrap_or_default();
         if !(1..=100_000).contains(&profile.bins) {

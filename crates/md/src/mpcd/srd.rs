@@ -35,7 +35,7 @@
 //! and 8 per cell, 55.6 bytes per particle at density 5; nothing is allocated per step (except for cells with more
 //! than [`CELL_CAPACITY`] members, which are rare).
 
-use super::boundary::{Confinement, WallKind};
+use super::boundary::Confinement;
 use super::{Draw, MpcdError, draw};
 use crate::state::SimBox;
 use colloidsim_core::rng::Ziggurat;
@@ -1406,6 +1406,7 @@ pub fn rotation(n: [f64; 3], cos: f64, sin: f64) -> [[f64; 3]; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mpcd::WallKind;
     use crate::potential::SphereAreaLaw;
 
     /// `steps` streaming steps and collisions of `srd` (no walls unless `conf`).

@@ -1,0 +1,1190 @@
+//! Multiparticle collision dynamics (`crates/md/src/mpcd`, docs/mpcd.md), in MPCD units:
+//!
+//! - `method = "mpcd"`: the SRD solvent in a periodic cube; with `[viscosity]` the periodic
+//!   Poiseuille drive, and `summary.json` reports the measured shear viscosity with its standard
+//!   error beside Kikuchi et al.'s formula.
+//! - `method = "droplet-mpcd"`: the drying droplet filled with the solvent, boundary `none`,
+//!   `slip` or `no-slip`; the solvent's density and radial velocity against `r / R(t)` and its
+//!   count against the droplet volume.
+//!
+//! Checkpoints hold the solvent exactly (fixed-point positions, velocities, storage order):
+//! a restart continues bitwise. Results do not depend on the number of threads.
+
+use crate::Scenario as Source;
+use crate::checkpoint::Envelope;
+use crate::droplet::trim_trajectory;
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot, picture};
+use crate::trajectory::FrameDigest;
+use anyhow::{Context, Result, bail};
+use colloidsim_core::output::OutputDir;
+use colloidsim_md::gsd::GsdWriter;
+use colloidsim_md::mpcd::drying::{SolventProfile, remove_excess};
+use colloidsim_md::mpcd::measure::{BlockAverage, PoiseuilleProbe};
+use colloidsim_md::mpcd::scenario::{Boundary, BulkRun, BulkScenario, DropletRun, DropletScenario};
+use colloidsim_md::mpcd::{Acceleration, Confinement, Srd, WallKind};
+use colloidsim_md::{Particles, SimBox};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::f64::consts::PI;
+
+/// The exact state of the solvent, as checkpoints hold it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct SolventState {
+    step: u64,
+    sort_every: u64,
+    pos: Vec<[u32; 3]>,
+    vel: Vec<[f64; 3]>,
+}
+
+impl SolventState {
+    fn of(srd: &Srd) -> Self {
+        Self {
+            step: srd.step(),
+            sort_every: srd.sort_every(),
+            pos: srd.raw_positions(),
+            vel: srd.velocities(),
+        }
+    }
+
+    fn engine(self, params: colloidsim_md::mpcd::SrdParams, sbox: SimBox) -> Result<Srd> {
+        let mut srd = Srd::from_raw(params, sbox, &self.pos, &self.vel, self.step)
+            .context("checkpoint.bin: the solvent state")?;
+        srd.set_sort_every(self.sort_every);
+        Ok(srd)
+    }
+}
+
+/// A GSD frame of the solvent (type `S`, diameter 0.2 cells, velocities and masses).
+fn solvent_frame(w: &mut GsdWriter, srd: &Srd, log: &[(&str, f64)]) -> Result<()> {
+    let mut p = Particles::monodisperse(srd.positions(), 0.2 * srd.params().cell);
+    p.type_names = vec!["S".into()];
+    p.vel = srd.velocities();
+    p.mass = vec![srd.params().mass; srd.len()];
+    w.write_frame(srd.step(), srd.sbox(), &p, false, log)?;
+    Ok(())
+}
+
+/// Open (fresh) or reopen (restart) the trajectory when frames are due.
+fn open_trajectory(out: &OutputDir, every: u64, fresh: bool) -> Result<Option<GsdWriter>> {
+    if every == 0 {
+        return Ok(None);
+    }
+    let path = out.join("trajectory.gsd");
+    Ok(Some(if path.exists() && !fresh {
+        GsdWriter::append(&path)?.with_velocities()
+    } else {
+        GsdWriter::create_new(&path)?.with_velocities()
+    }))
+}
+
+/// The first position at or after `pos` past which a regular checkpoint (every ~10 %) is due.
+fn tenth_after(pos: u64, total: u64) -> Option<u64> {
+    let every = (total / 10).max(1);
+    let next = (pos / every + 1) * every;
+    (next < total).then_some(next)
+}
+
+// ------------------------------------------------------------------------------------------
+// Bulk solvent.
+
+/// The bulk SRD solvent (`method = "mpcd"`).
+pub struct MpcdBulk;
+
+fn resolve_bulk(src: &Source, seed: Option<u64>) -> Result<BulkRun> {
+    crate::keys::validate(&src.table()?, crate::keys::MPCD).with_context(|| src.label())?;
+    let mut sc = BulkScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+        sc.seed = s;
+    }
+    sc.validate().with_context(|| src.label())
+}
+
+fn build_bulk(p: &BulkRun) -> Result<Srd> {
+    Ok(Srd::new(
+        p.solvent.srd,
+        SimBox::cube(p.box_edge),
+        &Confinement::None,
+        0.0,
+    )?)
+}
+
+impl Method for MpcdBulk {
+    fn names(&self) -> &'static [&'static str] {
+        &["mpcd"]
+    }
+
+    fn about(&self) -> &'static str {
+        "MPCD (stochastic rotation dynamics) solvent in a periodic cube; its shear viscosity by periodic Poiseuille flow"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/mpcd.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let p = resolve_bulk(src, None)?;
+        Ok(Checked {
+            resolved: serde_json::to_value(&p)?,
+            warnings: Vec::new(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let p = resolve_bulk(src, seed)?;
+        let srd = build_bulk(&p).with_context(|| src.label())?;
+        let acc = BulkAccum::new(&p);
+        Ok(Box::new(BulkSession {
+            p,
+            srd,
+            acc,
+            gsd: None,
+        }))
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let p = resolve_bulk(src, Some(seed))?;
+        let saved: BulkSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if saved.solvent.pos.len() != p.particles {
+            bail!("checkpoint: its solvent does not fit the scenario");
+        }
+        let srd = saved
+            .solvent
+            .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+        if p.trajectory_every > 0 {
+            saved
+                .acc
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, &[], true)
+                })?;
+        }
+        Ok(Box::new(BulkSession {
+            p,
+            srd,
+            acc: saved.acc,
+            gsd: None,
+        }))
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::mpcd()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let p = resolve_bulk(src, seed)?;
+        let drive = p.drive.map(|g0| Acceleration::CosineX {
+            amplitude: g0,
+            wavenumber: 2.0 * PI / p.box_edge,
+        });
+        Ok(Box::new(SolventEngine {
+            srd: build_bulk(&p)?,
+            method: "mpcd",
+            conf: Confinement::None,
+            drive: drive.unwrap_or(Acceleration::None),
+            scratch: Vec::new(),
+        }))
+    }
+}
+
+/// One row of `thermo.csv` (bulk).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct BulkRow {
+    collision: u64,
+    temperature: f64,
+    flow: f64,
+    momentum: [f64; 3],
+}
+
+/// What a bulk run accumulates (saved in every checkpoint).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct BulkAccum {
+    rows: Vec<BulkRow>,
+    /// The flow amplitude samples (with a drive).
+    probe: Option<PoiseuilleProbe>,
+    /// Mean flow amplitudes just before and after the collisions, summed over the samples.
+    before_after: [f64; 2],
+    /// Temperature of the sampling part, per collision in blocks.
+    temperature: BlockAverage,
+    /// `v_x` summed in slabs along z over the profile samples, and the samples.
+    flow_profile: Vec<f64>,
+    flow_counts: Vec<f64>,
+    frames: u64,
+    digest: FrameDigest,
+}
+
+impl BulkAccum {
+    fn new(p: &BulkRun) -> Self {
+        let sampling = p.collisions - p.equilibrate;
+        let block = (sampling / p.blocks).max(1);
+        let k = 2.0 * PI / p.box_edge;
+        let slabs = (p.box_edge / p.solvent.srd.cell).round() as usize;
+        Self {
+            rows: Vec::new(),
+            probe: p
+                .drive
+                .map(|g0| PoiseuilleProbe::new(g0, k, p.solvent.mass_density, block)),
+            before_after: [0.0; 2],
+            temperature: BlockAverage::new(block.div_ceil(p.thermo_every).max(1)),
+            flow_profile: vec![0.0; slabs],
+            flow_counts: vec![0.0; slabs],
+            frames: 0,
+            digest: FrameDigest::default(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct BulkSaved {
+    solvent: SolventState,
+    acc: BulkAccum,
+}
+
+struct BulkSession {
+    p: BulkRun,
+    srd: Srd,
+    acc: BulkAccum,
+    gsd: Option<GsdWriter>,
+}
+
+impl BulkSession {
+    fn wavenumber(&self) -> f64 {
+        2.0 * PI / self.p.box_edge
+    }
+
+    /// Observations after `c` collisions.
+    fn record(&mut self, c: u64) -> Result<()> {
+        let p = &self.p;
+        if c.is_multiple_of(p.thermo_every) {
+            let k = 2.0 * PI / p.box_edge;
+            let flow = PoiseuilleProbe::amplitude_of(&self.srd, k);
+            let m = p.solvent.srd.mass;
+            let temperature = if p.drive.is_some() {
+                // Relative to the driven flow.
+                let n = self.srd.len() as f64;
+                let twice = self.srd.sum(|x, v| {
+                    let w = [v[0] - flow * (k * x[2]).cos(), v[1], v[2]];
+                    [m * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])]
+                })[0];
+                twice / (3.0 * (n - 1.0))
+            } else {
+                self.srd.temperature()
+            };
+            self.acc.rows.push(BulkRow {
+                collision: c,
+                temperature,
+                flow,
+                momentum: self.srd.momentum(),
+            });
+            if c > p.equilibrate {
+                self.acc.temperature.push(temperature);
+                let slabs = self.acc.flow_profile.len();
+                let l = p.box_edge;
+                for i in 0..self.srd.len() {
+                    let x = self.srd.position(i);
+                    let b = (((x[2] / l + 0.5) * slabs as f64) as usize).min(slabs - 1);
+                    self.acc.flow_profile[b] += self.srd.velocity(i)[0];
+                    self.acc.flow_counts[b] += 1.0;
+                }
+            }
+        }
+        if let Some(w) = self.gsd.as_mut()
+            && c.is_multiple_of(p.trajectory_every)
+        {
+            solvent_frame(w, &self.srd, &[])?;
+            self.acc.frames += 1;
+        }
+        Ok(())
+    }
+}
+
+impl Session for BulkSession {
+    fn label(&self) -> String {
+        "mpcd".into()
+    }
+
+    fn total(&self) -> u64 {
+        self.p.collisions
+    }
+
+    fn position(&self) -> u64 {
+        self.srd.step()
+    }
+
+    fn seed(&self) -> u64 {
+        self.p.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::to_value(&self.p).unwrap_or_default()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        [
+            "thermo.csv",
+            "flow_profile.csv",
+            "flow_profile.png",
+            "trajectory.gsd",
+        ]
+        .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+        if fresh {
+            self.record(0)?;
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        tenth_after(self.position(), self.p.collisions)
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        let tau = self.p.solvent.srd.tau;
+        let k = self.wavenumber();
+        let drive = match self.p.drive {
+            Some(g0) => Acceleration::CosineX {
+                amplitude: g0,
+                wavenumber: k,
+            },
+            None => Acceleration::None,
+        };
+        let conf = Confinement::None;
+        let thermostat = self.p.solvent.srd.thermostat;
+        while self.srd.step() < until.min(self.p.collisions) {
+            let t = (self.srd.step() + 1) as f64 * tau;
+            if let Err(e) = self.srd.stream(t, &conf, &drive) {
+                return Ok(Some(e.to_string()));
+            }
+            let sampling = self.srd.step() >= self.p.equilibrate;
+            let before = match (&self.acc.probe, sampling) {
+                (Some(_), true) => PoiseuilleProbe::amplitude_of(&self.srd, k),
+                _ => 0.0,
+            };
+            self.srd.collide(t, &conf, None);
+            if let Some(probe) = self.acc.probe.as_mut() {
+                if !thermostat {
+                    // Without the cell thermostat the viscous heat leaves by a global
+                    // rescaling about the flow (measure::poiseuille_viscosity).
+                    let a = PoiseuilleProbe::amplitude_of(&self.srd, k);
+                    self.srd.rescale_about(|x| [a * (k * x[2]).cos(), 0.0, 0.0]);
+                }
+                if sampling {
+                    let after = PoiseuilleProbe::amplitude_of(&self.srd, k);
+                    self.acc.before_after[0] += before;
+                    self.acc.before_after[1] += after;
+                    probe.push(0.5 * (before + after));
+                }
+            }
+            self.record(self.srd.step())?;
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.p.trajectory_every > 0 {
+            self.flush()?;
+            self.acc
+                .digest
+                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        }
+        Ok(bincode::serialize(&BulkSaved {
+            solvent: SolventState::of(&self.srd),
+            acc: self.acc.clone(),
+        })?)
+    }
+
+    fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        write_bulk_thermo(out, &self.p, &self.acc.rows)?;
+        Ok(vec!["thermo.csv".into()])
+    }
+
+    fn finish(
+        mut self: Box<Self>,
+        out: &OutputDir,
+        wall_s: f64,
+        failure: Option<&str>,
+    ) -> Result<Finished> {
+        self.flush()?;
+        let p = &self.p;
+        let mut files = Vec::new();
+        let mut warnings = Vec::new();
+        write_bulk_thermo(out, p, &self.acc.rows)?;
+        files.push("thermo.csv".into());
+        let collisions = self.srd.step();
+        let sampled = collisions.saturating_sub(p.equilibrate);
+        let (t_mean, t_se) = (
+            self.acc.temperature.mean(),
+            self.acc.temperature.standard_error(),
+        );
+        let mut summary = json!({
+            "software": crate::software(),
+            "method": "mpcd",
+            "seed": p.seed,
+            "parameters": p,
+            "units": "MPCD: lengths in the cell edge a, masses in the solvent mass m, energies in kT, times in a sqrt(m / kT)",
+            "collisions": collisions,
+            "sampled_collisions": sampled,
+            "time": collisions as f64 * p.solvent.srd.tau,
+            "solvent_particles": self.srd.len(),
+            "temperature": { "value": t_mean, "standard_error": t_se, "target": p.solvent.srd.kt },
+            "momentum": self.srd.momentum(),
+            "viscosity_theory": p.solvent.viscosity_theory,
+            "wall_seconds": wall_s,
+            "particle_updates_per_second": collisions as f64 * self.srd.len() as f64 / wall_s.max(1e-9),
+            "threads": rayon::current_num_threads(),
+            "trajectory_frames": self.acc.frames,
+        });
+        if let Some(probe) = &self.acc.probe {
+            let (eta, se) = probe.viscosity();
+            let blocks = probe.flow.blocks.len();
+            let n = (sampled as f64).max(1.0);
+            let theory = p.solvent.viscosity_theory;
+            if blocks < 2 {
+                warnings.push(format!(
+                    "viscosity: only {blocks} complete block(s) of the flow amplitude, no standard error"
+                ));
+            }
+            summary["viscosity"] = json!({
+                "value": eta,
+                "standard_error": se,
+                "theory": theory,
+                "relative_deviation": eta / theory - 1.0,
+                "method": "periodic Poiseuille flow (Backer et al. 2005): eta = rho g0 / (k^2 A), A the flow amplitude averaged over the free flight",
+                "drive": probe.amplitude,
+                "flow_amplitude": probe.flow.mean(),
+                "flow_before_after_collisions": [self.acc.before_after[0] / n, self.acc.before_after[1] / n],
+                "blocks": blocks,
+            });
+            // The flow profile against A cos(k z).
+            let slabs = self.acc.flow_profile.len();
+            let l = p.box_edge;
+            let k = self.wavenumber();
+            let z: Vec<f64> = (0..slabs)
+                .map(|b| ((b as f64 + 0.5) / slabs as f64 - 0.5) * l)
+                .collect();
+            let vx: Vec<f64> = (0..slabs)
+                .map(|b| self.acc.flow_profile[b] / self.acc.flow_counts[b].max(1.0))
+                .collect();
+            let a = probe.flow.mean();
+            let fit: Vec<f64> = z.iter().map(|z| a * (k * z).cos()).collect();
+            if self.acc.flow_counts.iter().any(|&c| c > 0.0) {
+                out.write_table(
+                    "flow_profile.csv",
+                    &[("z", &z), ("vx", &vx), ("a_cos_kz", &fit)],
+                )?;
+                files.push("flow_profile.csv".into());
+                let title = format!(
+                    "MPCD periodic Poiseuille flow: eta = {eta:.4} +- {se:.4} (Kikuchi {theory:.4})"
+                );
+                picture(
+                    line_plot(
+                        &out.join("flow_profile.png"),
+                        &title,
+                        "z / a",
+                        "v_x sqrt(m / kT)",
+                        &[
+                            Series {
+                                label: "measured",
+                                x: &z,
+                                y: &vx,
+                                points: true,
+                            },
+                            Series {
+                                label: "A cos(2 pi z / L)",
+                                x: &z,
+                                y: &fit,
+                                points: false,
+                            },
+                        ],
+                        Scale::Linear,
+                    ),
+                    "flow_profile.png",
+                    &mut files,
+                    &mut warnings,
+                );
+            }
+        }
+        if self.acc.frames > 0 {
+            files.push("trajectory.gsd".into());
+        }
+        summary["warnings"] = json!(warnings);
+        let message = match (failure, summary.get("viscosity")) {
+            (Some(f), _) => format!("mpcd stopped at collision {collisions}: {f}"),
+            (None, Some(v)) => format!(
+                "mpcd: {collisions} collisions of {} solvent particles; viscosity {:.4} +- {:.4} (Kikuchi et al. {:.4})",
+                self.srd.len(),
+                v["value"].as_f64().unwrap_or(f64::NAN),
+                v["standard_error"].as_f64().unwrap_or(f64::NAN),
+                p.solvent.viscosity_theory
+            ),
+            (None, None) => format!(
+                "mpcd: {collisions} collisions of {} solvent particles; T = {t_mean:.4} +- {t_se:.4}",
+                self.srd.len()
+            ),
+        };
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+fn write_bulk_thermo(out: &OutputDir, p: &BulkRun, rows: &[BulkRow]) -> Result<()> {
+    let col = |f: &dyn Fn(&BulkRow) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
+    let tau = p.solvent.srd.tau;
+    out.write_table(
+        "thermo.csv",
+        &[
+            ("collision", &col(&|r| r.collision as f64)),
+            ("time", &col(&|r| r.collision as f64 * tau)),
+            ("temperature", &col(&|r| r.temperature)),
+            ("flow_amplitude", &col(&|r| r.flow)),
+            ("px", &col(&|r| r.momentum[0])),
+            ("py", &col(&|r| r.momentum[1])),
+            ("pz", &col(&|r| r.momentum[2])),
+        ],
+    )?;
+    Ok(())
+}
+
+// ------------------------------------------------------------------------------------------
+// Drying droplet.
+
+/// The drying droplet of MPCD solvent (`method = "droplet-mpcd"`).
+pub struct DropletMpcd;
+
+fn resolve_droplet(src: &Source, seed: Option<u64>) -> Result<DropletRun> {
+    crate::keys::validate(&src.table()?, crate::keys::DROPLET_MPCD).with_context(|| src.label())?;
+    let mut sc = DropletScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+        sc.seed = s;
+    }
+    sc.validate().with_context(|| src.label())
+}
+
+/// Where the solvent streams (the sphere, or nothing for `boundary = "none"`).
+fn confinement(p: &DropletRun) -> Confinement {
+    let law = p.law();
+    match p.boundary {
+        Boundary::None => Confinement::None,
+        Boundary::Slip => Confinement::Sphere {
+            law,
+            kind: WallKind::Slip,
+        },
+        Boundary::NoSlip => Confinement::Sphere {
+            law,
+            kind: WallKind::NoSlip,
+        },
+    }
+}
+
+fn build_droplet(p: &DropletRun) -> Result<Srd> {
+    Ok(Srd::new(
+        p.solvent.srd,
+        SimBox::cube(p.box_edge),
+        &confinement(p),
+        0.0,
+    )?)
+}
+
+impl Method for DropletMpcd {
+    fn names(&self) -> &'static [&'static str] {
+        &["droplet-mpcd"]
+    }
+
+    fn about(&self) -> &'static str {
+        "drying droplet of MPCD solvent with a none, slip or no-slip boundary at the moving interface"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/mpcd.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let p = resolve_droplet(src, None)?;
+        Ok(Checked {
+            resolved: serde_json::to_value(&p)?,
+            warnings: Vec::new(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let p = resolve_droplet(src, seed)?;
+        let srd = build_droplet(&p).with_context(|| src.label())?;
+        let acc = DropletAccum::new(&p, srd.len());
+        Ok(Box::new(DropletSession {
+            p,
+            srd,
+            acc,
+            gsd: None,
+            scratch: Vec::new(),
+        }))
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let p = resolve_droplet(src, Some(seed))?;
+        let saved: DropletSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        if saved.acc.profiles.len() != p.profile_collisions.len() {
+            bail!("checkpoint: its profiles do not fit the scenario");
+        }
+        let srd = saved
+            .solvent
+            .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+        if p.trajectory_every > 0 {
+            saved
+                .acc
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, &["radius"], true)
+                })?;
+        }
+        Ok(Box::new(DropletSession {
+            p,
+            srd,
+            acc: saved.acc,
+            gsd: None,
+            scratch: Vec::new(),
+        }))
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::droplet_mpcd()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let p = resolve_droplet(src, seed)?;
+        Ok(Box::new(SolventEngine {
+            srd: build_droplet(&p)?,
+            method: "droplet-mpcd",
+            conf: confinement(&p),
+            drive: Acceleration::None,
+            scratch: Vec::new(),
+        }))
+    }
+}
+
+/// One row of `thermo.csv` (droplet).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct DropletRow {
+    collision: u64,
+    radius: f64,
+    solvent: u64,
+    expected: u64,
+    removed: u64,
+    bounced: u64,
+    temperature: f64,
+}
+
+/// What a droplet run accumulates (saved in every checkpoint).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct DropletAccum {
+    rows: Vec<DropletRow>,
+    /// One solvent profile per profile time.
+    profiles: Vec<SolventProfile>,
+    solvent0: u64,
+    removed: u64,
+    /// Largest residual excess after a removal, and the last one.
+    residual_max: u64,
+    residual_last: u64,
+    bounced: u64,
+    reflections: u64,
+    stuck: u64,
+    virtual_particles: u64,
+    frames: u64,
+    digest: FrameDigest,
+}
+
+impl DropletAccum {
+    fn new(p: &DropletRun, solvent: usize) -> Self {
+        let blocks = |c: u64| p.solvent_window.min(c + 1).min(10) as usize;
+        Self {
+            rows: Vec::new(),
+            profiles: p
+                .profile_collisions
+                .iter()
+                .map(|&c| SolventProfile::new(p.solvent_bins, blocks(c)))
+                .collect(),
+            solvent0: solvent as u64,
+            removed: 0,
+            residual_max: 0,
+            residual_last: 0,
+            bounced: 0,
+            reflections: 0,
+            stuck: 0,
+            virtual_particles: 0,
+            frames: 0,
+            digest: FrameDigest::default(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct DropletSaved {
+    solvent: SolventState,
+    acc: DropletAccum,
+}
+
+struct DropletSession {
+    p: DropletRun,
+    srd: Srd,
+    acc: DropletAccum,
+    gsd: Option<GsdWriter>,
+    scratch: Vec<u32>,
+}
+
+impl DropletSession {
+    fn radius(&self, c: u64) -> f64 {
+        self.p.law().radius(c as f64 * self.p.solvent.srd.tau)
+    }
+
+    /// The expected solvent count at collision `c`: `round(n V)` of the fluid region.
+    fn expected(&self, c: u64) -> u64 {
+        let t = c as f64 * self.p.solvent.srd.tau;
+        let v = confinement(&self.p).volume(t, [self.p.box_edge; 3]);
+        (self.p.solvent.number_density * v).round() as u64
+    }
+
+    /// Observations after `c` collisions; `Some(why)` if the solvent has left the droplet.
+    fn record(&mut self, c: u64, bounced: u64) -> Result<Option<String>> {
+        let r = self.radius(c);
+        let p = &self.p;
+        for (j, &cf) in p.profile_collisions.iter().enumerate() {
+            let w = p.solvent_window;
+            let first = cf.saturating_sub(w - 1);
+            if c >= first && c <= cf {
+                let prof = &mut self.acc.profiles[j];
+                let blocks = prof.samples.len() as u64;
+                let span = cf - first + 1;
+                let b = ((c - first) * blocks / span) as usize;
+                prof.sample(&self.srd, r, b);
+            }
+        }
+        if c.is_multiple_of(p.thermo_every) || c == p.collisions {
+            if p.boundary != Boundary::None {
+                let r2 = r * r * (1.0 + 1e-9);
+                if let Some(i) = (0..self.srd.len()).find(|&i| {
+                    let x = self.srd.position(i);
+                    x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > r2
+                }) {
+                    let x = self.srd.position(i);
+                    return Ok(Some(format!(
+                        "solvent particle in slot {i} is outside the droplet at collision {c} (|x| = {:.6}, R = {r:.6})",
+                        (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+                    )));
+                }
+            }
+            self.acc.rows.push(DropletRow {
+                collision: c,
+                radius: r,
+                solvent: self.srd.len() as u64,
+                expected: self.expected(c),
+                removed: self.acc.removed,
+                bounced,
+                temperature: self.srd.temperature(),
+            });
+        }
+        if let Some(w) = self.gsd.as_mut()
+            && c.is_multiple_of(p.trajectory_every)
+        {
+            solvent_frame(w, &self.srd, &[("radius", r)])?;
+            self.acc.frames += 1;
+        }
+        Ok(None)
+    }
+}
+
+impl Session for DropletSession {
+    fn label(&self) -> String {
+        "droplet-mpcd".into()
+    }
+
+    fn total(&self) -> u64 {
+        self.p.collisions
+    }
+
+    fn position(&self) -> u64 {
+        self.srd.step()
+    }
+
+    fn seed(&self) -> u64 {
+        self.p.seed as u64
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::to_value(&self.p).unwrap_or_default()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        [
+            "thermo.csv",
+            "solvent_profiles.csv",
+            "solvent_density.png",
+            "solvent_velocity.png",
+            "trajectory.gsd",
+        ]
+        .contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+        if fresh && let Some(why) = self.record(0, 0)? {
+            bail!("{why}");
+        }
+        Ok(())
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        tenth_after(self.position(), self.p.collisions)
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        let tau = self.p.solvent.srd.tau;
+        let conf = confinement(&self.p);
+        let walls = self.p.boundary != Boundary::None;
+        while self.srd.step() < until.min(self.p.collisions) {
+            let step = self.srd.step();
+            let t = (step + 1) as f64 * tau;
+            let st = match self.srd.stream(t, &conf, &Acceleration::None) {
+                Ok(st) => st,
+                Err(e) => return Ok(Some(e.to_string())),
+            };
+            self.acc.bounced += st.bounced;
+            self.acc.reflections += st.reflections;
+            self.acc.stuck += st.stuck;
+            if walls {
+                let expected = self.expected(step + 1) as usize;
+                let r = remove_excess(&mut self.srd, expected, step, &mut self.scratch);
+                self.acc.removed += r.removed;
+                self.acc.residual_max = self.acc.residual_max.max(r.residual);
+                self.acc.residual_last = r.residual;
+            }
+            let cs = self.srd.collide(t, &conf, None);
+            self.acc.virtual_particles += cs.virtual_particles;
+            if let Some(why) = self.record(step + 1, st.bounced)? {
+                return Ok(Some(why));
+            }
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        if self.p.trajectory_every > 0 {
+            self.flush()?;
+            self.acc
+                .digest
+                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        }
+        Ok(bincode::serialize(&DropletSaved {
+            solvent: SolventState::of(&self.srd),
+            acc: self.acc.clone(),
+        })?)
+    }
+
+    fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        write_droplet_thermo(out, &self.p, &self.acc.rows)?;
+        Ok(vec!["thermo.csv".into()])
+    }
+
+    fn finish(
+        mut self: Box<Self>,
+        out: &OutputDir,
+        wall_s: f64,
+        failure: Option<&str>,
+    ) -> Result<Finished> {
+        self.flush()?;
+        let p = &self.p;
+        let tau = p.solvent.srd.tau;
+        let n0 = p.solvent.number_density;
+        let mut files = Vec::new();
+        let mut warnings = Vec::new();
+        write_droplet_thermo(out, p, &self.acc.rows)?;
+        files.push("thermo.csv".into());
+        let collisions = self.srd.step();
+        // The solvent profiles taken (complete windows only).
+        let mut cols: [Vec<f64>; 9] = Default::default();
+        let mut curves: Vec<Curve> = Vec::new();
+        let mut uniformity = Vec::new();
+        for (j, prof) in self.acc.profiles.iter().enumerate() {
+            let cf = p.profile_collisions[j];
+            if cf > collisions || prof.total_samples() == 0 {
+                continue;
+            }
+            let f = p.profile.fractions[j];
+            let (rows, rho) = prof.table();
+            let (mut x, mut dens, mut vr) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut worst, mut chi2, mut dof) = (f64::NAN, 0.0, 0usize);
+            for row in &rows {
+                let [xr, n, ne, v, ve] = *row;
+                for (c, val) in cols.iter_mut().zip([
+                    f,
+                    cf as f64 * tau,
+                    prof.mean_radius(),
+                    xr,
+                    n,
+                    ne,
+                    v,
+                    ve,
+                    prof.total_samples() as f64,
+                ]) {
+                    c.push(val);
+                }
+                x.push(xr);
+                dens.push(n / n0);
+                vr.push(v);
+                if ne.is_finite() && ne > 0.0 {
+                    worst = (n / n0 - 1.0)
+                        .abs()
+                        .max(if worst.is_nan() { 0.0 } else { worst });
+                    chi2 += ((n - n0) / ne).powi(2);
+                    dof += 1;
+                }
+            }
+            uniformity.push(json!({
+                "fraction": f,
+                "collision": cf,
+                "samples": prof.total_samples(),
+                "max_relative_density_deviation": if worst.is_nan() { serde_json::Value::Null } else { json!(worst) },
+                "chi2_uniform": chi2,
+                "bins_with_errors": dof,
+                "block_correlation": rho,
+            }));
+            if rho > 0.5 {
+                warnings.push(format!(
+                    "solvent profile at {:.0} %: consecutive blocks correlated (rho = {rho:.2}); its errors are widened for it, but a longer observe.solvent.window gives more honest ones",
+                    f * 100.0
+                ));
+            }
+            curves.push((format!("t = {:.0} %", f * 100.0), x, dens, vr));
+        }
+        if !cols[0].is_empty() {
+            let names = [
+                "fraction",
+                "time",
+                "radius",
+                "r_over_R",
+                "density",
+                "density_err",
+                "radial_velocity",
+                "radial_velocity_err",
+                "samples",
+            ];
+            let table: Vec<(&str, &[f64])> = names
+                .iter()
+                .zip(cols.iter())
+                .map(|(n, c)| (*n, c.as_slice()))
+                .collect();
+            out.write_table("solvent_profiles.csv", &table)?;
+            files.push("solvent_profiles.csv".into());
+            let boundary = match p.boundary {
+                Boundary::None => "none",
+                Boundary::Slip => "slip",
+                Boundary::NoSlip => "no-slip",
+            };
+            for (name, ylabel, pick) in [
+                ("solvent_density.png", "solvent density n(r) / n0", 2usize),
+                (
+                    "solvent_velocity.png",
+                    "mean radial velocity <v_r> sqrt(m / kT)",
+                    3,
+                ),
+            ] {
+                let series: Vec<Series> = curves
+                    .iter()
+                    .map(|(l, x, d, v)| Series {
+                        label: l,
+                        x,
+                        y: if pick == 2 { d } else { v },
+                        points: true,
+                    })
+                    .collect();
+                picture(
+                    line_plot(
+                        &out.join(name),
+                        &format!(
+                            "Drying MPCD droplet, boundary {boundary}: R0 = {}, Pe = {}",
+                            p.r0, p.peclet
+                        ),
+                        "r / R(t)",
+                        ylabel,
+                        &series,
+                        Scale::Linear,
+                    ),
+                    name,
+                    &mut files,
+                    &mut warnings,
+                );
+            }
+        }
+        if self.acc.frames > 0 {
+            files.push("trajectory.gsd".into());
+        }
+        let t = collisions as f64 * tau;
+        let r = p.law().radius(t);
+        let expected = self.expected(collisions);
+        let summary = json!({
+            "software": crate::software(),
+            "method": "droplet-mpcd",
+            "seed": p.seed,
+            "parameters": p,
+            "units": "MPCD: lengths in the cell edge a, masses in the solvent mass m, energies in kT, times in a sqrt(m / kT)",
+            "collisions": collisions,
+            "time": t,
+            "final_radius": r,
+            "wall_speed_at_end": -p.alpha / (8.0 * PI * r),
+            "solvent": {
+                "initial": self.acc.solvent0,
+                "final": self.srd.len(),
+                "expected_final": expected,
+                "removed": self.acc.removed,
+                "residual_excess_max": self.acc.residual_max,
+                "residual_excess_last": self.acc.residual_last,
+                "bounced": self.acc.bounced,
+                "reflections": self.acc.reflections,
+                "stuck": self.acc.stuck,
+                "virtual_particles_per_collision": self.acc.virtual_particles as f64 / collisions.max(1) as f64,
+                "temperature_final": self.srd.temperature(),
+            },
+            "solvent_uniformity": uniformity,
+            "wall_seconds": wall_s,
+            "particle_updates_per_second": collisions as f64 * self.srd.len() as f64 / wall_s.max(1e-9),
+            "threads": rayon::current_num_threads(),
+            "trajectory_frames": self.acc.frames,
+            "warnings": warnings,
+        });
+        let message = match failure {
+            Some(f) => format!("droplet-mpcd stopped at collision {collisions}: {f}"),
+            None => format!(
+                "droplet-mpcd: {collisions} collisions, R {:.3} -> {r:.3}; solvent {} -> {} (expected {expected}, {} removed)",
+                p.r0,
+                self.acc.solvent0,
+                self.srd.len(),
+                self.acc.removed
+            ),
+        };
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+/// One solvent profile drawn: label, r/R, n/n0, <v_r>.
+type Curve = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn write_droplet_thermo(out: &OutputDir, p: &DropletRun, rows: &[DropletRow]) -> Result<()> {
+    let col = |f: &dyn Fn(&DropletRow) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
+    let tau = p.solvent.srd.tau;
+    out.write_table(
+        "thermo.csv",
+        &[
+            ("collision", &col(&|r| r.collision as f64)),
+            ("time", &col(&|r| r.collision as f64 * tau)),
+            ("radius", &col(&|r| r.radius)),
+            ("solvent", &col(&|r| r.solvent as f64)),
+            ("expected", &col(&|r| r.expected as f64)),
+            ("removed", &col(&|r| r.removed as f64)),
+            ("bounced", &col(&|r| r.bounced as f64)),
+            ("temperature", &col(&|r| r.temperature)),
+        ],
+    )?;
+    Ok(())
+}
+
+// ------------------------------------------------------------------------------------------
+// An engine a script steps by hand.
+
+/// The solvent stepped by hand: one step is one streaming step, the removal of the excess
+/// solvent of a confined droplet, and one collision (the bulk's viscosity drive acts, the
+/// measurement's rescaling without the cell thermostat does not).
+struct SolventEngine {
+    srd: Srd,
+    method: &'static str,
+    conf: Confinement,
+    drive: Acceleration,
+    scratch: Vec<u32>,
+}
+
+impl crate::Engine for SolventEngine {
+    fn method(&self) -> &str {
+        self.method
+    }
+    fn dimensions(&self) -> usize {
+        3
+    }
+    fn particles(&self) -> usize {
+        self.srd.len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        let tau = self.srd.params().tau;
+        for _ in 0..steps {
+            let t = (self.srd.step() + 1) as f64 * tau;
+            let step = self.srd.step();
+            self.srd.stream(t, &self.conf, &self.drive)?;
+            if !matches!(self.conf, Confinement::None) {
+                let l = self.srd.sbox().l;
+                let n = self.srd.params().density / self.srd.params().cell.powi(3);
+                let expected = (n * self.conf.volume(t, l)).round() as usize;
+                remove_excess(&mut self.srd, expected, step, &mut self.scratch);
+            }
+            self.srd.collide(t, &self.conf, None);
+        }
+        Ok(())
+    }
+    fn steps(&self) -> u64 {
+        self.srd.step()
+    }
+    fn time(&self) -> f64 {
+        self.srd.step() as f64 * self.srd.params().tau
+    }
+    fn dt(&self) -> f64 {
+        self.srd.params().tau
+    }
+    fn positions(&self) -> Vec<f64> {
+        crate::droplet::flat(&self.srd.positions())
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        Some(crate::droplet::flat(&self.srd.velocities()))
+    }
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(vec![0.0; 3 * self.srd.len()])
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        self.srd.sbox().l.to_vec()
+    }
+}
