@@ -141,7 +141,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// CPU time (user + system, all threads) of this process in seconds, from /proc (Linux).
+/// A scratch folder for the LAMMPS inputs and outputs of this run.
 fn tempfile_dir() -> Result<PathBuf> {
     let dir = std::env::temp_dir().join(format!("colloidsim-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;

@@ -4,6 +4,7 @@
 mod bench_bcd;
 mod bench_bd;
 mod bench_mc;
+mod bench_mpcd;
 mod common;
 mod dpd_bench;
 mod rpy_bench;
@@ -182,6 +183,8 @@ enum BenchKind {
     Dpd(dpd_bench::BenchArgs),
     /// RPY mobility: direct product beside pystokes, PSE from 10^3 to 10^5, BD+RPY step.
     Rpy(rpy_bench::BenchArgs),
+    /// SRD solvent, 1.08e6 particles at density 5 (L = 60 cells), beside LAMMPS fix srd.
+    Mpcd(bench_mpcd::BenchArgs),
 }
 
 /// The progress bar: appears only on a terminal, only when not quiet, and only once the run
@@ -467,6 +470,7 @@ fn run_cli() -> Result<()> {
             BenchKind::Dpd(args) => dpd_bench::bench(&args),
             BenchKind::Mc(args) => bench_mc::bench(&args),
             BenchKind::Rpy(args) => rpy_bench::bench(&args),
+            BenchKind::Mpcd(args) => bench_mpcd::bench(&args),
         },
     }
 }
