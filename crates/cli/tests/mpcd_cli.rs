@@ -263,3 +263,17 @@ fn bad_input_is_refused_naming_the_key_and_range() {
         assert!(!tmp.path().join("a/summary.json").exists());
     }
 }
+
+#[test]
+fn the_examples_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for name in ["mpcd/viscosity.toml", "droplet/drying-mpcd-solvent.toml"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let o = run(
+            tmp.path(),
+            &["check", root.join(name).to_str().unwrap()],
+            &[],
+        );
+        assert!(o.status.success(), "{name}: {}", text(&o));
+    }
+}
