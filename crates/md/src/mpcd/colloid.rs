@@ -1728,7 +1728,7 @@ mod tests {
         eprintln!(
             "colloid T(all) mean {t_all:.4}, largest rms strain {strain:.4}, total momentum {p_total:?}"
         );
-        assert!(se / dm < 0.025, "too noisy: {se} of {dm}");
+        assert!(se / dm < 0.035, "too noisy: {se} of {dm}");
         assert!(
             (dm / theory - 1.0).abs() < 0.05,
             "D = {dm} +- {se} vs {theory}"
