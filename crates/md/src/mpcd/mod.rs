@@ -9,6 +9,7 @@
 //! that results depend neither on the number of threads nor on the order of the work.
 
 pub mod boundary;
+pub mod colloid;
 pub mod drying;
 pub mod measure;
 pub mod scenario;
@@ -18,6 +19,7 @@ pub mod theory;
 use colloidsim_core::rng::{Purpose, stream};
 
 pub use boundary::{Confinement, WallKind};
+pub use colloid::{ColloidParams, ColloidState, DiscreteColloids, MpcdSystem, Region};
 pub use srd::{Acceleration, Embedded, Srd, SrdParams};
 
 /// What a random stream of the MPCD engine is drawn for (the top byte of its index).

@@ -1,0 +1,1737 @@
+//! Colloids as discrete particles (the drying-droplet paper's MPCD colloid model, METHODS.md
+//! section 3): the surface of a sphere of diameter `d` is a regular icosahedron subdivided once,
+//! its 42 vertices projected onto the sphere ([`Geometry`]); every vertex is bonded to its
+//! nearest neighbours on the mesh (120 edges) and to a central particle (42 spokes) by harmonic
+//! bonds `U = k/2 (r - r0)^2` with `r0` the bond's length in the ideal shape. Centres repel by
+//! WCA (`epsilon = kT`, `sigma = d`, cut at `2^(1/6) d`) and may feel the droplet's
+//! [`HarmonicInterface`] at `R(t)`. Between two collisions the `43 N` particles move by velocity
+//! Verlet with `md_steps` steps of `dt = tau / md_steps`; in the collisions only the VERTICES
+//! join the cells ([`DiscreteColloids::embedded`]; the paper: "the colloidal particles were
+//! coupled to the solvent by including the vertex particles in the collision step"); the
+//! solvent streams through the colloids (no excluded region). [`MpcdSystem`] does one
+//! streaming step, the colloids' MD over it and the collision.
+//!
+//! **Layout and determinism.** One array per quantity: centres (`N`) and vertices (`42 N`,
+//! colloid by colloid) apart, as `[f64; 3]` rows so that the vertices can be lent to
+//! [`Srd::collide`] as they are. The 43 particles of a colloid are stored as one unwrapped
+//! rigid-ish cluster around its centre; when the centre leaves the box the whole colloid is
+//! shifted by a box edge and the centre's image counter moves. Bonds act within a colloid, so
+//! forces are summed colloid by colloid (rayon over colloids, each writes only its own rows);
+//! the WCA force on a centre is gathered from a cell list of the centres built in index order,
+//! so a step is bitwise the same on any number of threads. Nothing is allocated per step.
+
+use super::boundary::Confinement;
+use super::srd::{Acceleration, CollisionStats, Embedded, Srd, StreamStats};
+use super::{Draw, MpcdError, draw};
+use crate::potential::{External, HarmonicInterface, LennardJones, NoExternal, Pair};
+use crate::state::SimBox;
+use colloidsim_core::rng::Ziggurat;
+use rand::RngExt;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Vertices per colloid.
+pub const VERTICES: usize = 42;
+/// Mesh edges per colloid (vertex-vertex bonds).
+pub const EDGES: usize = 120;
+/// Most trial positions per colloid in a random placement.
+pub const MAX_PLACEMENT_TRIALS: u64 = 1_000_000;
+
+/// The ideal shape on the unit sphere: 42 vertices (the 12 of a regular icosahedron, then the
+/// 30 edge midpoints) and the 120 edges of the once-subdivided mesh (`i < j`, sorted).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Geometry {
+    /// Unit vectors of the vertices.
+    pub vertices: Vec<[f64; 3]>,
+    /// Mesh edges (vertex pairs).
+    pub edges: Vec<[usize; 2]>,
+}
+
+impl Geometry {
+    /// The once-subdivided icosahedron: the icosahedron's vertices `(0, +-1, +-phi)` and their
+    /// cyclic permutations, its 20 faces (triples of vertices at mutual distance 2), each face
+    /// cut into 4 by its edge midpoints, all 42 points projected onto the unit sphere.
+    pub fn subdivided_icosahedron() -> Self {
+        let phi = 0.5 * (1.0 + 5f64.sqrt());
+        let mut ico = Vec::with_capacity(12);
+        for s1 in [-1.0, 1.0] {
+            for s2 in [-phi, phi] {
+                ico.push([0.0, s1, s2]);
+                ico.push([s1, s2, 0.0]);
+                ico.push([s2, 0.0, s1]);
+            }
+        }
+        let dist2 = |a: [f64; 3], b: [f64; 3]| {
+            (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+        };
+        // Icosahedron edges have length 2 (squared 4); the next distance is 2 phi.
+        let adjacent = |i: usize, j: usize| (dist2(ico[i], ico[j]) - 4.0).abs() < 1e-9;
+        let mut ico_edges = Vec::new();
+        for i in 0..12 {
+            for j in i + 1..12 {
+                if adjacent(i, j) {
+                    ico_edges.push([i, j]);
+                }
+            }
+        }
+        let midpoint = |i: usize, j: usize| -> usize {
+            12 + ico_edges
+                .iter()
+                .position(|e| *e == [i.min(j), i.max(j)])
+                .expect("an icosahedron edge")
+        };
+        let mut vertices: Vec<[f64; 3]> = ico.clone();
+        for e in &ico_edges {
+            let (a, b) = (ico[e[0]], ico[e[1]]);
+            vertices.push([
+                0.5 * (a[0] + b[0]),
+                0.5 * (a[1] + b[1]),
+                0.5 * (a[2] + b[2]),
+            ]);
+        }
+        for v in &mut vertices {
+            let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            *v = v.map(|x| x / r);
+        }
+        let mut edges = std::collections::BTreeSet::new();
+        let mut add = |i: usize, j: usize| {
+            edges.insert([i.min(j), i.max(j)]);
+        };
+        for i in 0..12 {
+            for j in i + 1..12 {
+                for k in j + 1..12 {
+                    if adjacent(i, j) && adjacent(j, k) && adjacent(i, k) {
+                        let (ij, jk, ik) = (midpoint(i, j), midpoint(j, k), midpoint(i, k));
+                        for (a, b) in [(i, ij), (ij, j), (j, jk), (jk, k), (k, ik), (ik, i)] {
+                            add(a, b);
+                        }
+                        add(ij, jk);
+                        add(jk, ik);
+                        add(ik, ij);
+                    }
+                }
+            }
+        }
+        Self {
+            vertices,
+            edges: edges.into_iter().collect(),
+        }
+    }
+}
+
+/// Parameters of the discrete-particle colloids (MPCD units: lengths in the cell edge `a`,
+/// masses in the solvent mass `m`, energies in `kT`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ColloidParams {
+    /// Diameter `d` of the sphere the vertices lie on (also the WCA `sigma` of the centres).
+    pub diameter: f64,
+    /// Mass of each vertex particle.
+    pub vertex_mass: f64,
+    /// Mass of the central particle.
+    pub centre_mass: f64,
+    /// Spring constant `k` of every bond (energy / length^2).
+    pub bond_k: f64,
+    /// Velocity-Verlet steps per collision time (`dt = tau / md_steps`).
+    pub md_steps: u32,
+    /// WCA `epsilon` between centres (energy; 0 switches it off).
+    pub wca_epsilon: f64,
+}
+
+impl ColloidParams {
+    /// Defaults for diameter `d` at temperature `kt` (all CHOSEN, the paper's values were lost
+    /// in our copy; see docs/mpcd.md, "Colloids"): every particle of mass `5 m` (the solvent
+    /// mass of one cell at density 5), `k = 5000 kT / a^2` (bond-length fluctuations about 1 %),
+    /// 50 Verlet steps per `tau` (`dt = 0.002` at `tau = 0.1`), `epsilon = kT`.
+    pub fn standard(diameter: f64, kt: f64) -> Self {
+        Self {
+            diameter,
+            vertex_mass: 5.0,
+            centre_mass: 5.0,
+            bond_k: 5000.0 * kt,
+            md_steps: 50,
+            wca_epsilon: kt,
+        }
+    }
+
+    /// Every parameter at its edge; the message names the key and its allowed range.
+    pub fn check(&self) -> Result<(), MpcdError> {
+        for (key, v) in [
+            ("colloid diameter", self.diameter),
+            ("colloid vertex_mass", self.vertex_mass),
+            ("colloid centre_mass", self.centre_mass),
+            ("bond k", self.bond_k),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(MpcdError::Invalid(format!(
+                    "{key} = {v} must be a finite number > 0"
+                )));
+            }
+        }
+        if !(self.wca_epsilon.is_finite() && self.wca_epsilon >= 0.0) {
+            return Err(MpcdError::Invalid(format!(
+                "colloid wca_epsilon = {} must be a finite number >= 0",
+                self.wca_epsilon
+            )));
+        }
+        if !(1..=100_000).contains(&self.md_steps) {
+            return Err(MpcdError::Invalid(format!(
+                "md_steps = {} must lie in 1..=100000",
+                self.md_steps
+            )));
+        }
+        Ok(())
+    }
+
+    /// WCA cut-off `2^(1/6) d`.
+    pub fn wca_cut(&self) -> f64 {
+        2f64.powf(1.0 / 6.0) * self.diameter
+    }
+
+    /// Mass of one colloid (centre and vertices).
+    pub fn colloid_mass(&self) -> f64 {
+        self.centre_mass + VERTICES as f64 * self.vertex_mass
+    }
+}
+
+/// Where random colloids go.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Region {
+    /// Anywhere in the periodic box.
+    Box,
+    /// Centres within `radius - d/2` of the origin (the whole sphere of diameter `d` inside
+    /// the droplet of radius `radius`).
+    Sphere {
+        /// Droplet radius.
+        radius: f64,
+    },
+}
+
+/// The exact state of the colloids (for checkpoints): with the same [`ColloidParams`] and box,
+/// [`DiscreteColloids::from_state`] continues bitwise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ColloidState {
+    /// Centre positions (in the box).
+    pub centre_pos: Vec<[f64; 3]>,
+    /// Centre velocities.
+    pub centre_vel: Vec<[f64; 3]>,
+    /// Box crossings of each centre.
+    pub centre_image: Vec<[i32; 3]>,
+    /// Vertex positions, 42 per colloid, unwrapped about their centre.
+    pub vertex_pos: Vec<[f64; 3]>,
+    /// Vertex velocities.
+    pub vertex_vel: Vec<[f64; 3]>,
+    /// MD blocks (collision times) done.
+    pub step: u64,
+}
+
+/// A bond of the ideal shape: vertex indices (or the centre for spokes) and rest length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Edge {
+    i: usize,
+    j: usize,
+    r0: f64,
+}
+
+/// `N` discrete-particle colloids in the periodic box of the solvent (see the module docs).
+#[derive(Debug)]
+pub struct DiscreteColloids {
+    params: ColloidParams,
+    sbox: SimBox,
+    /// The ideal shape scaled to diameter `d` (offsets of the vertices from the centre).
+    shape: Vec<[f64; 3]>,
+    edges: Vec<Edge>,
+    /// Rest length of the spokes (`d/2`).
+    spoke: f64,
+    wca: LennardJones,
+    centre_pos: Vec<[f64; 3]>,
+    centre_vel: Vec<[f64; 3]>,
+    centre_image: Vec<[i32; 3]>,
+    centre_force: Vec<[f64; 3]>,
+    vertex_pos: Vec<[f64; 3]>,
+    vertex_vel: Vec<[f64; 3]>,
+    vertex_force: Vec<[f64; 3]>,
+    /// Vertex masses (one value repeated, lent to the collisions).
+    vertex_mass: Vec<f64>,
+    /// Cell list of the centres: cells per axis (0: all pairs), starts and members.
+    cells: [usize; 3],
+    cell_start: Vec<u32>,
+    cell_members: Vec<u32>,
+    cell_of: Vec<u32>,
+    step: u64,
+}
+
+impl DiscreteColloids {
+    /// Colloids centred at `centres` (any periodic image) with random orientations and
+    /// Maxwell–Boltzmann velocities at `kt` for all 43 particles of each, from the stream
+    /// `(seed, 0, Colloid, i)` of colloid `i`; the total momentum of all colloid particles is
+    /// then removed (the solvent of [`Srd::new`] has none either, so the whole system starts at
+    /// rest). Overlaps are not checked here.
+    pub fn new(
+        params: ColloidParams,
+        sbox: SimBox,
+        centres: &[[f64; 3]],
+        kt: f64,
+        seed: u32,
+    ) -> Result<Self, MpcdError> {
+        params.check()?;
+        if !(kt.is_finite() && kt > 0.0) {
+            return Err(MpcdError::Invalid(format!(
+                "colloid kT = {kt} must be a finite number > 0"
+            )));
+        }
+        if let Some(i) = centres
+            .iter()
+            .position(|x| x.iter().any(|c| !c.is_finite()))
+        {
+            return Err(MpcdError::NonFinite {
+                step: 0,
+                what: "colloid",
+                index: i,
+            });
+        }
+        let mut me = Self::empty(params, sbox, centres.len())?;
+        let zig = Ziggurat::get();
+        let n = centres.len();
+        let shape = me.shape.clone();
+        let (mp, mc) = (params.vertex_mass, params.centre_mass);
+        let (sd_c, sd_v) = ((kt / mc).sqrt(), (kt / mp).sqrt());
+        for (i, c) in centres.iter().enumerate() {
+            let mut rng = draw(seed, 0, Draw::Colloid, i as u64);
+            // A uniform random rotation: the unit quaternion of four normal deviates.
+            let rot = loop {
+                let q: [f64; 4] = std::array::from_fn(|_| zig.sample(&mut rng));
+                let norm = (q.iter().map(|x| x * x).sum::<f64>()).sqrt();
+                if norm > 1e-6 {
+                    break rotation_of(q.map(|x| x / norm));
+                }
+            };
+            let mut x = *c;
+            let mut image = [0; 3];
+            sbox.wrap(&mut x, &mut image);
+            me.centre_pos[i] = x;
+            me.centre_vel[i] = std::array::from_fn(|_| sd_c * zig.sample(&mut rng));
+            for (k, s) in shape.iter().enumerate() {
+                let r = apply(&rot, *s);
+                me.vertex_pos[i * VERTICES + k] = [x[0] + r[0], x[1] + r[1], x[2] + r[2]];
+                me.vertex_vel[i * VERTICES + k] =
+                    std::array::from_fn(|_| sd_v * zig.sample(&mut rng));
+            }
+        }
+        if n > 0 {
+            let p = me.momentum();
+            let m = n as f64 * params.colloid_mass();
+            let u = p.map(|x| x / m);
+            for v in me.centre_vel.iter_mut().chain(me.vertex_vel.iter_mut()) {
+                for k in 0..3 {
+                    v[k] -= u[k];
+                }
+            }
+        }
+        me.compute_forces(0.0, &NoExternal);
+        Ok(me)
+    }
+
+    /// `n` colloids at random non-overlapping positions (centres at least `d` apart, periodic)
+    /// in `region`, by random sequential addition: colloid `i` tries positions from the stream
+    /// `(seed, 0, Colloid, 2^48 + i)` until one fits (at most [`MAX_PLACEMENT_TRIALS`]);
+    /// orientations and velocities as [`Self::new`].
+    pub fn random(
+        params: ColloidParams,
+        sbox: SimBox,
+        n: usize,
+        region: Region,
+        kt: f64,
+        seed: u32,
+    ) -> Result<Self, MpcdError> {
+        params.check()?;
+        let d = params.diameter;
+        let l = sbox.l;
+        let reach = match region {
+            Region::Box => None,
+            Region::Sphere { radius } => {
+                let half = 0.5 * l.iter().cloned().fold(f64::INFINITY, f64::min);
+                if !(radius.is_finite() && radius > 0.5 * d && radius <= half) {
+                    return Err(MpcdError::Invalid(format!(
+                        "colloid placement radius = {radius} must lie in (d/2, L/2] = ({}, {half}]",
+                        0.5 * d
+                    )));
+                }
+                Some(radius - 0.5 * d)
+            }
+        };
+        if n >= 1 << 40 {
+            return Err(MpcdError::Invalid(format!(
+                "{n} colloids: at most 2^40 are supported"
+            )));
+        }
+        // A grid of cells at least d wide over the box for the overlap checks.
+        let nc: [usize; 3] = std::array::from_fn(|k| ((l[k] / d).floor() as usize).clamp(1, 1024));
+        let cell = |x: [f64; 3]| -> [usize; 3] {
+            std::array::from_fn(|k| {
+                (((x[k] / l[k] + 0.5) * nc[k] as f64).floor() as usize).min(nc[k] - 1)
+            })
+        };
+        let mut grid: Vec<Vec<u32>> = vec![Vec::new(); nc[0] * nc[1] * nc[2]];
+        let mut centres: Vec<[f64; 3]> = Vec::with_capacity(n);
+        for i in 0..n {
+            let mut rng = draw(seed, 0, Draw::Colloid, (1 << 48) + i as u64);
+            let mut placed = false;
+            for _ in 0..MAX_PLACEMENT_TRIALS {
+                let mut x: [f64; 3] = std::array::from_fn(|k| (rng.random::<f64>() - 0.5) * l[k]);
+                if let Some(rmax) = reach {
+                    // Uniform in the ball: rejection from the cube of edge 2 rmax.
+                    x = std::array::from_fn(|k| (2.0 * x[k] / l[k]) * rmax);
+                    if x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > rmax * rmax {
+                        continue;
+                    }
+                    let mut image = [0; 3];
+                    sbox.wrap(&mut x, &mut image);
+                }
+                let c = cell(x);
+                let mut free = true;
+                'search: for dz in -1i64..=1 {
+                    for dy in -1i64..=1 {
+                        for dx in -1i64..=1 {
+                            let q = [dx, dy, dz];
+                            let cc: [usize; 3] = std::array::from_fn(|k| {
+                                (c[k] as i64 + q[k]).rem_euclid(nc[k] as i64) as usize
+                            });
+                            for &j in &grid[(cc[2] * nc[1] + cc[1]) * nc[0] + cc[0]] {
+                                let y = centres[j as usize];
+                                let r = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
+                                if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < d * d {
+                                    free = false;
+                                    break 'search;
+                                }
+                            }
+                        }
+                    }
+                }
+                if free {
+                    grid[(c[2] * nc[1] + c[1]) * nc[0] + c[0]].push(i as u32);
+                    centres.push(x);
+                    placed = true;
+                    break;
+                }
+            }
+            if !placed {
+                return Err(MpcdError::Invalid(format!(
+                    "could not place colloid {i} of {n} without overlap in {MAX_PLACEMENT_TRIALS} trials: lower the number of colloids or enlarge the region"
+                )));
+            }
+        }
+        Self::new(params, sbox, &centres, kt, seed)
+    }
+
+    /// Colloids in a saved state (see [`ColloidState`]).
+    pub fn from_state(
+        params: ColloidParams,
+        sbox: SimBox,
+        state: &ColloidState,
+    ) -> Result<Self, MpcdError> {
+        params.check()?;
+        let n = state.centre_pos.len();
+        if state.centre_vel.len() != n
+            || state.centre_image.len() != n
+            || state.vertex_pos.len() != n * VERTICES
+            || state.vertex_vel.len() != n * VERTICES
+        {
+            return Err(MpcdError::Invalid(format!(
+                "colloid state: {n} centres need {n} velocities and images and {} vertex positions and velocities (got {}, {}, {}, {})",
+                n * VERTICES,
+                state.centre_vel.len(),
+                state.centre_image.len(),
+                state.vertex_pos.len(),
+                state.vertex_vel.len()
+            )));
+        }
+        let mut me = Self::empty(params, sbox, n)?;
+        me.centre_pos.copy_from_slice(&state.centre_pos);
+        me.centre_vel.copy_from_slice(&state.centre_vel);
+        me.centre_image.copy_from_slice(&state.centre_image);
+        me.vertex_pos.copy_from_slice(&state.vertex_pos);
+        me.vertex_vel.copy_from_slice(&state.vertex_vel);
+        me.step = state.step;
+        if let Some(i) = me.first_non_finite() {
+            return Err(MpcdError::NonFinite {
+                step: me.step,
+                what: "colloid",
+                index: i,
+            });
+        }
+        Ok(me)
+    }
+
+    /// The state, exactly (for checkpoints).
+    pub fn state(&self) -> ColloidState {
+        ColloidState {
+            centre_pos: self.centre_pos.clone(),
+            centre_vel: self.centre_vel.clone(),
+            centre_image: self.centre_image.clone(),
+            vertex_pos: self.vertex_pos.clone(),
+            vertex_vel: self.vertex_vel.clone(),
+            step: self.step,
+        }
+    }
+
+    fn empty(params: ColloidParams, sbox: SimBox, n: usize) -> Result<Self, MpcdError> {
+        let cut = params.wca_cut();
+        if let Some(k) = (0..3).find(|&k| sbox.l[k] <= 2.0 * cut) {
+            return Err(MpcdError::Invalid(format!(
+                "box edge {} must exceed twice the WCA cut-off 2^(1/6) d = {cut} (colloid diameter {})",
+                sbox.l[k], params.diameter
+            )));
+        }
+        let geo = Geometry::subdivided_icosahedron();
+        let r = 0.5 * params.diameter;
+        let shape: Vec<[f64; 3]> = geo.vertices.iter().map(|v| v.map(|x| r * x)).collect();
+        let edges = geo
+            .edges
+            .iter()
+            .map(|&[i, j]| {
+                let (a, b) = (shape[i], shape[j]);
+                let r0 =
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                Edge { i, j, r0 }
+            })
+            .collect();
+        // Cells at least the cut-off wide; fewer than 3 per axis: all pairs.
+        let nc: [usize; 3] = std::array::from_fn(|k| (sbox.l[k] / cut).floor() as usize);
+        let cells = if nc.iter().all(|&c| c >= 3) && n > 1 {
+            nc
+        } else {
+            [0; 3]
+        };
+        let n_cells = cells[0] * cells[1] * cells[2];
+        Ok(Self {
+            params,
+            sbox,
+            shape,
+            edges,
+            spoke: r,
+            wca: LennardJones::wca(params.wca_epsilon, params.diameter),
+            centre_pos: vec![[0.0; 3]; n],
+            centre_vel: vec![[0.0; 3]; n],
+            centre_image: vec![[0; 3]; n],
+            centre_force: vec![[0.0; 3]; n],
+            vertex_pos: vec![[0.0; 3]; n * VERTICES],
+            vertex_vel: vec![[0.0; 3]; n * VERTICES],
+            vertex_force: vec![[0.0; 3]; n * VERTICES],
+            vertex_mass: vec![params.vertex_mass; n * VERTICES],
+            cells,
+            cell_start: vec![0; n_cells + 1],
+            cell_members: vec![0; if n_cells > 0 { n } else { 0 }],
+            cell_of: vec![0; if n_cells > 0 { n } else { 0 }],
+            step: 0,
+        })
+    }
+
+    /// Parameters.
+    pub fn params(&self) -> &ColloidParams {
+        &self.params
+    }
+
+    /// Number of colloids.
+    pub fn len(&self) -> usize {
+        self.centre_pos.len()
+    }
+
+    /// No colloids?
+    pub fn is_empty(&self) -> bool {
+        self.centre_pos.is_empty()
+    }
+
+    /// MD blocks (collision times) done.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// Rest lengths of the 120 mesh bonds (the spokes have `d/2`).
+    pub fn rest_lengths(&self) -> Vec<f64> {
+        self.edges.iter().map(|e| e.r0).collect()
+    }
+
+    /// Centre positions in the box.
+    pub fn centre_positions(&self) -> &[[f64; 3]] {
+        &self.centre_pos
+    }
+
+    /// Unwrapped centre positions (position plus image times the box edges).
+    pub fn unwrapped_centres(&self) -> Vec<[f64; 3]> {
+        self.centre_pos
+            .iter()
+            .zip(&self.centre_image)
+            .map(|(x, i)| self.sbox.unwrap(*x, *i))
+            .collect()
+    }
+
+    /// Centre velocities.
+    pub fn centre_velocities(&self) -> &[[f64; 3]] {
+        &self.centre_vel
+    }
+
+    /// Vertex positions (42 per colloid, unwrapped about their centre).
+    pub fn vertex_positions(&self) -> &[[f64; 3]] {
+        &self.vertex_pos
+    }
+
+    /// Vertex velocities.
+    pub fn vertex_velocities(&self) -> &[[f64; 3]] {
+        &self.vertex_vel
+    }
+
+    /// The vertices as embedded particles of a collision ([`Srd::collide`]): positions,
+    /// velocities (replaced by the collision) and masses, borrowed (no copy). The centres do
+    /// not join the collisions (the paper's model).
+    pub fn embedded(&mut self) -> Embedded<'_> {
+        Embedded {
+            pos: &self.vertex_pos,
+            vel: &mut self.vertex_vel,
+            mass: &self.vertex_mass,
+        }
+    }
+
+    /// Centre-of-mass velocity of each colloid (centre and vertices, mass-weighted).
+    pub fn com_velocities(&self) -> Vec<[f64; 3]> {
+        let (mc, mv, m) = (
+            self.params.centre_mass,
+            self.params.vertex_mass,
+            self.params.colloid_mass(),
+        );
+        (0..self.len())
+            .map(|i| {
+                let mut p = self.centre_vel[i].map(|x| mc * x);
+                for v in &self.vertex_vel[i * VERTICES..(i + 1) * VERTICES] {
+                    for k in 0..3 {
+                        p[k] += mv * v[k];
+                    }
+                }
+                p.map(|x| x / m)
+            })
+            .collect()
+    }
+
+    /// Total momentum of all colloid particles (summed in index order).
+    pub fn momentum(&self) -> [f64; 3] {
+        let (mc, mv) = (self.params.centre_mass, self.params.vertex_mass);
+        let mut p = [0.0; 3];
+        for v in &self.centre_vel {
+            for k in 0..3 {
+                p[k] += mc * v[k];
+            }
+        }
+        for v in &self.vertex_vel {
+            for k in 0..3 {
+                p[k] += mv * v[k];
+            }
+        }
+        p
+    }
+
+    /// Kinetic energy of all colloid particles.
+    pub fn kinetic_energy(&self) -> f64 {
+        let sq = |v: &[f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        0.5 * self.params.centre_mass * self.centre_vel.iter().map(sq).sum::<f64>()
+            + 0.5 * self.params.vertex_mass * self.vertex_vel.iter().map(sq).sum::<f64>()
+    }
+
+    /// Potential energy: bonds and WCA between centres (no external field).
+    pub fn potential_energy(&self) -> f64 {
+        let k = self.params.bond_k;
+        let mut u = 0.0;
+        for i in 0..self.len() {
+            let (c, vs) = (
+                self.centre_pos[i],
+                &self.vertex_pos[i * VERTICES..][..VERTICES],
+            );
+            for e in &self.edges {
+                let r = dist(vs[e.i], vs[e.j]);
+                u += 0.5 * k * (r - e.r0).powi(2);
+            }
+            for v in vs {
+                u += 0.5 * k * (dist(*v, c) - self.spoke).powi(2);
+            }
+            for j in i + 1..self.len() {
+                let y = self.centre_pos[j];
+                let d = self.sbox.min_image([c[0] - y[0], c[1] - y[1], c[2] - y[2]]);
+                u += self
+                    .wca
+                    .energy(d[0] * d[0] + d[1] * d[1] + d[2] * d[2], 0, 0, 0.0, 0.0);
+            }
+        }
+        u
+    }
+
+    /// Kinetic temperature of all colloid particles, `sum m v^2 / (3 * 43 N)`.
+    pub fn temperature(&self) -> f64 {
+        2.0 * self.kinetic_energy() / (3.0 * (VERTICES + 1) as f64 * self.len() as f64)
+    }
+
+    /// Kinetic temperature of the colloids' centre-of-mass velocities, `sum M V^2 / (3 N)`.
+    pub fn com_temperature(&self) -> f64 {
+        let m = self.params.colloid_mass();
+        let v = self.com_velocities();
+        v.iter()
+            .map(|v| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+            .sum::<f64>()
+            / (3.0 * self.len() as f64)
+    }
+
+    /// Root-mean-square relative deviation `(r - r0) / r0` over all bonds (mesh and spokes).
+    pub fn bond_strain_rms(&self) -> f64 {
+        let mut s = 0.0;
+        for i in 0..self.len() {
+            let (c, vs) = (
+                self.centre_pos[i],
+                &self.vertex_pos[i * VERTICES..][..VERTICES],
+            );
+            for e in &self.edges {
+                s += (dist(vs[e.i], vs[e.j]) / e.r0 - 1.0).powi(2);
+            }
+            for v in vs {
+                s += (dist(*v, c) / self.spoke - 1.0).powi(2);
+            }
+        }
+        (s / ((EDGES + VERTICES) * self.len()) as f64).sqrt()
+    }
+
+    /// Velocity Verlet over one collision time: `md_steps` steps of `dt = tau / md_steps` from
+    /// time `t0`, forces from the bonds, WCA between centres and `external` on the centres
+    /// (e.g. the droplet's [`HarmonicInterface`], evaluated at the time of each force
+    /// evaluation). The forces at `t0` are recomputed from the positions, so the state is the
+    /// positions and velocities alone. Advances the step counter.
+    pub fn advance<E: External>(
+        &mut self,
+        t0: f64,
+        tau: f64,
+        external: &E,
+    ) -> Result<(), MpcdError> {
+        if self.is_empty() {
+            self.step += 1;
+            return Ok(());
+        }
+        let steps = self.params.md_steps;
+        let dt = tau / steps as f64;
+        let (hc, hv) = (
+            0.5 * dt / self.params.centre_mass,
+            0.5 * dt / self.params.vertex_mass,
+        );
+        self.compute_forces(t0, external);
+        for s in 0..steps {
+            let sbox = self.sbox;
+            self.centre_pos
+                .par_iter_mut()
+                .zip(self.centre_vel.par_iter_mut())
+                .zip(self.centre_image.par_iter_mut())
+                .zip(self.centre_force.par_iter())
+                .zip(self.vertex_pos.par_chunks_mut(VERTICES))
+                .zip(self.vertex_vel.par_chunks_mut(VERTICES))
+                .zip(self.vertex_force.par_chunks(VERTICES))
+                .for_each(|((((((x, v), image), f), xs), vs), fs)| {
+                    kick_drift(x, v, f, hc, dt);
+                    for ((x, v), f) in xs.iter_mut().zip(vs.iter_mut()).zip(fs) {
+                        kick_drift(x, v, f, hv, dt);
+                    }
+                    // Wrap the whole colloid with its centre.
+                    let before = *x;
+                    sbox.wrap(x, image);
+                    let shift = [x[0] - before[0], x[1] - before[1], x[2] - before[2]];
+                    if shift != [0.0; 3] {
+                        for y in xs.iter_mut() {
+                            for k in 0..3 {
+                                y[k] += shift[k];
+                            }
+                        }
+                    }
+                });
+            self.compute_forces(t0 + (s + 1) as f64 * dt, external);
+            self.centre_vel
+                .par_iter_mut()
+                .zip(self.centre_force.par_iter())
+                .zip(self.vertex_vel.par_chunks_mut(VERTICES))
+                .zip(self.vertex_force.par_chunks(VERTICES))
+                .for_each(|(((v, f), vs), fs)| {
+                    kick(v, f, hc);
+                    for (v, f) in vs.iter_mut().zip(fs) {
+                        kick(v, f, hv);
+                    }
+                });
+        }
+        self.step += 1;
+        if let Some(i) = self.first_non_finite() {
+            return Err(MpcdError::NonFinite {
+                step: self.step,
+                what: "colloid",
+                index: i,
+            });
+        }
+        Ok(())
+    }
+
+    /// The lowest colloid index with a non-finite position or velocity.
+    fn first_non_finite(&self) -> Option<usize> {
+        let bad = |x: &[f64; 3]| !(x[0].is_finite() && x[1].is_finite() && x[2].is_finite());
+        (0..self.len()).into_par_iter().find_first(|&i| {
+            bad(&self.centre_pos[i])
+                || bad(&self.centre_vel[i])
+                || self.vertex_pos[i * VERTICES..][..VERTICES]
+                    .iter()
+                    .chain(&self.vertex_vel[i * VERTICES..][..VERTICES])
+                    .any(bad)
+        })
+    }
+
+    /// Sort the centres into the cells (index order within a cell).
+    fn build_cells(&mut self) {
+        let nc = self.cells;
+        let l = self.sbox.l;
+        self.cell_start.fill(0);
+        for (i, x) in self.centre_pos.iter().enumerate() {
+            let c: [usize; 3] = std::array::from_fn(|k| {
+                let u = (x[k] / l[k] + 0.5) * nc[k] as f64;
+                // Non-finite positions land in cell 0 (caught after the block).
+                (if u.is_finite() {
+                    u.max(0.0) as usize
+                } else {
+                    0
+                })
+                .min(nc[k] - 1)
+            });
+            let cell = (c[2] * nc[1] + c[1]) * nc[0] + c[0];
+            self.cell_of[i] = cell as u32;
+            self.cell_start[cell + 1] += 1;
+        }
+        for c in 0..nc[0] * nc[1] * nc[2] {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        // Fill in index order, using the starts as cursors, then restore them.
+        for i in 0..self.len() {
+            let c = self.cell_of[i] as usize;
+            self.cell_members[self.cell_start[c] as usize] = i as u32;
+            self.cell_start[c] += 1;
+        }
+        for c in (1..=nc[0] * nc[1] * nc[2]).rev() {
+            self.cell_start[c] = self.cell_start[c - 1];
+        }
+        self.cell_start[0] = 0;
+    }
+
+    /// Forces at time `t`: bonds on all particles, WCA and `external` on the centres.
+    fn compute_forces<E: External>(&mut self, t: f64, external: &E) {
+        let wca_on = self.params.wca_epsilon > 0.0 && self.len() > 1;
+        if wca_on && self.cells[0] > 0 {
+            self.build_cells();
+        }
+        let k = self.params.bond_k;
+        let (sbox, wca, rc2) = (self.sbox, &self.wca, self.params.wca_cut().powi(2));
+        let (centres, edges, spoke) = (&self.centre_pos, &self.edges, self.spoke);
+        let (nc, start, members) = (self.cells, &self.cell_start, &self.cell_members);
+        let n = centres.len();
+        self.centre_force
+            .par_iter_mut()
+            .zip(self.vertex_force.par_chunks_mut(VERTICES))
+            .zip(self.vertex_pos.par_chunks(VERTICES))
+            .enumerate()
+            .for_each(|(i, ((fc, fs), xs))| {
+                let c = centres[i];
+                fs.fill([0.0; 3]);
+                let mut f = external.force(c, t);
+                for e in edges {
+                    let (a, b) = (xs[e.i], xs[e.j]);
+                    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    // Force on a: k (r - r0) d / r (pulled towards b when stretched).
+                    let g = k * (r - e.r0) / r;
+                    for q in 0..3 {
+                        fs[e.i][q] += g * d[q];
+                        fs[e.j][q] -= g * d[q];
+                    }
+                }
+                for (fv, x) in fs.iter_mut().zip(xs) {
+                    let d = [c[0] - x[0], c[1] - x[1], c[2] - x[2]];
+                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let g = k * (r - spoke) / r;
+                    for q in 0..3 {
+                        fv[q] += g * d[q];
+                        f[q] -= g * d[q];
+                    }
+                }
+                if wca_on {
+                    let mut pair = |j: usize| {
+                        if j == i {
+                            return;
+                        }
+                        let y = centres[j];
+                        let d = sbox.min_image([c[0] - y[0], c[1] - y[1], c[2] - y[2]]);
+                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        if r2 < rc2 {
+                            let g = wca.force_over_r(r2, 0, 0, 0.0, 0.0);
+                            for q in 0..3 {
+                                f[q] += g * d[q];
+                            }
+                        }
+                    };
+                    if nc[0] == 0 {
+                        (0..n).for_each(&mut pair);
+                    } else {
+                        let l = sbox.l;
+                        let own: [i64; 3] = std::array::from_fn(|q| {
+                            let u = (c[q] / l[q] + 0.5) * nc[q] as f64;
+                            (if u.is_finite() {
+                                u.max(0.0) as usize
+                            } else {
+                                0
+                            })
+                            .min(nc[q] - 1) as i64
+                        });
+                        for dz in -1..=1 {
+                            for dy in -1..=1 {
+                                for dx in -1..=1 {
+                                    let o = [dx, dy, dz];
+                                    let cc: [usize; 3] = std::array::from_fn(|q| {
+                                        (own[q] + o[q]).rem_euclid(nc[q] as i64) as usize
+                                    });
+                                    let cell = (cc[2] * nc[1] + cc[1]) * nc[0] + cc[0];
+                                    for &j in
+                                        &members[start[cell] as usize..start[cell + 1] as usize]
+                                    {
+                                        pair(j as usize);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                *fc = f;
+            });
+    }
+}
+
+#[inline(always)]
+fn kick_drift(x: &mut [f64; 3], v: &mut [f64; 3], f: &[f64; 3], half_dt_over_m: f64, dt: f64) {
+    for k in 0..3 {
+        v[k] += half_dt_over_m * f[k];
+        x[k] += dt * v[k];
+    }
+}
+
+#[inline(always)]
+fn kick(v: &mut [f64; 3], f: &[f64; 3], half_dt_over_m: f64) {
+    for k in 0..3 {
+        v[k] += half_dt_over_m * f[k];
+    }
+}
+
+#[inline(always)]
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The rotation matrix of the unit quaternion `(w, x, y, z)`.
+fn rotation_of(q: [f64; 4]) -> [[f64; 3]; 3] {
+    let [w, x, y, z] = q;
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
+fn apply(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
+}
+
+/// What one coupled step did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepStats {
+    /// The solvent's streaming.
+    pub stream: StreamStats,
+    /// The collision.
+    pub collision: CollisionStats,
+}
+
+/// The solvent and its colloids, advanced together one collision time at a time:
+/// stream the solvent, move the colloids by MD over the same interval, collide (solvent and
+/// vertices). Time is `srd.step() * tau`.
+#[derive(Debug)]
+pub struct MpcdSystem {
+    /// The solvent.
+    pub srd: Srd,
+    /// The colloids.
+    pub colloids: DiscreteColloids,
+    /// Walls of the solvent.
+    pub confinement: Confinement,
+    /// The droplet's interface force on the colloid centres, if any.
+    pub interface: Option<HarmonicInterface>,
+}
+
+impl MpcdSystem {
+    /// Solvent and colloids in the same box, at the same step.
+    pub fn new(
+        srd: Srd,
+        colloids: DiscreteColloids,
+        confinement: Confinement,
+        interface: Option<HarmonicInterface>,
+    ) -> Result<Self, MpcdError> {
+        if srd.sbox() != &colloids.sbox {
+            return Err(MpcdError::Invalid(format!(
+                "solvent box {:?} and colloid box {:?} differ",
+                srd.sbox().l,
+                colloids.sbox.l
+            )));
+        }
+        if srd.step() != colloids.step() {
+            return Err(MpcdError::Invalid(format!(
+                "solvent at step {} but colloids at step {}",
+                srd.step(),
+                colloids.step()
+            )));
+        }
+        Ok(Self {
+            srd,
+            colloids,
+            confinement,
+            interface,
+        })
+    }
+
+    /// Time at the start of the next step.
+    pub fn time(&self) -> f64 {
+        self.srd.step() as f64 * self.srd.params().tau
+    }
+
+    /// First half of a step: stream the solvent from `time()` to `time() + tau` (driven by
+    /// `accel`) and move the colloids over the same interval. The caller may then act on the
+    /// streamed solvent (e.g. [`Srd::remove`] some of [`Srd::bounced`]) before
+    /// [`Self::collide`].
+    pub fn stream_and_move(&mut self, accel: &Acceleration) -> Result<StreamStats, MpcdError> {
+        let tau = self.srd.params().tau;
+        let t0 = self.time();
+        let st = self.srd.stream(t0 + tau, &self.confinement, accel)?;
+        match &self.interface {
+            Some(h) => self.colloids.advance(t0, tau, h)?,
+            None => self.colloids.advance(t0, tau, &NoExternal)?,
+        }
+        Ok(st)
+    }
+
+    /// Second half: the collision at the end of the streaming step, the vertices embedded.
+    pub fn collide(&mut self) -> CollisionStats {
+        let t = (self.srd.step() + 1) as f64 * self.srd.params().tau;
+        let emb = self.colloids.embedded();
+        self.srd.collide(t, &self.confinement, Some(emb))
+    }
+
+    /// One whole step: [`Self::stream_and_move`] then [`Self::collide`].
+    pub fn step(&mut self, accel: &Acceleration) -> Result<StepStats, MpcdError> {
+        let stream = self.stream_and_move(accel)?;
+        let collision = self.collide();
+        Ok(StepStats { stream, collision })
+    }
+
+    /// Total momentum of solvent and colloids.
+    pub fn momentum(&self) -> [f64; 3] {
+        let (a, b) = (self.srd.momentum(), self.colloids.momentum());
+        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mpcd::SrdParams;
+
+    /// A periodic cube of edge `l` with standard solvent and `n` random colloids of diameter `d`.
+    fn system(l: f64, d: f64, n: usize, thermostat: bool, seed: u32) -> MpcdSystem {
+        let mut p = SrdParams::standard(seed);
+        p.thermostat = thermostat;
+        let sbox = SimBox::cube(l);
+        let srd = Srd::new(p, sbox, &Confinement::None, 0.0).unwrap();
+        let c = DiscreteColloids::random(
+            ColloidParams::standard(d, p.kt),
+            sbox,
+            n,
+            Region::Box,
+            p.kt,
+            seed,
+        )
+        .unwrap();
+        MpcdSystem::new(srd, c, Confinement::None, None).unwrap()
+    }
+
+    fn bits(v: &[[f64; 3]]) -> Vec<[u64; 3]> {
+        v.iter().map(|x| x.map(f64::to_bits)).collect()
+    }
+
+    #[test]
+    fn the_subdivided_icosahedron_has_42_vertices_and_120_nearest_neighbour_edges() {
+        let g = Geometry::subdivided_icosahedron();
+        assert_eq!(g.vertices.len(), VERTICES);
+        assert_eq!(g.edges.len(), EDGES);
+        let mut degree = [0usize; VERTICES];
+        for &[i, j] in &g.edges {
+            assert!(i < j);
+            degree[i] += 1;
+            degree[j] += 1;
+        }
+        assert_eq!(degree.iter().filter(|&&k| k == 5).count(), 12);
+        assert_eq!(degree.iter().filter(|&&k| k == 6).count(), 30);
+        // The edges join nearest neighbours: every edge is shorter than every non-edge.
+        let (mut longest_edge, mut shortest_other) = (0f64, f64::INFINITY);
+        for i in 0..VERTICES {
+            assert!((dist(g.vertices[i], [0.0; 3]) - 1.0).abs() < 1e-15);
+            for j in i + 1..VERTICES {
+                let r = dist(g.vertices[i], g.vertices[j]);
+                if g.edges.contains(&[i, j]) {
+                    longest_edge = longest_edge.max(r);
+                } else {
+                    shortest_other = shortest_other.min(r);
+                }
+            }
+        }
+        assert!(
+            longest_edge < 0.9 * shortest_other,
+            "{longest_edge} {shortest_other}"
+        );
+        // Built colloids: vertices at d/2 from the centre, the ideal shape free of force.
+        let d = 4.0;
+        let c = DiscreteColloids::new(
+            ColloidParams::standard(d, 1.0),
+            SimBox::cube(12.0),
+            &[[5.9, -5.9, 0.3], [0.0, 0.0, 0.0]],
+            1.0,
+            7,
+        )
+        .unwrap();
+        for i in 0..2 {
+            for v in &c.vertex_positions()[i * VERTICES..][..VERTICES] {
+                let r = dist(*v, c.centre_positions()[i]);
+                assert!((r - 0.5 * d).abs() < 1e-12, "{r}");
+            }
+        }
+        for f in c.vertex_force.iter().chain(&c.centre_force) {
+            assert!(f.iter().all(|x| x.abs() < 1e-10), "{f:?}");
+        }
+        // Two lengths of mesh bond (the projected midpoints), both near 0.55 d/2.
+        let r0 = c.rest_lengths();
+        let (lo, hi) = r0
+            .iter()
+            .fold((f64::INFINITY, 0f64), |(a, b), &r| (a.min(r), b.max(r)));
+        assert!(lo > 0.5 * 0.5 * d && hi < 0.65 * 0.5 * d, "{lo} {hi}");
+    }
+
+    #[test]
+    fn parameters_out_of_range_are_rejected_naming_the_key_and_range() {
+        let ok = ColloidParams::standard(3.0, 1.0);
+        let sbox = SimBox::cube(10.0);
+        let msg = |p: ColloidParams| {
+            DiscreteColloids::new(p, sbox, &[[0.0; 3]], 1.0, 1)
+                .unwrap_err()
+                .to_string()
+        };
+        for (key, bad) in [
+            (
+                "colloid diameter",
+                ColloidParams {
+                    diameter: 0.0,
+                    ..ok
+                },
+            ),
+            (
+                "colloid diameter",
+                ColloidParams {
+                    diameter: f64::NAN,
+                    ..ok
+                },
+            ),
+            (
+                "colloid vertex_mass",
+                ColloidParams {
+                    vertex_mass: -1.0,
+                    ..ok
+                },
+            ),
+            (
+                "colloid centre_mass",
+                ColloidParams {
+                    centre_mass: 0.0,
+                    ..ok
+                },
+            ),
+            (
+                "bond k",
+                ColloidParams {
+                    bond_k: f64::INFINITY,
+                    ..ok
+                },
+            ),
+        ] {
+            let m = msg(bad);
+            assert!(m.contains(&format!("{key} = ")) && m.contains("> 0"), "{m}");
+        }
+        let m = msg(ColloidParams { md_steps: 0, ..ok });
+        assert!(
+            m.contains("md_steps = 0") && m.contains("1..=100000"),
+            "{m}"
+        );
+        let m = msg(ColloidParams {
+            wca_epsilon: -1.0,
+            ..ok
+        });
+        assert!(
+            m.contains("colloid wca_epsilon") && m.contains(">= 0"),
+            "{m}"
+        );
+        // A box too small for the WCA cut-off, a bad kT, a non-finite centre.
+        let m = DiscreteColloids::new(ok, SimBox::cube(6.5), &[[0.0; 3]], 1.0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            m.contains("box edge 6.5") && m.contains("twice the WCA cut-off"),
+            "{m}"
+        );
+        let m = DiscreteColloids::new(ok, sbox, &[[0.0; 3]], 0.0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(m.contains("colloid kT = 0"), "{m}");
+        let e =
+            DiscreteColloids::new(ok, sbox, &[[0.0; 3], [f64::NAN, 0.0, 0.0]], 1.0, 1).unwrap_err();
+        assert_eq!(
+            e,
+            MpcdError::NonFinite {
+                step: 0,
+                what: "colloid",
+                index: 1
+            }
+        );
+        let m = DiscreteColloids::random(ok, sbox, 3, Region::Sphere { radius: 1.0 }, 1.0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            m.contains("placement radius = 1") && m.contains("(1.5, 5]"),
+            "{m}"
+        );
+        // Too many colloids for the region.
+        let m = DiscreteColloids::random(ok, sbox, 200, Region::Box, 1.0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(m.contains("could not place colloid"), "{m}");
+    }
+
+    /// A stiff spring with one Verlet step per collision time blows up; the error names the
+    /// step and the colloid.
+    #[test]
+    fn a_blown_up_colloid_is_reported_with_its_step_and_index() {
+        let p = ColloidParams {
+            bond_k: 1e7,
+            md_steps: 1,
+            ..ColloidParams::standard(3.0, 1.0)
+        };
+        let mut c =
+            DiscreteColloids::new(p, SimBox::cube(10.0), &[[0.0; 3], [4.0, 0.0, 0.0]], 1.0, 3)
+                .unwrap();
+        let mut err = None;
+        for _ in 0..1000 {
+            if let Err(e) = c.advance(0.0, 0.1, &NoExternal) {
+                err = Some(e);
+                break;
+            }
+        }
+        match err {
+            Some(MpcdError::NonFinite { step, what, index }) => {
+                assert_eq!(what, "colloid");
+                assert!(step >= 1 && index < 2, "{step} {index}");
+            }
+            e => panic!("{e:?}"),
+        }
+    }
+
+    /// Random placement: no two centres closer than d (periodic), all inside the sphere,
+    /// the same configuration for the same seed.
+    #[test]
+    fn random_placement_does_not_overlap_and_stays_in_the_region() {
+        let (d, radius) = (2.0, 9.0);
+        let p = ColloidParams::standard(d, 1.0);
+        let sbox = SimBox::cube(20.0);
+        let region = Region::Sphere { radius };
+        // 100 colloids of d = 2 in a sphere of radius 8 (centres): phi about 0.2.
+        let a = DiscreteColloids::random(p, sbox, 100, region, 1.0, 5).unwrap();
+        let b = DiscreteColloids::random(p, sbox, 100, region, 1.0, 5).unwrap();
+        assert_eq!(bits(a.centre_positions()), bits(b.centre_positions()));
+        assert_eq!(bits(a.vertex_velocities()), bits(b.vertex_velocities()));
+        let x = a.centre_positions();
+        for i in 0..x.len() {
+            let r = dist(x[i], [0.0; 3]);
+            assert!(r <= radius - 0.5 * d + 1e-12, "{r}");
+            for j in 0..i {
+                let s = sbox.min_image([x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]]);
+                assert!(dist(s, [0.0; 3]) >= d, "{i} {j}");
+            }
+        }
+        // The colloids' total momentum is removed.
+        let m = a.momentum();
+        assert!(m.iter().all(|c| c.abs() < 1e-10), "{m:?}");
+    }
+
+    /// The WCA forces from the cell list equal the all-pairs sum with minimum images, obey
+    /// Newton's third law, and vanish beyond the cut-off.
+    #[test]
+    fn wca_forces_from_the_cell_list_match_all_pairs() {
+        let d = 2.0;
+        let p = ColloidParams::standard(d, 1.0);
+        let sbox = SimBox::cube(14.0);
+        // Close pairs across the periodic boundary and inside.
+        let mut c = DiscreteColloids::random(p, sbox, 120, Region::Box, 1.0, 9).unwrap();
+        assert!(c.cells[0] >= 3);
+        // Push some pairs into range: move every other colloid towards its predecessor.
+        let mut x = c.centre_positions().to_vec();
+        for i in (1..x.len()).step_by(2) {
+            let s = sbox.min_image([
+                x[i - 1][0] - x[i][0],
+                x[i - 1][1] - x[i][1],
+                x[i - 1][2] - x[i][2],
+            ]);
+            let r = dist(s, [0.0; 3]);
+            let target = 0.95 * d + 0.15 * d * (i % 3) as f64;
+            for k in 0..3 {
+                x[i][k] += s[k] * (1.0 - target / r);
+            }
+        }
+        let mut state = c.state();
+        for (i, y) in x.iter().enumerate() {
+            let mut y = *y;
+            let mut image = [0; 3];
+            sbox.wrap(&mut y, &mut image);
+            let shift = [
+                y[0] - state.centre_pos[i][0],
+                y[1] - state.centre_pos[i][1],
+                y[2] - state.centre_pos[i][2],
+            ];
+            state.centre_pos[i] = y;
+            for v in &mut state.vertex_pos[i * VERTICES..][..VERTICES] {
+                for k in 0..3 {
+                    v[k] += shift[k];
+                }
+            }
+        }
+        c = DiscreteColloids::from_state(p, sbox, &state).unwrap();
+        c.compute_forces(0.0, &NoExternal);
+        let wca = LennardJones::wca(1.0, d);
+        let x = c.centre_positions();
+        let mut pairs = 0;
+        let mut total = [0.0; 3];
+        for i in 0..x.len() {
+            // Bond part: the ideal shape exerts none, so the centre force is WCA alone.
+            let mut f = [0.0; 3];
+            for j in 0..x.len() {
+                if j == i {
+                    continue;
+                }
+                let s = sbox.min_image([x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]]);
+                let r2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+                let g = wca.force_over_r(r2, 0, 0, 0.0, 0.0);
+                if g != 0.0 {
+                    pairs += 1;
+                }
+                for k in 0..3 {
+                    f[k] += g * s[k];
+                }
+            }
+            let got = c.centre_force[i];
+            for k in 0..3 {
+                assert!(
+                    (got[k] - f[k]).abs() < 1e-9 * (1.0 + f[k].abs()),
+                    "{i}: {got:?} {f:?}"
+                );
+                total[k] += got[k];
+            }
+        }
+        assert!(pairs >= 40, "{pairs}");
+        // Newton's third law to round-off of the largest forces (close pairs).
+        let scale: f64 = c
+            .centre_force
+            .iter()
+            .map(|f| f[0].abs() + f[1].abs() + f[2].abs())
+            .sum();
+        assert!(
+            total.iter().all(|t| t.abs() < 1e-13 * scale),
+            "{total:?} {scale}"
+        );
+    }
+
+    /// An isolated colloid (no solvent): velocity Verlet keeps the energy within a bounded
+    /// error of order `dt^2` (a quarter of it at half the step: the integrator's error, not a
+    /// force that is not the gradient of the energy) and the momentum exactly.
+    #[test]
+    fn an_isolated_colloid_conserves_energy_and_momentum() {
+        let error = |md_steps: u32| {
+            let p = ColloidParams {
+                md_steps,
+                ..ColloidParams::standard(4.0, 1.0)
+            };
+            let mut c =
+                DiscreteColloids::new(p, SimBox::cube(12.0), &[[1.0, 2.0, 3.0]], 1.0, 4).unwrap();
+            let e0 = c.kinetic_energy() + c.potential_energy();
+            let p0 = c.momentum();
+            let mut spread: f64 = 0.0;
+            for _ in 0..200 {
+                c.advance(0.0, 0.1, &NoExternal).unwrap();
+                let e = c.kinetic_energy() + c.potential_energy();
+                spread = spread.max((e - e0).abs());
+            }
+            let p1 = c.momentum();
+            assert!(
+                (0..3).all(|k| (p1[k] - p0[k]).abs() < 1e-11),
+                "{p0:?} {p1:?}"
+            );
+            spread
+        };
+        let (e50, e100) = (error(50), error(100));
+        eprintln!("largest energy error over 200 tau: {e50} (50 steps), {e100} (100 steps)");
+        // 43 particles started at kT: about 64.5 kT of kinetic energy.
+        assert!(e50 < 0.3, "{e50}");
+        let ratio = e100 / e50;
+        assert!(ratio > 0.15 && ratio < 0.4, "{ratio}");
+    }
+
+    /// Without the cell thermostat the total momentum of solvent and colloids is conserved to
+    /// round-off, while the colloids' own momentum changes (they exchange momentum with the
+    /// solvent).
+    #[test]
+    fn solvent_and_colloids_conserve_the_total_momentum_without_the_thermostat() {
+        let mut sys = system(12.0, 3.0, 6, false, 31);
+        let p0 = sys.momentum();
+        let c0 = sys.colloids.momentum();
+        let mut changed: f64 = 0.0;
+        for _ in 0..60 {
+            sys.step(&Acceleration::None).unwrap();
+            let c = sys.colloids.momentum();
+            changed = changed.max((c[0] - c0[0]).abs());
+        }
+        let p1 = sys.momentum();
+        for k in 0..3 {
+            assert!((p1[k] - p0[k]).abs() < 1e-10, "{p0:?} {p1:?}");
+        }
+        assert!(changed > 1.0, "{changed}");
+    }
+
+    /// The same run on 1 and on 2 threads gives the same bits (colloids with WCA contacts,
+    /// cell list and storage sorts of the solvent).
+    #[test]
+    fn results_do_not_depend_on_the_thread_count() {
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    let mut sys = system(14.0, 2.0, 60, true, 17);
+                    for _ in 0..12 {
+                        sys.step(&Acceleration::None).unwrap();
+                    }
+                    (
+                        sys.srd.raw_positions(),
+                        sys.srd.velocities(),
+                        sys.colloids.state(),
+                    )
+                })
+        };
+        let (a, b) = (on(1), on(2));
+        assert_eq!(a.0, b.0);
+        assert_eq!(bits(&a.1), bits(&b.1));
+        assert_eq!(bits(&a.2.vertex_pos), bits(&b.2.vertex_pos));
+        assert_eq!(bits(&a.2.vertex_vel), bits(&b.2.vertex_vel));
+        assert_eq!(bits(&a.2.centre_pos), bits(&b.2.centre_pos));
+        assert_eq!(bits(&a.2.centre_vel), bits(&b.2.centre_vel));
+    }
+
+    /// 2k steps in one go, or k steps, a checkpoint (solvent raw state, colloid state), a
+    /// rebuild and k more: the same bits.
+    #[test]
+    fn a_restart_from_the_state_continues_bitwise() {
+        let k = 15;
+        let mut one = system(12.0, 3.0, 5, true, 23);
+        for _ in 0..2 * k {
+            one.step(&Acceleration::None).unwrap();
+        }
+        let mut first = system(12.0, 3.0, 5, true, 23);
+        for _ in 0..k {
+            first.step(&Acceleration::None).unwrap();
+        }
+        let (p, sbox) = (*first.srd.params(), *first.srd.sbox());
+        let srd = Srd::from_raw(
+            p,
+            sbox,
+            &first.srd.raw_positions(),
+            &first.srd.velocities(),
+            first.srd.step(),
+        )
+        .unwrap();
+        let state = first.colloids.state();
+        drop(first);
+        let colloids =
+            DiscreteColloids::from_state(ColloidParams::standard(3.0, 1.0), sbox, &state).unwrap();
+        let mut two = MpcdSystem::new(srd, colloids, Confinement::None, None).unwrap();
+        for _ in 0..k {
+            two.step(&Acceleration::None).unwrap();
+        }
+        assert_eq!(one.srd.raw_positions(), two.srd.raw_positions());
+        assert_eq!(bits(&one.srd.velocities()), bits(&two.srd.velocities()));
+        assert_eq!(one.colloids.state(), two.colloids.state());
+        let (a, b) = (one.colloids.state(), two.colloids.state());
+        assert_eq!(bits(&a.vertex_vel), bits(&b.vertex_vel));
+        assert_eq!(bits(&a.centre_pos), bits(&b.centre_pos));
+    }
+
+    /// An external force acts on the centres only and enters the momentum exactly: a constant
+    /// force `F` on `N` free colloids adds `N F tau` per collision time (no solvent).
+    #[test]
+    fn an_external_force_on_the_centres_adds_its_impulse() {
+        let f = [0.3, -0.1, 0.05];
+        let mut c = DiscreteColloids::new(
+            ColloidParams::standard(2.0, 1.0),
+            SimBox::cube(10.0),
+            &[[0.0; 3], [3.0, 3.0, 3.0], [-3.0, 2.0, 0.0]],
+            1.0,
+            8,
+        )
+        .unwrap();
+        let p0 = c.momentum();
+        for _ in 0..10 {
+            c.advance(0.0, 0.1, &crate::potential::ConstantForce(f))
+                .unwrap();
+        }
+        let p1 = c.momentum();
+        for k in 0..3 {
+            let expect = p0[k] + 3.0 * f[k] * 10.0 * 0.1;
+            assert!((p1[k] - expect).abs() < 1e-12, "{p1:?} vs {expect}");
+        }
+    }
+
+    /// A drying droplet with colloids: solvent in the sphere (slip wall, virtual particles),
+    /// colloids placed inside and held by the harmonic interface on their centres at R(t);
+    /// they stay inside while the sphere shrinks.
+    #[test]
+    fn colloids_in_a_drying_droplet_stay_inside_the_interface() {
+        use crate::mpcd::WallKind;
+        use crate::potential::SphereAreaLaw;
+        let (d, r0) = (2.0, 7.0);
+        let law = SphereAreaLaw { r0, alpha: 10.0 };
+        let conf = Confinement::Sphere {
+            law,
+            kind: WallKind::Slip,
+        };
+        let p = SrdParams::standard(12);
+        let sbox = SimBox::cube(18.0);
+        let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
+        let c = DiscreteColloids::random(
+            ColloidParams::standard(d, p.kt),
+            sbox,
+            20,
+            Region::Sphere { radius: r0 },
+            p.kt,
+            12,
+        )
+        .unwrap();
+        let interface = HarmonicInterface {
+            centre: [0.0; 3],
+            radius: law,
+            stiffness: 100.0,
+            range: 0.5 * d,
+            offset: -0.5 * d,
+        };
+        let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+        let mut virt = 0;
+        for _ in 0..100 {
+            virt += sys
+                .step(&Acceleration::None)
+                .unwrap()
+                .collision
+                .virtual_particles;
+        }
+        assert!(virt > 0);
+        let r = law.radius(sys.time());
+        assert!(r < 0.95 * r0, "{r}");
+        for x in sys.colloids.centre_positions() {
+            // Within the interface (the spring lets them in by a fraction of d).
+            assert!(dist(*x, [0.0; 3]) < r - 0.5 * d + 0.25 * d, "{x:?} {r}");
+        }
+    }
+
+    /// Mean and standard error of a correlated series from `blocks` block means.
+    fn block_mean(x: &[f64], blocks: usize) -> (f64, f64) {
+        let len = x.len() / blocks;
+        let means: Vec<f64> = (0..blocks)
+            .map(|b| x[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
+            .collect();
+        let m = means.iter().sum::<f64>() / blocks as f64;
+        let var = means.iter().map(|y| (y - m).powi(2)).sum::<f64>() / (blocks - 1) as f64;
+        (m, (var / blocks as f64).sqrt())
+    }
+
+    /// In a thermostatted solvent the colloids reach kT: the temperature of their
+    /// centre-of-mass velocities and of all their particles within 3 standard errors
+    /// (block averages); the bonds keep the shape (rms strain below 3 %).
+    #[test]
+    fn colloids_in_a_thermostatted_solvent_reach_kt() {
+        let mut sys = system(16.0, 4.0, 8, true, 41);
+        for _ in 0..200 {
+            sys.step(&Acceleration::None).unwrap();
+        }
+        let (mut com, mut all, mut strain) = (Vec::new(), Vec::new(), 0f64);
+        for _ in 0..2000 {
+            sys.step(&Acceleration::None).unwrap();
+            com.push(sys.colloids.com_temperature());
+            all.push(sys.colloids.temperature());
+            strain = strain.max(sys.colloids.bond_strain_rms());
+        }
+        let (tc, sc) = block_mean(&com, 20);
+        let (ta, sa) = block_mean(&all, 20);
+        eprintln!("T(com) = {tc} +- {sc}, T(all) = {ta} +- {sa}, max rms strain {strain}");
+        assert!(
+            (tc - 1.0).abs() < 3.0 * sc && sc < 0.05,
+            "T(com) = {tc} +- {sc}"
+        );
+        assert!(
+            (ta - 1.0).abs() < 3.0 * sa && sa < 0.01,
+            "T(all) = {ta} +- {sa}"
+        );
+        assert!(strain < 0.03, "{strain}");
+    }
+
+    /// One colloid in a periodic box of the standard solvent (cell thermostat): its
+    /// long-time diffusion coefficient against Stokes–Einstein with Hasimoto's finite-size
+    /// correction, `D_L = kT / (6 pi eta a_h) (1 - 2.837297 x + 4.19 x^3 - 27.4 x^6)`,
+    /// `x = a_h / L`, with `a_h = d/2` and the solvent's measured viscosity (docs/mpcd.md, long
+    /// run at L = 16: 3.9438 +- 0.0057), within 5 %.
+    ///
+    /// `D` by Green–Kubo from the colloid's centre-of-mass velocity `V`: only the collisions
+    /// change it (the bonds are internal forces), so the centre of mass flies straight between
+    /// collisions and `D = (tau / 3) (C_0 / 2 + sum_{k >= 1} C_k)` exactly, with
+    /// `C_k = <V_n . V_{n+k}>` (the discrete form of the integral of the velocity
+    /// autocorrelation). The sum runs to 5 decay times of the slowest transverse mode of the
+    /// box, `L^2 / (4 pi^2 nu)` (the tail beyond, below 0.3 % of D, is left out); error from
+    /// 20 blocks. The slope of the mean squared displacement between 5 and 12 decay times is
+    /// printed as a check (noisier). `COLLOID_L`, `COLLOID_D`, `COLLOID_TIME` (time units)
+    /// override the size; see docs/mpcd.md, "Colloids".
+    #[test]
+    #[ignore]
+    fn colloid_diffusion_long() {
+        let env = |k: &str, v: f64| std::env::var(k).ok().map_or(v, |s| s.parse().unwrap());
+        let (l, d, time) = (
+            env("COLLOID_L", 16.0),
+            env("COLLOID_D", 4.0),
+            env("COLLOID_TIME", 80000.0),
+        );
+        let seed = env("COLLOID_SEED", 2026.0) as u32;
+        let clock = std::time::Instant::now();
+        let p = SrdParams::standard(seed);
+        let sbox = SimBox::cube(l);
+        let srd = Srd::new(p, sbox, &Confinement::None, 0.0).unwrap();
+        let cp = ColloidParams::standard(d, p.kt);
+        let c = DiscreteColloids::new(cp, sbox, &[[0.3, -0.2, 0.1]], p.kt, seed).unwrap();
+        let mut sys = MpcdSystem::new(srd, c, Confinement::None, None).unwrap();
+        let warm = 1000;
+        for _ in 0..warm {
+            sys.step(&Acceleration::None).unwrap();
+        }
+        let steps = (time / p.tau) as usize;
+        let mut vel = Vec::with_capacity(steps);
+        let (mut t_all, mut strain) = (0.0, 0f64);
+        for _ in 0..steps {
+            sys.step(&Acceleration::None).unwrap();
+            vel.push(sys.colloids.com_velocities()[0]);
+            t_all += sys.colloids.temperature() / steps as f64;
+            strain = strain.max(sys.colloids.bond_strain_rms());
+        }
+        let p_total = sys.momentum();
+        let nu = 3.9438 / p.density;
+        let slowest = l * l / (4.0 * std::f64::consts::PI.powi(2) * nu);
+        let kmax = (5.0 * slowest / p.tau).round() as usize;
+        let green_kubo = |v: &[[f64; 3]]| -> f64 {
+            let mut sum = 0.0;
+            for k in 0..=kmax {
+                let n = v.len() - k;
+                let c = (0..n)
+                    .map(|i| v[i][0] * v[i + k][0] + v[i][1] * v[i + k][1] + v[i][2] * v[i + k][2])
+                    .sum::<f64>()
+                    / n as f64;
+                sum += if k == 0 { 0.5 * c } else { c };
+            }
+            p.tau * sum / 3.0
+        };
+        let blocks = 20;
+        let len = vel.len() / blocks;
+        let ds: Vec<f64> = (0..blocks)
+            .map(|b| green_kubo(&vel[b * len..(b + 1) * len]))
+            .collect();
+        let dm = ds.iter().sum::<f64>() / blocks as f64;
+        let se = (ds.iter().map(|x| (x - dm).powi(2)).sum::<f64>()
+            / ((blocks - 1) * blocks) as f64)
+            .sqrt();
+        // The check: the MSD slope from the centre-of-mass trajectory x_n = tau sum V.
+        let mut x = vec![[0.0; 3]; vel.len() + 1];
+        for (n, v) in vel.iter().enumerate() {
+            x[n + 1] = std::array::from_fn(|k| x[n][k] + p.tau * v[k]);
+        }
+        let msd = |lag: usize| -> f64 {
+            let n = x.len() - lag;
+            (0..n)
+                .map(|i| {
+                    let (a, b) = (x[i], x[i + lag]);
+                    (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)
+                })
+                .sum::<f64>()
+                / n as f64
+        };
+        let (k1, k2) = (kmax, (12.0 * slowest / p.tau).round() as usize);
+        let d_msd = (msd(k2) - msd(k1)) / (6.0 * (k2 - k1) as f64 * p.tau);
+        let eta = 3.9438;
+        let hasimoto = |a: f64| {
+            let x = a / l;
+            1.0 - 2.837297 * x + 4.19 * x.powi(3) - 27.4 * x.powi(6)
+        };
+        let stokes = |a: f64| p.kt / (6.0 * std::f64::consts::PI * eta * a) * hasimoto(a);
+        let a = 0.5 * d;
+        let theory = stokes(a);
+        // The radius that would match: bisection on the decreasing stokes(a).
+        let (mut lo, mut hi) = (0.1 * a, 3.0 * a);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if stokes(mid) > dm { lo = mid } else { hi = mid }
+        }
+        eprintln!(
+            "L = {l}, d = {d}, {time} time units ({} collisions after {warm}) in {:.0} s; Green-Kubo to {:.1}",
+            steps,
+            clock.elapsed().as_secs_f64(),
+            kmax as f64 * p.tau
+        );
+        eprintln!(
+            "D = {dm:.6} +- {se:.6} (MSD slope {d_msd:.6}); Stokes-Einstein-Hasimoto with a = d/2: {theory:.6} (Hasimoto factor {:.4}); D / theory - 1 = {:+.2} % +- {:.2} %; matching radius {:.3}",
+            hasimoto(a),
+            100.0 * (dm / theory - 1.0),
+            100.0 * se / theory,
+            0.5 * (lo + hi)
+        );
+        eprintln!(
+            "colloid T(all) mean {t_all:.4}, largest rms strain {strain:.4}, total momentum {p_total:?}"
+        );
+        assert!(se / dm < 0.035, "too noisy: {se} of {dm}");
+        assert!(
+            (dm / theory - 1.0).abs() < 0.05,
+            "D = {dm} +- {se} vs {theory}"
+        );
+    }
+}
