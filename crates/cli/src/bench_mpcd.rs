@@ -77,7 +77,17 @@ fn lammps_run(a: &BenchArgs, dir: &Path, ranks: usize) -> Option<(f64, f64, f64)
     let l = a.l.to_string();
     let steps = a.steps.to_string();
     let lmp_args = [
-        "-in", "in.srd.bulk", "-var", "L", &l, "-var", "steps", &steps, "-log", "none", "-screen",
+        "-in",
+        "in.srd.bulk",
+        "-var",
+        "L",
+        &l,
+        "-var",
+        "steps",
+        &steps,
+        "-log",
+        "none",
+        "-screen",
         &screen,
     ];
     let mut cmd = if ranks == 1 {
@@ -232,7 +242,11 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         println!(
             "lammps\t{r}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{c:.4e}\t{:.2}\t1.00\t# {mb:.1} MB per rank ({:.0} B per particle on one rank)",
             m / b,
-            if r == 1 { mb * 1048576.0 / n as f64 } else { f64::NAN }
+            if r == 1 {
+                mb * 1048576.0 / n as f64
+            } else {
+                f64::NAN
+            }
         );
     }
     Ok(())

@@ -47,6 +47,26 @@ every = 50
 solvent = true
 "#;
 
+/// A drying droplet of R0 = 8 cells with 6 colloids of d = 4 (no-slip), 300 collisions.
+const COLLOIDS: &str = r#"
+method = "droplet-mpcd"
+seed = 4
+boundary = "no-slip"
+[system]
+particles = 6
+diameter = 4
+radius = 8
+[drying]
+peclet = 10
+duration = 30
+[observe.profile]
+bins = 8
+[observe.solvent]
+window = 50
+[observe.trajectory]
+every = 50
+"#;
+
 fn run(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
     c.current_dir(dir).args(args);
@@ -65,7 +85,7 @@ fn summary(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn killed_interrupted_and_threaded_runs_give_the_same_bits() {
-    for scenario in [BULK, DROPLET] {
+    for scenario in [BULK, DROPLET, COLLOIDS] {
         let tmp = tempfile::tempdir().unwrap();
         let d = tmp.path();
         std::fs::write(d.join("s.toml"), scenario).unwrap();
@@ -94,7 +114,15 @@ fn killed_interrupted_and_threaded_runs_give_the_same_bits() {
         }
         let s = summary(&d.join("a"));
         assert_eq!(s["completed"], true);
-        assert_eq!(s["trajectory_frames"], 9);
+        if scenario == COLLOIDS {
+            assert_eq!(s["trajectory_frames"], 7);
+            assert_eq!(s["colloids"]["centres_beyond_R_at_end"], 0);
+            for f in ["profile_0.00.csv", "profile_1.00.csv", "profiles.png"] {
+                assert!(d.join("a").join(f).exists(), "{f}");
+            }
+        } else {
+            assert_eq!(s["trajectory_frames"], 9);
+        }
     }
 }
 
@@ -237,8 +265,12 @@ fn bad_input_is_refused_naming_the_key_and_range() {
         ),
         (drop("boundary = \"sticky\"", ""), "boundary: must be one of"),
         (
-            drop("", "particles = 10"),
-            "system.particles: must be an integer in [0, 0]",
+            drop("", "particles = 20000000"),
+            "system.particles: must be an integer in [0, 10000000]",
+        ),
+        (
+            drop("", "particles = 40\ndiameter = 4"),
+            "system.radius: 40 colloids of diameter 4 in radius 6 give phi0 = 1.4815",
         ),
         (
             "method = \"droplet-mpcd\"\n[system]\nradius = 6\n[drying]\nduration = 1e6\n".into(),

@@ -1510,10 +1510,10 @@ pub static DROPLET_MPCD: &[Spec] = &[
         "system.particles",
         "-",
         "0",
-        Integer(0, 0),
-        "colloids (0: a pure-solvent droplet)",
+        Integer(0, 10_000_000),
+        "colloids N (0: a pure-solvent droplet), placed at random with centres within R0 - d/2",
     )
-    .also("colloids are not built yet"),
+    .also("they must fit: random sequential addition, at most phi0 = 0.3"),
     key(
         "system.diameter",
         "length",
@@ -1583,6 +1583,71 @@ pub static DROPLET_MPCD: &[Spec] = &[
         "stop after this time",
     )
     .also("R must stay above two cells"),
+    key(
+        "interface",
+        "-",
+        "-",
+        Table,
+        "the harmonic interface on the colloid centres, as droplet-bd's",
+    ),
+    key(
+        "interface.stiffness",
+        "energy / length^2",
+        "50 kT / d^2",
+        Positive,
+        "spring constant k of V = k s^2 / 2, s = r - (R(t) + offset)",
+    ),
+    key(
+        "interface.range",
+        "length",
+        "d / 2",
+        Positive,
+        "range of the harmonic part (linear beyond)",
+    )
+    .also("at most R0"),
+    key(
+        "interface.offset",
+        "length",
+        "-d / 2",
+        Finite,
+        "offset of the wall from R(t) (-d/2: the surface touches R)",
+    )
+    .also("in [-R0, R0]"),
+    key(
+        "colloid",
+        "-",
+        "-",
+        Table,
+        "the discrete-particle colloid: 42 vertices and a centre, harmonic bonds (defaults chosen, docs/mpcd.md)",
+    ),
+    key(
+        "colloid.vertex_mass",
+        "mass",
+        "5",
+        Positive,
+        "mass of each of the 42 vertices (they join the collisions)",
+    ),
+    key(
+        "colloid.centre_mass",
+        "mass",
+        "5",
+        Positive,
+        "mass of the central particle (WCA between centres, the interface acts on it)",
+    ),
+    key(
+        "colloid.bond_k",
+        "energy / length^2",
+        "5000",
+        Positive,
+        "spring constant of the 120 edge and 42 spoke bonds (5000 kT / a^2 at kT = 1)",
+    ),
+    key(
+        "colloid.md_steps",
+        "-",
+        "50",
+        Integer(1, 100_000),
+        "velocity Verlet steps per collision time",
+    ),
     key("observe", "-", "-", Table, "observables"),
     key(
         "observe.every",

@@ -20,6 +20,7 @@ use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::gsd::GsdWriter;
+use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region};
 use colloidsim_md::mpcd::drying::{SolventProfile, remove_excess};
 use colloidsim_md::mpcd::measure::{BlockAverage, PoiseuilleProbe};
 use colloidsim_md::mpcd::scenario::{Boundary, BulkRun, BulkScenario, DropletRun, DropletScenario};
@@ -63,6 +64,53 @@ fn solvent_frame(w: &mut GsdWriter, srd: &Srd, log: &[(&str, f64)]) -> Result<()
     p.vel = srd.velocities();
     p.mass = vec![srd.params().mass; srd.len()];
     w.write_frame(srd.step(), srd.sbox(), &p, false, log)?;
+    Ok(())
+}
+
+/// A GSD frame of a droplet with colloids: the centres (type `A`, diameter d), the vertices
+/// (type `V`) and, when asked, the solvent (type `S`).
+fn droplet_frame(
+    w: &mut GsdWriter,
+    srd: &Srd,
+    col: &DiscreteColloids,
+    p: &DropletRun,
+    log: &[(&str, f64)],
+) -> Result<()> {
+    let sbox = *srd.sbox();
+    let mut pos: Vec<[f64; 3]> = col.centre_positions().to_vec();
+    let mut vel: Vec<[f64; 3]> = col.centre_velocities().to_vec();
+    let mut typeid = vec![0u32; pos.len()];
+    let mut diameter = vec![p.diameter; pos.len()];
+    let mut mass = vec![p.colloid.centre_mass; pos.len()];
+    for (x, v) in col.vertex_positions().iter().zip(col.vertex_velocities()) {
+        let mut x = *x;
+        let mut image = [0; 3];
+        sbox.wrap(&mut x, &mut image);
+        pos.push(x);
+        vel.push(*v);
+        typeid.push(1);
+        diameter.push(0.25 * p.solvent.srd.cell);
+        mass.push(p.colloid.vertex_mass);
+    }
+    if p.trajectory_solvent {
+        pos.extend(srd.positions());
+        vel.extend(srd.velocities());
+        let n = srd.len();
+        typeid.extend(std::iter::repeat_n(2, n));
+        diameter.extend(std::iter::repeat_n(0.2 * p.solvent.srd.cell, n));
+        mass.extend(std::iter::repeat_n(p.solvent.srd.mass, n));
+    }
+    let n = pos.len();
+    let frame = Particles {
+        pos,
+        image: vec![[0; 3]; n],
+        typeid,
+        diameter,
+        vel,
+        mass,
+        type_names: vec!["A".into(), "V".into(), "S".into()],
+    };
+    w.write_frame(srd.step(), &sbox, &frame, false, log)?;
     Ok(())
 }
 
@@ -608,6 +656,23 @@ fn build_droplet(p: &DropletRun) -> Result<Srd> {
     )?)
 }
 
+/// The colloids at the start: random sequential addition with centres within `R0 - d/2`.
+fn build_colloids(p: &DropletRun) -> Result<Option<DiscreteColloids>> {
+    if p.particles == 0 {
+        return Ok(None);
+    }
+    DiscreteColloids::random(
+        p.colloid,
+        SimBox::cube(p.box_edge),
+        p.particles,
+        Region::Sphere { radius: p.r0 },
+        p.solvent.srd.kt,
+        p.seed,
+    )
+    .map(Some)
+    .map_err(|e| anyhow::anyhow!("system.particles: {e}"))
+}
+
 impl Method for DropletMpcd {
     fn names(&self) -> &'static [&'static str] {
         &["droplet-mpcd"]
@@ -623,6 +688,7 @@ impl Method for DropletMpcd {
 
     fn check(&self, src: &Source) -> Result<Checked> {
         let p = resolve_droplet(src, None)?;
+        build_colloids(&p).with_context(|| src.label())?;
         Ok(Checked {
             resolved: serde_json::to_value(&p)?,
             warnings: Vec::new(),
@@ -631,11 +697,13 @@ impl Method for DropletMpcd {
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
         let p = resolve_droplet(src, seed)?;
+        let colloids = build_colloids(&p).with_context(|| src.label())?;
         let srd = build_droplet(&p).with_context(|| src.label())?;
         let acc = DropletAccum::new(&p, srd.len());
         Ok(Box::new(DropletSession {
             p,
             srd,
+            colloids,
             acc,
             gsd: None,
             scratch: Vec::new(),
@@ -657,6 +725,14 @@ impl Method for DropletMpcd {
         let srd = saved
             .solvent
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+        let colloids = match &saved.colloids {
+            Some(state) if state.centre_pos.len() == p.particles => Some(
+                DiscreteColloids::from_state(p.colloid, SimBox::cube(p.box_edge), state)
+                    .context("checkpoint.bin: the colloids")?,
+            ),
+            None if p.particles == 0 => None,
+            _ => bail!("checkpoint: its colloids do not fit the scenario"),
+        };
         if p.trajectory_every > 0 {
             saved
                 .acc
@@ -668,6 +744,7 @@ impl Method for DropletMpcd {
         Ok(Box::new(DropletSession {
             p,
             srd,
+            colloids,
             acc: saved.acc,
             gsd: None,
             scratch: Vec::new(),
@@ -680,6 +757,12 @@ impl Method for DropletMpcd {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve_droplet(src, seed)?;
+        if p.particles > 0 {
+            bail!(
+                "{}: a droplet-mpcd engine with colloids cannot be stepped by hand yet (only a pure-solvent droplet)",
+                src.label()
+            );
+        }
         Ok(Box::new(SolventEngine {
             srd: build_droplet(&p)?,
             method: "droplet-mpcd",
@@ -700,6 +783,22 @@ struct DropletRow {
     removed: u64,
     bounced: u64,
     temperature: f64,
+    /// Kinetic temperature of the colloids' centre-of-mass velocities (NaN without).
+    colloid_temperature: f64,
+}
+
+/// The colloid volume-fraction profiles: per profile time, phi per bin, the bin centres and
+/// the radius when taken.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct ColloidProfiles {
+    phi: Vec<Vec<f64>>,
+    r: Vec<Vec<f64>>,
+    radius: Vec<f64>,
+    taken: Vec<bool>,
+    /// Largest distance of a centre beyond the interface's wall `R(t) + offset`.
+    max_excursion: f64,
+    /// Centres beyond R(t) at the end.
+    outside_final: u64,
 }
 
 /// What a droplet run accumulates (saved in every checkpoint).
@@ -717,6 +816,7 @@ struct DropletAccum {
     reflections: u64,
     stuck: u64,
     virtual_particles: u64,
+    colloid_profiles: ColloidProfiles,
     frames: u64,
     digest: FrameDigest,
 }
@@ -739,6 +839,17 @@ impl DropletAccum {
             reflections: 0,
             stuck: 0,
             virtual_particles: 0,
+            colloid_profiles: {
+                let k = p.profile_collisions.len();
+                ColloidProfiles {
+                    phi: vec![Vec::new(); k],
+                    r: vec![Vec::new(); k],
+                    radius: vec![0.0; k],
+                    taken: vec![false; k],
+                    max_excursion: f64::NEG_INFINITY,
+                    outside_final: 0,
+                }
+            },
             frames: 0,
             digest: FrameDigest::default(),
         }
@@ -748,12 +859,14 @@ impl DropletAccum {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct DropletSaved {
     solvent: SolventState,
+    colloids: Option<ColloidState>,
     acc: DropletAccum,
 }
 
 struct DropletSession {
     p: DropletRun,
     srd: Srd,
+    colloids: Option<DiscreteColloids>,
     acc: DropletAccum,
     gsd: Option<GsdWriter>,
     scratch: Vec<u32>,
@@ -775,6 +888,33 @@ impl DropletSession {
     fn record(&mut self, c: u64, bounced: u64) -> Result<Option<String>> {
         let r = self.radius(c);
         let p = &self.p;
+        if let Some(col) = &self.colloids {
+            let cp = &mut self.acc.colloid_profiles;
+            let wall = r + p.interface[2];
+            for x in col.centre_positions() {
+                let d = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                cp.max_excursion = cp.max_excursion.max(d - wall);
+            }
+            for (j, &cf) in p.profile_collisions.iter().enumerate() {
+                if cf == c {
+                    let pos = col.centre_positions();
+                    let prof = colloidsim_analysis::radial_profile(
+                        pos,
+                        &vec![p.diameter; pos.len()],
+                        [0.0; 3],
+                        r,
+                        p.profile.bins,
+                    );
+                    cp.phi[j] = prof.phi;
+                    cp.r[j] = prof.r;
+                    cp.radius[j] = r;
+                    cp.taken[j] = true;
+                    if c == p.collisions {
+                        cp.outside_final = prof.outside as u64;
+                    }
+                }
+            }
+        }
         for (j, &cf) in p.profile_collisions.iter().enumerate() {
             let w = p.solvent_window;
             let first = cf.saturating_sub(w - 1);
@@ -808,12 +948,19 @@ impl DropletSession {
                 removed: self.acc.removed,
                 bounced,
                 temperature: self.srd.temperature(),
+                colloid_temperature: self
+                    .colloids
+                    .as_ref()
+                    .map_or(f64::NAN, |c| c.com_temperature()),
             });
         }
         if let Some(w) = self.gsd.as_mut()
             && c.is_multiple_of(p.trajectory_every)
         {
-            solvent_frame(w, &self.srd, &[("radius", r)])?;
+            match &self.colloids {
+                Some(col) => droplet_frame(w, &self.srd, col, p, &[("radius", r)])?,
+                None => solvent_frame(w, &self.srd, &[("radius", r)])?,
+            }
             self.acc.frames += 1;
         }
         Ok(None)
@@ -847,9 +994,14 @@ impl Session for DropletSession {
             "solvent_profiles.csv",
             "solvent_density.png",
             "solvent_velocity.png",
+            "profiles.png",
             "trajectory.gsd",
         ]
         .contains(&name)
+            || name
+                .strip_prefix("profile_")
+                .and_then(|r| r.strip_suffix(".csv"))
+                .is_some_and(|f| f.parse::<f64>().is_ok())
     }
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
@@ -875,6 +1027,11 @@ impl Session for DropletSession {
                 Ok(st) => st,
                 Err(e) => return Ok(Some(e.to_string())),
             };
+            if let Some(col) = self.colloids.as_mut()
+                && let Err(e) = col.advance(step as f64 * tau, tau, &self.p.harmonic())
+            {
+                return Ok(Some(e.to_string()));
+            }
             self.acc.bounced += st.bounced;
             self.acc.reflections += st.reflections;
             self.acc.stuck += st.stuck;
@@ -885,7 +1042,8 @@ impl Session for DropletSession {
                 self.acc.residual_max = self.acc.residual_max.max(r.residual);
                 self.acc.residual_last = r.residual;
             }
-            let cs = self.srd.collide(t, &conf, None);
+            let emb = self.colloids.as_mut().map(|c| c.embedded());
+            let cs = self.srd.collide(t, &conf, emb);
             self.acc.virtual_particles += cs.virtual_particles;
             if let Some(why) = self.record(step + 1, st.bounced)? {
                 return Ok(Some(why));
@@ -910,6 +1068,7 @@ impl Session for DropletSession {
         }
         Ok(bincode::serialize(&DropletSaved {
             solvent: SolventState::of(&self.srd),
+            colloids: self.colloids.as_ref().map(|c| c.state()),
             acc: self.acc.clone(),
         })?)
     }
@@ -934,6 +1093,61 @@ impl Session for DropletSession {
         write_droplet_thermo(out, p, &self.acc.rows)?;
         files.push("thermo.csv".into());
         let collisions = self.srd.step();
+        let boundary = match p.boundary {
+            Boundary::None => "none",
+            Boundary::Slip => "slip",
+            Boundary::NoSlip => "no-slip",
+        };
+        // The colloid profiles, on droplet-bd's file names and columns.
+        let cp = &self.acc.colloid_profiles;
+        if self.colloids.is_some() {
+            let mut labels = Vec::new();
+            let mut xs = Vec::new();
+            let mut drawn = Vec::new();
+            for j in (0..cp.taken.len()).filter(|&j| cp.taken[j]) {
+                let name = crate::theory_droplet::profile_name(p.profile.fractions[j]);
+                out.write_table(&name, &[("r", &cp.r[j]), ("phi", &cp.phi[j])])?;
+                files.push(name);
+                labels.push(format!(
+                    "t = {:.0} % (R = {:.2})",
+                    p.profile.fractions[j] * 100.0,
+                    cp.radius[j]
+                ));
+                xs.push(
+                    cp.r[j]
+                        .iter()
+                        .map(|x| x / cp.radius[j])
+                        .collect::<Vec<f64>>(),
+                );
+                drawn.push(j);
+            }
+            let series: Vec<Series> = drawn
+                .iter()
+                .enumerate()
+                .map(|(k, &j)| Series {
+                    label: &labels[k],
+                    x: &xs[k],
+                    y: &cp.phi[j],
+                    points: false,
+                })
+                .collect();
+            picture(
+                line_plot(
+                    &out.join("profiles.png"),
+                    &format!(
+                        "Drying droplet, MPCD ({boundary}): N = {}, Pe = {}",
+                        p.particles, p.peclet
+                    ),
+                    "r / R(t)",
+                    "volume fraction phi(r)",
+                    &series,
+                    Scale::Linear,
+                ),
+                "profiles.png",
+                &mut files,
+                &mut warnings,
+            );
+        }
         // The solvent profiles taken (complete windows only).
         let mut cols: [Vec<f64>; 9] = Default::default();
         let mut curves: Vec<Curve> = Vec::new();
@@ -1009,11 +1223,6 @@ impl Session for DropletSession {
                 .collect();
             out.write_table("solvent_profiles.csv", &table)?;
             files.push("solvent_profiles.csv".into());
-            let boundary = match p.boundary {
-                Boundary::None => "none",
-                Boundary::Slip => "slip",
-                Boundary::NoSlip => "no-slip",
-            };
             for (name, ylabel, pick) in [
                 ("solvent_density.png", "solvent density n(r) / n0", 2usize),
                 (
@@ -1055,7 +1264,20 @@ impl Session for DropletSession {
         let t = collisions as f64 * tau;
         let r = p.law().radius(t);
         let expected = self.expected(collisions);
+        let colloids = self.colloids.as_ref().map(|c| {
+            json!({
+                "particles": c.len(),
+                "final_mean_volume_fraction": p.particles as f64 * p.diameter.powi(3) / (8.0 * r.powi(3)),
+                "max_excursion_beyond_wall": cp.max_excursion,
+                "centres_beyond_R_at_end": cp.outside_final,
+                "temperature_centre_of_mass": c.com_temperature(),
+                "temperature_all_particles": c.temperature(),
+                "bond_strain_rms": c.bond_strain_rms(),
+                "stokes_einstein_d0": p.d0,
+            })
+        });
         let summary = json!({
+            "colloids": colloids,
             "software": crate::software(),
             "method": "droplet-mpcd",
             "seed": p.seed,
@@ -1121,6 +1343,7 @@ fn write_droplet_thermo(out: &OutputDir, p: &DropletRun, rows: &[DropletRow]) ->
             ("removed", &col(&|r| r.removed as f64)),
             ("bounced", &col(&|r| r.bounced as f64)),
             ("temperature", &col(&|r| r.temperature)),
+            ("colloid_temperature", &col(&|r| r.colloid_temperature)),
         ],
     )?;
     Ok(())

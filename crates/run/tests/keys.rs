@@ -198,6 +198,15 @@ box = 12.0
 [drying]
 peclet = 10.0
 duration = 10.0
+[interface]
+stiffness = 3.125
+range = 2.0
+offset = -2.0
+[colloid]
+vertex_mass = 5.0
+centre_mass = 5.0
+bond_k = 5000.0
+md_steps = 50
 [observe]
 every = 10
 [observe.profile]
