@@ -43,6 +43,8 @@ __all__ = [
     "ColloidsimError",
     "DPD",
     "Engine",
+    "MPCD",
+    "MonteCarlo",
     "Result",
     "Table",
     "check",
@@ -384,3 +386,17 @@ class DPD(Engine):
     """DPD colloids in explicit solvent (``method = "dpd"``)."""
 
     _method = ("dpd",)
+
+
+class MonteCarlo(Engine):
+    """Hard-sphere Monte Carlo (``method = "hs-mc"``); one step is one sweep of N trial moves
+    (the move size is the scenario's starting one: the run path's warm-up tuning is not done)."""
+
+    _method = ("hs-mc",)
+
+
+class MPCD(Engine):
+    """The MPCD solvent (``method = "mpcd"``, or a pure-solvent ``"droplet-mpcd"``); one step
+    is one streaming step and one collision, ``velocities`` the solvent's in storage order."""
+
+    _method = ("mpcd", "droplet-mpcd")

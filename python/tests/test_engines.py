@@ -65,6 +65,25 @@ def test_brownian_dynamics_and_dpd_engines():
     assert dpd.steps == 5
 
 
+def test_monte_carlo_and_mpcd_engines():
+    mc = colloidsim.MonteCarlo(EXAMPLES / "mc/bulk.toml")
+    p0 = mc.positions.copy()
+    mc.step(2)
+    assert mc.steps == 2 and mc.positions.shape == p0.shape and not np.array_equal(p0, mc.positions)
+    srd = colloidsim.MPCD(EXAMPLES / "mpcd/viscosity.toml", overrides={"system.box": 6.0})
+    assert srd.particles == 5 * 6**3
+    srd.step(3)
+    v = srd.velocities
+    assert v.shape == (srd.particles, 3) and np.all(np.isfinite(v))
+    assert abs(srd.time - 0.3) < 1e-12 and srd.dt == 0.1
+    # The cell thermostat keeps the solvent at kT = 1 (m = 1): 3 (N - 1) kT within 5 sigma.
+    n = srd.particles
+    twice_ke = float(np.sum((v - v.mean(axis=0)) ** 2))
+    assert abs(twice_ke / (3 * (n - 1)) - 1.0) < 5 * (2 / (3 * n)) ** 0.5
+    with pytest.raises(colloidsim.ColloidsimError, match="method = 'mpcd'"):
+        colloidsim.MPCD(BCD_SCENARIO)
+
+
 def test_engine_classes_check_the_method():
     with pytest.raises(colloidsim.ColloidsimError, match="method = 'dpd'"):
         colloidsim.DPD(BCD_SCENARIO)

@@ -125,6 +125,36 @@ pub struct DryingSection {
     pub duration: Option<f64>,
 }
 
+impl DryingSection {
+    /// The Peclet number and the rate of loss of surface area `(Pe, alpha)`,
+    /// `alpha = 8 pi Pe D0` (`Pe = R |dR/dt| / D0`), from `peclet` (default 10) or `alpha`.
+    pub fn rate(&self, d0: f64) -> Result<(f64, f64), ParamError> {
+        match (self.peclet, self.alpha) {
+            (Some(_), Some(_)) => Err(ParamError::new(
+                "drying.peclet",
+                "give either drying.peclet or drying.alpha, not both",
+            )),
+            (None, Some(a)) => {
+                let a = positive("drying.alpha", a)?;
+                Ok((a / (8.0 * PI * d0), a))
+            }
+            (pe, None) => {
+                let pe = pe.unwrap_or(10.0);
+                if !(pe.is_finite() && pe >= 0.0) {
+                    return Err(ParamError::new(
+                        "drying.peclet",
+                        format!(
+                            "must be a finite number >= 0 (0: a static droplet), got {}",
+                            colloidsim_core::param::show(pe)
+                        ),
+                    ));
+                }
+                Ok((pe, 8.0 * PI * pe * d0))
+            }
+        }
+    }
+}
+
 /// `[interface]`: harmonic wall `V = k/2 s^2` for `0 <= s < range`, linear beyond, with
 /// `s = r - (R(t) + offset)`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
@@ -408,28 +438,7 @@ impl DropletScenario {
         }
 
         let dr = &self.drying;
-        let (peclet, alpha) = match (dr.peclet, dr.alpha) {
-            (Some(_), Some(_)) => {
-                return Err(ParamError::new(
-                    "drying.peclet",
-                    "give either drying.peclet or drying.alpha, not both",
-                ));
-            }
-            (None, Some(a)) => {
-                let a = positive("drying.alpha", a)?;
-                (a / (8.0 * PI * d0), a)
-            }
-            (pe, None) => {
-                let pe = pe.unwrap_or(10.0);
-                if !(pe.is_finite() && pe >= 0.0) {
-                    return Err(ParamError::new(
-                        "drying.peclet",
-                        format!("must be a finite number >= 0 (0: a static droplet), got {pe}"),
-                    ));
-                }
-                (pe, 8.0 * PI * pe * d0)
-            }
-        };
+        let (peclet, alpha) = dr.rate(d0)?;
         let fixed = alpha == 0.0;
         if fixed && dr.duration.is_none() {
             let key = if dr.final_volume_fraction.is_some() {

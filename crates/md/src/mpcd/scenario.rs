@@ -710,31 +710,7 @@ impl DropletScenario {
         };
         let d0 = srd.kt / (3.0 * PI * solvent.viscosity_theory * d);
         let dr = &self.drying;
-        let (peclet, alpha) = match (dr.peclet, dr.alpha) {
-            (Some(_), Some(_)) => {
-                return Err(ParamError::new(
-                    "drying.peclet",
-                    "give either drying.peclet or drying.alpha, not both",
-                ));
-            }
-            (None, Some(al)) => {
-                let al = positive("drying.alpha", al)?;
-                (al / (8.0 * PI * d0), al)
-            }
-            (pe, None) => {
-                let pe = pe.unwrap_or(10.0);
-                if !(pe.is_finite() && pe >= 0.0) {
-                    return Err(ParamError::new(
-                        "drying.peclet",
-                        format!(
-                            "must be a finite number >= 0 (0: a static droplet), got {}",
-                            show(pe)
-                        ),
-                    ));
-                }
-                (pe, 8.0 * PI * pe * d0)
-            }
-        };
+        let (peclet, alpha) = dr.rate(d0)?;
         let t_end = match (dr.final_volume_fraction, dr.duration) {
             (Some(_), _) if s.particles == 0 => {
                 return Err(ParamError::new(
