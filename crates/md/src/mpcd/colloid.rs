@@ -635,7 +635,8 @@ impl DiscreteColloids {
             + 0.5 * self.params.vertex_mass * self.vertex_vel.iter().map(sq).sum::<f64>()
     }
 
-    /// Potential energy: bonds and WCA between centres (no external field).
+    /// Potential energy: bonds and WCA between centres (no external field; a diagnostic, the
+    /// WCA part by all pairs, O(N^2)).
     pub fn potential_energy(&self) -> f64 {
         let k = self.params.bond_k;
         let mut u = 0.0;
