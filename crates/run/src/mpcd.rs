@@ -1244,7 +1244,7 @@ impl Session for DropletSession {
                     line_plot(
                         &out.join(name),
                         &format!(
-                            "Drying MPCD droplet, boundary {boundary}: R0 = {}, Pe = {}",
+                            "Drying MPCD droplet, boundary {boundary}: R0 = {:.2}, Pe = {}",
                             p.r0, p.peclet
                         ),
                         "r / R(t)",
