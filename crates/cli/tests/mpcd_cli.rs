@@ -67,6 +67,24 @@ window = 50
 every = 50
 "#;
 
+/// Four colloids of d = 3 in a bulk box of 10 cells, 400 collisions, Green-Kubo over 20 lags.
+const BULK_COLLOIDS: &str = r#"
+method = "mpcd"
+seed = 6
+[system]
+box = 10
+colloids = 4
+diameter = 3
+[run]
+collisions = 400
+equilibrate = 100
+[observe]
+every = 10
+vacf_lags = 20
+[observe.trajectory]
+every = 50
+"#;
+
 fn run(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
     c.current_dir(dir).args(args);
@@ -85,7 +103,7 @@ fn summary(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn killed_interrupted_and_threaded_runs_give_the_same_bits() {
-    for scenario in [BULK, DROPLET, COLLOIDS] {
+    for scenario in [BULK, DROPLET, COLLOIDS, BULK_COLLOIDS] {
         let tmp = tempfile::tempdir().unwrap();
         let d = tmp.path();
         std::fs::write(d.join("s.toml"), scenario).unwrap();
@@ -114,7 +132,20 @@ fn killed_interrupted_and_threaded_runs_give_the_same_bits() {
         }
         let s = summary(&d.join("a"));
         assert_eq!(s["completed"], true);
-        if scenario == COLLOIDS {
+        if scenario == BULK_COLLOIDS {
+            assert_eq!(s["trajectory_frames"], 9);
+            let dc = &s["colloid_diffusion"];
+            assert!(dc["value"].as_f64().unwrap().is_finite(), "{dc}");
+            assert!(dc["standard_error"].as_f64().unwrap() > 0.0, "{dc}");
+            // The cell collisions conserve the momentum of solvent and colloids together
+            // (it starts at zero): every row of thermo.csv.
+            let (names, cols) =
+                colloidsim_core::output::read_table(&d.join("a/thermo.csv")).unwrap();
+            for axis in ["px", "py", "pz"] {
+                let c = &cols[names.iter().position(|n| n == axis).unwrap()];
+                assert!(c.iter().all(|p| p.abs() < 1e-9), "{axis}: {c:?}");
+            }
+        } else if scenario == COLLOIDS {
             assert_eq!(s["trajectory_frames"], 7);
             assert_eq!(s["colloids"]["centres_beyond_R_at_end"], 0);
             for f in ["profile_0.00.csv", "profile_1.00.csv", "profiles.png"] {
@@ -299,7 +330,12 @@ fn bad_input_is_refused_naming_the_key_and_range() {
 #[test]
 fn the_examples_are_valid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
-    for name in ["mpcd/viscosity.toml", "droplet/drying-mpcd-solvent.toml"] {
+    for name in [
+        "mpcd/viscosity.toml",
+        "mpcd/colloid-diffusion.toml",
+        "droplet/drying-mpcd-solvent.toml",
+        "droplet/drying-mpcd.toml",
+    ] {
         let tmp = tempfile::tempdir().unwrap();
         let o = run(
             tmp.path(),

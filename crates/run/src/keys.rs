@@ -1403,6 +1403,15 @@ pub static MPCD: &[Spec] = &[
         "edge L of the periodic cube",
     )
     .also("a whole number of cells, 2 to 4096 of them"),
+    key("system.colloids", "-", "0", Integer(0, 1_000_000), "discrete-particle colloids placed at random; their diffusivity by Green-Kubo (vacf.csv, summary colloid_diffusion)")
+        .also("not with [viscosity]; they must fit"),
+    key("system.diameter", "length", "4", Positive, "colloid diameter d")
+        .also("the box above twice the WCA cut-off 2^(1/6) d"),
+    key("colloid", "-", "-", Table, "the discrete-particle colloid, as droplet-mpcd's"),
+    key("colloid.vertex_mass", "mass", "5", Positive, "mass of each of the 42 vertices (they join the collisions)"),
+    key("colloid.centre_mass", "mass", "5", Positive, "mass of the central particle"),
+    key("colloid.bond_k", "energy / length^2", "5000", Positive, "spring constant of the 120 edge and 42 spoke bonds"),
+    key("colloid.md_steps", "-", "50", Integer(1, 100_000), "velocity Verlet steps per collision time"),
     key("run", "-", "required", Table, "collisions"),
     key(
         "run.collisions",
@@ -1450,6 +1459,8 @@ pub static MPCD: &[Spec] = &[
         Integer(1, COUNT),
         "rows of thermo.csv (temperature, flow amplitude, momentum)",
     ),
+    key("observe.vacf_lags", "collisions", "5 L^2 / (4 pi^2 nu tau)", Integer(1, COUNT), "lags of the colloids' velocity autocorrelation summed by Green-Kubo (five decay times of the box's slowest shear mode)")
+        .also("at most half the sampling collisions"),
     key("observe.trajectory", "-", "-", Table, "GSD trajectory"),
     key(
         "observe.trajectory.every",
@@ -1463,9 +1474,9 @@ pub static MPCD: &[Spec] = &[
         "-",
         "false",
         Bool,
-        "frames hold the solvent (type S, with velocities)",
+        "frames hold the solvent (type S, with velocities; colloids are types A and V)",
     )
-    .also("true when frames are written: a bulk solvent has no colloids"),
+    .also("true when frames are written without colloids"),
 ];
 
 /// The keys of `droplet-mpcd` scenarios.

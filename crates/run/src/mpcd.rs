@@ -67,21 +67,22 @@ fn solvent_frame(w: &mut GsdWriter, srd: &Srd, log: &[(&str, f64)]) -> Result<()
     Ok(())
 }
 
-/// A GSD frame of a droplet with colloids: the centres (type `A`, diameter d), the vertices
-/// (type `V`) and, when asked, the solvent (type `S`).
-fn droplet_frame(
+/// A GSD frame with colloids: the centres (type `A`, diameter d), the vertices (type `V`) and,
+/// with `solvent`, the solvent (type `S`).
+fn colloid_frame(
     w: &mut GsdWriter,
     srd: &Srd,
     col: &DiscreteColloids,
-    p: &DropletRun,
+    solvent: bool,
     log: &[(&str, f64)],
 ) -> Result<()> {
     let sbox = *srd.sbox();
+    let cp = col.params();
     let mut pos: Vec<[f64; 3]> = col.centre_positions().to_vec();
     let mut vel: Vec<[f64; 3]> = col.centre_velocities().to_vec();
     let mut typeid = vec![0u32; pos.len()];
-    let mut diameter = vec![p.diameter; pos.len()];
-    let mut mass = vec![p.colloid.centre_mass; pos.len()];
+    let mut diameter = vec![cp.diameter; pos.len()];
+    let mut mass = vec![cp.centre_mass; pos.len()];
     for (x, v) in col.vertex_positions().iter().zip(col.vertex_velocities()) {
         let mut x = *x;
         let mut image = [0; 3];
@@ -89,16 +90,16 @@ fn droplet_frame(
         pos.push(x);
         vel.push(*v);
         typeid.push(1);
-        diameter.push(0.25 * p.solvent.srd.cell);
-        mass.push(p.colloid.vertex_mass);
+        diameter.push(0.25 * srd.params().cell);
+        mass.push(cp.vertex_mass);
     }
-    if p.trajectory_solvent {
+    if solvent {
         pos.extend(srd.positions());
         vel.extend(srd.velocities());
         let n = srd.len();
         typeid.extend(std::iter::repeat_n(2, n));
-        diameter.extend(std::iter::repeat_n(0.2 * p.solvent.srd.cell, n));
-        mass.extend(std::iter::repeat_n(p.solvent.srd.mass, n));
+        diameter.extend(std::iter::repeat_n(0.2 * srd.params().cell, n));
+        mass.extend(std::iter::repeat_n(srd.params().mass, n));
     }
     let n = pos.len();
     let frame = Particles {
@@ -112,6 +113,86 @@ fn droplet_frame(
     };
     w.write_frame(srd.step(), &sbox, &frame, false, log)?;
     Ok(())
+}
+
+/// The Green–Kubo diffusivity of colloids from their centre-of-mass velocities `V`, which only
+/// the collisions change (bonds are internal; the colloids fly straight between collisions
+/// apart from WCA contacts): `D = (tau / 3) (C_0 / 2 + sum_{k=1}^{K} C_k)`, `C_k = <V_n . V_{n+k}>`
+/// over colloids and origins, per block of the sampling collisions (docs/mpcd.md, "Colloids:
+/// diffusion").
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Vacf {
+    lags: usize,
+    /// The last `lags + 1` velocity sets, a ring; `head` is the newest.
+    history: Vec<Vec<[f64; 3]>>,
+    head: usize,
+    filled: usize,
+    /// Per block: sums of `V_n . V_{n-k}` over colloids and origins, and their counts.
+    sums: Vec<Vec<f64>>,
+    counts: Vec<Vec<f64>>,
+}
+
+impl Vacf {
+    fn new(lags: u64, blocks: u64) -> Self {
+        let lags = lags as usize;
+        Self {
+            lags,
+            history: vec![Vec::new(); lags + 1],
+            head: 0,
+            filled: 0,
+            sums: vec![vec![0.0; lags + 1]; blocks as usize],
+            counts: vec![vec![0.0; lags + 1]; blocks as usize],
+        }
+    }
+
+    /// Add the velocities of one collision to block `block`.
+    fn push(&mut self, v: &[[f64; 3]], block: usize) {
+        let slots = self.lags + 1;
+        self.head = (self.head + 1) % slots;
+        let slot = &mut self.history[self.head];
+        slot.clear();
+        slot.extend_from_slice(v);
+        self.filled = (self.filled + 1).min(slots);
+        for k in 0..self.filled {
+            let old = &self.history[(self.head + slots - k) % slots];
+            let c: f64 = v
+                .iter()
+                .zip(old)
+                .map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+                .sum();
+            self.sums[block][k] += c;
+            self.counts[block][k] += v.len() as f64;
+        }
+    }
+
+    /// `(D, its standard error from the block scatter, C_k / 3 over all blocks)`.
+    fn estimate(&self, tau: f64) -> (f64, f64, Vec<f64>) {
+        let per_block: Vec<f64> = (0..self.sums.len())
+            .filter(|&b| self.counts[b][self.lags] > 0.0)
+            .map(|b| {
+                let c = |k: usize| self.sums[b][k] / self.counts[b][k];
+                tau / 3.0 * (0.5 * c(0) + (1..=self.lags).map(c).sum::<f64>())
+            })
+            .collect();
+        let m = per_block.len() as f64;
+        let d = per_block.iter().sum::<f64>() / m;
+        let se = if per_block.len() >= 2 {
+            (per_block.iter().map(|x| (x - d).powi(2)).sum::<f64>() / (m - 1.0) / m).sqrt()
+        } else {
+            f64::NAN
+        };
+        let curve = (0..=self.lags)
+            .map(|k| {
+                let (s, n) = self
+                    .sums
+                    .iter()
+                    .zip(&self.counts)
+                    .fold((0.0, 0.0), |(s, n), (a, b)| (s + a[k], n + b[k]));
+                s / n.max(1.0) / 3.0
+            })
+            .collect();
+        (d, se, curve)
+    }
 }
 
 /// Open (fresh) or reopen (restart) the trajectory when frames are due.
@@ -159,6 +240,23 @@ fn build_bulk(p: &BulkRun) -> Result<Srd> {
     )?)
 }
 
+/// The bulk's colloids: random sequential addition in the box.
+fn build_bulk_colloids(p: &BulkRun) -> Result<Option<DiscreteColloids>> {
+    if p.colloids == 0 {
+        return Ok(None);
+    }
+    DiscreteColloids::random(
+        p.colloid,
+        SimBox::cube(p.box_edge),
+        p.colloids,
+        Region::Box,
+        p.solvent.srd.kt,
+        p.seed,
+    )
+    .map(Some)
+    .map_err(|e| anyhow::anyhow!("system.colloids: {e}"))
+}
+
 impl Method for MpcdBulk {
     fn names(&self) -> &'static [&'static str] {
         &["mpcd"]
@@ -174,6 +272,7 @@ impl Method for MpcdBulk {
 
     fn check(&self, src: &Source) -> Result<Checked> {
         let p = resolve_bulk(src, None)?;
+        build_bulk_colloids(&p).with_context(|| src.label())?;
         Ok(Checked {
             resolved: serde_json::to_value(&p)?,
             warnings: Vec::new(),
@@ -182,11 +281,13 @@ impl Method for MpcdBulk {
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
         let p = resolve_bulk(src, seed)?;
+        let colloids = build_bulk_colloids(&p).with_context(|| src.label())?;
         let srd = build_bulk(&p).with_context(|| src.label())?;
         let acc = BulkAccum::new(&p);
         Ok(Box::new(BulkSession {
             p,
             srd,
+            colloids,
             acc,
             gsd: None,
         }))
@@ -207,6 +308,14 @@ impl Method for MpcdBulk {
         let srd = saved
             .solvent
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+        let colloids = match &saved.colloids {
+            Some(state) if state.centre_pos.len() == p.colloids => Some(
+                DiscreteColloids::from_state(p.colloid, SimBox::cube(p.box_edge), state)
+                    .context("checkpoint.bin: the colloids")?,
+            ),
+            None if p.colloids == 0 => None,
+            _ => bail!("checkpoint: its colloids do not fit the scenario"),
+        };
         if p.trajectory_every > 0 {
             saved
                 .acc
@@ -218,6 +327,7 @@ impl Method for MpcdBulk {
         Ok(Box::new(BulkSession {
             p,
             srd,
+            colloids,
             acc: saved.acc,
             gsd: None,
         }))
@@ -229,6 +339,12 @@ impl Method for MpcdBulk {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve_bulk(src, seed)?;
+        if p.colloids > 0 {
+            bail!(
+                "{}: an mpcd engine with colloids cannot be stepped by hand yet (only the solvent)",
+                src.label()
+            );
+        }
         let drive = p.drive.map(|g0| Acceleration::CosineX {
             amplitude: g0,
             wavenumber: 2.0 * PI / p.box_edge,
@@ -249,7 +365,10 @@ struct BulkRow {
     collision: u64,
     temperature: f64,
     flow: f64,
+    /// Of the solvent and the colloids.
     momentum: [f64; 3],
+    /// Kinetic temperature of the colloids' centre-of-mass velocities (NaN without).
+    colloid_temperature: f64,
 }
 
 /// What a bulk run accumulates (saved in every checkpoint).
@@ -265,6 +384,8 @@ struct BulkAccum {
     /// `v_x` summed in slabs along z over the profile samples, and the samples.
     flow_profile: Vec<f64>,
     flow_counts: Vec<f64>,
+    /// The colloids' velocity autocorrelation (with colloids).
+    vacf: Option<Vacf>,
     frames: u64,
     digest: FrameDigest,
 }
@@ -284,6 +405,7 @@ impl BulkAccum {
             temperature: BlockAverage::new(block.div_ceil(p.thermo_every).max(1)),
             flow_profile: vec![0.0; slabs],
             flow_counts: vec![0.0; slabs],
+            vacf: (p.colloids > 0).then(|| Vacf::new(p.vacf_lags, p.blocks)),
             frames: 0,
             digest: FrameDigest::default(),
         }
@@ -293,12 +415,14 @@ impl BulkAccum {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct BulkSaved {
     solvent: SolventState,
+    colloids: Option<ColloidState>,
     acc: BulkAccum,
 }
 
 struct BulkSession {
     p: BulkRun,
     srd: Srd,
+    colloids: Option<DiscreteColloids>,
     acc: BulkAccum,
     gsd: Option<GsdWriter>,
 }
@@ -326,11 +450,20 @@ impl BulkSession {
             } else {
                 self.srd.temperature()
             };
+            let mut momentum = self.srd.momentum();
+            if let Some(col) = &self.colloids {
+                let pc = col.momentum();
+                momentum = std::array::from_fn(|k| momentum[k] + pc[k]);
+            }
             self.acc.rows.push(BulkRow {
                 collision: c,
                 temperature,
                 flow,
-                momentum: self.srd.momentum(),
+                momentum,
+                colloid_temperature: self
+                    .colloids
+                    .as_ref()
+                    .map_or(f64::NAN, |c| c.com_temperature()),
             });
             if c > p.equilibrate {
                 self.acc.temperature.push(temperature);
@@ -347,7 +480,10 @@ impl BulkSession {
         if let Some(w) = self.gsd.as_mut()
             && c.is_multiple_of(p.trajectory_every)
         {
-            solvent_frame(w, &self.srd, &[])?;
+            match &self.colloids {
+                Some(col) => colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[])?,
+                None => solvent_frame(w, &self.srd, &[])?,
+            }
             self.acc.frames += 1;
         }
         Ok(())
@@ -380,6 +516,7 @@ impl Session for BulkSession {
             "thermo.csv",
             "flow_profile.csv",
             "flow_profile.png",
+            "vacf.csv",
             "trajectory.gsd",
         ]
         .contains(&name)
@@ -414,12 +551,25 @@ impl Session for BulkSession {
             if let Err(e) = self.srd.stream(t, &conf, &drive) {
                 return Ok(Some(e.to_string()));
             }
+            if let Some(col) = self.colloids.as_mut()
+                && let Err(e) = col.advance(t - tau, tau, &colloidsim_md::NoExternal)
+            {
+                return Ok(Some(e.to_string()));
+            }
             let sampling = self.srd.step() >= self.p.equilibrate;
             let before = match (&self.acc.probe, sampling) {
                 (Some(_), true) => PoiseuilleProbe::amplitude_of(&self.srd, k),
                 _ => 0.0,
             };
-            self.srd.collide(t, &conf, None);
+            let emb = self.colloids.as_mut().map(|c| c.embedded());
+            self.srd.collide(t, &conf, emb);
+            if sampling && let (Some(col), Some(vacf)) = (&self.colloids, self.acc.vacf.as_mut()) {
+                // Sample j of the sampling part belongs to block j * blocks / sampling.
+                let j = self.srd.step() - self.p.equilibrate - 1;
+                let n = self.p.collisions - self.p.equilibrate;
+                let b = ((j as u128 * self.p.blocks as u128) / n as u128) as usize;
+                vacf.push(&col.com_velocities(), b);
+            }
             if let Some(probe) = self.acc.probe.as_mut() {
                 if !thermostat {
                     // Without the cell thermostat the viscous heat leaves by a global
@@ -455,6 +605,7 @@ impl Session for BulkSession {
         }
         Ok(bincode::serialize(&BulkSaved {
             solvent: SolventState::of(&self.srd),
+            colloids: self.colloids.as_ref().map(|c| c.state()),
             acc: self.acc.clone(),
         })?)
     }
@@ -570,12 +721,63 @@ impl Session for BulkSession {
                 );
             }
         }
+        if let Some(vacf) = &self.acc.vacf {
+            let tau = p.solvent.srd.tau;
+            let (d, se, curve) = vacf.estimate(tau);
+            let lag: Vec<f64> = (0..curve.len()).map(|k| k as f64 * tau).collect();
+            let mut running = Vec::with_capacity(curve.len());
+            let mut acc = 0.0;
+            for (k, c) in curve.iter().enumerate() {
+                acc += if k == 0 { 0.5 * c } else { *c };
+                running.push(tau * acc);
+            }
+            out.write_table(
+                "vacf.csv",
+                &[
+                    ("lag", &lag),
+                    ("vacf_over_3", &curve),
+                    ("d_running", &running),
+                ],
+            )?;
+            files.push("vacf.csv".into());
+            let theory = p.stokes_einstein_hasimoto;
+            summary["colloid_diffusion"] = json!({
+                "value": d,
+                "standard_error": se,
+                "method": "Green-Kubo of the colloids' centre-of-mass velocities, D = (tau/3) (C_0/2 + sum_k C_k), blocks for the error",
+                "lags": p.vacf_lags,
+                "stokes_einstein_hasimoto": theory,
+                "relative_deviation": d / theory - 1.0,
+                "hydrodynamic_radius_assumed": 0.5 * p.colloid.diameter,
+                "viscosity_used": p.solvent.viscosity_theory,
+            });
+            if let Some(col) = &self.colloids {
+                summary["colloids"] = json!({
+                    "particles": col.len(),
+                    "temperature_centre_of_mass": col.com_temperature(),
+                    "temperature_all_particles": col.temperature(),
+                    "bond_strain_rms": col.bond_strain_rms(),
+                });
+            }
+        }
         if self.acc.frames > 0 {
             files.push("trajectory.gsd".into());
         }
         summary["warnings"] = json!(warnings);
         let message = match (failure, summary.get("viscosity")) {
             (Some(f), _) => format!("mpcd stopped at collision {collisions}: {f}"),
+            (None, None) if summary.get("colloid_diffusion").is_some() => format!(
+                "mpcd: {collisions} collisions of {} solvent particles and {} colloids; D = {:.6} +- {:.6} (Stokes-Einstein-Hasimoto at a = d/2: {:.6})",
+                self.srd.len(),
+                p.colloids,
+                summary["colloid_diffusion"]["value"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                summary["colloid_diffusion"]["standard_error"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN),
+                p.stokes_einstein_hasimoto
+            ),
             (None, Some(v)) => format!(
                 "mpcd: {collisions} collisions of {} solvent particles; viscosity {:.4} +- {:.4} (Kikuchi et al. {:.4})",
                 self.srd.len(),
@@ -610,6 +812,7 @@ fn write_bulk_thermo(out: &OutputDir, p: &BulkRun, rows: &[BulkRow]) -> Result<(
             ("px", &col(&|r| r.momentum[0])),
             ("py", &col(&|r| r.momentum[1])),
             ("pz", &col(&|r| r.momentum[2])),
+            ("colloid_temperature", &col(&|r| r.colloid_temperature)),
         ],
     )?;
     Ok(())
@@ -958,7 +1161,9 @@ impl DropletSession {
             && c.is_multiple_of(p.trajectory_every)
         {
             match &self.colloids {
-                Some(col) => droplet_frame(w, &self.srd, col, p, &[("radius", r)])?,
+                Some(col) => {
+                    colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[("radius", r)])?
+                }
                 None => solvent_frame(w, &self.srd, &[("radius", r)])?,
             }
             self.acc.frames += 1;

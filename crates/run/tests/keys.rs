@@ -165,14 +165,22 @@ cell = 1.0
 thermostat = true
 [system]
 box = 8.0
+colloids = 0
+diameter = 4.0
 [run]
 collisions = 400
 equilibrate = 100
 [viscosity]
 drive = 0.01
 blocks = 10
+[colloid]
+vertex_mass = 5.0
+centre_mass = 5.0
+bond_k = 5000.0
+md_steps = 50
 [observe]
 every = 10
+vacf_lags = 100
 [observe.trajectory]
 every = 0
 solvent = false

@@ -152,6 +152,11 @@ pub struct BulkSystem {
     /// Edge of the periodic cube (a whole number of cells).
     #[serde(rename = "box")]
     pub box_edge: f64,
+    /// Discrete-particle colloids placed at random (default 0).
+    #[serde(default)]
+    pub colloids: usize,
+    /// Colloid diameter d (default 4 cells).
+    pub diameter: Option<f64>,
 }
 
 /// `[run]` of a bulk scenario.
@@ -183,6 +188,9 @@ pub struct ViscositySection {
 pub struct BulkObserve {
     /// A row of `thermo.csv` every this many collisions (default: 200 rows over the run).
     pub every: Option<u64>,
+    /// Lags (collisions) of the colloids' velocity autocorrelation summed by Green–Kubo
+    /// (default: five decay times `L^2 / (4 pi^2 nu)` of the box's slowest shear mode).
+    pub vacf_lags: Option<u64>,
     /// GSD trajectory.
     #[serde(default)]
     pub trajectory: TrajectorySection,
@@ -244,6 +252,9 @@ pub struct BulkScenario {
     pub run: BulkRunSection,
     /// Shear-viscosity measurement (absent: none, the solvent at rest).
     pub viscosity: Option<ViscositySection>,
+    /// The discrete-particle colloid.
+    #[serde(default)]
+    pub colloid: ColloidSection,
     /// Observables.
     #[serde(default)]
     pub observe: BulkObserve,
@@ -278,6 +289,17 @@ pub struct BulkRun {
     pub thermo_every: u64,
     /// GSD frame period (0: none).
     pub trajectory_every: u64,
+    /// Frames hold the solvent.
+    pub trajectory_solvent: bool,
+    /// Colloids.
+    pub colloids: usize,
+    /// The colloid model.
+    pub colloid: ColloidParams,
+    /// Lags of the Green–Kubo sum of the colloids' centre-of-mass velocity autocorrelation.
+    pub vacf_lags: u64,
+    /// Stokes–Einstein–Hasimoto diffusivity `kT / (3 pi eta d) (1 - 2.837297 a/L + (4 pi / 3)
+    /// (a/L)^3)` of a sphere of radius `a = d/2` with the theory's viscosity.
+    pub stokes_einstein_hasimoto: f64,
 }
 
 fn thermo_every(every: Option<u64>, collisions: u64) -> Result<u64, ParamError> {
@@ -373,12 +395,58 @@ impl BulkScenario {
         }
         let o = &self.observe;
         let t = &o.trajectory;
-        if t.every > 0 && !t.solvent {
+        let nc = self.system.colloids;
+        if t.every > 0 && !t.solvent && nc == 0 {
             return Err(ParamError::new(
                 "observe.trajectory.solvent",
-                "a bulk solvent has no colloids: a trajectory (observe.trajectory.every > 0) needs observe.trajectory.solvent = true",
+                "a bulk solvent without colloids: a trajectory (observe.trajectory.every > 0) needs observe.trajectory.solvent = true",
             ));
         }
+        if nc > 1_000_000 {
+            return Err(ParamError::new(
+                "system.colloids",
+                format!("must be an integer in [0, 1000000], got {nc}"),
+            ));
+        }
+        if nc > 0 && self.viscosity.is_some() {
+            return Err(ParamError::new(
+                "viscosity",
+                "the Poiseuille drive acts on the solvent alone: with colloids it would measure neither the solvent nor the suspension; measure the solvent without colloids (system.colloids = 0)",
+            ));
+        }
+        let d = positive(
+            "system.diameter",
+            self.system.diameter.unwrap_or(4.0 * srd.cell),
+        )?;
+        if nc > 0 && 2.0 * 2f64.powf(1.0 / 6.0) * d >= l {
+            return Err(ParamError::new(
+                "system.box",
+                format!(
+                    "{} must exceed twice the colloids' WCA cut-off 2^(1/6) d = {:.4}",
+                    show(l),
+                    2f64.powf(1.0 / 6.0) * d
+                ),
+            ));
+        }
+        let colloid = self.colloid.params(d, srd.kt)?;
+        let nu = eta / rho;
+        let slowest = l * l / (4.0 * PI * PI * nu);
+        let vacf_lags = o
+            .vacf_lags
+            .unwrap_or((5.0 * slowest / srd.tau).round().max(1.0) as u64);
+        let sampling = collisions - equilibrate;
+        if nc > 0 && !(1..=sampling / 2).contains(&vacf_lags) {
+            return Err(ParamError::new(
+                "observe.vacf_lags",
+                format!(
+                    "must be an integer in [1, half the sampling collisions = {}], got {vacf_lags}: run longer",
+                    sampling / 2
+                ),
+            ));
+        }
+        let x = 0.5 * d / l;
+        let stokes_einstein_hasimoto =
+            srd.kt / (3.0 * PI * eta * d) * (1.0 - 2.837297 * x + 4.0 / 3.0 * PI * x.powi(3));
         Ok(BulkRun {
             seed,
             solvent,
@@ -391,6 +459,11 @@ impl BulkScenario {
             blocks,
             thermo_every: thermo_every(o.every, collisions)?,
             trajectory_every: t.every,
+            trajectory_solvent: t.solvent,
+            colloids: nc,
+            colloid,
+            vacf_lags,
+            stokes_einstein_hasimoto,
         })
     }
 }
@@ -438,6 +511,34 @@ pub struct ColloidSection {
     pub bond_k: Option<f64>,
     /// Velocity Verlet steps per collision time (default 50).
     pub md_steps: Option<u32>,
+}
+
+impl ColloidSection {
+    /// The colloid model of diameter `d`, every key checked.
+    pub fn params(&self, d: f64, kt: f64) -> Result<ColloidParams, ParamError> {
+        let std = ColloidParams::standard(d, kt);
+        let md_steps = self.md_steps.unwrap_or(std.md_steps);
+        if !(1..=100_000).contains(&md_steps) {
+            return Err(ParamError::new(
+                "colloid.md_steps",
+                format!("must be an integer in [1, 100000], got {md_steps}"),
+            ));
+        }
+        Ok(ColloidParams {
+            diameter: d,
+            vertex_mass: positive(
+                "colloid.vertex_mass",
+                self.vertex_mass.unwrap_or(std.vertex_mass),
+            )?,
+            centre_mass: positive(
+                "colloid.centre_mass",
+                self.centre_mass.unwrap_or(std.centre_mass),
+            )?,
+            bond_k: positive("colloid.bond_k", self.bond_k.unwrap_or(std.bond_k))?,
+            md_steps,
+            wca_epsilon: std.wca_epsilon,
+        })
+    }
 }
 
 /// A `droplet-mpcd` scenario as written.
@@ -574,29 +675,7 @@ impl DropletScenario {
         }
         let d = positive("system.diameter", s.diameter.unwrap_or(4.0 * a))?;
         let kt = srd.kt;
-        let std = ColloidParams::standard(d, kt);
-        let c = &self.colloid;
-        let md_steps = c.md_steps.unwrap_or(std.md_steps);
-        if !(1..=100_000).contains(&md_steps) {
-            return Err(ParamError::new(
-                "colloid.md_steps",
-                format!("must be an integer in [1, 100000], got {md_steps}"),
-            ));
-        }
-        let colloid = ColloidParams {
-            diameter: d,
-            vertex_mass: positive(
-                "colloid.vertex_mass",
-                c.vertex_mass.unwrap_or(std.vertex_mass),
-            )?,
-            centre_mass: positive(
-                "colloid.centre_mass",
-                c.centre_mass.unwrap_or(std.centre_mass),
-            )?,
-            bond_k: positive("colloid.bond_k", c.bond_k.unwrap_or(std.bond_k))?,
-            md_steps,
-            wca_epsilon: std.wca_epsilon,
-        };
+        let colloid = self.colloid.params(d, kt)?;
         let n = s.particles as f64;
         let (r0, phi0) = match (s.radius, s.phi0) {
             (Some(_), Some(_)) => {
