@@ -1370,6 +1370,46 @@ macro_rules! solvent_keys {
 
 const SOLVENT: [Spec; 8] = solvent_keys!();
 
+/// The `[colloid]` keys of both MPCD methods (the discrete-particle colloid; defaults chosen,
+/// docs/mpcd.md).
+const COLLOID: [Spec; 5] = [
+    key(
+        "colloid",
+        "-",
+        "-",
+        Table,
+        "the discrete-particle colloid: 42 vertices and a centre, harmonic bonds (defaults chosen, docs/mpcd.md)",
+    ),
+    key(
+        "colloid.vertex_mass",
+        "mass",
+        "5",
+        Positive,
+        "mass of each of the 42 vertices (they join the collisions)",
+    ),
+    key(
+        "colloid.centre_mass",
+        "mass",
+        "5",
+        Positive,
+        "mass of the central particle (WCA between centres, the droplet's interface acts on it)",
+    ),
+    key(
+        "colloid.bond_k",
+        "energy / length^2",
+        "5000",
+        Positive,
+        "spring constant of the 120 edge and 42 spoke bonds (5000 kT / a^2 at kT = 1)",
+    ),
+    key(
+        "colloid.md_steps",
+        "-",
+        "50",
+        Integer(1, 100_000),
+        "velocity Verlet steps per collision time",
+    ),
+];
+
 /// The keys of `mpcd` scenarios.
 pub static MPCD: &[Spec] = &[
     key(
@@ -1407,11 +1447,11 @@ pub static MPCD: &[Spec] = &[
         .also("not with [viscosity]; they must fit"),
     key("system.diameter", "length", "4", Positive, "colloid diameter d")
         .also("the box above twice the WCA cut-off 2^(1/6) d"),
-    key("colloid", "-", "-", Table, "the discrete-particle colloid, as droplet-mpcd's"),
-    key("colloid.vertex_mass", "mass", "5", Positive, "mass of each of the 42 vertices (they join the collisions)"),
-    key("colloid.centre_mass", "mass", "5", Positive, "mass of the central particle"),
-    key("colloid.bond_k", "energy / length^2", "5000", Positive, "spring constant of the 120 edge and 42 spoke bonds"),
-    key("colloid.md_steps", "-", "50", Integer(1, 100_000), "velocity Verlet steps per collision time"),
+    COLLOID[0],
+    COLLOID[1],
+    COLLOID[2],
+    COLLOID[3],
+    COLLOID[4],
     key("run", "-", "required", Table, "collisions"),
     key(
         "run.collisions",
@@ -1624,41 +1664,11 @@ pub static DROPLET_MPCD: &[Spec] = &[
         "offset of the wall from R(t) (-d/2: the surface touches R)",
     )
     .also("in [-R0, R0]"),
-    key(
-        "colloid",
-        "-",
-        "-",
-        Table,
-        "the discrete-particle colloid: 42 vertices and a centre, harmonic bonds (defaults chosen, docs/mpcd.md)",
-    ),
-    key(
-        "colloid.vertex_mass",
-        "mass",
-        "5",
-        Positive,
-        "mass of each of the 42 vertices (they join the collisions)",
-    ),
-    key(
-        "colloid.centre_mass",
-        "mass",
-        "5",
-        Positive,
-        "mass of the central particle (WCA between centres, the interface acts on it)",
-    ),
-    key(
-        "colloid.bond_k",
-        "energy / length^2",
-        "5000",
-        Positive,
-        "spring constant of the 120 edge and 42 spoke bonds (5000 kT / a^2 at kT = 1)",
-    ),
-    key(
-        "colloid.md_steps",
-        "-",
-        "50",
-        Integer(1, 100_000),
-        "velocity Verlet steps per collision time",
-    ),
+    COLLOID[0],
+    COLLOID[1],
+    COLLOID[2],
+    COLLOID[3],
+    COLLOID[4],
     key("observe", "-", "-", Table, "observables"),
     key(
         "observe.every",

@@ -242,19 +242,55 @@ fn build_bulk(p: &BulkRun) -> Result<Srd> {
 
 /// The bulk's colloids: random sequential addition in the box.
 fn build_bulk_colloids(p: &BulkRun) -> Result<Option<DiscreteColloids>> {
-    if p.colloids == 0 {
-        return Ok(None);
-    }
-    DiscreteColloids::random(
-        p.colloid,
-        SimBox::cube(p.box_edge),
+    place_colloids(
         p.colloids,
+        p.colloid,
+        p.box_edge,
         Region::Box,
         p.solvent.srd.kt,
         p.seed,
     )
-    .map(Some)
-    .map_err(|e| anyhow::anyhow!("system.colloids: {e}"))
+    .context("system.colloids")
+}
+
+/// `n` colloids placed by random sequential addition in `region` of the cube of edge `l`
+/// (none when `n = 0`).
+fn place_colloids(
+    n: usize,
+    params: colloidsim_md::mpcd::colloid::ColloidParams,
+    l: f64,
+    region: Region,
+    kt: f64,
+    seed: u32,
+) -> Result<Option<DiscreteColloids>> {
+    if n == 0 {
+        return Ok(None);
+    }
+    Ok(Some(DiscreteColloids::random(
+        params,
+        SimBox::cube(l),
+        n,
+        region,
+        kt,
+        seed,
+    )?))
+}
+
+/// The colloids a checkpoint holds, checked against the scenario's `n`.
+fn restore_colloids(
+    saved: Option<&ColloidState>,
+    n: usize,
+    params: colloidsim_md::mpcd::colloid::ColloidParams,
+    l: f64,
+) -> Result<Option<DiscreteColloids>> {
+    match saved {
+        Some(state) if state.centre_pos.len() == n && n > 0 => Ok(Some(
+            DiscreteColloids::from_state(params, SimBox::cube(l), state)
+                .context("checkpoint.bin: the colloids")?,
+        )),
+        None if n == 0 => Ok(None),
+        _ => bail!("checkpoint: its colloids do not fit the scenario"),
+    }
 }
 
 impl Method for MpcdBulk {
@@ -308,14 +344,8 @@ impl Method for MpcdBulk {
         let srd = saved
             .solvent
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
-        let colloids = match &saved.colloids {
-            Some(state) if state.centre_pos.len() == p.colloids => Some(
-                DiscreteColloids::from_state(p.colloid, SimBox::cube(p.box_edge), state)
-                    .context("checkpoint.bin: the colloids")?,
-            ),
-            None if p.colloids == 0 => None,
-            _ => bail!("checkpoint: its colloids do not fit the scenario"),
-        };
+        let colloids =
+            restore_colloids(saved.colloids.as_ref(), p.colloids, p.colloid, p.box_edge)?;
         if p.trajectory_every > 0 {
             saved
                 .acc
@@ -861,19 +891,15 @@ fn build_droplet(p: &DropletRun) -> Result<Srd> {
 
 /// The colloids at the start: random sequential addition with centres within `R0 - d/2`.
 fn build_colloids(p: &DropletRun) -> Result<Option<DiscreteColloids>> {
-    if p.particles == 0 {
-        return Ok(None);
-    }
-    DiscreteColloids::random(
-        p.colloid,
-        SimBox::cube(p.box_edge),
+    place_colloids(
         p.particles,
+        p.colloid,
+        p.box_edge,
         Region::Sphere { radius: p.r0 },
         p.solvent.srd.kt,
         p.seed,
     )
-    .map(Some)
-    .map_err(|e| anyhow::anyhow!("system.particles: {e}"))
+    .context("system.particles")
 }
 
 impl Method for DropletMpcd {
@@ -928,14 +954,8 @@ impl Method for DropletMpcd {
         let srd = saved
             .solvent
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
-        let colloids = match &saved.colloids {
-            Some(state) if state.centre_pos.len() == p.particles => Some(
-                DiscreteColloids::from_state(p.colloid, SimBox::cube(p.box_edge), state)
-                    .context("checkpoint.bin: the colloids")?,
-            ),
-            None if p.particles == 0 => None,
-            _ => bail!("checkpoint: its colloids do not fit the scenario"),
-        };
+        let colloids =
+            restore_colloids(saved.colloids.as_ref(), p.particles, p.colloid, p.box_edge)?;
         if p.trajectory_every > 0 {
             saved
                 .acc
