@@ -326,6 +326,7 @@ impl Method for MpcdBulk {
             colloids,
             acc,
             gsd: None,
+            com_scratch: Vec::new(),
         }))
     }
 
@@ -360,6 +361,7 @@ impl Method for MpcdBulk {
             colloids,
             acc: saved.acc,
             gsd: None,
+            com_scratch: Vec::new(),
         }))
     }
 
@@ -455,6 +457,8 @@ struct BulkSession {
     colloids: Option<DiscreteColloids>,
     acc: BulkAccum,
     gsd: Option<GsdWriter>,
+    /// The colloids' centre-of-mass velocities of the current collision (reused).
+    com_scratch: Vec<[f64; 3]>,
 }
 
 impl BulkSession {
@@ -598,7 +602,8 @@ impl Session for BulkSession {
                 let j = self.srd.step() - self.p.equilibrate - 1;
                 let n = self.p.collisions - self.p.equilibrate;
                 let b = ((j as u128 * self.p.blocks as u128) / n as u128) as usize;
-                vacf.push(&col.com_velocities(), b);
+                col.com_velocities_into(&mut self.com_scratch);
+                vacf.push(&self.com_scratch, b);
             }
             if let Some(probe) = self.acc.probe.as_mut() {
                 if !thermostat {

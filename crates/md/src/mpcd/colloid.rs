@@ -593,22 +593,29 @@ impl DiscreteColloids {
 
     /// Centre-of-mass velocity of each colloid (centre and vertices, mass-weighted).
     pub fn com_velocities(&self) -> Vec<[f64; 3]> {
+        let mut out = Vec::with_capacity(self.len());
+        self.com_velocities_into(&mut out);
+        out
+    }
+
+    /// [`Self::com_velocities`] into `out` (cleared first), for callers that sample every
+    /// collision without allocating.
+    pub fn com_velocities_into(&self, out: &mut Vec<[f64; 3]>) {
         let (mc, mv, m) = (
             self.params.centre_mass,
             self.params.vertex_mass,
             self.params.colloid_mass(),
         );
-        (0..self.len())
-            .map(|i| {
-                let mut p = self.centre_vel[i].map(|x| mc * x);
-                for v in &self.vertex_vel[i * VERTICES..(i + 1) * VERTICES] {
-                    for k in 0..3 {
-                        p[k] += mv * v[k];
-                    }
+        out.clear();
+        out.extend((0..self.len()).map(|i| {
+            let mut p = self.centre_vel[i].map(|x| mc * x);
+            for v in &self.vertex_vel[i * VERTICES..(i + 1) * VERTICES] {
+                for k in 0..3 {
+                    p[k] += mv * v[k];
                 }
-                p.map(|x| x / m)
-            })
-            .collect()
+            }
+            p.map(|x| x / m)
+        }));
     }
 
     /// Total momentum of all colloid particles (summed in index order).
