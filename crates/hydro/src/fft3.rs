@@ -2,9 +2,10 @@
 //! along x, `rustfft` along y and z), planes and lines in parallel.
 //!
 //! Layouts (n points per axis, `nh = n / 2 + 1` stored x-frequencies):
-//! real grid `[z][y][x]`; half spectrum after the x and y passes `[z][ky][kx]` (the `spec`
-//! buffer); full spectrum after the z pass `[ky][kx][kz]` (the `work` buffer, where the
-//! wave-space kernel is applied). Transforms are unnormalised (forward `e^{-ikx}`, inverse
+//! real grid `[z][y][x]`; half spectrum after the x and y passes `[z][kx][ky]` (the `spec`
+//! buffer); full spectrum after the z pass `[kx][ky][kz]` (the `work` buffer, where the
+//! wave-space kernel is applied). Each plane is transposed once per direction (`[y][kx]` to
+//! `[kx][y]`), and the z pass gathers contiguous rows. Transforms are unnormalised (forward `e^{-ikx}`, inverse
 //! `e^{+ikx}`; a round trip multiplies by `n^3`). Every line's transform is independent of the
 //! others, so the result does not depend on how the planes are shared among threads.
 
@@ -75,71 +76,79 @@ impl Fft3 {
         16 * self.scratch.len()
     }
 
-    /// Forward transform of `real` (`[z][y][x]`, overwritten) into `work` (`[ky][kx][kz]`),
+    /// Forward transform of `real` (`[z][y][x]`, overwritten) into `work` (`[kx][ky][kz]`),
     /// through `spec`.
     pub fn forward(&mut self, real: &mut [f64], spec: &mut [C64], work: &mut [C64]) {
         let (n, nh, sl) = (self.n, self.nh, self.scratch_len);
         let (r2c, fwd) = (&self.r2c, &self.fwd);
-        // x: real lines to half spectra; y: per plane, transpose [y][kx] -> [kx][y] into the
-        // plane's part of `work`, transform the lines, transpose back.
+        // x: real lines to half spectra; y: per plane, transpose [y][kx] -> [kx][y] into
+        // `spec` and transform its lines: `spec` is then [z][kx][ky].
         real.par_chunks_mut(n * n)
             .zip(spec.par_chunks_mut(n * nh))
             .zip(work.par_chunks_mut(n * nh))
             .zip(self.scratch.par_chunks_mut(sl))
             .for_each(|(((rp, sp), tmp), scratch)| {
-                for (line, out) in rp.chunks_exact_mut(n).zip(sp.chunks_exact_mut(nh)) {
+                for (line, out) in rp.chunks_exact_mut(n).zip(tmp.chunks_exact_mut(nh)) {
                     r2c.process_with_scratch(line, out, scratch)
                         .expect("r2c lengths");
                 }
-                transpose(sp, tmp, n, nh);
-                fwd.process_with_scratch(tmp, &mut scratch[..fwd.get_inplace_scratch_len()]);
-                transpose(tmp, sp, nh, n);
+                transpose(tmp, sp, n, nh);
+                fwd.process_with_scratch(sp, &mut scratch[..fwd.get_inplace_scratch_len()]);
             });
-        // z: gather [z][ky][kx] -> [ky][kx][kz], transform the kz lines.
+        // z: per kx, gather [z][kx][ky] -> [kx][ky][kz] (contiguous reads; the writes stay in
+        // the plane) and transform the kz lines.
         let spec = &*spec;
-        work.par_chunks_mut(nh * n)
+        work.par_chunks_mut(n * n)
             .zip(self.scratch.par_chunks_mut(sl))
             .enumerate()
-            .for_each(|(ky, (wp, scratch))| {
-                for kx in 0..nh {
-                    for z in 0..n {
-                        wp[kx * n + z] = spec[(z * n + ky) * nh + kx];
+            .for_each(|(kx, (wp, scratch))| {
+                for z in 0..n {
+                    let row = &spec[(z * nh + kx) * n..(z * nh + kx + 1) * n];
+                    for (ky, &v) in row.iter().enumerate() {
+                        wp[ky * n + z] = v;
                     }
                 }
                 fwd.process_with_scratch(wp, &mut scratch[..fwd.get_inplace_scratch_len()]);
             });
     }
 
-    /// Inverse transform of `work` (`[ky][kx][kz]`, overwritten) into `real` (`[z][y][x]`),
+    /// Inverse transform of `work` (`[kx][ky][kz]`, overwritten) into `real` (`[z][y][x]`),
     /// through `spec`. The imaginary parts that a real signal's spectrum cannot have (kx = 0
     /// and kx = n/2 after the y pass) are dropped.
     pub fn inverse(&mut self, work: &mut [C64], spec: &mut [C64], real: &mut [f64]) {
         let (n, nh, sl) = (self.n, self.nh, self.scratch_len);
         let (c2r, inv) = (&self.c2r, &self.inv);
-        work.par_chunks_mut(nh * n)
+        work.par_chunks_mut(n * n)
             .zip(self.scratch.par_chunks_mut(sl))
             .for_each(|(wp, scratch)| {
                 inv.process_with_scratch(wp, &mut scratch[..inv.get_inplace_scratch_len()]);
             });
         {
+            // [kx][ky][z] -> [z][kx][ky], blocks of Z planes so that each z line is read a
+            // cache line at a time.
+            const Z: usize = 4;
             let work = &*work;
-            spec.par_chunks_mut(n * nh).enumerate().for_each(|(z, sp)| {
-                for ky in 0..n {
-                    for kx in 0..nh {
-                        sp[ky * nh + kx] = work[(ky * nh + kx) * n + z];
+            spec.par_chunks_mut(Z * n * nh)
+                .enumerate()
+                .for_each(|(b, sp)| {
+                    let z0 = b * Z;
+                    let planes = sp.len() / (n * nh);
+                    for i in 0..n * nh {
+                        let line = &work[i * n + z0..i * n + z0 + planes];
+                        for (dz, &v) in line.iter().enumerate() {
+                            sp[dz * n * nh + i] = v;
+                        }
                     }
-                }
-            });
+                });
         }
         real.par_chunks_mut(n * n)
             .zip(spec.par_chunks_mut(n * nh))
             .zip(work.par_chunks_mut(n * nh))
             .zip(self.scratch.par_chunks_mut(sl))
             .for_each(|(((rp, sp), tmp), scratch)| {
-                transpose(sp, tmp, n, nh);
-                inv.process_with_scratch(tmp, &mut scratch[..inv.get_inplace_scratch_len()]);
-                transpose(tmp, sp, nh, n);
-                for (line, out) in sp.chunks_exact_mut(nh).zip(rp.chunks_exact_mut(n)) {
+                inv.process_with_scratch(sp, &mut scratch[..inv.get_inplace_scratch_len()]);
+                transpose(sp, tmp, nh, n);
+                for (line, out) in tmp.chunks_exact_mut(nh).zip(rp.chunks_exact_mut(n)) {
                     line[0].im = 0.0;
                     line[nh - 1].im = 0.0;
                     c2r.process_with_scratch(line, out, scratch)
@@ -153,10 +162,13 @@ impl Fft3 {
 fn transpose(src: &[C64], dst: &mut [C64], rows: usize, cols: usize) {
     const B: usize = 16;
     for r0 in (0..rows).step_by(B) {
+        let r1 = (r0 + B).min(rows);
         for c0 in (0..cols).step_by(B) {
-            for r in r0..(r0 + B).min(rows) {
-                for c in c0..(c0 + B).min(cols) {
-                    dst[c * rows + r] = src[r * cols + c];
+            let c1 = (c0 + B).min(cols);
+            for r in r0..r1 {
+                let line = &src[r * cols + c0..r * cols + c1];
+                for (c, &v) in (c0..c1).zip(line) {
+                    dst[c * rows + r] = v;
                 }
             }
         }
@@ -192,7 +204,7 @@ mod tests {
                             }
                         }
                     }
-                    let got = work[(ky * nh + kx) * n + kz];
+                    let got = work[(kx * n + ky) * n + kz];
                     assert!((got - s).norm() < 1e-11, "({kx},{ky},{kz}): {got} vs {s}");
                 }
             }

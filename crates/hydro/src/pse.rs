@@ -51,7 +51,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 /// Threshold of the Fourier cut-off, relative to the tolerance.
-const FOURIER_SHARE: f64 = 3.0;
+const FOURIER_SHARE: f64 = 6.0;
 /// Threshold of the Gaussian's aliasing and truncation, relative to the tolerance.
 const SUPPORT_SHARE: f64 = 2.0;
 /// Threshold of the real-space cut-off, relative to the tolerance (the real-space truncation
@@ -286,13 +286,77 @@ pub struct PseTimes {
     pub lanczos_iterations: u64,
 }
 
-/// One real-space pair of a neighbour list: `M^r_ij = a I + b e e^T`.
+/// One real-space pair of a neighbour list: `M^r_ij = a I + b e e^T`, stored in `T` (`f32`
+/// halves the data the Lanczos iterations stream; the sums are in `f64`).
 #[derive(Debug, Clone, Copy, Default)]
-struct Entry {
+struct Entry<T> {
     j: u32,
-    a: f64,
-    b: f64,
-    e: [f64; 3],
+    a: T,
+    b: T,
+    e: [T; 3],
+}
+
+/// Storage precision of the real-space pair tensors.
+trait Stored: Copy + Default + Send + Sync {
+    fn store(x: f64) -> Self;
+    fn load(self) -> f64;
+}
+
+impl Stored for f32 {
+    #[inline(always)]
+    fn store(x: f64) -> Self {
+        x as f32
+    }
+    #[inline(always)]
+    fn load(self) -> f64 {
+        self as f64
+    }
+}
+
+impl Stored for f64 {
+    #[inline(always)]
+    fn store(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn load(self) -> f64 {
+        self
+    }
+}
+
+/// Tolerances from which the real-space tensors are stored in single precision: their
+/// rounding (relative 6e-8, the operator stays exactly symmetric) is then at most 1/16 of the
+/// tolerance. Tighter tolerances keep them in double precision.
+const SINGLE_PRECISION_FROM: f64 = 1e-6;
+
+/// The real-space pair tensors of every row, in the precision the tolerance allows.
+enum Entries {
+    Single(Vec<Entry<f32>>),
+    Double(Vec<Entry<f64>>),
+}
+
+impl Entries {
+    fn for_tolerance(tolerance: f64) -> Self {
+        if tolerance >= SINGLE_PRECISION_FROM {
+            Self::Single(Vec::new())
+        } else {
+            Self::Double(Vec::new())
+        }
+    }
+
+    fn resize(&mut self, len: usize) {
+        match self {
+            Self::Single(v) => v.resize(len, Entry::default()),
+            Self::Double(v) => v.resize(len, Entry::default()),
+        }
+    }
+
+    fn bytes(&self) -> usize {
+        match self {
+            Self::Single(v) => v.capacity() * std::mem::size_of::<Entry<f32>>(),
+            Self::Double(v) => v.capacity() * std::mem::size_of::<Entry<f64>>(),
+        }
+    }
 }
 
 /// Positively split Ewald RPY mobility in a periodic cube.
@@ -320,7 +384,7 @@ pub struct Pse {
     candidates: Vec<u32>,
     /// The first `counts[r]` entries of row r are the pairs within the cut-off; an entry's
     /// `j` is the neighbour's row.
-    entries: Vec<Entry>,
+    entries: Entries,
     counts: Vec<u32>,
     /// Particle of each row, and row of each particle (cell order at the last candidate build).
     row_particle: Vec<u32>,
@@ -328,9 +392,11 @@ pub struct Pse {
     /// Forces and velocities of the real-space product in row order.
     f_rows: Vec<f64>,
     u_rows: Vec<f64>,
-    // Gaussian spreading: first grid index per axis and P weights per axis per particle.
+    // Gaussian spreading, in `plane_order`: first grid index per axis and P weights per axis
+    // of each particle, and the forces being spread.
     base: Vec<[u32; 3]>,
     weights: Vec<f64>,
+    f_sorted: Vec<[f64; 3]>,
     /// Sort key of each particle: first grid plane and row of its support, `z g + y`.
     plane_key: Vec<u32>,
     plane_start: Vec<u32>,
@@ -341,7 +407,7 @@ pub struct Pse {
     slot_of: Vec<u32>,
     /// Interpolated velocities in `plane_order`.
     sorted: Vec<[f64; 3]>,
-    // Grids: real `[z][y][x]`, one shared half spectrum, full spectra `[ky][kx][kz]`.
+    // Grids: real `[z][y][x]`, one shared half spectrum, full spectra `[kx][ky][kz]`.
     fft: Fft3,
     real: [Vec<f64>; 3],
     spec: Vec<C64>,
@@ -433,6 +499,16 @@ impl PseGeometry {
             grid = fft_size(pts);
             (h, sigma, pts) = support(grid);
         }
+        if pts > MAX_SUPPORT {
+            return Err(ParamError::new(
+                "hydrodynamics.tolerance",
+                format!(
+                    "{eps:e} needs a Gaussian support of {pts} grid points per axis, more than \
+                     {MAX_SUPPORT}; use a tolerance of 1e-13 or more"
+                ),
+            )
+            .into());
+        }
         let frac = 4.0 * xi * xi * sigma * sigma;
         debug_assert!(frac <= 1.0 + 1e-12, "Gaussian fraction {frac}");
         if grid > 1024 {
@@ -506,14 +582,14 @@ impl Pse {
                 (2 * m != grid).then(|| 2.0 * PI * f as f64 / l)
             })
             .collect();
-        let mut kernel = vec![0.0; grid * nh * grid];
+        let mut kernel = vec![0.0; nh * grid * grid];
         kernel
-            .par_chunks_mut(nh * grid)
+            .par_chunks_mut(grid * grid)
             .enumerate()
-            .for_each(|(ky, plane)| {
-                for kx in 0..nh {
+            .for_each(|(kx, plane)| {
+                for ky in 0..grid {
                     for kz in 0..grid {
-                        plane[kx * grid + kz] = match (kvec[kx], kvec[ky], kvec[kz]) {
+                        plane[ky * grid + kz] = match (kvec[kx], kvec[ky], kvec[kz]) {
                             (Some(x), Some(y), Some(z)) if kx + ky + kz > 0 => {
                                 let k2 = x * x + y * y + z * z;
                                 let q = k2 / (4.0 * xi * xi);
@@ -547,7 +623,7 @@ impl Pse {
             reference: Vec::new(),
             offsets: vec![0; n + 1],
             candidates: Vec::new(),
-            entries: Vec::new(),
+            entries: Entries::for_tolerance(params.tolerance),
             counts: vec![0; n],
             row_particle: (0..n as u32).collect(),
             row_of: (0..n as u32).collect(),
@@ -555,6 +631,7 @@ impl Pse {
             u_rows: vec![0.0; 3 * n],
             base: vec![[0; 3]; n],
             weights: vec![0.0; 3 * pts * n],
+            f_sorted: vec![[0.0; 3]; n],
             plane_key: vec![0; n],
             plane_start: vec![0; grid * grid + 1],
             slot_of: vec![0; n],
@@ -637,7 +714,7 @@ impl Pse {
             off[i + 1] += off[i];
         }
         self.candidates.resize(off[n], 0);
-        self.entries.resize(off[n], Entry::default());
+        self.entries.resize(off[n]);
         for_row_chunks(&off, &mut self.candidates, |lo, hi, out| {
             let base = off[lo];
             for r in lo..hi {
@@ -675,73 +752,46 @@ impl Pse {
         if moved {
             self.build_candidates();
         }
-        let rc2 = self.geom.r_cut * self.geom.r_cut;
-        let (a, eta, table) = (self.params.radius, self.params.viscosity, &self.table);
-        let (pos, off, cand) = (&self.pos, &self.offsets, &self.candidates);
-        let (row_particle, row_of) = (&self.row_particle, &self.row_of);
-        let counts = &mut self.counts;
-        let mut rows: Vec<(usize, usize, &mut [Entry], &mut [u32])> = Vec::new();
-        for_row_chunks_collect(off, &mut self.entries, counts, &mut rows);
-        rows.into_par_iter().for_each(|(lo, hi, out, count)| {
-            let base = off[lo];
-            for r in lo..hi {
-                let xi = pos[row_particle[r] as usize];
-                let mut k = off[r] - base;
-                for &j in &cand[off[r]..off[r + 1]] {
-                    let xj = pos[j as usize];
-                    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-                    for c in d.iter_mut() {
-                        if *c >= 0.5 * l {
-                            *c -= l;
-                        } else if *c < -0.5 * l {
-                            *c += l;
-                        }
-                    }
-                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    if r2 < rc2 {
-                        let r = r2.sqrt();
-                        let t = rpy(r, a, eta);
-                        let (aw, bw) = table.eval(r);
-                        out[k] = Entry {
-                            j: row_of[j as usize],
-                            a: t.a - aw,
-                            b: t.b - bw,
-                            e: d.map(|x| x / r),
-                        };
-                        k += 1;
-                    }
-                }
-                count[r - lo] = (k - (off[r] - base)) as u32;
-            }
-        });
+        let geometry = RealSpace {
+            box_length: l,
+            r_cut: self.geom.r_cut,
+            radius: self.params.radius,
+            viscosity: self.params.viscosity,
+            table: &self.table,
+            pos: &self.pos,
+            offsets: &self.offsets,
+            candidates: &self.candidates,
+            row_particle: &self.row_particle,
+            row_of: &self.row_of,
+        };
+        match &mut self.entries {
+            Entries::Single(e) => geometry.fill(e, &mut self.counts),
+            Entries::Double(e) => geometry.fill(e, &mut self.counts),
+        }
     }
 
-    /// Gaussian weights and grid bases of every particle, and their order by first plane.
+    /// The particles' order by the first grid plane and row of their support, and their grid
+    /// bases and Gaussian weights in that order (so that spreading and interpolation read them
+    /// one after the other).
     fn build_spreading(&mut self) {
         let (g, pts) = (self.geom.grid, self.geom.support);
         let (h, l, sigma) = (self.geom.spacing, self.params.box_length, self.geom.sigma);
         let norm = 1.0 / (2.0 * PI * sigma * sigma).sqrt();
         let c = -0.5 / (sigma * sigma);
-        // Odd supports centre on the nearest grid point, even ones on the cell.
+        // Odd supports centre on the nearest grid point, even ones on the cell: the first
+        // point of the support along an axis, and the particle's position in grid units.
         let (half, shift) = ((pts as isize - 1) / 2, if pts % 2 == 1 { 0.5 } else { 0.0 });
-        self.base
+        let first = move |x: f64| {
+            let s = (x + 0.5 * l) / h;
+            ((s + shift).floor() as isize - half, s)
+        };
+        let wrap_base = |i0: isize| i0.rem_euclid(g as isize) as u32;
+        self.plane_key
             .par_iter_mut()
-            .zip(self.weights.par_chunks_mut(3 * pts))
             .zip(self.pos.par_iter())
-            .for_each(|((base, w), x)| {
-                for k in 0..3 {
-                    let s = (x[k] + 0.5 * l) / h;
-                    let i0 = (s + shift).floor() as isize - half;
-                    base[k] = i0.rem_euclid(g as isize) as u32;
-                    for m in 0..pts {
-                        let d = ((i0 + m as isize) as f64 - s) * h;
-                        w[k * pts + m] = norm * (c * d * d).exp();
-                    }
-                }
+            .for_each(|(o, x)| {
+                *o = wrap_base(first(x[2]).0) * g as u32 + wrap_base(first(x[1]).0);
             });
-        for (o, b) in self.plane_key.iter_mut().zip(&self.base) {
-            *o = b[2] * g as u32 + b[1];
-        }
         counting_sort(
             &self.plane_key,
             &mut self.plane_start,
@@ -750,13 +800,41 @@ impl Pse {
         for (k, &j) in self.plane_order.iter().enumerate() {
             self.slot_of[j as usize] = k as u32;
         }
+        let (pos, order) = (&self.pos, &self.plane_order);
+        self.base
+            .par_iter_mut()
+            .zip(self.weights.par_chunks_mut(3 * pts))
+            .zip(order.par_iter())
+            .for_each(|((base, w), &j)| {
+                let x = pos[j as usize];
+                for k in 0..3 {
+                    let (i0, s) = first(x[k]);
+                    base[k] = wrap_base(i0);
+                    for m in 0..pts {
+                        let d = ((i0 + m as isize) as f64 - s) * h;
+                        w[k * pts + m] = norm * (c * d * d).exp();
+                    }
+                }
+            });
     }
 
     /// Spread the forces `f` onto the three real grids (a gather per plane).
     fn spread(&mut self, f: &[[f64; 3]]) {
-        let (g, pts) = (self.geom.grid, self.geom.support);
-        let (base, weights) = (&self.base, &self.weights);
-        let (start, order) = (&self.plane_start, &self.plane_order);
+        with_support!(self.geom.support, P => self.spread_p::<P>(f))
+    }
+
+    /// [`Self::spread`] with the support `P` known at compile time (`P = 0`: read at run time),
+    /// so that the rows of the support vectorise.
+    fn spread_p<const P: usize>(&mut self, f: &[[f64; 3]]) {
+        let g = self.geom.grid;
+        let pts = if P > 0 { P } else { self.geom.support };
+        self.f_sorted
+            .par_iter_mut()
+            .zip(self.plane_order.par_iter())
+            .with_min_len(1024)
+            .for_each(|(o, &j)| *o = f[j as usize]);
+        let (base, weights, f) = (&self.base, &self.weights, &self.f_sorted);
+        let start = &self.plane_start;
         let [gx, gy, gz] = &mut self.real;
         gx.par_chunks_mut(g * g)
             .zip(gy.par_chunks_mut(g * g))
@@ -767,22 +845,30 @@ impl Pse {
                 py.iter_mut().for_each(|v| *v = 0.0);
                 pz.iter_mut().for_each(|v| *v = 0.0);
                 for m in 0..pts {
-                    let b = (p + g * pts - m) % g;
-                    for &j in &order[start[b * g] as usize..start[(b + 1) * g] as usize] {
-                        let j = j as usize;
+                    let b = wrap(p + g - m, g);
+                    for j in start[b * g] as usize..start[(b + 1) * g] as usize {
                         let w = &weights[3 * pts * j..3 * pts * (j + 1)];
                         let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
                         let fz = f[j].map(|c| c * wz[m]);
                         let [bx, by, _] = base[j];
+                        let bx = bx as usize;
+                        let contiguous = P > 0 && bx + P <= g;
                         for (iy, &wyv) in wy.iter().enumerate() {
-                            let row = (by as usize + iy) % g * g;
+                            let row = wrap(by as usize + iy, g) * g;
                             let c = fz.map(|c| c * wyv);
-                            for_row(bx as usize, pts, g, |x, ix| {
-                                let wv = wx[ix];
-                                px[row + x] += c[0] * wv;
-                                py[row + x] += c[1] * wv;
-                                pz[row + x] += c[2] * wv;
-                            });
+                            if contiguous {
+                                let r = row + bx;
+                                add_scaled_fixed::<P>(&mut px[r..r + P], wx, c[0]);
+                                add_scaled_fixed::<P>(&mut py[r..r + P], wx, c[1]);
+                                add_scaled_fixed::<P>(&mut pz[r..r + P], wx, c[2]);
+                                continue;
+                            }
+                            for (x, w) in row_runs(bx, pts, g) {
+                                let r = row + x.start..row + x.end;
+                                add_scaled(&mut px[r.clone()], &wx[w.clone()], c[0]);
+                                add_scaled(&mut py[r.clone()], &wx[w.clone()], c[1]);
+                                add_scaled(&mut pz[r], &wx[w], c[2]);
+                            }
                         }
                     }
                 }
@@ -792,38 +878,56 @@ impl Pse {
     /// `out_i (+)= h^3 sum_g u(x_g) g(x_g − x_i)` from the three real grids (particles in the
     /// sorted order, then scattered back).
     fn interpolate(&mut self, out: &mut [[f64; 3]], add: bool) {
-        let (g, pts, h) = (self.geom.grid, self.geom.support, self.geom.spacing);
+        with_support!(self.geom.support, P => self.interpolate_p::<P>(out, add))
+    }
+
+    /// [`Self::interpolate`] with the support `P` known at compile time (`P = 0`: read at run
+    /// time).
+    fn interpolate_p<const P: usize>(&mut self, out: &mut [[f64; 3]], add: bool) {
+        let (g, h) = (self.geom.grid, self.geom.spacing);
+        let pts = if P > 0 { P } else { self.geom.support };
         let h3 = h * h * h;
         let [gx, gy, gz] = &self.real;
-        let (weights, base, order) = (&self.weights, &self.base, &self.plane_order);
+        let (weights, base) = (&self.weights, &self.base);
         self.sorted
             .par_iter_mut()
-            .zip(order.par_iter())
+            .enumerate()
             .with_min_len(64)
-            .for_each(|(o, &j)| {
-                let j = j as usize;
+            .for_each(|(j, o)| {
                 let w = &weights[3 * pts * j..3 * pts * (j + 1)];
                 let (wx, wy, wz) = (&w[..pts], &w[pts..2 * pts], &w[2 * pts..]);
                 let [bx, by, bz] = base[j];
-                let mut u = [0.0; 3];
+                let bx = bx as usize;
+                let contiguous = P > 0 && bx + P <= g;
+                // Per x column of the support, the grid summed over y and z with their
+                // weights (independent lanes, so the sums vectorise), then the x weights.
+                let mut t = [[0.0; MAX_SUPPORT]; 3];
                 for (iz, &wzv) in wz.iter().enumerate() {
-                    let plane = (bz as usize + iz) % g * g * g;
+                    let plane = wrap(bz as usize + iz, g) * g * g;
                     for (iy, &wyv) in wy.iter().enumerate() {
-                        let row = plane + (by as usize + iy) % g * g;
-                        let mut s = [0.0; 3];
-                        for_row(bx as usize, pts, g, |x, ix| {
-                            let wv = wx[ix];
-                            s[0] += gx[row + x] * wv;
-                            s[1] += gy[row + x] * wv;
-                            s[2] += gz[row + x] * wv;
-                        });
+                        let row = plane + wrap(by as usize + iy, g) * g;
                         let c = wzv * wyv;
-                        for k in 0..3 {
-                            u[k] += c * s[k];
+                        if contiguous {
+                            let r = row + bx;
+                            add_scaled_fixed::<P>(&mut t[0], &gx[r..r + P], c);
+                            add_scaled_fixed::<P>(&mut t[1], &gy[r..r + P], c);
+                            add_scaled_fixed::<P>(&mut t[2], &gz[r..r + P], c);
+                            continue;
+                        }
+                        for (x, w) in row_runs(bx, pts, g) {
+                            let r = row + x.start..row + x.end;
+                            add_scaled(&mut t[0][w.clone()], &gx[r.clone()], c);
+                            add_scaled(&mut t[1][w.clone()], &gy[r.clone()], c);
+                            add_scaled(&mut t[2][w], &gz[r], c);
                         }
                     }
                 }
-                *o = u.map(|c| h3 * c);
+                *o = t.map(|tk| {
+                    h3 * tk[..pts]
+                        .iter()
+                        .zip(wx)
+                        .fold(0.0, |acc, (a, b)| acc + a * b)
+                });
             });
         let (sorted, slot_of) = (&self.sorted, &self.slot_of);
         out.par_iter_mut()
@@ -874,14 +978,14 @@ impl Pse {
         let (kernel, kvec, pn) = (&self.kernel, &self.kvec, &self.plane_noise);
         let zig = Ziggurat::get();
         let [wx, wy, wz] = &mut self.work;
-        wx.par_chunks_mut(nh * g)
-            .zip(wy.par_chunks_mut(nh * g))
-            .zip(wz.par_chunks_mut(nh * g))
+        wx.par_chunks_mut(g * g)
+            .zip(wy.par_chunks_mut(g * g))
+            .zip(wz.par_chunks_mut(g * g))
             .enumerate()
-            .for_each(|(ky, ((px, py), pz))| {
-                let kyv = kvec[ky].unwrap_or(0.0);
-                for kx in 0..nh {
-                    let kxv = kvec[kx].unwrap_or(0.0);
+            .for_each(|(kx, ((px, py), pz))| {
+                let kxv = kvec[kx].unwrap_or(0.0);
+                for ky in 0..g {
+                    let kyv = kvec[ky].unwrap_or(0.0);
                     let mut rng = key.map(|key| {
                         stream(
                             key.seed,
@@ -891,8 +995,8 @@ impl Pse {
                         )
                     });
                     for kz in 0..g {
-                        let i = kx * g + kz;
-                        let b = kernel[i + ky * nh * g];
+                        let i = ky * g + kz;
+                        let b = kernel[i + kx * g * g];
                         let kzv = kvec[kz].unwrap_or(0.0);
                         let k = [kxv, kyv, kzv];
                         let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
@@ -977,7 +1081,7 @@ impl Pse {
     /// `out (+)= M^r f`: the forces gathered into row (cell) order, the rows summed there,
     /// the velocities gathered back.
     fn real_product(&mut self, f: &[f64], out: &mut [f64], add: bool) {
-        let (offsets, entries, s) = (&self.offsets, &self.entries, self.self_real);
+        let (offsets, s) = (&self.offsets, self.self_real);
         let (counts, row_particle, row_of) = (&self.counts, &self.row_particle, &self.row_of);
         let (f_rows, u_rows) = (&mut self.f_rows, &mut self.u_rows);
         f_rows
@@ -985,27 +1089,10 @@ impl Pse {
             .zip(row_particle.par_iter())
             .with_min_len(1024)
             .for_each(|(o, &p)| o.copy_from_slice(&f[3 * p as usize..3 * p as usize + 3]));
-        let f_rows = &*f_rows;
-        u_rows
-            .par_chunks_mut(3)
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(r, o)| {
-                let mut u = [
-                    s * f_rows[3 * r],
-                    s * f_rows[3 * r + 1],
-                    s * f_rows[3 * r + 2],
-                ];
-                for e in &entries[offsets[r]..offsets[r] + counts[r] as usize] {
-                    let j = e.j as usize;
-                    let fj = [f_rows[3 * j], f_rows[3 * j + 1], f_rows[3 * j + 2]];
-                    let ef = e.b * (e.e[0] * fj[0] + e.e[1] * fj[1] + e.e[2] * fj[2]);
-                    for k in 0..3 {
-                        u[k] += e.a * fj[k] + ef * e.e[k];
-                    }
-                }
-                o.copy_from_slice(&u);
-            });
+        match &self.entries {
+            Entries::Single(e) => sum_rows(e, offsets, counts, s, f_rows, u_rows),
+            Entries::Double(e) => sum_rows(e, offsets, counts, s, f_rows, u_rows),
+        }
         let u_rows = &*u_rows;
         out.par_chunks_mut(3)
             .zip(row_of.par_iter())
@@ -1052,6 +1139,98 @@ impl Pse {
         out.iter_mut().flatten().for_each(|x| *x *= scale);
         Ok(rep)
     }
+}
+
+/// What the real-space pair tensors are computed from.
+struct RealSpace<'a> {
+    box_length: f64,
+    r_cut: f64,
+    radius: f64,
+    viscosity: f64,
+    table: &'a WaveTable,
+    pos: &'a [[f64; 3]],
+    offsets: &'a [usize],
+    candidates: &'a [u32],
+    row_particle: &'a [u32],
+    row_of: &'a [u32],
+}
+
+impl RealSpace<'_> {
+    /// The pair tensors `M^r = M^RPY − M^w_free` of the candidates within the cut-off, each
+    /// row in increasing index, and their number per row (a function of the positions alone,
+    /// whenever the candidates were built).
+    fn fill<T: Stored>(&self, entries: &mut [Entry<T>], counts: &mut [u32]) {
+        let l = self.box_length;
+        let rc2 = self.r_cut * self.r_cut;
+        let (off, cand, pos) = (self.offsets, self.candidates, self.pos);
+        let mut rows: Vec<RowChunk<'_, Entry<T>, u32>> = Vec::new();
+        for_row_chunks_collect(off, entries, counts, &mut rows);
+        rows.into_par_iter().for_each(|(lo, hi, out, count)| {
+            let base = off[lo];
+            for r in lo..hi {
+                let xi = pos[self.row_particle[r] as usize];
+                let mut k = off[r] - base;
+                for &j in &cand[off[r]..off[r + 1]] {
+                    let xj = pos[j as usize];
+                    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+                    for c in d.iter_mut() {
+                        if *c >= 0.5 * l {
+                            *c -= l;
+                        } else if *c < -0.5 * l {
+                            *c += l;
+                        }
+                    }
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if r2 < rc2 {
+                        let r = r2.sqrt();
+                        let t = rpy(r, self.radius, self.viscosity);
+                        let (aw, bw) = self.table.eval(r);
+                        out[k] = Entry {
+                            j: self.row_of[j as usize],
+                            a: T::store(t.a - aw),
+                            b: T::store(t.b - bw),
+                            e: d.map(|x| T::store(x / r)),
+                        };
+                        k += 1;
+                    }
+                }
+                count[r - lo] = (k - (off[r] - base)) as u32;
+            }
+        });
+    }
+}
+
+/// `u_r = s f_r + sum_j M^r_rj f_j` for every row `r` (forces and velocities in row order).
+fn sum_rows<T: Stored>(
+    entries: &[Entry<T>],
+    offsets: &[usize],
+    counts: &[u32],
+    s: f64,
+    f_rows: &[f64],
+    u_rows: &mut [f64],
+) {
+    u_rows
+        .par_chunks_mut(3)
+        .enumerate()
+        .with_min_len(256)
+        .for_each(|(r, o)| {
+            let mut u = [
+                s * f_rows[3 * r],
+                s * f_rows[3 * r + 1],
+                s * f_rows[3 * r + 2],
+            ];
+            for e in &entries[offsets[r]..offsets[r] + counts[r] as usize] {
+                let j = e.j as usize;
+                let fj = [f_rows[3 * j], f_rows[3 * j + 1], f_rows[3 * j + 2]];
+                let (a, b) = (e.a.load(), e.b.load());
+                let ev = e.e.map(Stored::load);
+                let ef = b * (ev[0] * fj[0] + ev[1] * fj[1] + ev[2] * fj[2]);
+                for k in 0..3 {
+                    u[k] += a * fj[k] + ef * ev[k];
+                }
+            }
+            o.copy_from_slice(&u);
+        });
 }
 
 /// The cell list of the real-space part.
@@ -1132,12 +1311,15 @@ fn for_row_chunks<T: Send>(
         .for_each(|(lo, hi, rows)| f(lo, hi, rows));
 }
 
+/// Rows `lo..hi` of a CSR array and of a per-row array: `(lo, hi, data, per_row)`.
+type RowChunk<'a, T, U> = (usize, usize, &'a mut [T], &'a mut [U]);
+
 /// The chunks of [`for_row_chunks`] of a CSR array and of a per-row array, collected.
 fn for_row_chunks_collect<'a, T, U>(
     off: &[usize],
     data: &'a mut [T],
     per_row: &'a mut [U],
-    out: &mut Vec<(usize, usize, &'a mut [T], &'a mut [U])>,
+    out: &mut Vec<RowChunk<'a, T, U>>,
 ) {
     const CH: usize = 256;
     let n = off.len() - 1;
@@ -1152,16 +1334,90 @@ fn for_row_chunks_collect<'a, T, U>(
     }
 }
 
-/// Visit the `pts` grid columns from `bx` (periodic in `g`) as `(column, offset)`, in two
-/// contiguous runs when the support wraps.
+/// Largest Gaussian support (points per axis): tolerances down to about 1e-14 need fewer
+/// (1e-3: 8 points, 1e-6: 14); a smaller tolerance is refused.
+const MAX_SUPPORT: usize = 32;
+
+/// The `pts` grid columns from `bx` (periodic in `g`) as at most two contiguous runs: pairs of
+/// (columns of the grid row, offsets into the support); the second run is empty unless the
+/// support wraps.
 #[inline(always)]
-fn for_row(bx: usize, pts: usize, g: usize, mut f: impl FnMut(usize, usize)) {
+fn row_runs(
+    bx: usize,
+    pts: usize,
+    g: usize,
+) -> [(std::ops::Range<usize>, std::ops::Range<usize>); 2] {
     let first = pts.min(g - bx);
-    for ix in 0..first {
-        f(bx + ix, ix);
+    [(bx..bx + first, 0..first), (0..pts - first, first..pts)]
+}
+
+/// `i mod g` for `i < 2 g`, without an integer division (which would dominate the spreading).
+#[inline(always)]
+fn wrap(i: usize, g: usize) -> usize {
+    if i >= g { i - g } else { i }
+}
+
+/// `y[..P] += c x[..P]` with the length known at compile time (vectorised in full).
+#[inline(always)]
+fn add_scaled_fixed<const P: usize>(y: &mut [f64], x: &[f64], c: f64) {
+    let y: &mut [f64; P] = (&mut y[..P]).try_into().expect("P elements");
+    let x: &[f64; P] = x[..P].try_into().expect("P elements");
+    for k in 0..P {
+        y[k] += c * x[k];
     }
-    for ix in first..pts {
-        f((bx + ix) % g, ix);
+}
+
+/// Call `$body` with the const `$p` equal to the support `$pts` for the supports the usual
+/// tolerances give (1e-2 to 1e-6: 6 to 14 points), else with `$p = 0` (read at run time).
+macro_rules! with_support {
+    ($pts:expr, $p:ident => $body:expr) => {
+        match $pts {
+            6 => {
+                const $p: usize = 6;
+                $body
+            }
+            7 => {
+                const $p: usize = 7;
+                $body
+            }
+            8 => {
+                const $p: usize = 8;
+                $body
+            }
+            9 => {
+                const $p: usize = 9;
+                $body
+            }
+            10 => {
+                const $p: usize = 10;
+                $body
+            }
+            11 => {
+                const $p: usize = 11;
+                $body
+            }
+            12 => {
+                const $p: usize = 12;
+                $body
+            }
+            14 => {
+                const $p: usize = 14;
+                $body
+            }
+            _ => {
+                const $p: usize = 0;
+                $body
+            }
+        }
+    };
+}
+use with_support;
+
+/// `y += c x` element by element.
+#[inline(always)]
+fn add_scaled(y: &mut [f64], x: &[f64], c: f64) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += c * x;
     }
 }
 
@@ -1274,7 +1530,7 @@ impl Mobility for Pse {
             + self.table.a.len() * 2)
             + 16 * (self.spec.len() + 3 * self.work[0].len())
             + 48 * self.plane_noise.len()
-            + 48 * self.entries.capacity()
+            + self.entries.bytes()
             + 8 * (self.offsets.len())
             + n * (24 + 12 + 4 * 4 + 2 * 24)
             + 4 * (self.cell_start.len() + self.plane_start.len())
