@@ -1371,39 +1371,14 @@ fn add_scaled_fixed<const P: usize>(y: &mut [f64], x: &[f64], c: f64) {
 /// tolerances give (1e-2 to 1e-6: 6 to 14 points), else with `$p = 0` (read at run time).
 macro_rules! with_support {
     ($pts:expr, $p:ident => $body:expr) => {
+        with_support!(@arms $pts, $p, $body; 6 7 8 9 10 11 12 14)
+    };
+    (@arms $pts:expr, $p:ident, $body:expr; $($n:literal)*) => {
         match $pts {
-            6 => {
-                const $p: usize = 6;
+            $($n => {
+                const $p: usize = $n;
                 $body
-            }
-            7 => {
-                const $p: usize = 7;
-                $body
-            }
-            8 => {
-                const $p: usize = 8;
-                $body
-            }
-            9 => {
-                const $p: usize = 9;
-                $body
-            }
-            10 => {
-                const $p: usize = 10;
-                $body
-            }
-            11 => {
-                const $p: usize = 11;
-                $body
-            }
-            12 => {
-                const $p: usize = 12;
-                $body
-            }
-            14 => {
-                const $p: usize = 14;
-                $body
-            }
+            })*
             _ => {
                 const $p: usize = 0;
                 $body
