@@ -5,7 +5,8 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use colloidsim_md::hydro::bench::{
-    PYSTOKES_SCRIPT, RADIUS, box_edge, median, random_system, time_direct, time_pse,
+    PYSTOKES_SCRIPT, RADIUS, box_edge, median, pse_product, random_system, relative_difference,
+    time_direct, time_pse,
 };
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -45,20 +46,33 @@ pub struct BenchArgs {
     /// Do not run pystokes.
     #[arg(long)]
     pub no_pystokes: bool,
-    /// Parts to run: direct, pse, bd.
-    #[arg(long, value_delimiter = ',', default_value = "direct,pse,bd")]
+    /// Particle numbers of PSE's accuracy against pystokes' periodic Ewald sum.
+    #[arg(long, value_delimiter = ',', default_value = "200,500")]
+    pub periodic_sizes: Vec<usize>,
+    /// Parts to run: direct, pse, periodic (PSE's accuracy against pystokes.periodic), bd.
+    #[arg(long, value_delimiter = ',', default_value = "direct,pse,periodic,bd")]
     pub parts: Vec<String>,
 }
 
 /// Positions and forces of one benchmark system.
 type System = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
-/// Run pystokes on the same systems; `None` (with the reason printed) when it cannot run.
-fn pystokes(a: &BenchArgs, systems: &[System]) -> Option<serde_json::Value> {
+/// Run pystokes on the same systems (in a periodic cube of that edge where `boxes` gives one);
+/// `None` (with the reason printed) when it cannot run.
+fn pystokes(a: &BenchArgs, systems: &[System], boxes: Option<&[f64]>) -> Option<serde_json::Value> {
     let cases: Vec<serde_json::Value> = systems
         .iter()
-        .map(|(p, f)| {
-            serde_json::json!({"n": p.len(), "pos": p.as_flattened(), "force": f.as_flattened()})
+        .enumerate()
+        .map(|(k, (p, f))| {
+            let mut c = serde_json::json!({"n": p.len(), "pos": p.as_flattened(), "force": f.as_flattened()});
+            if let Some(l) = boxes {
+                // Ewald sum converged to about 3e-11 (against 8 boxes and modes); slow, so once.
+                c["box"] = l[k].into();
+                c["nb"] = 6.into();
+                c["nm"] = 6.into();
+                c["repeats"] = 1.into();
+            }
+            c
         })
         .collect();
     let req = serde_json::json!({
@@ -122,6 +136,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     if part("pse") {
         pse(a, reps)?;
     }
+    if part("periodic") && !a.no_pystokes {
+        periodic(a)?;
+    }
     if part("bd") {
         bd_step(a, reps)?;
     }
@@ -134,16 +151,7 @@ fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
         "## direct RPY product M F (free space, non-overlapping spheres), beside pystokes.unbounded.Rbm.mobilityTT (OMP_NUM_THREADS=1); speed-ups of medians (and of minima)"
     );
     // Non-overlapping spheres (pystokes has only the r >= 2a branch of the tensor).
-    let systems = a
-        .sizes
-        .iter()
-        .map(|&n| -> Result<System> {
-            let l = box_edge(n, a.phi);
-            let sbox = colloidsim_md::SimBox::cube(l);
-            let pos = colloidsim_md::init::random_in_box(n, 2.0 * RADIUS, &sbox, 1, 0)?;
-            Ok((pos, random_system(n, l, 1).1))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let (systems, _) = hard_systems(&a.sizes, a.phi)?;
     let mut ours = Vec::new();
     for (p, f) in &systems {
         for &t in &a.threads {
@@ -154,7 +162,7 @@ fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
     let peer = if a.no_pystokes {
         None
     } else {
-        pystokes(a, &systems)
+        pystokes(a, &systems, None)
     };
     println!(
         "code\tN\tthreads\tseconds\tmin_seconds\tns_per_pair\tspeed-up_vs_pystokes\tof_minima\trel_diff_vs_pystokes"
@@ -175,15 +183,10 @@ fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
                     .as_array()
                     .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
                     .unwrap_or_default();
-                let (mut d2, mut w2) = (0.0, 0.0);
-                for (x, y) in u.as_flattened().iter().zip(&v) {
-                    d2 += (x - y) * (x - y);
-                    w2 += y * y;
-                }
                 (
                     format!("{:.2}", s / timing.seconds),
                     format!("{:.2}", smin / timing.min_seconds),
-                    format!("{:.2e}", (d2 / w2).sqrt()),
+                    format!("{:.2e}", relative_difference(u.as_flattened(), &v)),
                 )
             }
             None => ("-".into(), "-".into(), "-".into()),
@@ -203,6 +206,51 @@ fn direct(a: &BenchArgs, reps: usize) -> Result<()> {
                 c["min_s"].as_f64().unwrap_or(f64::NAN),
                 c["median_s"].as_f64().unwrap_or(f64::NAN) * 1e9
                     / (c["n"].as_f64().unwrap_or(1.0)).powi(2)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Non-overlapping random spheres at the benchmark's volume fraction, with random forces, and
+/// the edges of their cubes.
+fn hard_systems(sizes: &[usize], phi: f64) -> Result<(Vec<System>, Vec<f64>)> {
+    let mut systems = Vec::new();
+    let mut edges = Vec::new();
+    for &n in sizes {
+        let l = box_edge(n, phi);
+        let sbox = colloidsim_md::SimBox::cube(l);
+        let pos = colloidsim_md::init::random_in_box(n, 2.0 * RADIUS, &sbox, 1, 0)?;
+        systems.push((pos, random_system(n, l, 1).1));
+        edges.push(l);
+    }
+    Ok((systems, edges))
+}
+
+/// PSE's product against pystokes' periodic Ewald sum (an independent second reference
+/// besides the Beenakker sum of the tests), at several tolerances.
+fn periodic(a: &BenchArgs) -> Result<()> {
+    println!(
+        "## PSE (xi = 0.5/a) against pystokes.periodic.Rbm.mobilityTT (Ewald sum, 6 boxes and 6 modes, one product; non-overlapping spheres): relative difference of M F"
+    );
+    let (systems, edges) = hard_systems(&a.periodic_sizes, a.phi)?;
+    let Some(peer) = pystokes(a, &systems, Some(&edges)) else {
+        return Ok(());
+    };
+    println!("N\tL\ttolerance\trel_diff_vs_pystokes_periodic\tpse_product_s\tpystokes_periodic_s");
+    let cases = peer["cases"].as_array().cloned().unwrap_or_default();
+    for ((p, f), (&l, c)) in systems.iter().zip(edges.iter().zip(&cases)) {
+        let v: Vec<f64> = c["velocity"]
+            .as_array()
+            .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
+            .unwrap_or_default();
+        for tol in [1e-2, 1e-3, 1e-4, 1e-5] {
+            let (u, secs) = pse_product(p, f, l, tol)?;
+            println!(
+                "{}\t{l:.2}\t{tol:.0e}\t{:.2e}\t{secs:.3e}\t{:.3e}",
+                p.len(),
+                relative_difference(u.as_flattened(), &v),
+                c["median_s"].as_f64().unwrap_or(f64::NAN)
             );
         }
     }

@@ -198,10 +198,12 @@ pub fn time_pse(
     })
 }
 
-/// Python program timing `pystokes.unbounded.Rbm.mobilityTT` (the RPY product in an unbounded
-/// fluid). Reads one JSON document on standard input,
-/// `{"radius", "viscosity", "repeats", "cases": [{"n", "pos", "force"}]}` (positions and forces
-/// as flat `[x0, y0, z0, x1, ...]`), writes `{"version", "cases": [{"n", "median_s",
+/// Python program timing pystokes' RPY products: `pystokes.unbounded.Rbm.mobilityTT` (an
+/// unbounded fluid) or, for a case with `"box"`, `pystokes.periodic.Rbm.mobilityTT` (Ewald sum
+/// in a periodic cube, `"nb"` real-space boxes and `"nm"` Fourier modes). Reads one JSON
+/// document on standard input, `{"radius", "viscosity", "repeats", "cases": [{"n", "pos",
+/// "force", "box"?, "nb"?, "nm"?, "repeats"?}]}` (positions and forces as flat
+/// `[x0, y0, z0, x1, ...]`), writes `{"version", "cases": [{"n", "median_s", "min_s",
 /// "velocity"}]}` (velocities in the same layout), or `{"error": message}` when pystokes
 /// cannot be imported.
 pub const PYSTOKES_SCRIPT: &str = r#"
@@ -219,14 +221,23 @@ for case in req["cases"]:
     # pystokes stores all x, then all y, then all z.
     r = np.ascontiguousarray(np.array(case["pos"], dtype=np.float64).reshape(n, 3).T.ravel())
     f = np.ascontiguousarray(np.array(case["force"], dtype=np.float64).reshape(n, 3).T.ravel())
-    rbm = pystokes.unbounded.Rbm(radius=req["radius"], particles=n, viscosity=req["viscosity"])
+    if "box" in case:
+        rbm = pystokes.periodic.Rbm(radius=req["radius"], particles=n,
+                                    viscosity=req["viscosity"], boxSize=case["box"])
+        product = lambda v: rbm.mobilityTT(v, r, f, case["nb"], case["nm"])
+    else:
+        rbm = pystokes.unbounded.Rbm(radius=req["radius"], particles=n,
+                                     viscosity=req["viscosity"])
+        product = lambda v: rbm.mobilityTT(v, r, f)
     v = np.zeros(3 * n)
-    rbm.mobilityTT(v, r, f)
+    repeats = case.get("repeats", req["repeats"])
+    if repeats > 1:
+        product(v)
     times = []
-    for _ in range(req["repeats"]):
+    for _ in range(repeats):
         v[:] = 0.0
         t = time.perf_counter()
-        rbm.mobilityTT(v, r, f)
+        product(v)
         times.append(time.perf_counter() - t)
     times.sort()
     m = len(times) // 2
@@ -236,6 +247,36 @@ for case in req["cases"]:
 version = getattr(pystokes, "__version__", "unknown")
 print(json.dumps({"version": version, "cases": out}))
 "#;
+
+/// The PSE product `M F` (splitting `xi = 0.5 / a`, the given tolerance) of spheres of radius
+/// [`RADIUS`] in a periodic cube of edge `l`, viscosity 1, and the seconds it took (after one
+/// warm-up product).
+pub fn pse_product(
+    pos: &[[f64; 3]],
+    f: &[[f64; 3]],
+    l: f64,
+    tolerance: f64,
+) -> Result<(Vec<[f64; 3]>, f64), HydroError> {
+    let mut p = PseParams::paper(RADIUS, 1.0, l);
+    p.tolerance = tolerance;
+    let mut m = Pse::new(pos.len(), p)?;
+    m.set_positions(pos)?;
+    let mut u = vec![[0.0; 3]; pos.len()];
+    m.apply(f, &mut u);
+    let s = Instant::now();
+    m.apply(f, &mut u);
+    Ok((u, s.elapsed().as_secs_f64()))
+}
+
+/// `|u − v| / |v|` over all components.
+pub fn relative_difference(u: &[f64], v: &[f64]) -> f64 {
+    let (mut d2, mut w2) = (0.0, 0.0);
+    for (x, y) in u.iter().zip(v) {
+        d2 += (x - y) * (x - y);
+        w2 += y * y;
+    }
+    (d2 / w2).sqrt()
+}
 
 #[cfg(test)]
 mod tests {
