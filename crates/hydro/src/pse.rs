@@ -197,6 +197,7 @@ fn sinc(x: f64) -> f64 {
 #[derive(Debug, Clone)]
 struct WaveTable {
     dr: f64,
+    inv_dr: f64,
     a: Vec<f64>,
     b: Vec<f64>,
 }
@@ -238,12 +239,17 @@ impl WaveTable {
                 (pre * sa, pre * sb)
             })
             .unzip();
-        Self { dr, a, b }
+        Self {
+            dr,
+            inv_dr: 1.0 / dr,
+            a,
+            b,
+        }
     }
 
     /// `(A_w(r), B_w(r))`, 4-point Lagrange interpolation (B_w even in r, A_w too).
     fn eval(&self, r: f64) -> (f64, f64) {
-        let t = r / self.dr;
+        let t = r * self.inv_dr;
         let i = (t.floor() as usize).clamp(1, self.a.len() - 3);
         let u = t - i as f64;
         // Nodes i-1, i, i+1, i+2 at offsets -1, 0, 1, 2.
@@ -1182,14 +1188,16 @@ impl RealSpace<'_> {
                     }
                     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                     if r2 < rc2 {
-                        let r = r2.sqrt();
-                        let t = rpy(r, self.radius, self.viscosity);
+                        // One division per pair (the tensors are most of `set_positions`).
+                        let inv_r = 1.0 / r2.sqrt();
+                        let r = r2 * inv_r;
+                        let (ta, tb) = rpy_inv(r, inv_r, self.radius, self.viscosity);
                         let (aw, bw) = self.table.eval(r);
                         out[k] = Entry {
                             j: self.row_of[j as usize],
-                            a: T::store(t.a - aw),
-                            b: T::store(t.b - bw),
-                            e: d.map(|x| T::store(x / r)),
+                            a: T::store(ta - aw),
+                            b: T::store(tb - bw),
+                            e: d.map(|x| T::store(x * inv_r)),
                         };
                         k += 1;
                     }
@@ -1197,6 +1205,21 @@ impl RealSpace<'_> {
                 count[r - lo] = (k - (off[r] - base)) as u32;
             }
         });
+    }
+}
+
+/// `(A, B)` of the monodisperse RPY tensor ([`rpy`]) at distance `r = 1 / inv_r`, with
+/// multiplications by `inv_r` in place of divisions.
+#[inline(always)]
+fn rpy_inv(r: f64, inv_r: f64, a: f64, eta: f64) -> (f64, f64) {
+    if r >= 2.0 * a {
+        let c = inv_r * (1.0 / (8.0 * PI * eta));
+        let s2 = a * a * inv_r * inv_r;
+        (c * (1.0 + 2.0 / 3.0 * s2), c * (1.0 - 2.0 * s2))
+    } else {
+        let mu0 = 1.0 / (6.0 * PI * eta * a);
+        let x = r / (32.0 * a);
+        (mu0 * (1.0 - 9.0 * x), mu0 * 3.0 * x)
     }
 }
 
