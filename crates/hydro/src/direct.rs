@@ -543,14 +543,20 @@ mod tests {
 
     #[test]
     fn product_equals_the_pair_formulas_mono_and_unequal() {
-        // 29 particles (not a multiple of the lanes), dense enough for overlaps.
-        let pos = config(29, 4.0, 3);
+        // 29 particles (not a multiple of the lanes) and 150, dense enough for overlaps.
+        for (n, l) in [(29, 4.0), (150, 6.9)] {
+            product_matches_reference(n, l);
+        }
+    }
+
+    fn product_matches_reference(n: usize, l: f64) {
+        let pos = config(n, l, 3);
         let eta = 0.8;
         for radii in [
-            vec![0.5; 29],
-            (0..29).map(|i| 0.3 + 0.02 * i as f64).collect(),
+            vec![0.5; n],
+            (0..n).map(|i| 0.3 + 0.4 * i as f64 / n as f64).collect(),
         ] {
-            let mut m = DirectRpy::with_radii(&radii, eta, LanczosParams::default(), 100).unwrap();
+            let mut m = DirectRpy::with_radii(&radii, eta, LanczosParams::default(), 200).unwrap();
             m.set_positions(&pos).unwrap();
             let got = dense_matrix(&mut m);
             let want = reference(&pos, &radii, eta);
@@ -559,7 +565,7 @@ mod tests {
                 assert!((g - w).abs() < 1e-14 * scale, "{g} vs {w}");
             }
             // Symmetric.
-            let n3 = 87;
+            let n3 = 3 * n;
             for r in 0..n3 {
                 for c in 0..n3 {
                     assert!((got[r * n3 + c] - got[c * n3 + r]).abs() < 1e-15 * scale);

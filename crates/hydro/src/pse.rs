@@ -23,15 +23,16 @@
 //!   cut-off `r_c` are kept in neighbour lists (cells of edge `>= r_c`, nearest image); the
 //!   Brownian part is the Lanczos square root of `M^r` ([`crate::lanczos`]).
 //!
-//! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 3 eps`,
+//! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 6 eps`,
 //! `x = K^2/(4 xi^2)`; grid spacing `h <= pi / K` (n points per axis, the next even 2-3-5-smooth
 //! size); Gaussian `sigma = (h / pi) sqrt(ln(1/e_s))` (aliasing `exp(−pi^2 sigma^2 / h^2) = e_s`,
 //! `e_s = 2 eps`), support: the fewest points `P` per axis that cover the half-width
 //! `w = sigma sqrt(2 ln(1/e_s))` on both sides of any particle (`P = 2m` reaches `(m − 1) h`,
 //! `P = 2m + 1` centred on the nearest point `(m − 1/2) h`); real-space cut-off `r_c`: beyond it `|A_r|, |B_r| < 0.2 eps mu0`.
 //! The shares were set by measurement: against Beenakker's Ewald sum the error of the product
-//! is set by the real-space cut-off and lies between 0.15 and 0.6 of the tolerance
-//! (`tests/pse.rs`, docs/hydrodynamics.md).
+//! is set by the real-space cut-off and lies between 0.07 and 0.6 of the tolerance
+//! (`tests/pse.rs`, docs/hydrodynamics.md). The real-space pair tensors are stored in single
+//! precision for tolerances of 1e-6 and more (the sums are in double precision).
 //!
 //! **Determinism.** Spreading is a gather per grid plane (each plane sums the particles whose
 //! support reaches it, in a fixed order), interpolation a sum per particle, the FFT lines are
