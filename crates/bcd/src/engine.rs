@@ -467,6 +467,8 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         match &self.ring {
             // Rod i is bonded to rod i + 1 when their reduced positions are equal, the last rod
             // to the first when the seam is bonded.
+            // After a step, one count per pooled block; else from the positions.
+            Some(r) if r.count_clusters_from_blocks(counts) => {}
             Some(r) => {
                 let ends = r.y.windows(2).map(|w| w[0] != w[1]);
                 histogram_clusters(n, ends, r.seam, counts);

@@ -207,6 +207,8 @@ pub(crate) struct RingStep {
     lm: bool,
     /// The step whose deviates the chunks keep (`None`: draw them from the step counter).
     kept_step: Option<u64>,
+    /// The chunks' live blocks are the clusters of `y` (the last thing done was a step).
+    blocks_current: bool,
 }
 
 impl RingStep {
@@ -229,7 +231,24 @@ impl RingStep {
             scratch: Vec::new(),
             lm: false,
             kept_step: None,
+            blocks_current: false,
         }
+    }
+
+    /// Add the sizes of the clusters of the current configuration to `counts` (indexed by
+    /// size, at least N + 1 long) from the last step's pooled blocks, one per cluster:
+    /// O(clusters) rather than O(N). `false` (and nothing added) when there was no step since
+    /// the positions were set.
+    pub fn count_clusters_from_blocks(&self, counts: &mut [u64]) -> bool {
+        if !self.blocks_current {
+            return false;
+        }
+        for c in &self.chunks {
+            for b in &c.pool[c.head..c.end] {
+                counts[count(b[1])] += 1;
+            }
+        }
+        true
     }
 
     /// Use the Leimkuhler–Matthews noise (`true`) or Euler's (`false`). Costs 8 bytes per rod
@@ -260,6 +279,7 @@ impl RingStep {
         if self.scratch.len() < threads {
             self.scratch.resize_with(threads, || Mutex::new(None));
         }
+        self.blocks_current = false;
         let m = Motion::new(cfg, noise_amp, step, self.lm);
         let ctx = RingCtx {
             y: &self.y,
@@ -304,6 +324,7 @@ impl RingStep {
         }
         std::mem::swap(&mut self.y, &mut self.y_next);
         self.seam = seam && n > 1;
+        self.blocks_current = true;
         Ok(())
     }
 }

@@ -355,6 +355,29 @@ fn branch_free_cluster_histogram_equals_the_cluster_walk() {
             );
         }
     }
+    // Several chunks of the ring update (clusters pooled across chunk boundaries and the
+    // seam): the histogram from the pooled blocks equals the walk over the state, and so does
+    // the one from the positions before the first step.
+    let n = 3 * 4096 + 1000; // the ring update works in chunks of 4096 rods
+    let cfg = config(
+        1.01 * n as f64,
+        0.99,
+        1e-3,
+        Boundary::Periodic,
+        Update::Premerge,
+    );
+    let x = init::random(&cfg, n, 8).unwrap();
+    let mut a = Bcd::new(cfg, x, NoField, NoPair).unwrap();
+    for step in 0..40 {
+        if step > 0 {
+            a.run(1).unwrap();
+        }
+        let mut counts = Vec::new();
+        a.count_cluster_sizes(&mut counts);
+        let mut want = vec![0u64; counts.len()];
+        a.cluster_sizes(|s| want[s] += 1);
+        assert_eq!(counts, want, "{n} rods at step {step}");
+    }
     // One cluster of every rod round the ring (nothing ends): dense rods, long steps.
     let cfg = config(10.0, 0.99, 1.0, Boundary::Periodic, Update::Premerge);
     let x = init::random(&cfg, 10, 1).unwrap();
