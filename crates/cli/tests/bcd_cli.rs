@@ -191,14 +191,10 @@ fn interrupted_run_restarts_bitwise() {
 
 #[test]
 fn gsd_trajectory_is_readable_by_the_gsd_package() {
-    let ok = Command::new("python3")
-        .args(["-c", "import gsd.hoomd"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !ok {
-        eprintln!(
-            "NOTICE: python3 package 'gsd' not installed; skipping the GSD read-back (CI installs it)"
-        );
+    if !colloidsim_core::tools::python_module_or_skip(
+        "gsd.hoomd",
+        "gsd_trajectory_is_readable_by_the_gsd_package",
+    ) {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();

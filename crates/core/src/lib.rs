@@ -3,7 +3,8 @@
 //! Everything here is used by more than one method family: counter-based random streams
 //! ([`rng`]), validated parameters and their errors ([`param`]), output folders and CSV/JSON
 //! writers ([`output`]), memory estimates checked before allocating ([`resources`]), sampling triggers ([`trigger`]) and one-dimensional external fields
-//! ([`field1d`]) shared by Brownian cluster dynamics and the exact 1D theory.
+//! ([`field1d`]) shared by Brownian cluster dynamics and the exact 1D theory; the external tools
+//! tests check outputs with ([`tools`]).
 
 pub mod field1d;
 pub mod output;
@@ -11,6 +12,7 @@ pub mod param;
 pub mod resources;
 pub mod rng;
 pub mod timing;
+pub mod tools;
 pub mod trigger;
 
 pub use param::ParamError;

@@ -1,22 +1,18 @@
 //! Our GSD files are read by the field's own reader, the `gsd` Python package (as HOOMD-blue,
-//! freud and OVITO read them). Skips with a notice when Python or `gsd` is absent.
+//! freud and OVITO read them). Skips with a notice when Python or `gsd` is absent, fails then
+//! where `COLLOIDSIM_REQUIRE_TOOLS` is set (CI).
 
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::{Particles, SimBox};
 use std::process::Command;
 
 fn python_has_gsd() -> bool {
-    Command::new("python3")
-        .args(["-c", "import gsd.hoomd"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
+    colloidsim_core::tools::python_module_or_skip("gsd.hoomd", "python_gsd_reads_our_trajectories")
 }
 
 #[test]
 fn python_gsd_reads_our_trajectories() {
     if !python_has_gsd() {
-        eprintln!("NOTICE: python3 with the gsd package not found; skipping (pip install gsd)");
         return;
     }
     let dir = tempfile::tempdir().unwrap();
