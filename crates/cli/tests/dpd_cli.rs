@@ -73,6 +73,12 @@ fn a_small_suspension_runs_and_writes_every_output() {
             .unwrap();
     assert_eq!(s["completed"], true);
     assert_eq!(s["steps"], 400);
+    // g(r) stops under half the box by default (freud's RDF refuses r_max = L/2).
+    let (_, gr) = colloidsim_core::output::read_table(&d.join("out/gr.csv")).unwrap();
+    let r = &gr[0];
+    let (r_last, r_prev) = (r[r.len() - 1], r[r.len() - 2]);
+    let edge = r_last + 0.5 * (r_last - r_prev);
+    assert!((edge - 0.49 * 8.0).abs() < 1e-9, "g(r) ends at {edge}");
     let (head, rows) = colloidsim_core::output::read_table(&d.join("out/thermo.csv")).unwrap();
     assert_eq!(
         head[..6],

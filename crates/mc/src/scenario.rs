@@ -418,7 +418,8 @@ impl McScenario {
         at_least("output.profile_bins", o.profile_bins, 1)?;
         at_least("output.gr_bins", o.gr_bins, 1)?;
         let half = 0.5 * box_edge;
-        let gr_max = o.gr_max.unwrap_or(half);
+        // Just under half the box: freud's RDF (and any AABB query) refuses exactly L/2.
+        let gr_max = o.gr_max.unwrap_or(0.98 * half);
         if !(gr_max.is_finite() && gr_max > 0.0 && gr_max <= half * (1.0 + 1e-12)) {
             return Err(ParamError::new(
                 "output.gr_max",

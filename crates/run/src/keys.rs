@@ -1105,8 +1105,9 @@ pub static DPD: &[Spec] = &[
         Integer(1, 10_000_000),
         "bins of g(r)",
     ),
-    key("observe.gr_max", "rc", "L/2", Positive, "range of g(r)")
-        .also("at most half the shortest box edge"),
+    key("observe.gr_max", "rc", "0.49 L", Positive, "range of g(r)").also(
+        "at most half the shortest box edge (the default stays under it: freud's RDF refuses L/2)",
+    ),
     key(
         "observe.contact_gap",
         "rc",
@@ -1283,8 +1284,8 @@ pub static MC: &[Spec] = &[
         Integer(1, 1_000_000),
         "bins of g(r) between 0 and gr_max (bulk: g_r.csv)",
     ),
-    key("output.gr_max", "length", "L/2", Positive, "range of g(r)")
-        .also("at most L/2"),
+    key("output.gr_max", "length", "0.49 L", Positive, "range of g(r)")
+        .also("at most L/2 (the default stays under it: freud's RDF refuses L/2)"),
     key(
         "output.trajectory_every",
         "sweeps",

@@ -504,7 +504,8 @@ impl DpdScenario {
         let shortest = l.iter().cloned().fold(f64::INFINITY, f64::min);
         let gr_max = match o.gr_max {
             Some(g) => in_range("observe.gr_max", g, 1e-6, 0.5 * shortest)?,
-            None => 0.5 * shortest,
+            // Just under half the box: freud's RDF (and any AABB query) refuses exactly L/2.
+            None => 0.49 * shortest,
         };
         if o.gr_bins == 0 {
             return Err(ParamError::new("observe.gr_bins", "must be >= 1"));
