@@ -73,6 +73,13 @@ fn a_small_suspension_runs_and_writes_every_output() {
             .unwrap();
     assert_eq!(s["completed"], true);
     assert_eq!(s["steps"], 400);
+    // 400 steps are 0.007 tau_D: no long-time diffusion coefficient, and the reason.
+    assert!(s["colloid_diffusion_long_time"].is_null());
+    let note = s["colloid_diffusion_note"].as_str().unwrap();
+    assert!(
+        note.contains("not measured") && note.contains("tau_D"),
+        "{note}"
+    );
     // g(r) stops under half the box by default (freud's RDF refuses r_max = L/2).
     let (_, gr) = colloidsim_core::output::read_table(&d.join("out/gr.csv")).unwrap();
     let r = &gr[0];

@@ -746,9 +746,11 @@ fn write_outputs(
         )?;
         files.push("msd.csv".into());
         // Long-time colloid diffusion: slope of the MSD over the second half of the lags
-        // (least squares), D = slope / 6.
+        // (least squares), D = slope / 6; only when that half starts at a lag of at least one
+        // colloid diffusion time tau_D = R^2 / D0 (before it the slope is the short-time
+        // motion, not the long-time self-diffusion).
         let n = mc.len();
-        if s.colloids > 0 && n >= 4 {
+        if s.colloids > 0 && n >= 4 && time_tau[n / 2] >= 1.0 {
             let (a, b) = (n / 2, n);
             let xs = &time[a..b];
             let ys = &mc[a..b];
@@ -891,8 +893,30 @@ fn summary(
         "mean_pressure_second_half": mean_second_half(&obs.thermo, |t| (t.pressure[0] + t.pressure[1] + t.pressure[2]) / 3.0),
         "colloid_diffusion_long_time": diffusion,
         "colloid_diffusion_over_stokes_einstein": diffusion.map(|d| d / s.d0),
+        "colloid_diffusion_note": diffusion_note(s, obs, diffusion),
         "warnings": warnings,
     })
+}
+
+/// Why `colloid_diffusion_long_time` is null, or how it was measured.
+fn diffusion_note(s: &DpdSetup, obs: &Observed, diffusion: Option<f64>) -> String {
+    let lags = obs.msd_steps.len().saturating_sub(1);
+    let longest = obs
+        .msd_steps
+        .last()
+        .zip(obs.msd_steps.first())
+        .map_or(0.0, |(b, a)| (b - a) as f64 * s.params.dt / s.tau);
+    match diffusion {
+        Some(_) => format!(
+            "slope of the colloid MSD / 6 over the second half of its {lags} lags (up to {longest:.3} tau_D)"
+        ),
+        None if s.colloids == 0 => "no colloids".into(),
+        None => format!(
+            "not measured: the MSD's lags reach {longest:.3} tau_D; the long-time diffusion \
+             needs the second half of the lags to start at 1 tau_D or later (a run of at least \
+             about 2 tau_D)"
+        ),
+    }
 }
 
 fn mean_second_half(rows: &[(f64, Thermo)], f: impl Fn(&Thermo) -> f64) -> Option<f64> {
