@@ -11,6 +11,7 @@
 //! ```
 
 use crate::lanczos::LanczosParams;
+use crate::pse::PseParams;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::in_range;
 use serde::{Deserialize, Serialize};
@@ -89,6 +90,19 @@ impl HydroParams {
     /// The Lanczos parameters.
     pub fn lanczos(&self) -> LanczosParams {
         LanczosParams {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+        }
+    }
+
+    /// The PSE parameters of these settings for spheres of radius `radius` in a solvent of
+    /// viscosity `viscosity`, in a periodic cube of edge `box_length`.
+    pub fn pse_params(&self, radius: f64, viscosity: f64, box_length: f64) -> PseParams {
+        PseParams {
+            radius,
+            viscosity,
+            box_length,
+            splitting: self.splitting,
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
         }

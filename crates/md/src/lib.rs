@@ -2,6 +2,7 @@
 //! Brownian dynamics, initial configurations, GSD input/output) and the drying-droplet
 //! scenario.
 
+mod bd_scenario;
 pub mod bench;
 pub mod brownian;
 mod cells;

@@ -216,6 +216,14 @@ impl Spec {
 use Allowed::*;
 
 const SEED: Allowed = Integer(0, u32::MAX as i64);
+/// The `seed` key of the methods with counter-based random streams.
+const SEED_KEY: Spec = key(
+    "seed",
+    "-",
+    "1",
+    SEED,
+    "seed of the counter-based random streams (--seed overrides)",
+);
 /// Step counts and other integers a run can hold.
 const COUNT: i64 = 1 << 53;
 
@@ -584,6 +592,103 @@ pub static BCD: &[Spec] = &[
     ),
 ];
 
+/// Keys that `droplet-bd` and `bd` share (the same engines and units).
+const DIAMETER: Spec = key(
+    "system.diameter",
+    "length",
+    "1",
+    Positive,
+    "colloid diameter d",
+);
+
+const KT: Spec = key("system.kT", "energy", "1", Positive, "thermal energy");
+
+const VISCOSITY: Spec = key(
+    "system.viscosity",
+    "energy time / length^3",
+    "1",
+    Positive,
+    "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
+);
+
+const RUN_DT: Spec = key(
+    "run.dt",
+    "time",
+    "2e-4 d^2 / D0",
+    Positive,
+    "time step (too large a step for the WCA core stops the run naming the step and particle)",
+)
+.also("at most 1e12 steps");
+
+const RUN_SKIN: Spec =
+    key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]");
+
+const RUN_INTEGRATOR: Spec = key(
+        "run.integrator",
+        "-",
+        "euler",
+        OneOf(&["euler", "lm"]),
+        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
+    )
+    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")");
+
+const TRAJECTORY: Spec = key(
+    "observe.trajectory",
+    "-",
+    "none",
+    Table,
+    "GSD frames of replica 0: trajectory.gsd",
+);
+
+const TRAJECTORY_EVERY: Spec = key(
+    "observe.trajectory.every",
+    "steps",
+    "0",
+    Integer(0, COUNT),
+    "steps between frames (0: none)",
+);
+
+/// The `[hydrodynamics]` keys that `droplet-bd` and `bd` share (`method` and `box_factor`
+/// differ).
+const HYDRO: [Spec; 5] = [
+    key(
+        "hydrodynamics",
+        "-",
+        "free draining",
+        Table,
+        "hydrodynamic interactions; without this table the free-draining engine runs",
+    ),
+    key(
+        "hydrodynamics.model",
+        "-",
+        "free-draining",
+        OneOf(&["free-draining", "rpy"]),
+        "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
+    ),
+    key(
+        "hydrodynamics.tolerance",
+        "-",
+        "1e-3",
+        LeftOpen(0.0, 0.1),
+        "relative error of the PSE product and of each Lanczos square root",
+    ),
+    key(
+        "hydrodynamics.splitting",
+        "1 / length",
+        "0.5 / a = 1 / d",
+        Positive,
+        "PSE splitting parameter xi",
+    )
+    .also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3"),
+    key(
+        "hydrodynamics.max_iterations",
+        "-",
+        "200",
+        Integer(1, 1000),
+        "Lanczos iteration limit; reaching it stops the run naming the step",
+    ),
+];
+
 /// The keys of `droplet-bd` scenarios.
 pub static DROPLET: &[Spec] = &[
     key(
@@ -593,13 +698,7 @@ pub static DROPLET: &[Spec] = &[
         OneOf(&["droplet-bd"]),
         "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "replicas",
         "-",
@@ -621,21 +720,9 @@ pub static DROPLET: &[Spec] = &[
         Integer(1, 100_000_000),
         "number of colloids N",
     ),
-    key(
-        "system.diameter",
-        "length",
-        "1",
-        Positive,
-        "colloid diameter d",
-    ),
-    key("system.kT", "energy", "1", Positive, "thermal energy"),
-    key(
-        "system.viscosity",
-        "energy time / length^3",
-        "1",
-        Positive,
-        "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
-    ),
+    DIAMETER,
+    KT,
+    VISCOSITY,
     key(
         "system.phi0",
         "-",
@@ -730,23 +817,9 @@ pub static DROPLET: &[Spec] = &[
     )
     .also("in [-R0, R0] and R_end + offset > 0"),
     key("run", "-", "defaults", Table, "time stepping"),
-    key(
-        "run.dt",
-        "time",
-        "2e-4 d^2 / D0",
-        Positive,
-        "time step (too large a step for the WCA core stops the run naming the step and particle)",
-    )
-    .also("at most 1e12 steps"),
-    key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]"),
-    key(
-        "run.integrator",
-        "-",
-        "euler",
-        OneOf(&["euler", "lm"]),
-        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
-    )
-    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")"),
+    RUN_DT,
+    RUN_SKIN,
+    RUN_INTEGRATOR,
     key("observe", "-", "profiles", Table, "what to measure"),
     key(
         "observe.profile",
@@ -770,20 +843,8 @@ pub static DROPLET: &[Spec] = &[
         "fractions of the drying time at which profiles are written",
     )
     .also("at least one"),
-    key(
-        "observe.trajectory",
-        "-",
-        "none",
-        Table,
-        "GSD frames of replica 0: trajectory.gsd",
-    ),
-    key(
-        "observe.trajectory.every",
-        "steps",
-        "0",
-        Integer(0, COUNT),
-        "steps between frames (0: none)",
-    ),
+    TRAJECTORY,
+    TRAJECTORY_EVERY,
     key(
         "observe.cross_section",
         "-",
@@ -799,20 +860,8 @@ pub static DROPLET: &[Spec] = &[
         "slab thickness: centres with |z| < width / 2",
     )
     .also("in [0.001 d, 2 R0]"),
-    key(
-        "hydrodynamics",
-        "-",
-        "free draining",
-        Table,
-        "hydrodynamic interactions; without this table the free-draining engine runs",
-    ),
-    key(
-        "hydrodynamics.model",
-        "-",
-        "free-draining",
-        OneOf(&["free-draining", "rpy"]),
-        "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
-    ),
+    HYDRO[0],
+    HYDRO[1],
     key(
         "hydrodynamics.method",
         "-",
@@ -821,21 +870,8 @@ pub static DROPLET: &[Spec] = &[
         "RPY in an unbounded fluid by direct O(N^2) sums, or periodic by positively split Ewald",
     )
     .also("model = \"rpy\" only; direct: at most 20000 particles"),
-    key(
-        "hydrodynamics.tolerance",
-        "-",
-        "1e-3",
-        LeftOpen(0.0, 0.1),
-        "relative error of the PSE product and of each Lanczos square root",
-    ),
-    key(
-        "hydrodynamics.splitting",
-        "1 / length",
-        "0.5 / a = 1 / d",
-        Positive,
-        "PSE splitting parameter xi",
-    )
-    .also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3"),
+    HYDRO[2],
+    HYDRO[3],
     key(
         "hydrodynamics.box_factor",
         "droplet diameters",
@@ -844,13 +880,7 @@ pub static DROPLET: &[Spec] = &[
         "PSE: edge of the periodic box / initial droplet diameter 2 R0 (the paper: 2)",
     )
     .also("method = \"pse\" only; the box must hold the droplet, its interface and two neighbour ranges"),
-    key(
-        "hydrodynamics.max_iterations",
-        "-",
-        "200",
-        Integer(1, 1000),
-        "Lanczos iteration limit; reaching it stops the run naming the step",
-    ),
+    HYDRO[4],
 ];
 
 /// The keys of `dpd` scenarios.
@@ -862,13 +892,7 @@ pub static DPD: &[Spec] = &[
         OneOf(&["dpd"]),
         "DPD colloids in explicit solvent",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "system",
         "-",
@@ -1125,13 +1149,7 @@ pub static MC: &[Spec] = &[
         OneOf(&["hs-mc"]),
         "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key("system", "-", "required", Table, "spheres and container"),
     key(
         "system.geometry",
@@ -1419,13 +1437,7 @@ pub static MPCD: &[Spec] = &[
         OneOf(&["mpcd"]),
         "SRD solvent in a periodic cube (docs/mpcd.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     SOLVENT[0],
     SOLVENT[1],
     SOLVENT[2],
@@ -1528,13 +1540,7 @@ pub static DROPLET_MPCD: &[Spec] = &[
         OneOf(&["droplet-mpcd"]),
         "drying droplet of SRD solvent (docs/mpcd.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "boundary",
         "-",

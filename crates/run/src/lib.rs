@@ -18,6 +18,7 @@ pub mod scenario;
 pub mod trajectory;
 
 mod bcd;
+mod bd_replica;
 mod dpd;
 mod droplet;
 mod hs_mc;
