@@ -862,6 +862,12 @@ final_volume_fraction = 0.5
             err_key(&with("model = \"rpy\"\nmethod = \"pse\"\nsplitting = 0.02")),
             "hydrodynamics.splitting"
         );
+        // Absurd splittings are refused before the grid is sized (this panicked in the grid
+        // arithmetic: fuzz regression).
+        assert_eq!(
+            err_key(&with("model = \"rpy\"\nmethod = \"pse\"\nsplitting = 1e300")),
+            "hydrodynamics.splitting"
+        );
         assert_eq!(
             err_key(&with("model = \"rpy\"\ntolerance = 0.5")),
             "hydrodynamics.tolerance"
@@ -1048,6 +1054,7 @@ impl DropletParams {
         match h.method {
             Some(HydroMethod::Pse) => {
                 let l = self.hydro_box_edge(h)?;
+                h.check_pse_extent(l, "hydrodynamics.splitting")?;
                 PseGeometry::new(&self.pse_params(h, l))
                     .map(Some)
                     .map_err(as_param)
