@@ -72,6 +72,26 @@ impl<E: External> Replica<E> {
         }
     }
 
+    /// The unwrapped positions `x + image L` in input order, into `out` (no allocation once
+    /// `out` has its length).
+    pub(crate) fn unwrapped_into(&self, out: &mut Vec<[f64; 3]>) {
+        let p = self.particles();
+        out.resize(p.len(), [0.0; 3]);
+        let sbox = self.sbox();
+        match self {
+            Self::Free(s) => {
+                for ((x, img), &tag) in p.pos.iter().zip(&p.image).zip(s.order()) {
+                    out[tag as usize] = sbox.unwrap(*x, *img);
+                }
+            }
+            Self::Hydro(_) => {
+                for ((x, img), u) in p.pos.iter().zip(&p.image).zip(out.iter_mut()) {
+                    *u = sbox.unwrap(*x, *img);
+                }
+            }
+        }
+    }
+
     pub(crate) fn neighbor_builds(&self) -> u64 {
         match self {
             Self::Free(s) => s.neighbor_builds(),

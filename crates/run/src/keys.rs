@@ -883,6 +883,130 @@ pub static DROPLET: &[Spec] = &[
     HYDRO[4],
 ];
 
+/// The keys of `bd` scenarios.
+pub static BULK: &[Spec] = &[
+    key(
+        "method",
+        "-",
+        "required",
+        OneOf(&["bd"]),
+        "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE)",
+    ),
+    SEED_KEY,
+    key(
+        "replicas",
+        "-",
+        "1",
+        Integer(1, 1_000_000),
+        "independent systems run one after the other, their blocks pooled (replica r: initial stream r, noise keyed by (seed, step, r, block))",
+    ),
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "spheres, solvent, the periodic cube and the body force",
+    ),
+    key(
+        "system.particles",
+        "-",
+        "required",
+        Integer(1, 100_000_000),
+        "number of spheres N",
+    ),
+    key(
+        "system.box_length",
+        "length",
+        "required",
+        Positive,
+        "edge L of the periodic cube",
+    )
+    .also("phi = N pi d^3 / (6 L^3) at most 0.3 (random insertion; 0.64 with system.initial); L > 2 (2^(1/6) d + run.skin); with RPY the PSE cut-off below L/2"),
+    DIAMETER,
+    KT,
+    VISCOSITY,
+    key(
+        "system.body_force",
+        "energy / length",
+        "[0, 0, 0]",
+        Numbers(f64::MIN, f64::MAX, Some(3)),
+        "constant force F on every sphere (gravity less buoyancy): the mean velocity along it gives K = U / (mu0 F)",
+    )
+    .also("its drift F dt / (3 pi eta d) at most 0.1 d per step"),
+    key(
+        "system.initial",
+        "-",
+        "random insertion",
+        Path,
+        "start every replica from the last frame of this GSD file (HOOMD schema) instead of random insertion",
+    )
+    .also("must hold system.particles spheres of typeid 0 in a cube of edge system.box_length"),
+    key("run", "-", "required", Table, "time stepping"),
+    key(
+        "run.time",
+        "time",
+        "required",
+        Positive,
+        "sampled time per replica (rounded up to whole blocks)",
+    )
+    .also("at least 4 steps per block; at most 1e12 steps"),
+    RUN_DT,
+    key(
+        "run.equilibrate",
+        "time",
+        "0",
+        NonNegative,
+        "time run before sampling starts (random insertion is the hard-sphere equilibrium to first order in phi)",
+    ),
+    RUN_SKIN,
+    RUN_INTEGRATOR,
+    key("observe", "-", "defaults", Table, "what to measure"),
+    key(
+        "observe.blocks",
+        "-",
+        "8",
+        Integer(1, 10_000),
+        "blocks per replica of the sampled time; every error is the standard error of the block values, given with at least 8 blocks in all",
+    ),
+    key(
+        "observe.msd",
+        "-",
+        "30 lags up to a quarter of a block",
+        Table,
+        "mean-square displacement of the unwrapped positions (about the centre of mass under a body force): msd.csv, msd.png",
+    ),
+    key(
+        "observe.msd.points",
+        "-",
+        "30",
+        Integer(2, 1000),
+        "log-spaced lags from one step to max_lag",
+    ),
+    key(
+        "observe.msd.max_lag",
+        "time",
+        "a quarter of a block (at least 4 run.dt)",
+        Positive,
+        "longest lag T; D is the slope of the MSD between T/4 and T",
+    )
+    .also("in [4 run.dt, run.time / observe.blocks]"),
+    TRAJECTORY,
+    TRAJECTORY_EVERY,
+    HYDRO[0],
+    HYDRO[1],
+    key(
+        "hydrodynamics.method",
+        "-",
+        "pse",
+        OneOf(&["pse"]),
+        "RPY in the periodic cube by positively split Ewald (\"direct\" is the unbounded fluid: refused here)",
+    )
+    .also("model = \"rpy\" only"),
+    HYDRO[2],
+    HYDRO[3],
+    HYDRO[4],
+];
+
 /// The keys of `dpd` scenarios.
 pub static DPD: &[Spec] = &[
     key(
@@ -1763,6 +1887,11 @@ pub fn droplet() -> Vec<Key> {
     DROPLET.iter().map(Key::from).collect()
 }
 
+/// The keys of `bd` scenarios, as listed.
+pub fn bulk() -> Vec<Key> {
+    BULK.iter().map(Key::from).collect()
+}
+
 /// The keys of `dpd` scenarios, as listed.
 pub fn dpd() -> Vec<Key> {
     DPD.iter().map(Key::from).collect()
@@ -1908,7 +2037,7 @@ mod tests {
 
     #[test]
     fn every_path_is_listed_once_under_a_listed_table() {
-        for spec in [BCD, DROPLET, DPD, MC, MPCD, DROPLET_MPCD] {
+        for spec in [BCD, DROPLET, BULK, DPD, MC, MPCD, DROPLET_MPCD] {
             for (i, s) in spec.iter().enumerate() {
                 assert!(
                     spec[..i].iter().all(|t| t.path != s.path),

@@ -19,6 +19,7 @@ pub mod trajectory;
 
 mod bcd;
 mod bd_replica;
+mod bulk;
 mod dpd;
 mod droplet;
 mod hs_mc;
