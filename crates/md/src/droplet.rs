@@ -865,7 +865,9 @@ final_volume_fraction = 0.5
         // Absurd splittings are refused before the grid is sized (this panicked in the grid
         // arithmetic: fuzz regression).
         assert_eq!(
-            err_key(&with("model = \"rpy\"\nmethod = \"pse\"\nsplitting = 1e300")),
+            err_key(&with(
+                "model = \"rpy\"\nmethod = \"pse\"\nsplitting = 1e300"
+            )),
             "hydrodynamics.splitting"
         );
         assert_eq!(
