@@ -648,12 +648,23 @@ impl Results {
             few.clone()
         };
         let d = (why_d.is_none() && !d_blocks.is_empty()).then(|| mean_and_error(&d_blocks));
+        // Sedimenting spheres with hydrodynamic interactions move with the concentration
+        // fluctuations around them: their MSD holds a hydrodynamic dispersion on top of the
+        // Brownian motion.
+        let dispersion = p.force > 0.0 && coupled;
+        let note = dispersion.then_some(
+            "under a body force with RPY, D includes the hydrodynamic dispersion of sedimentation \
+             (velocity fluctuations from concentration fluctuations, growing with the Peclet number \
+             and the box): it is the long-time self-diffusion of the sedimenting suspension, not \
+             comparable with Hasimoto's equilibrium mobility",
+        );
         let diffusion = json!({
             "D_over_D0": d.map(|d| d.0),
             "error": d.map(|d| d.1),
             "D": d.map(|d| d.0 * p.d0),
             "lags": [lo as f64 * p.dt, hi as f64 * p.dt],
             "definition": "D = [MSD(T) - MSD(T/4)] / (6 (3T/4)), T = observe.msd.max_lag; about the centre of mass under a body force, times N / (N - 1)",
+            "note": note,
             "why_null": why_d,
         });
 
@@ -674,16 +685,25 @@ impl Results {
         });
         let mut parts = Vec::new();
         if let Some((k, e)) = k {
-            parts.push(format!(
-                "K = {k:.4} +- {e:.4} (dilute RPY {:.4})",
-                p.dilute_sedimentation()
-            ));
+            parts.push(if p.has_hydrodynamics() {
+                format!(
+                    "K = {k:.4} +- {e:.4} (dilute RPY {:.4})",
+                    p.dilute_sedimentation()
+                )
+            } else {
+                format!("K = {k:.4} +- {e:.4} (free draining: 1)")
+            });
         }
         if let Some((d, e)) = d {
-            parts.push(format!(
-                "D/D0 = {d:.4} +- {e:.4} (Hasimoto {:.4})",
-                p.hasimoto()
-            ));
+            parts.push(if dispersion {
+                format!(
+                    "D/D0 = {d:.4} +- {e:.4} (with the hydrodynamic dispersion of sedimentation)"
+                )
+            } else if p.has_hydrodynamics() {
+                format!("D/D0 = {d:.4} +- {e:.4} (Hasimoto {:.4})", p.hasimoto())
+            } else {
+                format!("D/D0 = {d:.4} +- {e:.4} (free draining, one sphere: 1)")
+            });
         }
         if parts.is_empty() {
             parts.push("no figure long enough to report (summary.json says why)".into());
