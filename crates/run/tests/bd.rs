@@ -239,4 +239,21 @@ fn figures_of_runs_too_short_are_null_with_the_reason() {
             .unwrap()
             .contains("a^2 / D0")
     );
+    // One sphere under a body force: its motion about the centre of mass is nil, so no MSD (and
+    // no D) but its sedimentation coefficient, 1 free draining.
+    let dir = tempfile::tempdir().unwrap();
+    let text = "method = \"bd\"\n[system]\nparticles = 1\nbox_length = 6.0\n\
+                body_force = [0.0, 3.0, 0.0]\n[run]\ndt = 0.02\ntime = 200.0\n";
+    let sc = Scenario::from_toml(text, dir.path()).unwrap();
+    let out = dir.path().join("one");
+    let opts = RunOptions {
+        out: Some(out.clone()),
+        ..Default::default()
+    };
+    let r = colloidsim_run::run(&sc, &opts, &Control::default()).unwrap();
+    assert!(!out.join("msd.csv").exists() && !r.files.contains(&"msd.csv".to_string()));
+    let why = r.summary["self_diffusion"]["why_null"].as_str().unwrap();
+    assert!(why.contains("one sphere under a body force"), "{why}");
+    let (k, e) = figure(&r.summary, "sedimentation_coefficient", "K");
+    assert!((k - 1.0).abs() < 4.0 * e, "K = {k} +- {e}");
 }
