@@ -257,3 +257,50 @@ fn figures_of_runs_too_short_are_null_with_the_reason() {
     let (k, e) = figure(&r.summary, "sedimentation_coefficient", "K");
     assert!((k - 1.0).abs() < 4.0 * e, "K = {k} +- {e}");
 }
+
+/// `system.initial`: a run starts from the last frame of another's trajectory (relative to the
+/// scenario's folder); a file of another box or another number of spheres is refused naming the
+/// key and the file, before anything is written.
+#[test]
+fn a_run_starts_from_a_gsd_frame_of_the_same_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = "method = \"bd\"\n[system]\nparticles = 30\nbox_length = 7.0\n[run]\ndt = 0.005\ntime = 0.4\n";
+    let first = Scenario::from_toml(
+        &format!("{base}[observe.trajectory]\nevery = 10\n"),
+        dir.path(),
+    )
+    .unwrap();
+    let opts = |name: &str| RunOptions {
+        out: Some(dir.path().join(name)),
+        ..Default::default()
+    };
+    colloidsim_run::run(&first, &opts("first"), &Control::default()).unwrap();
+    let start = |text: &str| {
+        Scenario::from_toml(
+            &text.replace("[run]", "initial = \"first/trajectory.gsd\"\n[run]"),
+            dir.path(),
+        )
+        .unwrap()
+    };
+    let r = colloidsim_run::run(&start(base), &opts("second"), &Control::default()).unwrap();
+    assert_eq!(r.summary["completed"], true);
+    for (text, words) in [
+        (
+            base.replace("box_length = 7.0", "box_length = 7.5"),
+            "is not the cube",
+        ),
+        (
+            base.replace("particles = 30", "particles = 31"),
+            "holds 30 particles",
+        ),
+    ] {
+        let e =
+            colloidsim_run::run(&start(&text), &opts("never"), &Control::default()).unwrap_err();
+        let e = format!("{e:#}");
+        assert!(
+            e.contains("system.initial") && e.contains("trajectory.gsd") && e.contains(words),
+            "{e}"
+        );
+        assert!(!dir.path().join("never").exists());
+    }
+}
