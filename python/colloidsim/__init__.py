@@ -376,10 +376,13 @@ class BCD(Engine):
 
 
 class BrownianDynamics(Engine):
-    """Free-draining Brownian dynamics of a droplet scenario (``method = "droplet-bd"``),
-    replica 0."""
+    """Brownian dynamics of WCA spheres, replica 0: a drying or static droplet
+    (``method = "droplet-bd"``) or a periodic cube (``method = "bd"``), free draining or with
+    RPY hydrodynamics as the scenario's ``[hydrodynamics]`` says. ``positions`` are wrapped
+    into the box (input order); ``forces`` are the systematic forces (WCA, the droplet's
+    interface or the body force); ``box`` the periodic box's edges."""
 
-    _method = ("droplet-bd",)
+    _method = ("droplet-bd", "bd")
 
 
 class DPD(Engine):

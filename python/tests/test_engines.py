@@ -65,6 +65,39 @@ def test_brownian_dynamics_and_dpd_engines():
     assert dpd.steps == 5
 
 
+BULK_SCENARIO = {
+    "method": "bd",
+    "seed": 3,
+    "system": {"particles": 1, "box_length": 7.0, "body_force": [0.0, 0.0, -2.0]},
+    "run": {"dt": 0.01, "time": 1.0},
+    "hydrodynamics": {"model": "rpy"},
+}
+
+
+def test_brownian_dynamics_engine_of_a_periodic_bulk():
+    # One sphere with RPY (PSE) under a body force: no pair force, so the systematic force is
+    # the body force; the sphere stays in the periodic box and drifts along -z.
+    bd = colloidsim.BrownianDynamics(BULK_SCENARIO)
+    assert bd.method == "bd" and bd.particles == 1
+    assert np.array_equal(bd.box, [7.0, 7.0, 7.0])
+    assert np.array_equal(bd.forces, [[0.0, 0.0, -2.0]])
+    again = colloidsim.BrownianDynamics(BULK_SCENARIO)
+    bd.step(40)
+    again.step(15)
+    again.step(25)
+    assert np.array_equal(bd.positions, again.positions)
+    assert np.all(np.abs(bd.positions) <= 3.5)
+    assert bd.steps == 40 and bd.time == pytest.approx(0.4)
+    # The free-draining twin, with Leimkuhler-Matthews.
+    free = dict(BULK_SCENARIO, hydrodynamics={"model": "free-draining"})
+    free["run"] = {"dt": 0.01, "time": 1.0, "integrator": "lm"}
+    fd = colloidsim.BrownianDynamics(free)
+    fd.step(10)
+    assert fd.positions.shape == (1, 3)
+    with pytest.raises(colloidsim.ColloidsimError, match="hydrodynamics.method"):
+        colloidsim.BrownianDynamics(dict(BULK_SCENARIO, hydrodynamics={"model": "rpy", "method": "direct"}))
+
+
 def test_monte_carlo_and_mpcd_engines():
     mc = colloidsim.MonteCarlo(EXAMPLES / "mc/bulk.toml")
     p0 = mc.positions.copy()

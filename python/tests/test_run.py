@@ -102,6 +102,22 @@ def test_theory_with_the_trokhymchuk_pair_correlation_equals_the_cli(tmp_path, c
         colloidsim.theory(scenario, out=tmp_path / "bad", hydrodynamics="rpy", pair="py")
 
 
+def test_a_bulk_bd_run_equals_the_cli_byte_for_byte(tmp_path, cli):
+    # method = "bd": RPY (PSE) under a body force, MSD, trajectory, two replicas.
+    path = tmp_path / "bulk.toml"
+    path.write_text(
+        'method = "bd"\nseed = 2\nreplicas = 2\n[system]\nparticles = 20\nbox_length = 8.0\n'
+        "body_force = [0.0, 0.0, -1.0]\n[run]\ndt = 0.01\ntime = 1.0\n"
+        "[observe.trajectory]\nevery = 20\n[hydrodynamics]\nmodel = \"rpy\"\n"
+    )
+    cli("run", path, "--out", tmp_path / "cli", "--quiet")
+    r = colloidsim.run(path, out=tmp_path / "py")
+    assert_same_outputs(tmp_path / "cli", tmp_path / "py")
+    assert list(r.msd) == ["t", "msd", "err"]
+    assert r.summary["blocks"] == 16
+    assert r.summary["sedimentation_coefficient"]["dilute_reference"] > 0
+
+
 def test_check_equals_the_cli(cli):
     path = EXAMPLES / "bcd/hard-rods-cosine.toml"
     out = cli("check", path, "--set", "run.dt=2e-4").stdout

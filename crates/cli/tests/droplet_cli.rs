@@ -1,10 +1,9 @@
 //! End-to-end tests of `colloidsim run` on droplet-bd scenarios: checkpoints and `--restart`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
 mod common;
-use common::{assert_same_outputs, files, text};
+use common::{assert_same_outputs, colloidsim as run, files, p, text};
 
 /// summary.json fields that depend on the session (timing) or on when the neighbour list was
 /// rebuilt (a restart rebuilds it).
@@ -13,10 +12,6 @@ const VOLATILE: &[&str] = &[
     "particle_steps_per_second",
     "neighbor_list_builds",
 ];
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_colloidsim"))
-}
 
 /// 200 colloids, 3 replicas of 300 steps (checkpoints every 30 steps), a trajectory frame of
 /// replica 0 every 20 steps: a second or two.
@@ -36,22 +31,6 @@ dt = 0.004
 profile = { bins = 10, fractions = [0, 0.25, 0.5, 0.75, 1.0] }
 trajectory = { every = 20 }
 "#;
-
-/// Run colloidsim with `args` and the environment variables `env`.
-fn run(args: &[&Path], env: &[(&str, &str)]) -> Output {
-    let mut c = bin();
-    c.args(args).arg("--quiet");
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    let o = c.output().unwrap();
-    eprintln!("{}", text(&o));
-    o
-}
-
-fn p(s: &str) -> &Path {
-    Path::new(s)
-}
 
 fn setup() -> (tempfile::TempDir, PathBuf, PathBuf) {
     let tmp = tempfile::tempdir().unwrap();

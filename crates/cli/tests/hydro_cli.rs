@@ -4,11 +4,8 @@
 //! through the failure path, naming the step, and bad `[hydrodynamics]` input is refused before
 //! anything is written.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
 mod common;
-use common::{assert_same_outputs, files, text};
+use common::{colloidsim as run, complete, files, p, restarts_bitwise, text};
 
 /// summary.json fields that depend on the session (timing) or on when the neighbour list was
 /// rebuilt (a restart rebuilds it).
@@ -62,47 +59,6 @@ method = "pse"
 box_factor = 2.0
 "#;
 
-fn run(args: &[&Path], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
-    c.args(args).arg("--quiet");
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    let o = c.output().unwrap();
-    eprintln!("{}", text(&o));
-    o
-}
-
-fn p(s: &str) -> &Path {
-    Path::new(s)
-}
-
-/// Write `scenario` as NAME.toml in a temporary folder and run it to completion into `NAME`.
-fn complete(name: &str, scenario: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
-    let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join(format!("{name}.toml"));
-    std::fs::write(&sc, scenario).unwrap();
-    let a = tmp.path().join(name);
-    let o = run(&[p("run"), &sc, p("--out"), &a], &[]);
-    assert!(o.status.success());
-    (tmp, sc, a)
-}
-
-/// Interrupted (as by Ctrl-C) or killed without a checkpoint at each position of `stops`,
-/// the run continues with `--restart` to the same files as the uninterrupted run in `a`.
-fn restarts_bitwise(tmp: &Path, sc: &Path, a: &Path, stops: &[(&str, &str)]) {
-    for (hook, at) in stops {
-        let b = tmp.join(format!("b-{hook}-{at}"));
-        let o = run(&[p("run"), sc, p("--out"), &b], &[(hook, at)]);
-        assert!(!o.status.success());
-        assert!(b.join("checkpoint.bin").exists(), "{hook} {at}");
-        assert!(!b.join("summary.json").exists());
-        let o = run(&[p("run"), sc, p("--restart"), &b], &[]);
-        assert!(o.status.success());
-        assert_same_outputs(a, &b, VOLATILE);
-    }
-}
-
 #[test]
 fn droplet_with_rpy_restarts_bitwise() {
     let (tmp, sc, a) = complete("direct", DIRECT);
@@ -131,6 +87,7 @@ fn droplet_with_rpy_restarts_bitwise() {
             ("COLLOIDSIM_INTERRUPT_AT_STEP", "200"),
             ("COLLOIDSIM_KILL_AT_STEP", "333"),
         ],
+        VOLATILE,
     );
     // Another seed gives another run.
     let c = tmp.path().join("c");
@@ -151,6 +108,7 @@ fn droplet_with_pse_restarts_bitwise() {
         &sc,
         &a,
         &[("COLLOIDSIM_INTERRUPT_AT_STEP", "23")],
+        VOLATILE,
     );
 }
 

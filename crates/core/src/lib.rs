@@ -2,11 +2,13 @@
 //!
 //! Everything here is used by more than one method family: counter-based random streams
 //! ([`rng`]), validated parameters and their errors ([`param`]), output folders and CSV/JSON
-//! writers ([`output`]), memory estimates checked before allocating ([`resources`]), sampling triggers ([`trigger`]) and one-dimensional external fields
-//! ([`field1d`]) shared by Brownian cluster dynamics and the exact 1D theory; the external tools
-//! tests check outputs with ([`tools`]).
+//! writers ([`output`]), the mean-square displacement of a running simulation ([`msd`]), memory
+//! estimates checked before allocating ([`resources`]), sampling triggers ([`trigger`]),
+//! one-dimensional external fields ([`field1d`]) shared by Brownian cluster dynamics and the
+//! exact 1D theory, and the external tools tests check outputs with ([`tools`]).
 
 pub mod field1d;
+pub mod msd;
 pub mod output;
 pub mod param;
 pub mod resources;

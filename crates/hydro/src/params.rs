@@ -11,6 +11,7 @@
 //! ```
 
 use crate::lanczos::LanczosParams;
+use crate::pse::PseParams;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::in_range;
 use serde::{Deserialize, Serialize};
@@ -89,6 +90,40 @@ impl HydroParams {
     /// The Lanczos parameters.
     pub fn lanczos(&self) -> LanczosParams {
         LanczosParams {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+        }
+    }
+
+    /// A bound checked before the PSE grid is sized: `xi L <= 1e6` for a box of edge
+    /// `box_length`. PSE needs at least `2 xi L / pi` grid points per axis (its Fourier cut-off
+    /// exceeds `2 xi`), so this refuses nothing PSE would accept (it takes at most 1024 per
+    /// axis); it keeps absurd values (a splitting or box of 1e300) from reaching the grid
+    /// arithmetic. The error names `key` (the splitting, or the box's key).
+    pub fn check_pse_extent(&self, box_length: f64, key: &str) -> Result<(), ParamError> {
+        let extent = self.splitting * box_length;
+        if extent.is_finite() && extent <= 1e6 {
+            return Ok(());
+        }
+        Err(ParamError::new(
+            key,
+            format!(
+                "splitting xi = {} in a box of edge {} gives xi L = {extent:e}: the PSE grid would \
+                 need far more than 1024 points per axis (about 2 xi L / pi at least)",
+                colloidsim_core::param::show(self.splitting),
+                colloidsim_core::param::show(box_length)
+            ),
+        ))
+    }
+
+    /// The PSE parameters of these settings for spheres of radius `radius` in a solvent of
+    /// viscosity `viscosity`, in a periodic cube of edge `box_length`.
+    pub fn pse_params(&self, radius: f64, viscosity: f64, box_length: f64) -> PseParams {
+        PseParams {
+            radius,
+            viscosity,
+            box_length,
+            splitting: self.splitting,
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
         }

@@ -37,6 +37,7 @@ use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::BoxTooSmall;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
+use colloidsim_core::ParamError;
 use colloidsim_core::rng::{BLOCK, Purpose, Ziggurat, stream};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -61,6 +62,35 @@ pub enum Integrator {
     /// (the diffusion coefficient) is not.
     Lm,
 }
+impl Integrator {
+    /// The scenario's `run.integrator` (`"euler"`, the default, or `"lm"`); `rpy`: the run
+    /// has RPY hydrodynamics, for which Leimkuhler–Matthews is refused (the noise is correlated
+    /// through the mobility, which the scheme does not cover).
+    pub fn from_scenario(name: Option<&str>, rpy: bool) -> Result<Self, ParamError> {
+        let integrator = match name {
+            None | Some("euler") => Integrator::Euler,
+            Some("lm") => Integrator::Lm,
+            Some(other) => {
+                return Err(ParamError::new(
+                    "run.integrator",
+                    format!(
+                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
+                    ),
+                ));
+            }
+        };
+        if integrator == Integrator::Lm && rpy {
+            return Err(ParamError::new(
+                "run.integrator",
+                "\"lm\" (Leimkuhler-Matthews) is for free draining only: with hydrodynamics.model = \
+                 \"rpy\" the noise is correlated through the mobility, which the scheme does not \
+                 cover; use run.integrator = \"euler\" or hydrodynamics.model = \"free-draining\"",
+            ));
+        }
+        Ok(integrator)
+    }
+}
+
 /// Parameters of the Brownian integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BdParams {

@@ -1,9 +1,11 @@
 //! colloidsim-md: 3D particles (state and box, neighbour search, pair and external forces,
-//! Brownian dynamics, initial configurations, GSD input/output) and the drying-droplet
-//! scenario.
+//! Brownian dynamics, initial configurations, GSD input/output), the drying-droplet scenario
+//! and the bulk periodic Brownian-dynamics scenario.
 
+mod bd_scenario;
 pub mod bench;
 pub mod brownian;
+pub mod bulk;
 mod cells;
 pub mod dpd;
 pub mod droplet;

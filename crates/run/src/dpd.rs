@@ -3,7 +3,8 @@
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
-use crate::droplet::{flat, trim_trajectory};
+use crate::droplet::trim_trajectory;
+use crate::engine::flat;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};

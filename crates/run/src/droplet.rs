@@ -4,7 +4,10 @@
 //! PSE in a periodic box), replicas one after the other, radial volume-fraction profiles at
 //! fractions of the drying time; `theory` is the radial FMT DDFT ([`crate::theory_droplet`]).
 
-use crate::checkpoint::{Envelope, file_crc};
+use crate::bd_replica::{
+    BdMethod, BdSession, Observe, ReplicaEngine, Replicas, Saved, read_replica_checkpoint,
+};
+use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
@@ -15,12 +18,9 @@ use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::brownian::Integrator;
-use colloidsim_md::droplet::{DropletSim, HydroDropletSim};
+use colloidsim_md::droplet::DropletSim;
 use colloidsim_md::gsd::{self, GsdWriter};
-use colloidsim_md::{
-    BdParams, DropletParams, DropletScenario, HydroBdParams, LennardJones, Particles, SimBox,
-};
+use colloidsim_md::{DropletParams, DropletScenario, HarmonicInterface, LennardJones};
 use hoomd_gsd::file_layer::Mode;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -72,9 +72,9 @@ impl Method for DropletBd {
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
         let (_, p) = resolve(src, seed)?;
         // Set up replica 0 before the output folder is created: bad input leaves nothing.
-        let sim = Replica::build(&p, 0)?;
+        let sim = build_replica(&p, 0)?;
         let acc = Accum::new(&p);
-        Ok(Box::new(DropletSession::new(p, acc, 0, Some((sim, 0)))))
+        Ok(Box::new(DropletObs::session(p, acc, 0, Some((sim, 0)))))
     }
 
     fn restore(
@@ -85,7 +85,7 @@ impl Method for DropletBd {
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
         let (_, p) = resolve(src, Some(seed))?;
-        let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+        let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
         if saved.replica >= p.replicas || saved.acc.sums.len() != p.fractions.len() {
             bail!(
                 "checkpoint: replica {} of {} with {} profiles does not fit the scenario",
@@ -103,7 +103,7 @@ impl Method for DropletBd {
                     trim_trajectory(path, frames, &["droplet/radius", "droplet/time"], false)
                 })?;
         }
-        Ok(Box::new(DropletSession::new(
+        Ok(Box::new(DropletObs::session(
             p,
             saved.acc,
             saved.replica,
@@ -125,8 +125,11 @@ impl Method for DropletBd {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let (_, p) = resolve(src, seed)?;
-        let sim = Replica::build(&p, 0)?;
-        Ok(Box::new(BdEngine { sim }))
+        let sim = build_replica(&p, 0)?;
+        Ok(Box::new(ReplicaEngine {
+            method: "droplet-bd",
+            sim,
+        }))
     }
 }
 
@@ -172,136 +175,28 @@ impl Accum {
     }
 }
 
-/// The integrator parameters of the running replica (`BdParams`), so that it continues with
-/// exactly the parameters it started with.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
-struct Engine {
-    kt: f64,
-    viscosity: f64,
-    dt: f64,
-    seed: u32,
-    replica: u32,
-    skin: f64,
-    sort_every: u64,
-    max_drift: f64,
-    /// Neighbour-list builds of this replica so far.
-    builds: u64,
-}
-
-impl Engine {
-    fn of(s: &Replica, builds: u64) -> Self {
-        match s {
-            Replica::Free(s) => {
-                let b = s.params();
-                Self {
-                    kt: b.kt,
-                    viscosity: b.viscosity,
-                    dt: b.dt,
-                    seed: b.seed,
-                    replica: b.replica,
-                    skin: b.skin,
-                    sort_every: b.sort_every,
-                    max_drift: b.max_drift,
-                    builds,
-                }
-            }
-            Replica::Hydro(s) => {
-                let b = s.params();
-                Self {
-                    kt: b.kt,
-                    viscosity: 0.0,
-                    dt: b.dt,
-                    seed: b.seed,
-                    replica: b.replica,
-                    skin: b.skin,
-                    sort_every: 0,
-                    max_drift: b.max_drift,
-                    builds,
-                }
-            }
-        }
-    }
-
-    fn hydro_params(&self) -> HydroBdParams {
-        HydroBdParams {
-            kt: self.kt,
-            dt: self.dt,
-            seed: self.seed,
-            replica: self.replica,
-            skin: self.skin,
-            max_drift: self.max_drift,
-        }
-    }
-
-    /// The free-draining engine's parameters with `integrator` (the scenario's
-    /// `run.integrator`: a restart runs the scenario it started with, so the checkpoint need not
-    /// hold it; nor the Leimkuhler–Matthews deviates, which the engine draws again from (seed,
-    /// step, particle)).
-    fn params(&self, integrator: Integrator) -> BdParams {
-        BdParams {
-            kt: self.kt,
-            viscosity: self.viscosity,
-            dt: self.dt,
-            seed: self.seed,
-            replica: self.replica,
-            skin: self.skin,
-            sort_every: self.sort_every,
-            max_drift: self.max_drift,
-            integrator,
-        }
-    }
-}
-
-/// The method's part of `checkpoint.bin`. The running replica's particles (exact positions,
-/// images, box, storage order, list reference positions) are in the GSD file it names, whose
-/// CRC-32 it keeps.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct Saved {
-    /// Replica to continue.
-    replica: usize,
-    /// Its step: every event (profile, frame) up to and including this step is in `acc`.
-    step: u64,
-    /// GSD checkpoint of the replica at `step`, its CRC-32 and its engine parameters; `None`:
-    /// the replica has not started (step 0, built afresh).
-    state: Option<(String, u32, Engine)>,
-    acc: Accum,
-}
-
 /// Restore the running replica from a checkpoint (verified against its CRC first).
 fn restore_replica(
     out: &OutputDir,
     p: &DropletParams,
-    saved: &Saved,
+    saved: &Saved<Accum>,
 ) -> Result<Option<(Replica, u64)>> {
-    let Some((name, crc, engine)) = &saved.state else {
+    let Some(state) = &saved.state else {
         return Ok(None);
     };
-    let path = out.join(name);
-    let found = file_crc(&path)?;
-    if found != *crc {
-        bail!(
-            "{}: damaged: checksum {found:08x}, the checkpoint recorded {crc:08x}",
-            path.display()
-        );
-    }
-    let mut f = gsd::read_frame(&path, None)?;
     // The hydrodynamic engine's state is its exact positions and images; the free-draining
     // engine's also holds its storage order and list reference positions.
     let hydro = p.hydrodynamics.as_ref().filter(|_| p.has_hydrodynamics());
-    if f.step != saved.step
-        || !f.exact
-        || f.list.is_none() != hydro.is_some()
-        || engine.replica as usize != saved.replica
-    {
-        bail!(
-            "{}: not the checkpoint of replica {} at step {} that checkpoint.bin names",
-            path.display(),
-            saved.replica,
-            saved.step
-        );
-    }
-    // GSD stores diameters in single precision: every colloid has the scenario's.
-    f.particles.diameter.fill(p.diameter);
+    let f = read_replica_checkpoint(
+        out,
+        state,
+        saved.step,
+        saved.replica,
+        hydro.is_some(),
+        p.diameter,
+    )?;
+    let path = out.join(&state.0);
+    let engine = &state.2;
     let sim = match hydro {
         None => Replica::Free(Box::new(
             DropletSim::restart(
@@ -315,140 +210,51 @@ fn restore_replica(
             )
             .with_context(|| format!("restart from {}", path.display()))?,
         )),
-        Some(h) => Replica::hydro(
+        Some(h) => Replica::Hydro(Box::new(
             p.restart_hydro_replica(f.particles, h, engine.hydro_params(), f.step)
                 .with_context(|| format!("restart from {}", path.display()))?,
-        ),
+        )),
     };
     // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
     let builds = engine.builds.saturating_sub(sim.neighbor_builds());
     Ok(Some((sim, builds)))
 }
 
-/// A running droplet replica: the free-draining engine (bitwise the engine of every
-/// free-draining run), or Brownian dynamics with a hydrodynamic mobility.
-enum Replica {
-    Free(Box<DropletSim>),
-    Hydro(Box<HydroDropletSim>),
-}
+/// A running droplet replica, in the moving harmonic interface.
+type Replica = crate::bd_replica::Replica<HarmonicInterface>;
 
-impl Replica {
-    /// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
-    fn build(p: &DropletParams, replica: u32) -> Result<Self> {
-        Ok(match &p.hydrodynamics {
-            Some(h) if p.has_hydrodynamics() => Self::hydro(p.build_hydro_replica(replica, h)?),
-            _ => Self::Free(Box::new(p.build_replica(replica)?)),
-        })
-    }
-
-    fn hydro(s: HydroDropletSim) -> Self {
-        Self::Hydro(Box::new(s))
-    }
-
-    fn step(&self) -> u64 {
-        match self {
-            Self::Free(s) => s.step,
-            Self::Hydro(s) => s.step,
+/// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
+fn build_replica(p: &DropletParams, replica: u32) -> Result<Replica> {
+    Ok(match &p.hydrodynamics {
+        Some(h) if p.has_hydrodynamics() => {
+            Replica::Hydro(Box::new(p.build_hydro_replica(replica, h)?))
         }
-    }
-
-    fn time(&self) -> f64 {
-        match self {
-            Self::Free(s) => s.time(),
-            Self::Hydro(s) => s.time(),
-        }
-    }
-
-    fn dt(&self) -> f64 {
-        match self {
-            Self::Free(s) => s.params().dt,
-            Self::Hydro(s) => s.params().dt,
-        }
-    }
-
-    fn sbox(&self) -> &SimBox {
-        match self {
-            Self::Free(s) => &s.sbox,
-            Self::Hydro(s) => &s.sbox,
-        }
-    }
-
-    /// The particles in the engine's order (for profiles, where the order does not matter).
-    fn particles(&self) -> &Particles {
-        match self {
-            Self::Free(s) => s.particles(),
-            Self::Hydro(s) => s.particles(),
-        }
-    }
-
-    /// The particles in input order, positions wrapped into the box.
-    fn snapshot(&self) -> Particles {
-        match self {
-            Self::Free(s) => s.snapshot(),
-            Self::Hydro(s) => s.particles().clone(),
-        }
-    }
-
-    fn neighbor_builds(&self) -> u64 {
-        match self {
-            Self::Free(s) => s.neighbor_builds(),
-            Self::Hydro(s) => s.neighbor_builds(),
-        }
-    }
-
-    /// Run `n` steps; the error says why the run cannot go on.
-    fn run(&mut self, n: u64) -> Result<(), String> {
-        match self {
-            Self::Free(s) => s.run(n).map_err(|e| e.to_string()),
-            Self::Hydro(s) => s.run(n).map_err(|e| e.to_string()),
-        }
-    }
-
-    /// The systematic forces at the current positions, in input order.
-    fn forces(&self) -> Vec<[f64; 3]> {
-        match self {
-            Self::Free(s) => s.forces(),
-            Self::Hydro(s) => s.systematic_forces(),
-        }
-    }
-
-    /// The checkpoint of this replica at its step into a new GSD file at `path`.
-    fn write_checkpoint(&self, path: &Path) -> Result<()> {
-        let mut w = GsdWriter::create_new(path)?;
-        match self {
-            Self::Free(s) => {
-                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?
-            }
-            Self::Hydro(s) => w.write_frame(s.step, &s.sbox, s.particles(), true, &[])?,
-        }
-        w.sync()?;
-        Ok(())
-    }
+        _ => Replica::Free(Box::new(p.build_replica(replica)?)),
+    })
 }
 
 /// A droplet run: replicas one after the other.
-struct DropletSession {
+type DropletSession = BdSession<HarmonicInterface, DropletObs>;
+
+/// What a droplet run observes: profiles, the excursion beyond the wall, trajectory frames,
+/// the cross-section of replica 0.
+struct DropletObs {
     p: DropletParams,
     acc: Accum,
-    /// The running replica (or the next one, when `sim` is `None`).
-    rep: usize,
-    /// The running replica and its neighbour-list builds before this session.
-    sim: Option<(Replica, u64)>,
     /// Steps of a replica at which something is recorded (profiles, frames, the end).
     stops: Vec<u64>,
-    /// Steps between a replica's regular checkpoints.
-    ck_every: u64,
-    gsd: Option<GsdWriter>,
-    /// The trajectory's path, once the folder is known.
-    traj: Option<std::path::PathBuf>,
     /// The output folder, once known (the cross-section is written when replica 0 ends).
     folder: Option<std::path::PathBuf>,
-    /// GSD file the previous checkpoint named, removed once the next one is in place.
-    stale: Vec<String>,
 }
 
-impl DropletSession {
-    fn new(p: DropletParams, acc: Accum, rep: usize, sim: Option<(Replica, u64)>) -> Self {
+impl DropletObs {
+    /// The session of `p` at replica `rep` (running `sim`, or not yet built) with `acc`.
+    fn session(
+        p: DropletParams,
+        acc: Accum,
+        rep: usize,
+        sim: Option<(Replica, u64)>,
+    ) -> DropletSession {
         let mut stops: Vec<u64> = p.profile_steps.clone();
         if p.trajectory_every > 0 {
             stops.extend((0..=p.steps).step_by(p.trajectory_every as usize));
@@ -456,43 +262,37 @@ impl DropletSession {
         stops.push(p.steps);
         stops.sort_unstable();
         stops.dedup();
-        let ck_every = (p.steps / 10).max(1);
-        Self {
-            p,
-            acc,
-            rep,
-            sim,
-            stops,
-            ck_every,
-            gsd: None,
-            traj: None,
-            folder: None,
-            stale: Vec::new(),
-        }
+        BdSession::new(
+            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim),
+            DropletObs {
+                p,
+                acc,
+                stops,
+                folder: None,
+            },
+        )
+    }
+}
+
+impl Observe<HarmonicInterface> for DropletObs {
+    fn build(&self, replica: u32) -> Result<Replica> {
+        build_replica(&self.p, replica)
     }
 
-    /// Open (or reopen) the trajectory when replica 0 runs.
-    fn open_trajectory(&mut self) -> Result<()> {
-        if self.rep == 0
-            && self.p.trajectory_every > 0
-            && let Some(traj) = &self.traj
-        {
-            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
-            self.gsd = Some(if traj.exists() {
-                GsdWriter::append(traj)?
-            } else {
-                GsdWriter::create_new(traj)?
-            });
-        }
-        Ok(())
+    fn next_event(&self, run: &Replicas<HarmonicInterface>, step: u64) -> u64 {
+        let k = self.stops.partition_point(|&e| e <= step);
+        self.stops.get(k).copied().unwrap_or(run.steps)
     }
 
     /// Record what is due at step `ev` of the running replica: profiles, the excursion
     /// beyond the wall, trajectory frames.
-    fn record(&mut self, ev: u64) -> Result<()> {
-        let Some((s, _)) = &self.sim else {
+    fn record(&mut self, run: &mut Replicas<HarmonicInterface>, ev: u64) -> Result<()> {
+        let Some((s, _)) = &run.sim else {
             return Ok(());
         };
+        if self.stops.binary_search(&ev).is_err() {
+            return Ok(());
+        }
         let p = &self.p;
         let acc = &mut self.acc;
         let t = s.time();
@@ -517,7 +317,7 @@ impl DropletSession {
                 }
             }
         }
-        if let Some(w) = self.gsd.as_mut()
+        if let Some(w) = run.gsd.as_mut()
             && ev.is_multiple_of(p.trajectory_every)
         {
             w.write_frame(
@@ -531,19 +331,33 @@ impl DropletSession {
         }
         Ok(())
     }
+
+    fn replica_done(&mut self, run: &Replicas<HarmonicInterface>, builds: u64) -> Result<()> {
+        if run.rep == 0
+            && let (Some(width), Some(out), Some((s, _))) =
+                (self.p.cross_section, &self.folder, &run.sim)
+        {
+            write_cross_section(out, &self.p, s, width)?;
+        }
+        self.acc.builds += builds;
+        Ok(())
+    }
 }
 
-impl Session for DropletSession {
-    fn label(&self) -> String {
-        "droplet-bd".into()
+impl BdMethod<HarmonicInterface> for DropletObs {
+    type Acc = Accum;
+
+    fn acc(&self) -> &Accum {
+        &self.acc
     }
 
-    fn total(&self) -> u64 {
-        self.p.steps * self.p.replicas as u64
+    fn bookkeeping(&mut self) -> (u64, &mut FrameDigest, &mut u64) {
+        let a = &mut self.acc;
+        (a.frames, &mut a.digest, &mut a.checkpoints)
     }
 
-    fn position(&self) -> u64 {
-        self.rep as u64 * self.p.steps + self.sim.as_ref().map_or(0, |(s, _)| s.step())
+    fn name(&self) -> &'static str {
+        "droplet-bd"
     }
 
     fn seed(&self) -> u64 {
@@ -566,140 +380,15 @@ impl Session for DropletSession {
                 "profile_mean.csv",
                 "cross_section.csv",
                 "cross_section.png",
-                "trajectory.gsd",
-                "checkpoint-0.gsd",
-                "checkpoint-1.gsd",
             ]
             .contains(&name)
     }
 
-    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
-        self.traj = Some(out.join("trajectory.gsd"));
+    fn output_folder(&mut self, out: &OutputDir) {
         self.folder = Some(out.path().to_path_buf());
-        if self.sim.is_some() {
-            self.open_trajectory()?;
-            if fresh && self.stops.first() == Some(&0) {
-                self.record(0)?;
-            }
-        }
-        Ok(())
     }
 
-    fn next_checkpoint(&self) -> Option<u64> {
-        let steps = self.p.steps;
-        let pos = self.position();
-        let (rep, local) = (pos / steps, pos % steps);
-        // Every 10 % of a replica, and between replicas.
-        let k = local / self.ck_every + 1;
-        if k <= 9 && k * self.ck_every < steps {
-            Some(rep * steps + k * self.ck_every)
-        } else if rep + 1 < self.p.replicas as u64 {
-            Some((rep + 1) * steps)
-        } else {
-            None
-        }
-    }
-
-    fn advance(&mut self, until: u64) -> Result<Option<String>> {
-        let steps = self.p.steps;
-        while self.position() < until {
-            if self.sim.is_none() {
-                self.sim = Some((Replica::build(&self.p, self.rep as u32)?, 0));
-                self.open_trajectory()?;
-                if self.stops.first() == Some(&0) {
-                    self.record(0)?;
-                }
-            }
-            let local_until = until.min((self.rep as u64 + 1) * steps) - self.rep as u64 * steps;
-            loop {
-                let step = self.sim.as_ref().map_or(0, |(s, _)| s.step());
-                if step >= local_until {
-                    break;
-                }
-                let k = self.stops.partition_point(|&e| e <= step);
-                let stop = self.stops.get(k).copied().unwrap_or(steps);
-                let target = stop.min(local_until);
-                let (s, _) = self.sim.as_mut().expect("a running replica");
-                if let Err(e) = s.run(target - step) {
-                    return Ok(Some(format!("replica {}: {e}", self.rep)));
-                }
-                if target == stop {
-                    self.record(stop)?;
-                }
-            }
-            if local_until == steps {
-                // The replica is complete.
-                if let Some(mut w) = self.gsd.take() {
-                    w.sync()?;
-                }
-                if self.rep == 0
-                    && let (Some(width), Some(out), Some((s, _))) =
-                        (self.p.cross_section, &self.folder, &self.sim)
-                {
-                    write_cross_section(out, &self.p, s, width)?;
-                }
-                let (s, builds0) = self.sim.take().expect("a running replica");
-                self.acc.builds += builds0 + s.neighbor_builds();
-                self.rep += 1;
-            }
-        }
-        Ok(None)
-    }
-
-    fn flush(&mut self) -> Result<()> {
-        if let Some(w) = self.gsd.as_mut() {
-            w.sync()?;
-        }
-        Ok(())
-    }
-
-    /// The running replica to the GSD file the current checkpoint does not name, then (by the
-    /// driver) `checkpoint.bin` naming it, then [`Session::after_save`] removes the older one:
-    /// a run killed at any point leaves a consistent checkpoint.
-    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
-        if self.p.trajectory_every > 0 {
-            self.acc
-                .digest
-                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
-        }
-        self.acc.checkpoints += 1;
-        let name = format!("checkpoint-{}.gsd", self.acc.checkpoints % 2);
-        let old = format!("checkpoint-{}.gsd", (self.acc.checkpoints + 1) % 2);
-        self.stale = vec![old];
-        let state = match &self.sim {
-            Some((s, builds)) => {
-                let path = out.join(&name);
-                let _ = std::fs::remove_file(&path);
-                s.write_checkpoint(&path)?;
-                let crc = file_crc(&path)?;
-                Some((name, crc, Engine::of(s, builds + s.neighbor_builds())))
-            }
-            None => {
-                self.stale.push(name);
-                None
-            }
-        };
-        let saved = Saved {
-            replica: self.rep,
-            step: self.sim.as_ref().map_or(0, |(s, _)| s.step()),
-            state,
-            acc: self.acc.clone(),
-        };
-        Ok(bincode::serialize(&saved)?)
-    }
-
-    fn after_save(&mut self, out: &OutputDir) {
-        for f in self.stale.drain(..) {
-            let _ = std::fs::remove_file(out.join(&f));
-        }
-    }
-
-    fn finish(
-        self: Box<Self>,
-        out: &OutputDir,
-        wall_s: f64,
-        _failure: Option<&str>,
-    ) -> Result<Finished> {
+    fn finish(self, out: &OutputDir, wall_s: f64, _failure: Option<&str>) -> Result<Finished> {
         let p = &self.p;
         let n_frac = p.fractions.len();
         let Accum {
@@ -829,10 +518,6 @@ impl Session for DropletSession {
             "trajectory_frames": frames,
             "warnings": warnings,
         });
-        // The run is over: the replica checkpoints are no longer needed.
-        for f in ["checkpoint-0.gsd", "checkpoint-1.gsd"] {
-            let _ = std::fs::remove_file(out.join(f));
-        }
         let message = format!(
             "{} replica(s) x {} steps of {} colloids in {wall_s:.1} s ({:.3e} particle-steps/s); outputs in {}",
             p.replicas,
@@ -969,50 +654,4 @@ pub(crate) fn trim_trajectory(
     }
     std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
     Ok(())
-}
-
-/// Replica 0 of a droplet scenario, stepped by hand.
-struct BdEngine {
-    sim: Replica,
-}
-
-/// Flatten `[x, y, z]` rows.
-pub(crate) fn flat(v: &[[f64; 3]]) -> Vec<f64> {
-    v.iter().flatten().copied().collect()
-}
-
-impl crate::Engine for BdEngine {
-    fn method(&self) -> &str {
-        "droplet-bd"
-    }
-    fn dimensions(&self) -> usize {
-        3
-    }
-    fn particles(&self) -> usize {
-        self.sim.particles().len()
-    }
-    fn step(&mut self, steps: u64) -> Result<()> {
-        self.sim.run(steps).map_err(anyhow::Error::msg)
-    }
-    fn steps(&self) -> u64 {
-        self.sim.step()
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn dt(&self) -> f64 {
-        self.sim.dt()
-    }
-    fn positions(&self) -> Vec<f64> {
-        flat(&self.sim.snapshot().pos)
-    }
-    fn velocities(&self) -> Option<Vec<f64>> {
-        None
-    }
-    fn forces(&self) -> Result<Vec<f64>> {
-        Ok(flat(&self.sim.forces()))
-    }
-    fn box_lengths(&self) -> Vec<f64> {
-        self.sim.sbox().l.to_vec()
-    }
 }

@@ -29,3 +29,8 @@ pub trait Engine: Send {
     /// The periodic box or system length (`[L]` for rods, `[Lx, Ly, Lz]` for spheres).
     fn box_lengths(&self) -> Vec<f64>;
 }
+
+/// Flatten `[x, y, z]` rows (the engines' particle-major arrays).
+pub(crate) fn flat(v: &[[f64; 3]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}

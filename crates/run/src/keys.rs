@@ -216,6 +216,14 @@ impl Spec {
 use Allowed::*;
 
 const SEED: Allowed = Integer(0, u32::MAX as i64);
+/// The `seed` key of the methods with counter-based random streams.
+const SEED_KEY: Spec = key(
+    "seed",
+    "-",
+    "1",
+    SEED,
+    "seed of the counter-based random streams (--seed overrides)",
+);
 /// Step counts and other integers a run can hold.
 const COUNT: i64 = 1 << 53;
 
@@ -584,6 +592,103 @@ pub static BCD: &[Spec] = &[
     ),
 ];
 
+/// Keys that `droplet-bd` and `bd` share (the same engines and units).
+const DIAMETER: Spec = key(
+    "system.diameter",
+    "length",
+    "1",
+    Positive,
+    "colloid diameter d",
+);
+
+const KT: Spec = key("system.kT", "energy", "1", Positive, "thermal energy");
+
+const VISCOSITY: Spec = key(
+    "system.viscosity",
+    "energy time / length^3",
+    "1",
+    Positive,
+    "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
+);
+
+const RUN_DT: Spec = key(
+    "run.dt",
+    "time",
+    "2e-4 d^2 / D0",
+    Positive,
+    "time step (too large a step for the WCA core stops the run naming the step and particle)",
+)
+.also("at most 1e12 steps");
+
+const RUN_SKIN: Spec =
+    key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]");
+
+const RUN_INTEGRATOR: Spec = key(
+        "run.integrator",
+        "-",
+        "euler",
+        OneOf(&["euler", "lm"]),
+        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
+    )
+    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")");
+
+const TRAJECTORY: Spec = key(
+    "observe.trajectory",
+    "-",
+    "none",
+    Table,
+    "GSD frames of replica 0: trajectory.gsd",
+);
+
+const TRAJECTORY_EVERY: Spec = key(
+    "observe.trajectory.every",
+    "steps",
+    "0",
+    Integer(0, COUNT),
+    "steps between frames (0: none)",
+);
+
+/// The `[hydrodynamics]` keys that `droplet-bd` and `bd` share (`method` and `box_factor`
+/// differ).
+const HYDRO: [Spec; 5] = [
+    key(
+        "hydrodynamics",
+        "-",
+        "free draining",
+        Table,
+        "hydrodynamic interactions; without this table the free-draining engine runs",
+    ),
+    key(
+        "hydrodynamics.model",
+        "-",
+        "free-draining",
+        OneOf(&["free-draining", "rpy"]),
+        "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
+    ),
+    key(
+        "hydrodynamics.tolerance",
+        "-",
+        "1e-3",
+        LeftOpen(0.0, 0.1),
+        "relative error of the PSE product and of each Lanczos square root",
+    ),
+    key(
+        "hydrodynamics.splitting",
+        "1 / length",
+        "0.5 / a = 1 / d",
+        Positive,
+        "PSE splitting parameter xi",
+    )
+    .also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3"),
+    key(
+        "hydrodynamics.max_iterations",
+        "-",
+        "200",
+        Integer(1, 1000),
+        "Lanczos iteration limit; reaching it stops the run naming the step",
+    ),
+];
+
 /// The keys of `droplet-bd` scenarios.
 pub static DROPLET: &[Spec] = &[
     key(
@@ -593,13 +698,7 @@ pub static DROPLET: &[Spec] = &[
         OneOf(&["droplet-bd"]),
         "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "replicas",
         "-",
@@ -621,21 +720,9 @@ pub static DROPLET: &[Spec] = &[
         Integer(1, 100_000_000),
         "number of colloids N",
     ),
-    key(
-        "system.diameter",
-        "length",
-        "1",
-        Positive,
-        "colloid diameter d",
-    ),
-    key("system.kT", "energy", "1", Positive, "thermal energy"),
-    key(
-        "system.viscosity",
-        "energy time / length^3",
-        "1",
-        Positive,
-        "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
-    ),
+    DIAMETER,
+    KT,
+    VISCOSITY,
     key(
         "system.phi0",
         "-",
@@ -730,23 +817,9 @@ pub static DROPLET: &[Spec] = &[
     )
     .also("in [-R0, R0] and R_end + offset > 0"),
     key("run", "-", "defaults", Table, "time stepping"),
-    key(
-        "run.dt",
-        "time",
-        "2e-4 d^2 / D0",
-        Positive,
-        "time step (too large a step for the WCA core stops the run naming the step and particle)",
-    )
-    .also("at most 1e12 steps"),
-    key("run.skin", "length", "0.6 d", Positive, "Verlet skin").also("in [0.001 d, 5 d]"),
-    key(
-        "run.integrator",
-        "-",
-        "euler",
-        OneOf(&["euler", "lm"]),
-        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
-    )
-    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")"),
+    RUN_DT,
+    RUN_SKIN,
+    RUN_INTEGRATOR,
     key("observe", "-", "profiles", Table, "what to measure"),
     key(
         "observe.profile",
@@ -770,20 +843,8 @@ pub static DROPLET: &[Spec] = &[
         "fractions of the drying time at which profiles are written",
     )
     .also("at least one"),
-    key(
-        "observe.trajectory",
-        "-",
-        "none",
-        Table,
-        "GSD frames of replica 0: trajectory.gsd",
-    ),
-    key(
-        "observe.trajectory.every",
-        "steps",
-        "0",
-        Integer(0, COUNT),
-        "steps between frames (0: none)",
-    ),
+    TRAJECTORY,
+    TRAJECTORY_EVERY,
     key(
         "observe.cross_section",
         "-",
@@ -799,20 +860,8 @@ pub static DROPLET: &[Spec] = &[
         "slab thickness: centres with |z| < width / 2",
     )
     .also("in [0.001 d, 2 R0]"),
-    key(
-        "hydrodynamics",
-        "-",
-        "free draining",
-        Table,
-        "hydrodynamic interactions; without this table the free-draining engine runs",
-    ),
-    key(
-        "hydrodynamics.model",
-        "-",
-        "free-draining",
-        OneOf(&["free-draining", "rpy"]),
-        "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
-    ),
+    HYDRO[0],
+    HYDRO[1],
     key(
         "hydrodynamics.method",
         "-",
@@ -821,21 +870,8 @@ pub static DROPLET: &[Spec] = &[
         "RPY in an unbounded fluid by direct O(N^2) sums, or periodic by positively split Ewald",
     )
     .also("model = \"rpy\" only; direct: at most 20000 particles"),
-    key(
-        "hydrodynamics.tolerance",
-        "-",
-        "1e-3",
-        LeftOpen(0.0, 0.1),
-        "relative error of the PSE product and of each Lanczos square root",
-    ),
-    key(
-        "hydrodynamics.splitting",
-        "1 / length",
-        "0.5 / a = 1 / d",
-        Positive,
-        "PSE splitting parameter xi",
-    )
-    .also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3"),
+    HYDRO[2],
+    HYDRO[3],
     key(
         "hydrodynamics.box_factor",
         "droplet diameters",
@@ -844,13 +880,131 @@ pub static DROPLET: &[Spec] = &[
         "PSE: edge of the periodic box / initial droplet diameter 2 R0 (the paper: 2)",
     )
     .also("method = \"pse\" only; the box must hold the droplet, its interface and two neighbour ranges"),
+    HYDRO[4],
+];
+
+/// The keys of `bd` scenarios.
+pub static BULK: &[Spec] = &[
     key(
-        "hydrodynamics.max_iterations",
+        "method",
         "-",
-        "200",
-        Integer(1, 1000),
-        "Lanczos iteration limit; reaching it stops the run naming the step",
+        "required",
+        OneOf(&["bd"]),
+        "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE)",
     ),
+    SEED_KEY,
+    key(
+        "replicas",
+        "-",
+        "1",
+        Integer(1, 1_000_000),
+        "independent systems run one after the other, their blocks pooled (replica r: initial stream r, noise keyed by (seed, step, r, block))",
+    ),
+    key(
+        "system",
+        "-",
+        "required",
+        Table,
+        "spheres, solvent, the periodic cube and the body force",
+    ),
+    key(
+        "system.particles",
+        "-",
+        "required",
+        Integer(1, 100_000_000),
+        "number of spheres N",
+    ),
+    key(
+        "system.box_length",
+        "length",
+        "required",
+        Positive,
+        "edge L of the periodic cube",
+    )
+    .also("phi = N pi d^3 / (6 L^3) at most 0.3 (random insertion; 0.64 with system.initial); L > 2 (2^(1/6) d + run.skin); with RPY the PSE cut-off below L/2"),
+    DIAMETER,
+    KT,
+    VISCOSITY,
+    key(
+        "system.body_force",
+        "energy / length",
+        "[0, 0, 0]",
+        Numbers(f64::MIN, f64::MAX, Some(3)),
+        "constant force F on every sphere (gravity less buoyancy): the mean velocity along it gives K = U / (mu0 F)",
+    )
+    .also("its drift F dt / (3 pi eta d) at most 0.1 d per step"),
+    key(
+        "system.initial",
+        "-",
+        "random insertion",
+        Path,
+        "start every replica from the last frame of this GSD file (HOOMD schema) instead of random insertion",
+    )
+    .also("must hold system.particles spheres of typeid 0 in a cube of edge system.box_length"),
+    key("run", "-", "required", Table, "time stepping"),
+    key(
+        "run.time",
+        "time",
+        "required",
+        Positive,
+        "sampled time per replica (rounded up to whole blocks)",
+    )
+    .also("at least 4 steps per block; at most 1e12 steps"),
+    RUN_DT,
+    key(
+        "run.equilibrate",
+        "time",
+        "0",
+        NonNegative,
+        "time run before sampling starts (random insertion is the hard-sphere equilibrium to first order in phi)",
+    ),
+    RUN_SKIN,
+    RUN_INTEGRATOR,
+    key("observe", "-", "defaults", Table, "what to measure"),
+    key(
+        "observe.blocks",
+        "-",
+        "8",
+        Integer(1, 10_000),
+        "blocks per replica of the sampled time; every error is the standard error of the block values, given with at least 8 blocks in all",
+    ),
+    key(
+        "observe.msd",
+        "-",
+        "30 lags up to a quarter of a block",
+        Table,
+        "mean-square displacement of the unwrapped positions (about the centre of mass under a body force): msd.csv, msd.png",
+    ),
+    key(
+        "observe.msd.points",
+        "-",
+        "30",
+        Integer(2, 1000),
+        "log-spaced lags from one step to max_lag",
+    ),
+    key(
+        "observe.msd.max_lag",
+        "time",
+        "a quarter of a block (at least 4 run.dt)",
+        Positive,
+        "longest lag T; D is the slope of the MSD between T/4 and T",
+    )
+    .also("in [4 run.dt, run.time / observe.blocks]"),
+    TRAJECTORY,
+    TRAJECTORY_EVERY,
+    HYDRO[0],
+    HYDRO[1],
+    key(
+        "hydrodynamics.method",
+        "-",
+        "pse",
+        OneOf(&["pse"]),
+        "RPY in the periodic cube by positively split Ewald (\"direct\" is the unbounded fluid: refused here)",
+    )
+    .also("model = \"rpy\" only"),
+    HYDRO[2],
+    HYDRO[3],
+    HYDRO[4],
 ];
 
 /// The keys of `dpd` scenarios.
@@ -862,13 +1016,7 @@ pub static DPD: &[Spec] = &[
         OneOf(&["dpd"]),
         "DPD colloids in explicit solvent",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "system",
         "-",
@@ -1126,13 +1274,7 @@ pub static MC: &[Spec] = &[
         OneOf(&["hs-mc"]),
         "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key("system", "-", "required", Table, "spheres and container"),
     key(
         "system.geometry",
@@ -1420,13 +1562,7 @@ pub static MPCD: &[Spec] = &[
         OneOf(&["mpcd"]),
         "SRD solvent in a periodic cube (docs/mpcd.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     SOLVENT[0],
     SOLVENT[1],
     SOLVENT[2],
@@ -1529,13 +1665,7 @@ pub static DROPLET_MPCD: &[Spec] = &[
         OneOf(&["droplet-mpcd"]),
         "drying droplet of SRD solvent (docs/mpcd.md)",
     ),
-    key(
-        "seed",
-        "-",
-        "1",
-        SEED,
-        "seed of the counter-based random streams (--seed overrides)",
-    ),
+    SEED_KEY,
     key(
         "boundary",
         "-",
@@ -1758,6 +1888,11 @@ pub fn droplet() -> Vec<Key> {
     DROPLET.iter().map(Key::from).collect()
 }
 
+/// The keys of `bd` scenarios, as listed.
+pub fn bulk() -> Vec<Key> {
+    BULK.iter().map(Key::from).collect()
+}
+
 /// The keys of `dpd` scenarios, as listed.
 pub fn dpd() -> Vec<Key> {
     DPD.iter().map(Key::from).collect()
@@ -1903,7 +2038,7 @@ mod tests {
 
     #[test]
     fn every_path_is_listed_once_under_a_listed_table() {
-        for spec in [BCD, DROPLET, DPD, MC, MPCD, DROPLET_MPCD] {
+        for spec in [BCD, DROPLET, BULK, DPD, MC, MPCD, DROPLET_MPCD] {
             for (i, s) in spec.iter().enumerate() {
                 assert!(
                     spec[..i].iter().all(|t| t.path != s.path),

@@ -18,6 +18,8 @@ pub mod scenario;
 pub mod trajectory;
 
 mod bcd;
+mod bd_replica;
+mod bulk;
 mod dpd;
 mod droplet;
 mod hs_mc;

@@ -133,6 +133,7 @@ pub use crate::scenario::Scenario;
 static METHODS: &[&dyn Method] = &[
     &crate::bcd::BcdMethod,
     &crate::droplet::DropletBd,
+    &crate::bulk::BulkBd,
     &crate::dpd::DpdMethod,
     &crate::hs_mc::HsMc,
     &crate::mpcd::MpcdBulk,

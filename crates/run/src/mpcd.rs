@@ -1629,10 +1629,10 @@ impl crate::Engine for SolventEngine {
         self.srd.params().tau
     }
     fn positions(&self) -> Vec<f64> {
-        crate::droplet::flat(&self.srd.positions())
+        crate::engine::flat(&self.srd.positions())
     }
     fn velocities(&self) -> Option<Vec<f64>> {
-        Some(crate::droplet::flat(&self.srd.velocities()))
+        Some(crate::engine::flat(&self.srd.velocities()))
     }
     fn forces(&self) -> Result<Vec<f64>> {
         Ok(vec![0.0; 3 * self.srd.len()])

@@ -56,13 +56,28 @@ pub fn line_plot(
     series: &[Series],
     scale: Scale,
 ) -> Result<()> {
+    line_plot_with_errors(path, title, xlabel, ylabel, series, &[], scale)
+}
+
+/// [`line_plot`] with error bars: `errors[k]`, when given, holds the standard error of each
+/// point of `series[k]`, drawn as a vertical bar `y +- err` (on a log axis a bar reaching zero
+/// is cut at `y / 100`).
+pub fn line_plot_with_errors(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    errors: &[Option<&[f64]>],
+    scale: Scale,
+) -> Result<()> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     // The extension stays .png: the encoder is chosen by it.
     let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_line_plot(&tmp, title, xlabel, ylabel, series, scale)
+    let drawn = draw_line_plot(&tmp, title, xlabel, ylabel, series, errors, scale)
         .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
     if drawn.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -76,6 +91,7 @@ fn draw_line_plot(
     xlabel: &str,
     ylabel: &str,
     series: &[Series],
+    errors: &[Option<&[f64]>],
     scale: Scale,
 ) -> Result<()> {
     register_font();
@@ -110,6 +126,22 @@ fn draw_line_plot(
                 .map_err(|e| anyhow!("plot: {e}"))?;
             for (k, s) in series.iter().enumerate() {
                 let c = COLOURS[k % COLOURS.len()];
+                if let Some(Some(err)) = errors.get(k) {
+                    let bars =
+                        s.x.iter()
+                            .zip(s.y)
+                            .zip(err.iter())
+                            .filter(|((x, y), e)| finite(**x) && finite(**y) && e.is_finite())
+                            .map(|((x, y), e)| {
+                                let lo = if scale == Scale::LogLog && y - e <= 0.0 {
+                                    0.01 * y
+                                } else {
+                                    y - e
+                                };
+                                PathElement::new(vec![(*x, lo), (*x, y + e)], c.stroke_width(1))
+                            });
+                    chart.draw_series(bars).map_err(|e| anyhow!("plot: {e}"))?;
+                }
                 let data =
                     s.x.iter()
                         .zip(s.y)

@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use std::path::Path;
 
 /// Small, fast scenarios of each method (the mutations start from these).
-const BASES: [(&str, &[Spec]); 8] = [
+const BASES: [(&str, &[Spec]); 10] = [
     (
         r#"method = "bcd"
 seed = 3
@@ -96,6 +96,34 @@ bins = 10
 fractions = [0.0, 1.0]
 "#,
         keys::DROPLET,
+    ),
+    (
+        r#"method = "bd"
+[system]
+particles = 20
+box_length = 8.0
+body_force = [0.0, 0.0, -1.0]
+[run]
+dt = 0.01
+time = 0.4
+[observe.trajectory]
+every = 10
+[hydrodynamics]
+model = "rpy"
+"#,
+        keys::BULK,
+    ),
+    (
+        r#"method = "bd"
+[system]
+particles = 30
+box_length = 6.0
+[run]
+dt = 0.01
+time = 0.4
+integrator = "lm"
+"#,
+        keys::BULK,
     ),
     (
         r#"method = "dpd"

@@ -78,6 +78,38 @@ box_factor = 2.0
 max_iterations = 200
 "#;
 
+const BULK: &str = r#"
+method = "bd"
+seed = 1
+replicas = 1
+[system]
+particles = 20
+box_length = 8.0
+diameter = 1.0
+kT = 1.0
+viscosity = 1.0
+body_force = [0.0, 0.0, -1.0]
+[run]
+time = 8.0
+dt = 0.01
+equilibrate = 0.0
+skin = 0.6
+integrator = "euler"
+[observe]
+blocks = 8
+[observe.msd]
+points = 30
+max_lag = 0.5
+[observe.trajectory]
+every = 0
+[hydrodynamics]
+model = "rpy"
+method = "pse"
+tolerance = 1e-3
+splitting = 1.0
+max_iterations = 200
+"#;
+
 const DPD: &str = r#"
 method = "dpd"
 seed = 1
@@ -230,7 +262,7 @@ solvent = false
 
 type Parse = fn(&str) -> Result<(), String>;
 
-fn methods() -> [(&'static str, &'static [Spec], Parse); 6] {
+fn methods() -> [(&'static str, &'static [Spec], Parse); 7] {
     [
         (BCD, keys::BCD, |t| {
             toml::from_str::<colloidsim_bcd::scenario::Scenario>(t)
@@ -239,6 +271,11 @@ fn methods() -> [(&'static str, &'static [Spec], Parse); 6] {
         }),
         (DROPLET, keys::DROPLET, |t| {
             colloidsim_md::DropletScenario::from_toml(t)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }),
+        (BULK, keys::BULK, |t| {
+            colloidsim_md::bulk::BulkScenario::from_toml(t)
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         }),

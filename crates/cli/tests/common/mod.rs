@@ -2,8 +2,8 @@
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
-use std::path::Path;
-use std::process::Output;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// Standard output and standard error of a finished command, together.
 pub fn text(o: &Output) -> String {
@@ -56,5 +56,57 @@ pub fn assert_same_outputs(a: &Path, b: &Path, volatile: &[&str]) {
         } else {
             assert!(bytes == &fb[name], "{name} differs after restart");
         }
+    }
+}
+
+/// Run the `colloidsim` binary with `args` (and `--quiet`) and the environment variables `env`;
+/// its output is echoed for a failing test.
+pub fn colloidsim(args: &[&Path], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_colloidsim"));
+    c.args(args).arg("--quiet");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let o = c.output().unwrap();
+    eprintln!("{}", text(&o));
+    o
+}
+
+/// A path argument from text.
+pub fn p(s: &str) -> &Path {
+    Path::new(s)
+}
+
+/// Write `scenario` as NAME.toml in a temporary folder and run it to completion into `NAME`:
+/// (the folder, the scenario file, the run folder).
+pub fn complete(name: &str, scenario: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join(format!("{name}.toml"));
+    std::fs::write(&sc, scenario).unwrap();
+    let a = tmp.path().join(name);
+    let o = colloidsim(&[p("run"), &sc, p("--out"), &a], &[]);
+    assert!(o.status.success());
+    (tmp, sc, a)
+}
+
+/// Interrupted (as by Ctrl-C) or killed without a checkpoint at each position of `stops`
+/// (`(hook, step)`), the run of `sc` continues with `--restart` to the same files as the
+/// uninterrupted run in `a`, but for the `volatile` fields of summary.json.
+pub fn restarts_bitwise(
+    tmp: &Path,
+    sc: &Path,
+    a: &Path,
+    stops: &[(&str, &str)],
+    volatile: &[&str],
+) {
+    for (hook, at) in stops {
+        let b = tmp.join(format!("b-{hook}-{at}"));
+        let o = colloidsim(&[p("run"), sc, p("--out"), &b], &[(hook, at)]);
+        assert!(!o.status.success());
+        assert!(b.join("checkpoint.bin").exists(), "{hook} {at}");
+        assert!(!b.join("summary.json").exists());
+        let o = colloidsim(&[p("run"), sc, p("--restart"), &b], &[]);
+        assert!(o.status.success());
+        assert_same_outputs(a, &b, volatile);
     }
 }

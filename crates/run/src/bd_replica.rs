@@ -1,0 +1,664 @@
+//! The running system of the Brownian-dynamics methods (`droplet-bd`, `bd`): WCA spheres in an
+//! external field `E` (the droplet's interface, a constant body force), moved by the
+//! free-draining engine or by Brownian dynamics with a hydrodynamic mobility; its GSD checkpoint
+//! beside `checkpoint.bin`, the verified read of that checkpoint, and the engine Python steps.
+
+use crate::checkpoint::file_crc;
+use crate::engine::flat;
+use crate::method::{Finished, Session};
+use crate::trajectory::FrameDigest;
+use anyhow::{Result, bail};
+use colloidsim_core::output::OutputDir;
+use colloidsim_md::brownian::Integrator;
+use colloidsim_md::gsd::{self, GsdFrame, GsdWriter};
+use colloidsim_md::hydro::AnyMobility;
+use colloidsim_md::{
+    BdParams, Brownian, External, HydroBdParams, HydroBrownian, LennardJones, Particles, SimBox,
+};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A running replica: the free-draining engine (bitwise the engine of every free-draining run),
+/// or Brownian dynamics with a hydrodynamic mobility.
+pub(crate) enum Replica<E: External> {
+    /// Free draining ([`Brownian`]: cell-ordered lists, Euler or Leimkuhler–Matthews).
+    Free(Box<Brownian<LennardJones, E>>),
+    /// `dx = M F dt + sqrt(2 kT dt) M^(1/2) xi` ([`HydroBrownian`]).
+    Hydro(Box<HydroBrownian<LennardJones, E, AnyMobility>>),
+}
+
+impl<E: External> Replica<E> {
+    pub(crate) fn step(&self) -> u64 {
+        match self {
+            Self::Free(s) => s.step,
+            Self::Hydro(s) => s.step,
+        }
+    }
+
+    pub(crate) fn time(&self) -> f64 {
+        match self {
+            Self::Free(s) => s.time(),
+            Self::Hydro(s) => s.time(),
+        }
+    }
+
+    pub(crate) fn dt(&self) -> f64 {
+        match self {
+            Self::Free(s) => s.params().dt,
+            Self::Hydro(s) => s.params().dt,
+        }
+    }
+
+    pub(crate) fn sbox(&self) -> &SimBox {
+        match self {
+            Self::Free(s) => &s.sbox,
+            Self::Hydro(s) => &s.sbox,
+        }
+    }
+
+    /// The particles in the engine's order (for profiles, where the order does not matter).
+    pub(crate) fn particles(&self) -> &Particles {
+        match self {
+            Self::Free(s) => s.particles(),
+            Self::Hydro(s) => s.particles(),
+        }
+    }
+
+    /// The particles in input order, positions wrapped into the box.
+    pub(crate) fn snapshot(&self) -> Particles {
+        match self {
+            Self::Free(s) => s.snapshot(),
+            Self::Hydro(s) => s.particles().clone(),
+        }
+    }
+
+    /// The unwrapped positions `x + image L` in input order, into `out` (no allocation once
+    /// `out` has its length).
+    pub(crate) fn unwrapped_into(&self, out: &mut Vec<[f64; 3]>) {
+        let p = self.particles();
+        out.resize(p.len(), [0.0; 3]);
+        let sbox = self.sbox();
+        match self {
+            Self::Free(s) => {
+                for ((x, img), &tag) in p.pos.iter().zip(&p.image).zip(s.order()) {
+                    out[tag as usize] = sbox.unwrap(*x, *img);
+                }
+            }
+            Self::Hydro(_) => {
+                for ((x, img), u) in p.pos.iter().zip(&p.image).zip(out.iter_mut()) {
+                    *u = sbox.unwrap(*x, *img);
+                }
+            }
+        }
+    }
+
+    pub(crate) fn neighbor_builds(&self) -> u64 {
+        match self {
+            Self::Free(s) => s.neighbor_builds(),
+            Self::Hydro(s) => s.neighbor_builds(),
+        }
+    }
+
+    /// Run `n` steps; the error says why the run cannot go on (and names the step).
+    pub(crate) fn run(&mut self, n: u64) -> Result<(), String> {
+        match self {
+            Self::Free(s) => s.run(n).map_err(|e| e.to_string()),
+            Self::Hydro(s) => s.run(n).map_err(|e| e.to_string()),
+        }
+    }
+
+    /// The systematic forces at the current positions, in input order.
+    pub(crate) fn forces(&self) -> Vec<[f64; 3]> {
+        match self {
+            Self::Free(s) => s.forces(),
+            Self::Hydro(s) => s.systematic_forces(),
+        }
+    }
+
+    /// The checkpoint of this replica at its step into a new GSD file at `path`: exact
+    /// positions and images, and for the free-draining engine its list state
+    /// (`GsdWriter::write_checkpoint`); the hydrodynamic engine's whole state is its exact
+    /// positions and images (its noise is keyed by (seed, step, replica, particle) and its
+    /// pair forces do not depend on when the list was built).
+    pub(crate) fn write_checkpoint(&self, path: &Path) -> Result<()> {
+        let mut w = GsdWriter::create_new(path)?;
+        match self {
+            Self::Free(s) => {
+                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?
+            }
+            Self::Hydro(s) => w.write_frame(s.step, &s.sbox, s.particles(), true, &[])?,
+        }
+        w.sync()?;
+        Ok(())
+    }
+}
+
+/// The integrator parameters of the running replica (`BdParams`), so that it continues with
+/// exactly the parameters it started with (part of the method's checkpoint state).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub(crate) struct EngineState {
+    kt: f64,
+    viscosity: f64,
+    dt: f64,
+    seed: u32,
+    replica: u32,
+    skin: f64,
+    sort_every: u64,
+    max_drift: f64,
+    /// Neighbour-list builds of this replica so far.
+    pub(crate) builds: u64,
+}
+
+impl EngineState {
+    pub(crate) fn of<E: External>(s: &Replica<E>, builds: u64) -> Self {
+        match s {
+            Replica::Free(s) => {
+                let b = s.params();
+                Self {
+                    kt: b.kt,
+                    viscosity: b.viscosity,
+                    dt: b.dt,
+                    seed: b.seed,
+                    replica: b.replica,
+                    skin: b.skin,
+                    sort_every: b.sort_every,
+                    max_drift: b.max_drift,
+                    builds,
+                }
+            }
+            Replica::Hydro(s) => {
+                let b = s.params();
+                Self {
+                    kt: b.kt,
+                    viscosity: 0.0,
+                    dt: b.dt,
+                    seed: b.seed,
+                    replica: b.replica,
+                    skin: b.skin,
+                    sort_every: 0,
+                    max_drift: b.max_drift,
+                    builds,
+                }
+            }
+        }
+    }
+
+    /// The hydrodynamic engine's parameters.
+    pub(crate) fn hydro_params(&self) -> HydroBdParams {
+        HydroBdParams {
+            kt: self.kt,
+            dt: self.dt,
+            seed: self.seed,
+            replica: self.replica,
+            skin: self.skin,
+            max_drift: self.max_drift,
+        }
+    }
+
+    /// The free-draining engine's parameters with `integrator` (the scenario's
+    /// `run.integrator`: a restart runs the scenario it started with, so the checkpoint need not
+    /// hold it; nor the Leimkuhler–Matthews deviates, which the engine draws again from (seed,
+    /// step, particle)).
+    pub(crate) fn params(&self, integrator: Integrator) -> BdParams {
+        BdParams {
+            kt: self.kt,
+            viscosity: self.viscosity,
+            dt: self.dt,
+            seed: self.seed,
+            replica: self.replica,
+            skin: self.skin,
+            sort_every: self.sort_every,
+            max_drift: self.max_drift,
+            integrator,
+        }
+    }
+}
+
+/// A replica's GSD checkpoint as `checkpoint.bin` names it: file name, its CRC-32 and the
+/// engine's parameters.
+pub(crate) type ReplicaState = (String, u32, EngineState);
+
+/// Checkpoint `sim` (the running replica and its list builds before this session), if any,
+/// into the GSD file (`checkpoint-0.gsd` / `checkpoint-1.gsd`, alternating with
+/// `checkpoints`, the count including this one) that the current `checkpoint.bin` does not
+/// name. Returns its state and the files to remove once `checkpoint.bin` names it, so that a
+/// run killed at any moment leaves a consistent checkpoint.
+fn save_replica<E: External>(
+    out: &OutputDir,
+    checkpoints: u64,
+    sim: Option<(&Replica<E>, u64)>,
+) -> Result<(Option<ReplicaState>, Vec<String>)> {
+    let name = format!("checkpoint-{}.gsd", checkpoints % 2);
+    let old = format!("checkpoint-{}.gsd", (checkpoints + 1) % 2);
+    let mut stale = vec![old];
+    let state = match sim {
+        Some((s, builds)) => {
+            let path = out.join(&name);
+            let _ = std::fs::remove_file(&path);
+            s.write_checkpoint(&path)?;
+            let crc = file_crc(&path)?;
+            Some((name, crc, EngineState::of(s, builds + s.neighbor_builds())))
+        }
+        None => {
+            stale.push(name);
+            None
+        }
+    };
+    Ok((state, stale))
+}
+
+/// The GSD files of [`save_replica`] (a completed run removes them).
+pub(crate) const CHECKPOINT_FILES: [&str; 2] = ["checkpoint-0.gsd", "checkpoint-1.gsd"];
+
+/// Read the GSD checkpoint `state` names for replica `replica` at `step`, verified against its
+/// CRC-32, its step, its exactness and its engine (`hydro`: positions and images only; free
+/// draining: with the list state); diameters are set to `diameter` (GSD stores them in single
+/// precision).
+pub(crate) fn read_replica_checkpoint(
+    out: &OutputDir,
+    state: &ReplicaState,
+    step: u64,
+    replica: usize,
+    hydro: bool,
+    diameter: f64,
+) -> Result<GsdFrame> {
+    let (name, crc, engine) = state;
+    let path = out.join(name);
+    let found = file_crc(&path)?;
+    if found != *crc {
+        bail!(
+            "{}: damaged: checksum {found:08x}, the checkpoint recorded {crc:08x}",
+            path.display()
+        );
+    }
+    let mut f = gsd::read_frame(&path, None)?;
+    if f.step != step || !f.exact || f.list.is_none() != hydro || engine.replica as usize != replica
+    {
+        bail!(
+            "{}: not the checkpoint of replica {replica} at step {step} that checkpoint.bin names",
+            path.display(),
+        );
+    }
+    f.particles.diameter.fill(diameter);
+    Ok(f)
+}
+
+/// What a method observes of its replicas ([`Replicas::advance`] calls it).
+pub(crate) trait Observe<E: External> {
+    /// Replica `replica` at step 0.
+    fn build(&self, replica: u32) -> Result<Replica<E>>;
+    /// The first step after `s` of the running replica at which something is due (at most
+    /// the replica's last step).
+    fn next_event(&self, run: &Replicas<E>, s: u64) -> u64;
+    /// Record what is due at step `s` of the running replica (`run.sim`), at step 0 of each
+    /// replica and at each event.
+    fn record(&mut self, run: &mut Replicas<E>, s: u64) -> Result<()>;
+    /// The running replica has reached its last step (its trajectory is synced); `builds`:
+    /// its neighbour-list builds.
+    fn replica_done(&mut self, run: &Replicas<E>, builds: u64) -> Result<()>;
+}
+
+/// The replicas of a Brownian-dynamics run, one after the other: where the run stands (the
+/// driver's position counts steps over the replicas), the running replica, replica 0's
+/// trajectory writer and the GSD checkpoint files.
+pub(crate) struct Replicas<E: External> {
+    /// Steps per replica.
+    pub(crate) steps: u64,
+    replicas: usize,
+    /// Steps between trajectory frames of replica 0 (0: none).
+    trajectory_every: u64,
+    /// The running replica (or the next one, when `sim` is `None`).
+    pub(crate) rep: usize,
+    /// The running replica and its neighbour-list builds before this session.
+    pub(crate) sim: Option<(Replica<E>, u64)>,
+    /// Steps between a replica's regular checkpoints.
+    ck_every: u64,
+    /// Replica 0's trajectory, while it runs.
+    pub(crate) gsd: Option<GsdWriter>,
+    /// The trajectory's path, once the folder is known.
+    traj: Option<PathBuf>,
+    /// GSD file the previous checkpoint named, removed once the next one is in place.
+    stale: Vec<String>,
+}
+
+impl<E: External> Replicas<E> {
+    /// `replicas` replicas of `steps` steps each, standing at replica `rep` (running `sim`, or
+    /// not yet built).
+    pub(crate) fn new(
+        steps: u64,
+        replicas: usize,
+        trajectory_every: u64,
+        rep: usize,
+        sim: Option<(Replica<E>, u64)>,
+    ) -> Self {
+        Self {
+            steps,
+            replicas,
+            trajectory_every,
+            rep,
+            sim,
+            ck_every: (steps / 10).max(1),
+            gsd: None,
+            traj: None,
+            stale: Vec::new(),
+        }
+    }
+
+    /// Steps of the whole run.
+    pub(crate) fn total(&self) -> u64 {
+        self.steps * self.replicas as u64
+    }
+
+    /// Steps done over the replicas.
+    pub(crate) fn position(&self) -> u64 {
+        self.rep as u64 * self.steps + self.step()
+    }
+
+    /// Step of the running replica (0 before it is built).
+    pub(crate) fn step(&self) -> u64 {
+        self.sim.as_ref().map_or(0, |(s, _)| s.step())
+    }
+
+    /// Every 10 % of a replica, and between replicas.
+    pub(crate) fn next_checkpoint(&self) -> Option<u64> {
+        let steps = self.steps;
+        let pos = self.position();
+        let (rep, local) = (pos / steps, pos % steps);
+        let k = local / self.ck_every + 1;
+        if k <= 9 && k * self.ck_every < steps {
+            Some(rep * steps + k * self.ck_every)
+        } else if rep + 1 < self.replicas as u64 {
+            Some((rep + 1) * steps)
+        } else {
+            None
+        }
+    }
+
+    /// Open (or reopen) the trajectory when replica 0 runs.
+    fn open_trajectory(&mut self) -> Result<()> {
+        if self.rep == 0
+            && self.trajectory_every > 0
+            && let Some(traj) = &self.traj
+        {
+            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            self.gsd = Some(if traj.exists() {
+                GsdWriter::append(traj)?
+            } else {
+                GsdWriter::create_new(traj)?
+            });
+        }
+        Ok(())
+    }
+
+    /// The output folder is ready: open the trajectory; on a fresh run record step 0.
+    pub(crate) fn begin(
+        &mut self,
+        obs: &mut impl Observe<E>,
+        out: &OutputDir,
+        fresh: bool,
+    ) -> Result<()> {
+        self.traj = Some(out.join("trajectory.gsd"));
+        if self.sim.is_some() {
+            self.open_trajectory()?;
+            if fresh {
+                obs.record(self, 0)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Run up to position `until`, building each replica when it starts and recording every
+    /// event on the way; `Ok(Some(why))` when the engine cannot go on (the message names the
+    /// replica and the step).
+    pub(crate) fn advance(
+        &mut self,
+        obs: &mut impl Observe<E>,
+        until: u64,
+    ) -> Result<Option<String>> {
+        let steps = self.steps;
+        while self.position() < until {
+            if self.sim.is_none() {
+                self.sim = Some((obs.build(self.rep as u32)?, 0));
+                self.open_trajectory()?;
+                obs.record(self, 0)?;
+            }
+            let local_until = until.min((self.rep as u64 + 1) * steps) - self.rep as u64 * steps;
+            loop {
+                let step = self.step();
+                if step >= local_until {
+                    break;
+                }
+                let event = obs.next_event(self, step);
+                let target = event.min(local_until);
+                let (s, _) = self.sim.as_mut().expect("a running replica");
+                if let Err(e) = s.run(target - step) {
+                    return Ok(Some(format!("replica {}: {e}", self.rep)));
+                }
+                if target == event {
+                    obs.record(self, event)?;
+                }
+            }
+            if local_until == steps {
+                // The replica is complete.
+                if let Some(mut w) = self.gsd.take() {
+                    w.sync()?;
+                }
+                let builds = self
+                    .sim
+                    .as_ref()
+                    .map_or(0, |(s, b)| b + s.neighbor_builds());
+                obs.replica_done(self, builds)?;
+                self.sim = None;
+                self.rep += 1;
+            }
+        }
+        Ok(None)
+    }
+
+    /// Bring the trajectory to the disk.
+    pub(crate) fn flush(&mut self) -> Result<()> {
+        if let Some(w) = self.gsd.as_mut() {
+            w.sync()?;
+        }
+        Ok(())
+    }
+
+    /// Checkpoint the running replica ([`save_replica`], `checkpoints` counting this one);
+    /// its state and step for `checkpoint.bin`.
+    pub(crate) fn save(
+        &mut self,
+        out: &OutputDir,
+        checkpoints: u64,
+    ) -> Result<(Option<ReplicaState>, u64)> {
+        let (state, stale) =
+            save_replica(out, checkpoints, self.sim.as_ref().map(|(s, b)| (s, *b)))?;
+        self.stale = stale;
+        Ok((state, self.step()))
+    }
+
+    /// `checkpoint.bin` names the new state: remove the previous GSD checkpoint.
+    pub(crate) fn after_save(&mut self, out: &OutputDir) {
+        for f in self.stale.drain(..) {
+            let _ = std::fs::remove_file(out.join(&f));
+        }
+    }
+}
+
+/// The method's part of `checkpoint.bin` for a run of replicas: where it stands and what it
+/// has accumulated (`A`). The running replica's particles are in the GSD file `state` names,
+/// whose CRC-32 it keeps.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct Saved<A> {
+    /// Replica to continue.
+    pub(crate) replica: usize,
+    /// Its step: every event up to and including this step is in `acc`.
+    pub(crate) step: u64,
+    /// GSD checkpoint of the replica at `step`, its CRC-32 and its engine parameters; `None`:
+    /// the replica has not started (step 0, built afresh).
+    pub(crate) state: Option<ReplicaState>,
+    pub(crate) acc: A,
+}
+
+/// A method of replicas: its observers ([`Observe`]), what it accumulates, and what it says
+/// and writes; [`BdSession`] does the rest.
+pub(crate) trait BdMethod<E: External>: Observe<E> + Send + Sized {
+    /// What a checkpoint keeps of the observations.
+    type Acc: Serialize + Clone;
+    /// The accumulators.
+    fn acc(&self) -> &Self::Acc;
+    /// Trajectory frames written, their digest and the checkpoints written, in the
+    /// accumulators.
+    fn bookkeeping(&mut self) -> (u64, &mut FrameDigest, &mut u64);
+    /// The method's name (the progress bar's label and `summary.json`'s method).
+    fn name(&self) -> &'static str;
+    /// The run's seed.
+    fn seed(&self) -> u64;
+    /// The resolved parameters.
+    fn parameters(&self) -> serde_json::Value;
+    /// Does the method write `name` (besides trajectory.gsd and the GSD checkpoints)?
+    fn writes(&self, name: &str) -> bool;
+    /// The output folder is known.
+    fn output_folder(&mut self, _out: &OutputDir) {}
+    /// Write every output; `failure` says why the run stopped early.
+    fn finish(self, out: &OutputDir, wall_seconds: f64, failure: Option<&str>) -> Result<Finished>;
+}
+
+/// A run of replicas of a Brownian-dynamics method `O`.
+pub(crate) struct BdSession<E: External, O> {
+    run: Replicas<E>,
+    obs: O,
+}
+
+impl<E: External, O: BdMethod<E>> BdSession<E, O> {
+    pub(crate) fn new(run: Replicas<E>, obs: O) -> Self {
+        Self { run, obs }
+    }
+}
+
+impl<E: External + 'static, O: BdMethod<E>> Session for BdSession<E, O>
+where
+    Replicas<E>: Send,
+{
+    fn label(&self) -> String {
+        self.obs.name().into()
+    }
+
+    fn total(&self) -> u64 {
+        self.run.total()
+    }
+
+    fn position(&self) -> u64 {
+        self.run.position()
+    }
+
+    fn seed(&self) -> u64 {
+        self.obs.seed()
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        self.obs.parameters()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        self.obs.writes(name) || name == "trajectory.gsd" || CHECKPOINT_FILES.contains(&name)
+    }
+
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        self.obs.output_folder(out);
+        self.run.begin(&mut self.obs, out, fresh)
+    }
+
+    fn next_checkpoint(&self) -> Option<u64> {
+        self.run.next_checkpoint()
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        self.run.advance(&mut self.obs, until)
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        self.run.flush()
+    }
+
+    /// The running replica to the GSD file the current checkpoint does not name, then (by the
+    /// driver) `checkpoint.bin` naming it, then [`Session::after_save`] removes the older one:
+    /// a run killed at any point leaves a consistent checkpoint.
+    fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        let (frames, digest, checkpoints) = self.obs.bookkeeping();
+        if self.run.trajectory_every > 0 {
+            digest.extend(&out.join("trajectory.gsd"), frames)?;
+        }
+        *checkpoints += 1;
+        let count = *checkpoints;
+        let (state, step) = self.run.save(out, count)?;
+        let saved = Saved {
+            replica: self.run.rep,
+            step,
+            state,
+            acc: self.obs.acc(),
+        };
+        Ok(bincode::serialize(&saved)?)
+    }
+
+    fn after_save(&mut self, out: &OutputDir) {
+        self.run.after_save(out);
+    }
+
+    fn finish(
+        self: Box<Self>,
+        out: &OutputDir,
+        wall_seconds: f64,
+        failure: Option<&str>,
+    ) -> Result<Finished> {
+        let Self { obs, .. } = *self;
+        let fin = obs.finish(out, wall_seconds, failure)?;
+        // The run is over: the replica checkpoints are no longer needed.
+        for f in CHECKPOINT_FILES {
+            let _ = std::fs::remove_file(out.join(f));
+        }
+        Ok(fin)
+    }
+}
+
+/// Replica 0 of a Brownian-dynamics scenario, stepped by hand (Python's `BrownianDynamics`).
+pub(crate) struct ReplicaEngine<E: External> {
+    /// The scenario's method.
+    pub(crate) method: &'static str,
+    pub(crate) sim: Replica<E>,
+}
+
+impl<E: External> crate::Engine for ReplicaEngine<E> {
+    fn method(&self) -> &str {
+        self.method
+    }
+    fn dimensions(&self) -> usize {
+        3
+    }
+    fn particles(&self) -> usize {
+        self.sim.particles().len()
+    }
+    fn step(&mut self, steps: u64) -> Result<()> {
+        self.sim.run(steps).map_err(anyhow::Error::msg)
+    }
+    fn steps(&self) -> u64 {
+        self.sim.step()
+    }
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+    fn positions(&self) -> Vec<f64> {
+        flat(&self.sim.snapshot().pos)
+    }
+    fn velocities(&self) -> Option<Vec<f64>> {
+        None
+    }
+    fn forces(&self) -> Result<Vec<f64>> {
+        Ok(flat(&self.sim.forces()))
+    }
+    fn box_lengths(&self) -> Vec<f64> {
+        self.sim.sbox().l.to_vec()
+    }
+}

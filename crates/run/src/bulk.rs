@@ -1,0 +1,801 @@
+//! Bulk Brownian dynamics in a periodic cube (`method = "bd"`): WCA spheres, free draining or
+//! with the RPY mobility of the periodic box (PSE), an optional constant body force; the
+//! mean-square displacement (`msd.csv`), the mean velocity and the sedimentation coefficient,
+//! the long-time self-diffusion coefficient, each with its error from block averages and
+//! beside Hasimoto's periodic self-mobility and the dilute sedimentation law (docs/bd.md).
+//!
+//! **Blocks.** The sampled time of each replica is cut into `observe.blocks` equal blocks; the
+//! blocks of all replicas are pooled, and every error is the standard error of the mean of the
+//! block values (`sd / sqrt(blocks)`), which counts the blocks as independent. A block gives
+//! - the velocity of the centre of mass, `U_b = [X(end) - X(start)] / block time` (unwrapped
+//!   positions), and
+//! - the MSD at each lag from the time origins inside the block whose lag ends inside it
+//!   (positions relative to the centre of mass when a body force acts), and from it
+//!   `D_b = [MSD(T) - MSD(T/4)] / (6 (3T/4))`, T = `observe.msd.max_lag`.
+//!
+//! **When a figure is reported.** Each figure needs at least [`MIN_BLOCKS`] blocks. The mean
+//! velocity of interacting spheres with RPY depends on the configuration through the
+//! long-wavelength density fluctuations of the box, which relax in `L^2 / (4 pi^2 D0)` (the
+//! slowest mode, k = 2 pi / L): a block must last at least that for the blocks to count as
+//! independent. The long-time self-diffusion coefficient of interacting spheres needs
+//! `T / 4 >= a^2 / D0` (a sphere has diffused its radius: past the short-time regime, whose
+//! remainder decays like `(a^2 / D0 t)^(3/2)` in a dilute suspension). Otherwise the figure
+//! and its error are `null` in `summary.json`, with the reason.
+
+use crate::Scenario as Source;
+use crate::bd_replica::{
+    BdMethod, BdSession, Observe, Replica as AnyReplica, ReplicaEngine, ReplicaState, Replicas,
+    Saved, read_replica_checkpoint,
+};
+use crate::checkpoint::Envelope;
+use crate::droplet::trim_trajectory;
+use crate::keys::Key;
+use crate::method::{Checked, Finished, Method, Session};
+use crate::plot::{Scale, Series, line_plot_with_errors, picture};
+use crate::trajectory::FrameDigest;
+use anyhow::{Context, Result, bail};
+use colloidsim_core::msd::Msd;
+use colloidsim_core::output::OutputDir;
+use colloidsim_mc::observe::mean_and_error;
+use colloidsim_md::bulk::{BulkParams, BulkScenario};
+use colloidsim_md::{Brownian, ConstantForce};
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
+use std::f64::consts::PI;
+
+/// Fewest blocks (over all replicas) from whose scatter an error is given.
+pub const MIN_BLOCKS: usize = 8;
+
+/// The bulk family of scenarios.
+pub struct BulkBd;
+
+type Replica = AnyReplica<ConstantForce>;
+
+/// Parse and validate a scenario; `system.initial` is taken relative to the scenario's folder.
+fn resolve(src: &Source, seed: Option<u64>) -> Result<BulkParams> {
+    let table = src.table()?;
+    if table
+        .get("hydrodynamics")
+        .and_then(|h| h.get("box_factor"))
+        .is_some()
+    {
+        bail!(
+            "{}: hydrodynamics.box_factor: applies to droplet-bd only (the PSE box of a droplet, \
+             in droplet diameters); the periodic box of a bulk run is system.box_length",
+            src.label()
+        );
+    }
+    if table
+        .get("hydrodynamics")
+        .and_then(|h| h.get("method"))
+        .and_then(|m| m.as_str())
+        == Some("direct")
+    {
+        bail!(
+            "{}: hydrodynamics.method: \"direct\" is RPY in an unbounded fluid (free space); the \
+             periodic cube of a bulk run needs \"pse\"",
+            src.label()
+        );
+    }
+    crate::keys::validate(&table, crate::keys::BULK).with_context(|| src.label())?;
+    let mut sc = BulkScenario::from_toml(src.text()).with_context(|| src.label())?;
+    if let Some(s) = seed {
+        crate::seed32(s)?;
+        sc.seed = s;
+    }
+    if let Some(init) = &sc.system.initial
+        && init.is_relative()
+    {
+        sc.system.initial = Some(src.base().join(init));
+    }
+    sc.validate().with_context(|| src.label())
+}
+
+/// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
+fn build_replica(p: &BulkParams, replica: u32) -> Result<Replica> {
+    Ok(if p.has_hydrodynamics() {
+        Replica::Hydro(Box::new(p.build_hydro_replica(replica)?))
+    } else {
+        Replica::Free(Box::new(p.build_replica(replica)?))
+    })
+}
+
+impl Method for BulkBd {
+    fn names(&self) -> &'static [&'static str] {
+        &["bd"]
+    }
+
+    fn about(&self) -> &'static str {
+        "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE): MSD, self-diffusion and sedimentation under a body force beside Hasimoto"
+    }
+
+    fn docs(&self) -> &'static str {
+        "docs/bd.md"
+    }
+
+    fn check(&self, src: &Source) -> Result<Checked> {
+        let p = resolve(src, None)?;
+        // What `run` does before it starts: set up replica 0 (reading system.initial).
+        build_replica(&p, 0).with_context(|| src.label())?;
+        let mut resolved = serde_json::to_value(&p)?;
+        resolved["references"] = references(&p);
+        Ok(Checked {
+            resolved,
+            warnings: Vec::new(),
+        })
+    }
+
+    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+        let p = resolve(src, seed)?;
+        // Set up replica 0 before the output folder is created: bad input leaves nothing.
+        let sim = build_replica(&p, 0).with_context(|| src.label())?;
+        let acc = Accum::new(&p);
+        Ok(Box::new(BulkObs::session(p, acc, 0, Some((sim, 0)))))
+    }
+
+    fn restore(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+    ) -> Result<Box<dyn Session>> {
+        let p = resolve(src, Some(seed))?;
+        let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
+        let lags = p.msd_lags().len();
+        if saved.replica >= p.replicas
+            || saved.acc.velocities.len() > p.replicas * p.blocks
+            || saved.acc.msd.iter().any(|m| m.len() != lags)
+        {
+            bail!(
+                "checkpoint: replica {} with {} blocks does not fit the scenario",
+                saved.replica,
+                saved.acc.velocities.len()
+            );
+        }
+        let sim = match &saved.state {
+            None => None,
+            Some(state) => Some(restore_replica(out, &p, &saved, state)?),
+        };
+        if p.trajectory_every > 0 {
+            saved
+                .acc
+                .digest
+                .restore(&out.join("trajectory.gsd"), |path, frames| {
+                    trim_trajectory(path, frames, &[TIME_LOG], false)
+                })?;
+        }
+        Ok(Box::new(BulkObs::session(p, saved.acc, saved.replica, sim)))
+    }
+
+    fn keys(&self) -> Vec<Key> {
+        crate::keys::bulk()
+    }
+
+    fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
+        let p = resolve(src, seed)?;
+        let sim = build_replica(&p, 0).with_context(|| src.label())?;
+        Ok(Box::new(ReplicaEngine { method: "bd", sim }))
+    }
+}
+
+/// The simulated time in every trajectory frame (`log/bd/time`).
+const TIME_LOG: &str = "bd/time";
+
+/// Restore the running replica from its GSD checkpoint (verified against its CRC first).
+fn restore_replica(
+    out: &OutputDir,
+    p: &BulkParams,
+    saved: &Saved<Accum>,
+    state: &ReplicaState,
+) -> Result<(Replica, u64)> {
+    let hydro = p.has_hydrodynamics();
+    let f = read_replica_checkpoint(out, state, saved.step, saved.replica, hydro, p.diameter)?;
+    let path = out.join(&state.0);
+    let engine = &state.2;
+    let sim = if hydro {
+        Replica::Hydro(Box::new(
+            p.restart_hydro_replica(f.particles, engine.hydro_params(), f.step)
+                .with_context(|| format!("restart from {}", path.display()))?,
+        ))
+    } else {
+        Replica::Free(Box::new(
+            Brownian::restart(
+                f.particles,
+                f.sbox,
+                p.pair(),
+                p.body(),
+                engine.params(p.integrator),
+                f.step,
+                f.list.as_ref(),
+            )
+            .with_context(|| format!("restart from {}", path.display()))?,
+        ))
+    };
+    // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
+    let builds = engine.builds.saturating_sub(sim.neighbor_builds());
+    Ok((sim, builds))
+}
+
+/// The block under way: its MSD and the centre of mass at its start.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Block {
+    /// Step (of the replica) at which the block started.
+    start: u64,
+    /// Centre of mass (unwrapped) at the start.
+    com: [f64; 3],
+    /// MSD over the block's origins, per coordinate (`None` when no MSD is taken).
+    msd: Option<Msd>,
+}
+
+/// Everything a bulk run accumulates across replicas, saved in every checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Accum {
+    /// Per finished block (replica by replica): the velocity of the centre of mass.
+    velocities: Vec<[f64; 3]>,
+    /// Per finished block: the 3D MSD at each lag of [`BulkParams::msd_lags`].
+    msd: Vec<Vec<f64>>,
+    /// The block under way.
+    block: Option<Block>,
+    /// Neighbour-list builds of the finished replicas.
+    builds: u64,
+    /// Frames in trajectory.gsd.
+    frames: u64,
+    /// CRC-32 of those frames, checked before a restart appends to the file.
+    digest: FrameDigest,
+    /// Checkpoints written so far (alternates the GSD file name).
+    checkpoints: u64,
+}
+
+impl Accum {
+    fn new(p: &BulkParams) -> Self {
+        let blocks = p.replicas * p.blocks;
+        Self {
+            velocities: Vec::with_capacity(blocks),
+            msd: Vec::with_capacity(blocks),
+            block: None,
+            builds: 0,
+            frames: 0,
+            digest: FrameDigest::default(),
+            checkpoints: 0,
+        }
+    }
+}
+
+/// A bulk run: replicas one after the other.
+type BulkSession = BdSession<ConstantForce, BulkObs>;
+
+/// What a bulk run observes: blocks (the centre of mass, the MSD), trajectory frames.
+struct BulkObs {
+    p: BulkParams,
+    acc: Accum,
+    /// MSD lags (steps).
+    lags: Vec<u64>,
+    /// Is an MSD taken? Not for one sphere under a body force (its MSD about the centre of
+    /// mass is zero).
+    msd_on: bool,
+    /// Unwrapped positions in input order (reused).
+    unwrapped: Vec<[f64; 3]>,
+    /// The MSD's coordinates (reused).
+    coords: Vec<f64>,
+}
+
+impl BulkObs {
+    /// The session of `p` at replica `rep` (running `sim`, or not yet built) with `acc`.
+    fn session(p: BulkParams, acc: Accum, rep: usize, sim: Option<(Replica, u64)>) -> BulkSession {
+        let lags = p.msd_lags();
+        let msd_on = !(p.force > 0.0 && p.particles == 1);
+        BdSession::new(
+            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim),
+            BulkObs {
+                p,
+                acc,
+                lags,
+                msd_on,
+                unwrapped: Vec::new(),
+                coords: Vec::new(),
+            },
+        )
+    }
+
+    /// Offer the block's MSD the configuration in `self.unwrapped` at step `s` (relative to
+    /// the centre of mass `com` when a body force acts).
+    fn sample_msd(&mut self, s: u64, com: [f64; 3]) {
+        let relative = self.p.force > 0.0;
+        let Some(b) = self.acc.block.as_mut() else {
+            return;
+        };
+        let Some(m) = b.msd.as_mut() else {
+            return;
+        };
+        self.coords.clear();
+        for u in &self.unwrapped {
+            for k in 0..3 {
+                self.coords
+                    .push(if relative { u[k] - com[k] } else { u[k] });
+            }
+        }
+        m.sample(s - b.start, &self.coords);
+    }
+}
+
+impl Observe<ConstantForce> for BulkObs {
+    fn build(&self, replica: u32) -> Result<Replica> {
+        build_replica(&self.p, replica)
+    }
+
+    /// The start of sampling, the block's next MSD sample or its end, a trajectory frame, the
+    /// end of the replica.
+    fn next_event(&self, run: &Replicas<ConstantForce>, s: u64) -> u64 {
+        let p = &self.p;
+        let mut next = p.steps;
+        if s < p.equilibrate_steps {
+            next = next.min(p.equilibrate_steps);
+        }
+        if let Some(b) = &self.acc.block {
+            next = next.min(b.start + p.block_steps);
+            if let Some(m) = &b.msd {
+                next = next.min(b.start + m.next_due(s + 1 - b.start));
+            }
+        }
+        if run.rep == 0 && p.trajectory_every > 0 {
+            next = next.min((s / p.trajectory_every + 1) * p.trajectory_every);
+        }
+        next
+    }
+
+    /// Record what is due at step `s`: a trajectory frame, the block's MSD sample, the end of
+    /// a block, the start of the next.
+    fn record(&mut self, run: &mut Replicas<ConstantForce>, s: u64) -> Result<()> {
+        let Some((sim, _)) = &run.sim else {
+            return Ok(());
+        };
+        let p = &self.p;
+        if let Some(w) = run.gsd.as_mut()
+            && s.is_multiple_of(p.trajectory_every)
+        {
+            w.write_frame(
+                s,
+                sim.sbox(),
+                &sim.snapshot(),
+                false,
+                &[(TIME_LOG, sim.time())],
+            )?;
+            self.acc.frames += 1;
+        }
+        if s < p.equilibrate_steps {
+            return Ok(());
+        }
+        let k = s - p.equilibrate_steps;
+        let (block_steps, sampled_steps) = (p.block_steps, p.sampled_steps);
+        let block_time = block_steps as f64 * p.dt;
+        let origin_every = p.msd_origin_every;
+        let boundary = k.is_multiple_of(block_steps);
+        let due = self.acc.block.as_ref().is_some_and(|b| {
+            b.msd
+                .as_ref()
+                .is_some_and(|m| m.next_due(s - b.start) == s - b.start)
+        });
+        if !boundary && !due {
+            return Ok(());
+        }
+        sim.unwrapped_into(&mut self.unwrapped);
+        let com = centre(&self.unwrapped);
+        if due {
+            self.sample_msd(s, com);
+        }
+        if boundary && k > 0 {
+            // The block ends.
+            let b = self.acc.block.take().context("a block under way")?;
+            self.acc
+                .velocities
+                .push(std::array::from_fn(|i| (com[i] - b.com[i]) / block_time));
+            if let Some(m) = &b.msd {
+                let rows = m.rows();
+                let per_lag = self
+                    .lags
+                    .iter()
+                    .map(|&lag| {
+                        rows.iter()
+                            .find(|r| r.0 == lag)
+                            .map_or(f64::NAN, |r| 3.0 * r.1)
+                    })
+                    .collect();
+                self.acc.msd.push(per_lag);
+            }
+        }
+        if boundary && k < sampled_steps {
+            // The next block starts.
+            self.acc.block = Some(Block {
+                start: s,
+                com,
+                msd: self
+                    .msd_on
+                    .then(|| Msd::new(self.lags.clone(), origin_every)),
+            });
+            self.sample_msd(s, com);
+        }
+        Ok(())
+    }
+
+    fn replica_done(&mut self, _run: &Replicas<ConstantForce>, builds: u64) -> Result<()> {
+        self.acc.builds += builds;
+        Ok(())
+    }
+}
+
+/// The centre of mass of `x` (a sum in input order: the same bits on any thread count).
+fn centre(x: &[[f64; 3]]) -> [f64; 3] {
+    let mut c = [0.0; 3];
+    for v in x {
+        for k in 0..3 {
+            c[k] += v[k];
+        }
+    }
+    let n = x.len().max(1) as f64;
+    c.map(|s| s / n)
+}
+
+impl BdMethod<ConstantForce> for BulkObs {
+    type Acc = Accum;
+
+    fn acc(&self) -> &Accum {
+        &self.acc
+    }
+
+    fn bookkeeping(&mut self) -> (u64, &mut FrameDigest, &mut u64) {
+        let a = &mut self.acc;
+        (a.frames, &mut a.digest, &mut a.checkpoints)
+    }
+
+    fn name(&self) -> &'static str {
+        "bd"
+    }
+
+    fn seed(&self) -> u64 {
+        self.p.seed as u64
+    }
+
+    fn parameters(&self) -> Value {
+        serde_json::to_value(&self.p).unwrap_or_default()
+    }
+
+    fn writes(&self, name: &str) -> bool {
+        ["msd.csv", "msd.png"].contains(&name)
+    }
+
+    fn finish(self, out: &OutputDir, wall_s: f64, _failure: Option<&str>) -> Result<Finished> {
+        let BulkObs {
+            p,
+            acc,
+            lags,
+            msd_on,
+            ..
+        } = &self;
+        let mut warnings = Vec::new();
+        let mut files = Vec::new();
+        let r = Results::of(p, acc, lags, *msd_on);
+        if let Some(m) = &r.msd {
+            let t: Vec<f64> = lags.iter().map(|&l| l as f64 * p.dt).collect();
+            let mut cols: Vec<(&str, &[f64])> = vec![("t", &t), ("msd", &m.mean)];
+            if let Some(e) = &m.err {
+                cols.push(("err", e));
+            }
+            out.write_table("msd.csv", &cols)?;
+            files.push("msd.csv".into());
+            msd_picture(out, p, &t, m, &mut files, &mut warnings);
+        }
+        if acc.frames > 0 {
+            files.push("trajectory.gsd".into());
+        }
+        let particle_steps = (p.steps * p.replicas as u64) as f64 * p.particles as f64;
+        let summary = json!({
+            "software": crate::software(),
+            "method": "bd",
+            "seed": p.seed,
+            "parameters": p,
+            "steps": p.steps,
+            "sampled_time": p.sampled_steps as f64 * p.dt,
+            "blocks": acc.velocities.len(),
+            "block_time": p.block_steps as f64 * p.dt,
+            "mean_velocity": r.velocity,
+            "sedimentation_coefficient": r.sedimentation,
+            "self_diffusion": r.diffusion,
+            "references": references(p),
+            "neighbor_list_builds": acc.builds,
+            "wall_seconds": wall_s,
+            "particle_steps_per_second": particle_steps / wall_s.max(1e-9),
+            "threads": rayon::current_num_threads(),
+            "trajectory_frames": acc.frames,
+            "warnings": warnings,
+        });
+        let message = format!(
+            "{} replica(s) x {} steps of {} spheres in {wall_s:.1} s; {}; outputs in {}",
+            p.replicas,
+            p.steps,
+            p.particles,
+            r.headline,
+            out.path().display()
+        );
+        Ok(Finished {
+            summary,
+            files,
+            message,
+            warnings,
+        })
+    }
+}
+
+/// The mean MSD over the blocks at each lag, with its standard error when there are enough
+/// blocks.
+struct MsdTable {
+    mean: Vec<f64>,
+    err: Option<Vec<f64>>,
+}
+
+/// The figures of a run with their errors and the reasons for any left out.
+struct Results {
+    velocity: Value,
+    sedimentation: Value,
+    diffusion: Value,
+    msd: Option<MsdTable>,
+    /// One line for the message.
+    headline: String,
+}
+
+impl Results {
+    fn of(p: &BulkParams, acc: &Accum, lags: &[u64], msd_on: bool) -> Self {
+        let blocks = acc.velocities.len();
+        let block_time = p.block_steps as f64 * p.dt;
+        let few = (blocks < MIN_BLOCKS).then(|| {
+            format!(
+                "{blocks} block(s) completed; errors need at least {MIN_BLOCKS} (more \
+                 observe.blocks, replicas or run.time)"
+            )
+        });
+        // Density fluctuations of the box relax in L^2 / (4 pi^2 D0) (k = 2 pi / L).
+        let relax = p.box_length * p.box_length / (4.0 * PI * PI * p.d0);
+        let coupled = p.has_hydrodynamics() && p.particles > 1;
+        let short = (coupled && block_time < relax).then(|| {
+            format!(
+                "a block lasts {block_time:.4}, less than the relaxation time L^2 / (4 pi^2 D0) = \
+                 {relax:.4} of the box's slowest density fluctuation, on which the mean velocity \
+                 of interacting spheres with RPY depends: the blocks are not independent (a \
+                 longer run.time or fewer observe.blocks)"
+            )
+        });
+        let why_velocity = few.clone().or(short);
+        let (velocity, along) = match &why_velocity {
+            None => {
+                let comps: Vec<(f64, f64)> = (0..3)
+                    .map(|k| {
+                        let v: Vec<f64> = acc.velocities.iter().map(|u| u[k]).collect();
+                        mean_and_error(&v)
+                    })
+                    .collect();
+                let along = (p.force > 0.0).then(|| {
+                    let v: Vec<f64> = acc
+                        .velocities
+                        .iter()
+                        .map(|u| (0..3).map(|k| u[k] * p.body_force[k]).sum::<f64>() / p.force)
+                        .collect();
+                    mean_and_error(&v)
+                });
+                (Some(comps), along)
+            }
+            Some(_) => (None, None),
+        };
+        let velocity_json = json!({
+            "value": velocity.as_ref().map(|c| c.iter().map(|x| x.0).collect::<Vec<_>>()),
+            "error": velocity.as_ref().map(|c| c.iter().map(|x| x.1).collect::<Vec<_>>()),
+            "along_force": along.map(|a| a.0),
+            "along_force_error": along.map(|a| a.1),
+            "unit": "length / time",
+            "why_null": why_velocity,
+        });
+        let mu0f = p.force / p.friction;
+        let why_k = if p.force == 0.0 {
+            Some("no body force (system.body_force)".to_string())
+        } else {
+            why_velocity.clone()
+        };
+        let k = along
+            .filter(|_| why_k.is_none())
+            .map(|(u, e)| (u / mu0f, e / mu0f));
+        let sedimentation = json!({
+            "K": k.map(|k| k.0),
+            "error": k.map(|k| k.1),
+            "definition": "K = U / (mu0 F): the mean velocity along the force over the Stokes velocity of one sphere",
+            "dilute_reference": p.dilute_sedimentation(),
+            "why_null": why_k,
+        });
+
+        // The MSD of each block, and D from its slope at long lags.
+        let (lo, hi) = p.slope_lags();
+        let (ilo, ihi) = (
+            lags.iter().position(|&l| l == lo),
+            lags.iter().position(|&l| l == hi),
+        );
+        let n = p.particles as f64;
+        // About the centre of mass (body force), the MSD lacks the centre's own, 1/N of it
+        // for uncorrelated spheres.
+        let com_factor = if p.force > 0.0 { n / (n - 1.0) } else { 1.0 };
+        let d_blocks: Vec<f64> = match (ilo, ihi) {
+            (Some(a), Some(b)) => acc
+                .msd
+                .iter()
+                .map(|m| com_factor * (m[b] - m[a]) / (6.0 * (hi - lo) as f64 * p.dt) / p.d0)
+                .collect(),
+            _ => Vec::new(),
+        };
+        let interacting = p.particles > 1;
+        let why_d = if !msd_on {
+            Some(
+                "one sphere under a body force: its displacement is the mean velocity, its MSD about the centre of mass is zero"
+                    .to_string(),
+            )
+        } else if interacting && (lo as f64 * p.dt) < 0.25 * p.diffusion_time {
+            Some(format!(
+                "the slope is taken between lags {:.4} and {:.4}; the long-time self-diffusion of \
+                 interacting spheres needs the shorter one at least a^2 / D0 = {:.4}, the time to \
+                 diffuse a radius (observe.msd.max_lag at least d^2 / D0 = {:.4})",
+                lo as f64 * p.dt,
+                hi as f64 * p.dt,
+                0.25 * p.diffusion_time,
+                p.diffusion_time
+            ))
+        } else {
+            few.clone()
+        };
+        let d = (why_d.is_none() && !d_blocks.is_empty()).then(|| mean_and_error(&d_blocks));
+        // Sedimenting spheres with hydrodynamic interactions move with the concentration
+        // fluctuations around them: their MSD holds a hydrodynamic dispersion on top of the
+        // Brownian motion.
+        let dispersion = p.force > 0.0 && coupled;
+        let note = dispersion.then_some(
+            "under a body force with RPY, D includes the hydrodynamic dispersion of sedimentation \
+             (velocity fluctuations from concentration fluctuations, growing with the Peclet number \
+             and the box): it is the long-time self-diffusion of the sedimenting suspension, not \
+             comparable with Hasimoto's equilibrium mobility",
+        );
+        let diffusion = json!({
+            "D_over_D0": d.map(|d| d.0),
+            "error": d.map(|d| d.1),
+            "D": d.map(|d| d.0 * p.d0),
+            "lags": [lo as f64 * p.dt, hi as f64 * p.dt],
+            "definition": "D = [MSD(T) - MSD(T/4)] / (6 (3T/4)), T = observe.msd.max_lag; about the centre of mass under a body force, times N / (N - 1)",
+            "note": note,
+            "why_null": why_d,
+        });
+
+        let msd = (msd_on && !acc.msd.is_empty()).then(|| {
+            let m = acc.msd.len();
+            let mean: Vec<f64> = (0..lags.len())
+                .map(|j| acc.msd.iter().map(|b| b[j]).sum::<f64>() / m as f64)
+                .collect();
+            let err = (m >= 2).then(|| {
+                (0..lags.len())
+                    .map(|j| {
+                        let v: Vec<f64> = acc.msd.iter().map(|b| b[j]).collect();
+                        mean_and_error(&v).1
+                    })
+                    .collect()
+            });
+            MsdTable { mean, err }
+        });
+        let mut parts = Vec::new();
+        if let Some((k, e)) = k {
+            parts.push(if p.has_hydrodynamics() {
+                format!(
+                    "K = {k:.4} +- {e:.4} (dilute RPY {:.4})",
+                    p.dilute_sedimentation()
+                )
+            } else {
+                format!("K = {k:.4} +- {e:.4} (free draining: 1)")
+            });
+        }
+        if let Some((d, e)) = d {
+            parts.push(if dispersion {
+                format!(
+                    "D/D0 = {d:.4} +- {e:.4} (with the hydrodynamic dispersion of sedimentation)"
+                )
+            } else if p.has_hydrodynamics() {
+                format!("D/D0 = {d:.4} +- {e:.4} (Hasimoto {:.4})", p.hasimoto())
+            } else {
+                format!("D/D0 = {d:.4} +- {e:.4} (free draining, one sphere: 1)")
+            });
+        }
+        if parts.is_empty() {
+            parts.push("no figure long enough to report (summary.json says why)".into());
+        }
+        Self {
+            velocity: velocity_json,
+            sedimentation,
+            diffusion,
+            msd,
+            headline: parts.join(", "),
+        }
+    }
+}
+
+/// The references `summary.json` and `colloidsim check` give beside the figures.
+fn references(p: &BulkParams) -> Value {
+    json!({
+        "hasimoto_mu_over_mu0": p.hasimoto(),
+        "hasimoto": "mu(L)/mu0 = 1 - 2.837297 (a/L) + (4 pi/3)(a/L)^3 - 27.4 (a/L)^6: one sphere in the periodic cube (Hasimoto 1959); D/D0 of one sphere with RPY",
+        "dilute_sedimentation_K": p.dilute_sedimentation(),
+        "dilute_sedimentation": "K = mu(L)/mu0 - 5 phi' - 8 phi' (mu(L)/mu0 - 1), phi' = phi (N - 1)/N: pairwise RPY with hard-sphere exclusion to first order in phi (the paper's 1 - 5 phi with the periodic box's self term)",
+        "free_draining": "K = 1 and D/D0 = 1 (one sphere; free draining has no hydrodynamic interactions)",
+    })
+}
+
+/// `msd.png`: the MSD with its error bars against time in diffusion times, beside free
+/// diffusion `6 D0 t` and, with RPY, Hasimoto's `6 mu(L)/mu0 D0 t`.
+fn msd_picture(
+    out: &OutputDir,
+    p: &BulkParams,
+    t: &[f64],
+    m: &MsdTable,
+    files: &mut Vec<String>,
+    warnings: &mut Vec<String>,
+) {
+    let tau = p.diffusion_time;
+    let d2 = p.diameter * p.diameter;
+    let x: Vec<f64> = t.iter().map(|t| t / tau).collect();
+    let y: Vec<f64> = m.mean.iter().map(|v| v / d2).collect();
+    let e: Option<Vec<f64>> = m.err.as_ref().map(|e| e.iter().map(|v| v / d2).collect());
+    let free: Vec<f64> = x.iter().map(|x| 6.0 * x).collect();
+    let hasimoto: Vec<f64> = x.iter().map(|x| 6.0 * p.hasimoto() * x).collect();
+    let mut series = vec![
+        Series {
+            label: "BD (error bars: block standard errors)",
+            x: &x,
+            y: &y,
+            points: true,
+        },
+        Series {
+            label: "free diffusion 6 D0 t",
+            x: &x,
+            y: &free,
+            points: false,
+        },
+    ];
+    if p.has_hydrodynamics() {
+        series.push(Series {
+            label: "one sphere, periodic RPY: 6 mu(L)/mu0 D0 t",
+            x: &x,
+            y: &hasimoto,
+            points: false,
+        });
+    }
+    let mobility = if p.has_hydrodynamics() {
+        "RPY (PSE)"
+    } else {
+        "free draining"
+    };
+    let about = if p.force > 0.0 {
+        ", about the centre of mass"
+    } else {
+        ""
+    };
+    let title = format!(
+        "MSD{about}: N = {}, phi = {:.3}, L = {} d, {mobility}",
+        p.particles,
+        p.phi,
+        colloidsim_core::param::show(p.box_length / p.diameter)
+    );
+    picture(
+        line_plot_with_errors(
+            &out.join("msd.png"),
+            &title,
+            "t / (d^2 / D0)",
+            "MSD / d^2",
+            &series,
+            &[e.as_deref()],
+            Scale::LogLog,
+        ),
+        "msd.png",
+        files,
+        warnings,
+    );
+}
