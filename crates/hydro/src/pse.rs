@@ -529,7 +529,21 @@ impl PseGeometry {
             )
             .into());
         }
-        // Real side: the table reaches where exp(-xi^2 r^2) < 1e-18.
+        // Real side: the table reaches where exp(-xi^2 r^2) < 1e-18. The real-space part
+        // reaches at least 1 / xi at any tolerance the run accepts (<= 0.1), so a splitting
+        // below 2 / L is refused here, before a table of 416 / (a xi) points is built.
+        if 1.0 / xi >= 0.5 * l {
+            return Err(ParamError::new(
+                "hydrodynamics.splitting",
+                format!(
+                    "xi = {xi} gives a real-space part reaching beyond half the box ({}); raise \
+                     the splitting well above {:.4} or enlarge the box",
+                    0.5 * l,
+                    2.0 / l
+                ),
+            )
+            .into());
+        }
         let r_max = (4.0 * a).max(6.5 / xi);
         let table = WaveTable::build(a, p.viscosity, xi, r_max);
         let self_real = mu0 - table.a[0];

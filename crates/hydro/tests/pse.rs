@@ -220,6 +220,15 @@ fn bad_parameters_are_refused_naming_the_key() {
         }),
         "hydrodynamics.splitting"
     );
+    // A splitting so small that its real-space table alone would take petabytes: refused
+    // before anything is allocated (it aborted the process before).
+    assert_eq!(
+        key(PseParams {
+            splitting: 1e-15,
+            ..ok
+        }),
+        "hydrodynamics.splitting"
+    );
     assert_eq!(
         key(PseParams {
             tolerance: 0.5,

@@ -1,11 +1,30 @@
 //! Hostile input, for every method: scenarios with keys set to extreme or wrong values, damaged
 //! GSD input files and damaged checkpoints must give a clean error or a valid run, never a
 //! panic or an abort (proptest reports a panic as a failure with the input that caused it).
+//!
+//! The cases are drawn from a fixed seed, so that every run (CI's too) checks the same inputs;
+//! `COLLOIDSIM_FUZZ_RANDOM=1 cargo test -p colloidsim-run --test fuzz` draws new ones, and a
+//! failure found so is saved in `fuzz.proptest-regressions` and replayed by every later run.
 
 use colloidsim_run::keys::{self, Spec};
 use colloidsim_run::{Control, RunOptions, Scenario};
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 use std::path::Path;
+
+/// `cases` cases from the fixed seed, or from a random one with `COLLOIDSIM_FUZZ_RANDOM` set.
+fn fuzz_config(cases: u32) -> ProptestConfig {
+    let rng_seed = if std::env::var_os("COLLOIDSIM_FUZZ_RANDOM").is_some() {
+        RngSeed::Random
+    } else {
+        RngSeed::Fixed(20_261_202)
+    };
+    ProptestConfig {
+        cases,
+        rng_seed,
+        ..ProptestConfig::default()
+    }
+}
 
 /// Small, fast scenarios of each method (the mutations start from these).
 const BASES: [(&str, &[Spec]); 10] = [
@@ -230,7 +249,7 @@ fn exercise(doc: &toml::Table) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 192, ..ProptestConfig::default() })]
+    #![proptest_config(fuzz_config(192))]
 
     #[test]
     fn hostile_scenarios_are_refused_or_run_never_panic(
@@ -404,7 +423,7 @@ density = { bins = 10 }
 ];
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    #![proptest_config(fuzz_config(256))]
 
     /// Every CSV input of a scenario (potential and pair tables, initial positions): a clean
     /// error naming the file, or a valid run; never a panic.
