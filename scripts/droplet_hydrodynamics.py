@@ -391,6 +391,8 @@ def analyse(root, n, names, vdefs, data_dir, img_dir):
                 qa = {q["seed"]: q["regions"][j][reg] for q in res[a]}
                 qb = {q["seed"]: q["regions"][j][reg] for q in res[b]}
                 m, e = mean_se([qa[s] - qb[s] for s in common])
+                if len(common) < 4 or not e > 1e-9:
+                    e = float("nan")  # too few pairs (or identical differences of counts)
                 row[f"{reg}_paired"] = m
                 row[f"{reg}_paired_se"] = e
             row["pairs"] = len(common)
@@ -465,7 +467,7 @@ def print_markdown(res, summ, drows, irows, trows, vdefs, n):
     print("|---|---|---|---|---|---|---|---|---|---|")
 
     def z(m, e):
-        return f"{m / e:+.1f}" if e > 0 else "–"
+        return f"{m / e:+.1f}" if e > 0 else "–"  # nan > 0 is False
 
     for d in drows:
         cells = [d["comparison"], f"{d['fraction']:g}"]
@@ -496,80 +498,93 @@ def print_markdown(res, summ, drows, irows, trows, vdefs, n):
               f"{r['wall_mean']:.0f} | {r['cpu_mean']:.0f} | {r['wall_total']:.0f} |")
 
 
+MERGE = 2  # the figures merge this many neighbouring bins (volume-weighted) against the noise
+
+
 def figures(res, prow, vdefs, img_dir, n):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    def ylim(names, fracs=FRACTIONS):
-        """Above the curves away from the centre (whose few innermost shells are noisy)."""
-        top = max(p["phi"] + (p["se"] if np.isfinite(p["se"]) else 0) for p in prow
-                  if p["variant"] in names and p["fraction"] in fracs and p["r_over_R"] > 0.15)
-        return 1.08 * top
+    def merged(name, frac):
+        """Mean and standard error over the droplets of the profile with MERGE bins merged."""
+        j = FRACTIONS.index(frac)
+        ys = []
+        for q in res[name]:
+            pr = q["prof"][j]
+            r, phi, dr = pr["r"], pr["phi"], pr["r"][1] - pr["r"][0]
+            vol = (r + dr / 2) ** 3 - (r - dr / 2) ** 3
+            m = len(r) // MERGE * MERGE
+            ys.append((phi[:m] * vol[:m]).reshape(-1, MERGE).sum(1)
+                      / vol[:m].reshape(-1, MERGE).sum(1))
+            x = r[:m].reshape(-1, MERGE).mean(1) / pr["R"]
+        ys = np.array(ys)
+        se = (ys.std(axis=0, ddof=1) / math.sqrt(len(ys)) if len(ys) > 1
+              else np.full(ys.shape[1], np.nan))
+        return x, ys.mean(axis=0), se
 
-    def curves(ax, name, style, lw, label_times):
-        for i, fr in enumerate(FRACTIONS):
-            sel = [p for p in prow if p["variant"] == name and p["fraction"] == fr]
-            x = np.array([p["r_over_R"] for p in sel])
-            y = np.array([p["phi"] for p in sel])
-            e = np.array([p["se"] for p in sel])
-            c = f"C{i}"
-            ax.plot(x, y, style, color=c, lw=lw,
-                    label=(f"{fr:.0%} of drying" if label_times else None))
-            if np.all(np.isfinite(e)):
-                ax.fill_between(x, y - e, y + e, color=c, alpha=0.25, lw=0)
+    def draw(ax, name, frac, style, color, lw, label=None):
+        x, y, e = merged(name, frac)
+        ax.plot(x, y, style, color=color, lw=lw, label=label)
+        if np.all(np.isfinite(e)):
+            ax.fill_between(x, y - e, y + e, color=color, alpha=0.22, lw=0)
+        return np.max((y + np.nan_to_num(e))[x > 0.15])
 
     def panel(fname, pairs, title):
         present = [(nm, st) for nm, st in pairs if nm in res]
         if len(present) < 2:
             return
-        fig, ax = plt.subplots(figsize=(7.2, 4.6))
-        for j, (nm, st) in enumerate(present):
-            curves(ax, nm, st, 1.6 if st == "-" else 1.2, j == 0)
-            ax.plot([], [], st, color="k", label=f"{vdefs[nm]['label']} ({len(res[nm])} droplets)")
-        ax.set_xlim(0, 1.0)
-        ax.set_ylim(0, ylim([nm for nm, _ in present]))
-        ax.set_xlabel("r / R(t)")
-        ax.set_ylabel("volume fraction phi(r)")
-        ax.set_title(title, fontsize=9.5)
-        ax.legend(fontsize=7.5, loc="upper left")
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.3), gridspec_kw={"width_ratios": [3, 2]})
+        for ax, fracs in zip(axes, (FRACTIONS[:-1], FRACTIONS[-1:])):
+            top = 0
+            for j, (nm, st) in enumerate(present):
+                for i, fr in enumerate(fracs):
+                    c = f"C{FRACTIONS.index(fr)}"
+                    top = max(top, draw(ax, nm, fr, st, c, 1.7 if st == "-" else 1.3,
+                                        f"{fr:.0%} of drying" if j == 0 else None))
+                ax.plot([], [], st, color="k",
+                        label=f"{vdefs[nm]['label']} ({len(res[nm])})")
+            ax.set_xlim(0, 1.0)
+            ax.set_ylim(0, 1.08 * top)
+            ax.set_xlabel("r / R(t)")
+            ax.set_ylabel("volume fraction phi(r)")
+            ax.legend(fontsize=7.5, loc="upper left")
+        fig.suptitle(title, fontsize=10)
         fig.tight_layout()
-        fig.savefig(os.path.join(img_dir, fname), dpi=100)
+        fig.savefig(os.path.join(img_dir, fname), dpi=90)
         plt.close(fig)
 
+    sub = (f"N = {n}, Pe = 10, dried to phi = 0.5; mean over droplets (their number in "
+           f"brackets), bands ± 1 standard error; {BINS // MERGE} shells")
     panel("droplet-hydro-fd-vs-rpy.png", [("fd", "--"), ("rpy", "-")],
-          f"Drying droplet N = {n}, Pe = 10: free draining vs RPY (free space); "
-          "bands: ± 1 standard error over droplets")
-    panel("droplet-hydro-direct-vs-pse.png", [("rpy", "-"), ("pse2", "--"), ("pse4", ":")],
-          f"Drying droplet N = {n}, Pe = 10: RPY direct (free space) vs PSE (periodic box); "
-          "bands: ± 1 standard error")
+          "Free draining vs RPY in free space\n" + sub)
+    panel("droplet-hydro-direct-vs-pse.png", [("rpy", "-"), ("pse2", "--"), ("pse3", "-."),
+                                              ("pse4", ":")],
+          "RPY: direct (free space) vs PSE (periodic box)\n" + sub)
 
-    # the interface: final profiles at the two stiffnesses, FD and RPY
+    # the interface: profiles at the two stiffnesses, FD and RPY
     pairs = [("fd", "--"), ("rpy", "-"), ("fd-k500", "--"), ("rpy-k500", "-")]
     if all(nm in res for nm, _ in pairs):
         fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
         for ax, frac in zip(axes, (0.75, 1.0)):
+            top = 0
             for nm, st in pairs:
-                sel = [p for p in prow if p["variant"] == nm and p["fraction"] == frac]
-                x = np.array([p["r_over_R"] for p in sel])
-                y = np.array([p["phi"] for p in sel])
-                e = np.array([p["se"] for p in sel])
-                c = "C0" if nm.startswith("fd") else "C3"
-                lw = 2.2 if "k500" in nm else 1.1
-                ax.plot(x, y, st, color=c, lw=lw, label=vdefs[nm]["label"].replace(
-                    "free draining", "FD").replace("RPY direct", "RPY") +
-                    ("" if "k" in nm.split("-")[-1] else ", k = 50"))
-                ax.fill_between(x, y - e, y + e, color=c, alpha=0.2, lw=0)
+                stiff = "k500" in nm
+                lab = ("RPY" if nm.startswith("rpy") else "FD") + (
+                    ", k = 500" if stiff else ", k = 50") + f" ({len(res[nm])})"
+                top = max(top, draw(ax, nm, frac, st, "C3" if nm.startswith("rpy") else "C0",
+                                    2.2 if stiff else 1.0, lab))
             ax.set_xlabel("r / R(t)")
             ax.set_ylabel("phi(r)")
             ax.set_xlim(0, 1)
-            ax.set_ylim(0, ylim([nm for nm, _ in pairs], (frac,)))
+            ax.set_ylim(0, 1.08 * top)
             ax.set_title(f"{frac:.0%} of the drying time", fontsize=10)
             ax.legend(fontsize=8, loc="upper left")
-        fig.suptitle(f"N = {n}: interface k = 50 (thin) and k = 500 kT/d² (thick)", fontsize=10)
+        fig.suptitle(f"N = {n}: interface k = 50 (thin) and 500 kT/d² (thick), "
+                     "mean ± standard error over droplets", fontsize=10)
         fig.tight_layout()
-        fig.savefig(os.path.join(img_dir, "droplet-hydro-interface.png"), dpi=100)
+        fig.savefig(os.path.join(img_dir, "droplet-hydro-interface.png"), dpi=90)
         plt.close(fig)
 
 
