@@ -209,6 +209,8 @@ pub(crate) struct RingStep {
     kept_step: Option<u64>,
     /// The chunks' live blocks are the clusters of `y` (the last thing done was a step).
     blocks_current: bool,
+    /// Scratch of [`RingStep::count_clusters_from_blocks`]: one size histogram per worker.
+    cluster_parts: Mutex<Vec<Vec<u64>>>,
 }
 
 impl RingStep {
@@ -232,6 +234,7 @@ impl RingStep {
             lm: false,
             kept_step: None,
             blocks_current: false,
+            cluster_parts: Mutex::new(Vec::new()),
         }
     }
 
@@ -243,9 +246,42 @@ impl RingStep {
         if !self.blocks_current {
             return false;
         }
-        for c in &self.chunks {
-            for b in &c.pool[c.head..c.end] {
-                counts[count(b[1])] += 1;
+        // The chunks in contiguous parts over the workers, each into its own histogram (as long
+        // as its largest cluster), then added in order: integer counts, the same for any number
+        // of workers.
+        if self.chunks.is_empty() {
+            return true;
+        }
+        let per = self
+            .chunks
+            .len()
+            .div_ceil(rayon::current_num_threads().max(1));
+        let parts = self.chunks.len().div_ceil(per);
+        let mut hists = self.cluster_parts.lock().unwrap_or_else(|e| e.into_inner());
+        hists.resize_with(parts, Vec::new);
+        let tally = |h: &mut Vec<u64>, cs: &[Chunk]| {
+            h.clear();
+            for c in cs {
+                for b in &c.pool[c.head..c.end] {
+                    let k = count(b[1]);
+                    if k >= h.len() {
+                        h.resize(k + 1, 0);
+                    }
+                    h[k] += 1;
+                }
+            }
+        };
+        if parts == 1 {
+            tally(&mut hists[0], &self.chunks);
+        } else {
+            hists
+                .par_iter_mut()
+                .zip(self.chunks.par_chunks(per))
+                .for_each(|(h, cs)| tally(h, cs));
+        }
+        for h in hists.iter() {
+            for (c, &v) in counts.iter_mut().zip(h) {
+                *c += v;
             }
         }
         true

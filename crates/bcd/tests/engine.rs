@@ -366,17 +366,26 @@ fn branch_free_cluster_histogram_equals_the_cluster_walk() {
         Boundary::Periodic,
         Update::Premerge,
     );
-    let x = init::random(&cfg, n, 8).unwrap();
-    let mut a = Bcd::new(cfg, x, NoField, NoPair).unwrap();
-    for step in 0..40 {
-        if step > 0 {
-            a.run(1).unwrap();
-        }
-        let mut counts = Vec::new();
-        a.count_cluster_sizes(&mut counts);
-        let mut want = vec![0u64; counts.len()];
-        a.cluster_sizes(|s| want[s] += 1);
-        assert_eq!(counts, want, "{n} rods at step {step}");
+    // Pools of 1, 2 and 3 workers: the blocks are counted in parts of whole chunks.
+    for workers in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(workers)
+            .build()
+            .unwrap();
+        let x = init::random(&cfg, n, 8).unwrap();
+        let mut a = Bcd::new(cfg.clone(), x, NoField, NoPair).unwrap();
+        pool.install(|| {
+            for step in 0..40 {
+                if step > 0 {
+                    a.run(1).unwrap();
+                }
+                let mut counts = Vec::new();
+                a.count_cluster_sizes(&mut counts);
+                let mut want = vec![0u64; counts.len()];
+                a.cluster_sizes(|s| want[s] += 1);
+                assert_eq!(counts, want, "{n} rods at step {step}, {workers} workers");
+            }
+        });
     }
     // One cluster of every rod round the ring (nothing ends): dense rods, long steps.
     let cfg = config(10.0, 0.99, 1.0, Boundary::Periodic, Update::Premerge);

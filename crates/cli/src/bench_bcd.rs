@@ -28,7 +28,8 @@ pub struct BenchArgs {
     pub repeats: usize,
     /// Instead: the whole run path (`colloidsim run`) at these N, with no observers and with
     /// the main example's (density of 100 bins, MSD of 30 lags and clusters, every step),
-    /// beside the bare engine, alternating the three in each repetition.
+    /// beside the bare engine, alternating the three in each repetition; runs of at least
+    /// 20,000 steps (the MSD's cost per step falls as 1 / steps).
     #[arg(long, value_delimiter = ',')]
     pub observers: Vec<usize>,
 }
@@ -129,6 +130,9 @@ fn scenario(n: usize, steps: u64, observers: bool) -> String {
     s
 }
 
+/// Least number of steps of a run in `--observers`.
+const OBSERVER_STEPS: u64 = 20_000;
+
 /// `colloidsim bench bcd --observers N,...`: nanoseconds per particle-step of the bare engine
 /// (`Bcd::run`), of `colloidsim run` without observers and with the main example's, in the
 /// same process, alternating; the run path's time is its step loop (`wall_seconds` of
@@ -151,7 +155,11 @@ fn bench_observers(a: &BenchArgs) -> Result<()> {
     });
     let dir = std::env::temp_dir().join(format!("colloidsim-bench-obs-{}", std::process::id()));
     for &n in &a.observers {
-        let steps = (a.work / n as u64).max(1000);
+        // At least OBSERVER_STEPS: the MSD's cost per step is ~3000 evaluations (100 origins
+        // x 30 lags) over the run's steps, 0.003 per step in the example's 10^6 steps; in a run of
+        // 1000 steps it would be 3 per step and the bench would time the MSD of a run far
+        // shorter than the example's.
+        let steps = (a.work / n as u64).max(OBSERVER_STEPS);
         let (mut eng, mut bare, mut obs) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..a.repeats.max(1) {
             let cfg = BcdConfig {

@@ -459,15 +459,21 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
     }
 
     fn advance(&mut self, until: u64) -> Result<Option<String>> {
-        while self.bcd.steps() < until {
-            let s = self.bcd.steps();
-            let next = self.next_observation(s).min(until);
-            if let Err(e) = self.bcd.run(next - s) {
-                return Ok(Some(e.to_string()));
+        // The whole chunk on a worker of the thread pool: `Bcd::run` then enters it once per
+        // chunk, not once per observation (entering from outside the pool wakes a worker and
+        // waits for it, which cost more than the observers themselves when they sample every
+        // step).
+        rayon::scope(|_| {
+            while self.bcd.steps() < until {
+                let s = self.bcd.steps();
+                let next = self.next_observation(s).min(until);
+                if let Err(e) = self.bcd.run(next - s) {
+                    return Ok(Some(e.to_string()));
+                }
+                self.observe(next)?;
             }
-            self.observe(next)?;
-        }
-        Ok(None)
+            Ok(None)
+        })
     }
 
     fn flush(&mut self) -> Result<()> {
