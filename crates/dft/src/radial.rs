@@ -1,6 +1,6 @@
 //! Rosenfeld fundamental-measure DDFT of hard spheres in spherical symmetry (drying droplet).
 //!
-//! METHODS.md section 3; paper `drying-droplet-hydrodynamics.md` Secs. II.2, III.1, III.4.
+//! The drying-droplet paper (docs/references.md), Secs. II.2, III.1, III.4.
 //!
 //! - [`grid`]: cell-centred radial finite-volume grid.
 //! - [`fmt`]: radial weighted densities `n3, n2, nv2` (and `n0, n1, nv1` by proportionality), the

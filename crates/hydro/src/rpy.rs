@@ -2,7 +2,7 @@
 //!
 //! Every tensor here has the form `M_ij = A(r) I + B(r) r̂r̂` (r = x_i − x_j); [`PairTensor`]
 //! stores `(A, B)`. Monodisperse spheres of radius a in a fluid of viscosity eta
-//! (METHODS.md section 3; Rotne & Prager 1969, Yamakawa 1970), with `mu0 = 1 / (6 pi eta a)`:
+//! (the drying-droplet paper, docs/references.md; Rotne & Prager 1969, Yamakawa 1970), with `mu0 = 1 / (6 pi eta a)`:
 //!
 //! - self: `M_ii = mu0 I`;
 //! - `r >= 2a`: `M_ij = 1/(8 pi eta r) [(1 + 2a^2/(3 r^2)) I + (1 − 2a^2/r^2) r̂r̂]`;

@@ -1,5 +1,5 @@
 //! The drying-droplet scenario: hard-sphere colloids confined by a shrinking spherical harmonic
-//! interface (METHODS.md section 3).
+//! interface (the drying-droplet paper, docs/references.md).
 //!
 //! [`DropletScenario`] is the typed form of a `method = "droplet-bd"` scenario file (every key is
 //! documented with its unit and default in `docs/droplet.md`); [`DropletScenario::validate`]

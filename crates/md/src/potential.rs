@@ -256,7 +256,7 @@ impl SphereAreaLaw {
     }
 }
 
-/// The droplet interface of METHODS.md: with `s = |p - centre| - (R(t) + offset)`, `V = 0` for
+/// The droplet interface of the drying-droplet paper: with `s = |p - centre| - (R(t) + offset)`, `V = 0` for
 /// `s < 0`, `V = k s^2 / 2` for `0 <= s < range`, `V = k range^2 / 2 + k range (s - range)` beyond.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HarmonicInterface {

@@ -1,4 +1,4 @@
-//! DDFT of the drying droplet on spherical shells (METHODS.md section 3; paper Eqs. 7–8, 16, 24).
+//! DDFT of the drying droplet on spherical shells (the drying-droplet paper, docs/references.md; paper Eqs. 7–8, 16, 24).
 //!
 //! `d rho / dt = -(1/r^2) d/dr (r^2 J)`, free-draining flux `J = -D0 rho d/dr(beta delta F/delta rho)`
 //! `= -D0 (d rho/dr + rho dw/dr)` with `w = beta mu_ex[rho] + beta V(r, t)`, optionally plus the

@@ -1,4 +1,4 @@
-//! Rosenfeld FMT on the radial grid (METHODS.md section 3; paper Eqs. 11–21).
+//! Rosenfeld FMT on the radial grid (the drying-droplet paper, docs/references.md; paper Eqs. 11–21).
 //!
 //! The density is piecewise constant on the cells; the radial kernels are integrated exactly over
 //! each cell, so the weighted densities at the centres `r_i` are

@@ -1,4 +1,4 @@
-//! The droplet's liquid–vapour interface and its shrinking radius (METHODS.md section 3; paper
+//! The droplet's liquid–vapour interface and its shrinking radius (the drying-droplet paper, docs/references.md; paper
 //! Eqs. 1–2).
 
 use std::f64::consts::PI;

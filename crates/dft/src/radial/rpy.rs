@@ -1,5 +1,5 @@
 //! Pairwise Rotne–Prager–Yamakawa flux in spherical symmetry, dilute pair correlation
-//! (METHODS.md section 3, flyft `rpy_diffusive_flux`; paper Eqs. 16, 24–27).
+//! (the drying-droplet paper, docs/references.md, flyft `rpy_diffusive_flux`; paper Eqs. 16, 24–27).
 //!
 //! With `g(r) = Theta(r - d)`, the radial hydrodynamic flux is
 //! `J_HI(x) = -rho(x) int dy M(x, y) rho(y) d_y(beta mu(y))` over `|x - d| < y < x + d`, where

@@ -8,7 +8,7 @@
 //! `1/rho = -d ln Omega / ds` at `s = beta p`, i.e. `beta p (1 + gamma beta p) = rho / (1 - rho sigma)`,
 //! the chemical potential from `beta mu = -ln Omega(beta p)` (thermal wavelength 1), and the
 //! nearest-neighbour distance density `rho e^{-beta p r} e^{-beta V(r)} / Omega(beta p)`.
-//! At `gamma = 0` these are the Tonks-gas results of METHODS.md section 2.
+//! At `gamma = 0` these are the Tonks-gas results of the hard-rods paper, docs/references.md.
 
 /// `beta p` of the homogeneous fluid at density `rho` (Tonks gas at `gamma = 0`).
 pub fn beta_pressure(sigma: f64, gamma: f64, rho: f64) -> f64 {

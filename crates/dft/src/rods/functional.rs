@@ -13,7 +13,7 @@
 //!
 //! with `T1 = sqrt(g) (1 + gamma d + S)`, `T2 = sqrt(g) (1 - gamma d + S)` and
 //! `W = (S - 1) / (2 gamma) = (s + gamma d^2 / 2) / (S + 1)`. At `gamma = 0`, `T1 = T2 = 2 sqrt(g)`
-//! and `W = s / 2`: the Percus hard-rod equation (METHODS.md section 2), so one code path serves
+//! and `W = s / 2`: the Percus hard-rod equation (the hard-rods paper, docs/references.md), so one code path serves
 //! both and the limit `gamma -> 0` is continuous. The forms used avoid cancellation: `W` as above,
 //! and `1 +- gamma d + S = 4 gamma rho / (g (S - (1 +- gamma d)))` when `1 +- gamma d < 0`.
 

@@ -1,4 +1,4 @@
-//! Pair forces of the DPD colloid model (METHODS.md section 4, `papers/dpd-colloids.md`).
+//! Pair forces of the DPD colloid model (the DPD notes, docs/references.md).
 //!
 //! All forces act along `e_ij = (x_i - x_j) / r` on the surface gap `h = r - (a_i + a_j)`; a
 //! positive magnitude pushes `i` away from `j`. Solvent beads are point particles (`a = 0`).

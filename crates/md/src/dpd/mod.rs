@@ -1,5 +1,5 @@
-//! Dissipative particle dynamics of hard colloids in an explicit solvent (METHODS.md section 4,
-//! `papers/dpd-colloids.md`).
+//! Dissipative particle dynamics of hard colloids in an explicit solvent (the DPD notes,
+//! docs/references.md).
 //!
 //! Velocity Verlet with the DPD pair forces as the thermostat (the dissipative force sees the
 //! half-step velocities, as in LAMMPS `pair_style dpd` + `fix nve` and HOOMD). Every pair force

@@ -3,7 +3,7 @@
 //!
 //! A solvent particle that ends a streaming step outside the fluid region is returned to the
 //! point where it crossed the wall, its velocity is reflected relative to the wall velocity `V`
-//! at that point (METHODS.md section 3; Whitmer & Luijten, J. Phys.: Condens. Matter 22, 104106
+//! at that point (the drying-droplet paper, docs/references.md; Whitmer & Luijten, J. Phys.: Condens. Matter 22, 104106
 //! (2010)):
 //!
 //! - slip: `v' = v - 2 ((v - V) . n) n` (the normal part of the relative velocity reversed),

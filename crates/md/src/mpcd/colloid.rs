@@ -1,5 +1,5 @@
-//! Colloids as discrete particles (the drying-droplet paper's MPCD colloid model, METHODS.md
-//! section 3): the surface of a sphere of diameter `d` is a regular icosahedron subdivided once,
+//! Colloids as discrete particles (the drying-droplet paper's MPCD colloid model,
+//! docs/references.md): the surface of a sphere of diameter `d` is a regular icosahedron subdivided once,
 //! its 42 vertices projected onto the sphere ([`Geometry`]); every vertex is bonded to its
 //! nearest neighbours on the mesh (120 edges) and to a central particle (42 spokes) by harmonic
 //! bonds `U = k/2 (r - r0)^2` with `r0` the bond's length in the ideal shape. Centres repel by

@@ -1,7 +1,7 @@
 //! Multiparticle collision dynamics (MPCD): a stochastic-rotation-dynamics solvent
 //! ([`srd`]), colloids as discrete particles that join its collisions ([`colloid`]), and the
 //! walls of the drying droplet ([`boundary`]); the transport coefficients of the solvent
-//! ([`theory`]). METHODS.md section 3 and the drying-droplet paper's MPCD model.
+//! ([`theory`]). The drying-droplet paper's MPCD model (docs/references.md).
 //!
 //! Every random number comes from a counter-based stream of `colloidsim_core::rng` with the
 //! purpose `Moves`, keyed by (seed, step, [`Draw`] and index): a collision's draws in cell `c`

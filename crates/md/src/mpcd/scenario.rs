@@ -26,7 +26,7 @@ pub const DEFAULT_FLOW: f64 = 0.25;
 /// Relaxation times `rho / (eta k^2)` of the Poiseuille flow before sampling starts.
 pub const RELAXATION_TIMES: f64 = 6.0;
 
-/// `[solvent]`: the SRD fluid (defaults: METHODS.md section 3, the group's usual values).
+/// `[solvent]`: the SRD fluid (defaults: the drying-droplet paper, docs/references.md, the group's usual values).
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SolventSection {

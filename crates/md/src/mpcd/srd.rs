@@ -76,7 +76,7 @@ pub struct SrdParams {
 }
 
 impl SrdParams {
-    /// The usual values (METHODS.md section 3): `a = 1`, density 5, 130 degrees, `tau = 0.1`,
+    /// The usual values (the drying-droplet paper, docs/references.md): `a = 1`, density 5, 130 degrees, `tau = 0.1`,
     /// `m = kT = 1`, thermostat on.
     pub fn standard(seed: u32) -> Self {
         Self {

@@ -8,7 +8,7 @@
 //! - collisional viscosity `eta_col = m (1 - cos(alpha)) (M - 1 + e^-M) / (18 a tau)`
 //!
 //! (Kikuchi, Pooley, Ryder & Yeomans, J. Chem. Phys. 119, 6388 (2003); Tüzel, Ihle & Kroll,
-//! Phys. Rev. E 74, 056702 (2006); METHODS.md section 5), and the self-diffusion coefficient
+//! Phys. Rev. E 74, 056702 (2006); docs/references.md), and the self-diffusion coefficient
 //! `D = (kT tau / 2m) [3 M / ((1 - cos(alpha))(M - 1 + e^-M)) - 1]` (Ihle & Kroll, Phys. Rev. E
 //! 67, 066705 (2003), with the same fluctuation factor).
 
