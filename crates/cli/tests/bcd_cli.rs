@@ -384,3 +384,38 @@ fn theory_writes_converged_profiles_on_the_simulation_bins() {
     ]);
     assert!(!o.status.success() && text(&o).contains("drive"));
 }
+
+/// `colloidsim check` prints the scenario's keys with their values and units, defaults
+/// marked, not the engine's names; `--json` the resolved parameters.
+#[test]
+fn check_prints_keys_values_and_units() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = write_scenario(tmp.path(), "small.toml", SMALL);
+    let o = run(&["check", sc.to_str().unwrap(), "--set", "run.dt=2e-3"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = |key: &str| {
+        out.lines()
+            .find(|l| l.starts_with(&format!("{key} ")))
+            .unwrap_or_else(|| panic!("no {key} in\n{out}"))
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    assert_eq!(
+        line("system.length"),
+        "system.length = 20.0 length",
+        "{out}"
+    );
+    assert_eq!(line("run.dt"), "run.dt = 0.002 time", "{out}");
+    assert!(line("system.boundary").ends_with("(default)"), "{out}");
+    assert!(
+        line("observe.trajectory.every").contains("= 500 steps"),
+        "{out}"
+    );
+    assert!(!out.contains("vectorised") && !out.contains('{'), "{out}");
+    let o = run(&["check", sc.to_str().unwrap(), "--json"]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let v: serde_json::Value = serde_json::from_str(&out[..=out.rfind('}').unwrap()]).unwrap();
+    assert_eq!(v["run"]["dt"], 1e-3);
+}

@@ -430,3 +430,27 @@ print('ok')
         .unwrap();
     assert!(o.status.success(), "{}", text(&o));
 }
+
+/// `--quiet`: nothing on stdout, no informational line (here: that an interrupted run goes on
+/// to the next point where it can write a checkpoint), the error still printed.
+#[test]
+fn quiet_keeps_errors_and_drops_information() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "q", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(o.stdout.is_empty() && o.stderr.is_empty(), "{}", text(&o));
+    let hook = [("COLLOIDSIM_INTERRUPT_AT_STEP", "123")];
+    let o = run_env(d, &["run", &sc, "--out", "i", "--quiet"], &hook);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success() && o.stdout.is_empty(), "{}", text(&o));
+    assert!(err.contains("error: interrupted at step 123"), "{err}");
+    assert!(!err.contains("running on to step"), "{err}");
+    let o = run_env(d, &["run", &sc, "--out", "v"], &hook);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("running on to step 160"),
+        "{}",
+        text(&o)
+    );
+}
