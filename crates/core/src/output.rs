@@ -117,6 +117,17 @@ impl OutputDir {
         self.write_bytes(name, &bytes)
     }
 
+    /// Write rows of `header.len()` numbers as a CSV table ([`rows_bytes`]).
+    pub fn write_rows(
+        &self,
+        name: &str,
+        header: &[&str],
+        rows: &[Vec<f64>],
+    ) -> Result<PathBuf, OutputError> {
+        let bytes = rows_bytes(name, header, rows)?;
+        self.write_bytes(name, &bytes)
+    }
+
     /// Write `value` as pretty JSON.
     pub fn write_json<T: serde::Serialize>(
         &self,

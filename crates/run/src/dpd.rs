@@ -14,7 +14,7 @@ use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
     pair_distribution, structure_factor_windowed,
 };
-use colloidsim_core::output::{CsvLog, OutputDir, rows_bytes};
+use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
 use colloidsim_md::dpd::{Dpd, Thermo};
 use colloidsim_md::gsd::GsdWriter;
@@ -810,10 +810,7 @@ fn write_outputs(
     // thermo.csv (also written row by row as the run goes: `DpdSession::step`)
     if !obs.thermo.is_empty() {
         let rows = thermo_rows_of(obs, vol, tau);
-        out.write_bytes(
-            "thermo.csv",
-            &rows_bytes("thermo.csv", &THERMO_COLUMNS, &rows)?,
-        )?;
+        out.write_rows("thermo.csv", &THERMO_COLUMNS, &rows)?;
         files.push("thermo.csv".to_string());
     }
     // msd.csv

@@ -18,7 +18,7 @@ use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
-use colloidsim_core::output::{CsvLog, OutputDir, rows_bytes};
+use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region};
 use colloidsim_md::mpcd::drying::{SolventProfile, remove_excess};
@@ -578,7 +578,7 @@ impl Session for BulkSession {
             out.join("thermo.csv"),
             &BULK_THERMO,
             fresh,
-            || bulk_thermo_rows(&self.p, &self.acc.rows),
+            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
         )?);
         if fresh {
             self.record(0)?;
@@ -668,7 +668,7 @@ impl Session for BulkSession {
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
-        write_bulk_thermo(out, &self.p, &self.acc.rows)?;
+        write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
 
@@ -682,7 +682,7 @@ impl Session for BulkSession {
         let p = &self.p;
         let mut files = Vec::new();
         let mut warnings = Vec::new();
-        write_bulk_thermo(out, p, &self.acc.rows)?;
+        write_thermo(out, p.solvent.srd.tau, &self.acc.rows)?;
         files.push("thermo.csv".into());
         let collisions = self.srd.step();
         let sampled = collisions.saturating_sub(p.equilibrate);
@@ -868,8 +868,8 @@ const BULK_THERMO: [&str; 8] = [
     "colloid_temperature",
 ];
 
-impl BulkRow {
-    /// The row of `thermo.csv`, with the collision time `tau`.
+impl ThermoRow for BulkRow {
+    const COLUMNS: &'static [&'static str] = &BULK_THERMO;
     fn values(&self, tau: f64) -> Vec<f64> {
         vec![
             self.collision as f64,
@@ -884,18 +884,21 @@ impl BulkRow {
     }
 }
 
-fn bulk_thermo_rows(p: &BulkRun, rows: &[BulkRow]) -> Vec<Vec<f64>> {
-    let tau = p.solvent.srd.tau;
+/// A row of `thermo.csv` (bulk or droplet).
+trait ThermoRow {
+    /// The columns.
+    const COLUMNS: &'static [&'static str];
+    /// The row, with the collision time `tau`.
+    fn values(&self, tau: f64) -> Vec<f64>;
+}
+
+fn thermo_rows<R: ThermoRow>(tau: f64, rows: &[R]) -> Vec<Vec<f64>> {
     rows.iter().map(|r| r.values(tau)).collect()
 }
 
 /// `thermo.csv` complete (it is also appended row by row as the run goes).
-fn write_bulk_thermo(out: &OutputDir, p: &BulkRun, rows: &[BulkRow]) -> Result<()> {
-    let rows = bulk_thermo_rows(p, rows);
-    out.write_bytes(
-        "thermo.csv",
-        &rows_bytes("thermo.csv", &BULK_THERMO, &rows)?,
-    )?;
+fn write_thermo<R: ThermoRow>(out: &OutputDir, tau: f64, rows: &[R]) -> Result<()> {
+    out.write_rows("thermo.csv", R::COLUMNS, &thermo_rows(tau, rows))?;
     Ok(())
 }
 
@@ -1302,7 +1305,7 @@ impl Session for DropletSession {
             out.join("thermo.csv"),
             &DROPLET_THERMO,
             fresh,
-            || droplet_thermo_rows(&self.p, &self.acc.rows),
+            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
         )?);
         if fresh && let Some(why) = self.record(0, 0)? {
             bail!("{why}");
@@ -1372,7 +1375,7 @@ impl Session for DropletSession {
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
-        write_droplet_thermo(out, &self.p, &self.acc.rows)?;
+        write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
 
@@ -1388,7 +1391,7 @@ impl Session for DropletSession {
         let n0 = p.solvent.number_density;
         let mut files = Vec::new();
         let mut warnings = Vec::new();
-        write_droplet_thermo(out, p, &self.acc.rows)?;
+        write_thermo(out, p.solvent.srd.tau, &self.acc.rows)?;
         files.push("thermo.csv".into());
         let collisions = self.srd.step();
         let boundary = match p.boundary {
@@ -1640,8 +1643,8 @@ const DROPLET_THERMO: [&str; 9] = [
     "colloid_temperature",
 ];
 
-impl DropletRow {
-    /// The row of `thermo.csv`, with the collision time `tau`.
+impl ThermoRow for DropletRow {
+    const COLUMNS: &'static [&'static str] = &DROPLET_THERMO;
     fn values(&self, tau: f64) -> Vec<f64> {
         vec![
             self.collision as f64,
@@ -1655,21 +1658,6 @@ impl DropletRow {
             self.colloid_temperature,
         ]
     }
-}
-
-fn droplet_thermo_rows(p: &DropletRun, rows: &[DropletRow]) -> Vec<Vec<f64>> {
-    let tau = p.solvent.srd.tau;
-    rows.iter().map(|r| r.values(tau)).collect()
-}
-
-/// `thermo.csv` complete (it is also appended row by row as the run goes).
-fn write_droplet_thermo(out: &OutputDir, p: &DropletRun, rows: &[DropletRow]) -> Result<()> {
-    let rows = droplet_thermo_rows(p, rows);
-    out.write_bytes(
-        "thermo.csv",
-        &rows_bytes("thermo.csv", &DROPLET_THERMO, &rows)?,
-    )?;
-    Ok(())
 }
 
 // ------------------------------------------------------------------------------------------
