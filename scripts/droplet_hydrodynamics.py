@@ -160,7 +160,7 @@ def scenario_text(name, v, n, steps):
 def check_steps(binary, path):
     """Steps of the scenario from `colloidsim check` (the trajectory writes the first and the
     last frame when its interval is the number of steps)."""
-    out = subprocess.run([binary, "check", path], check=True, capture_output=True,
+    out = subprocess.run([binary, "check", "--json", path], check=True, capture_output=True,
                          text=True).stdout
     m = re.search(r"\"steps\":\s*(\d+)", out)
     if not m:

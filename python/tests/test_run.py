@@ -120,7 +120,7 @@ def test_a_bulk_bd_run_equals_the_cli_byte_for_byte(tmp_path, cli):
 
 def test_check_equals_the_cli(cli):
     path = EXAMPLES / "bcd/hard-rods-cosine.toml"
-    out = cli("check", path, "--set", "run.dt=2e-4").stdout
+    out = cli("check", path, "--json", "--set", "run.dt=2e-4").stdout
     printed = json.loads(out[: out.rindex("}") + 1])
     assert colloidsim.check(path, overrides={"run.dt": 2e-4}) == printed
     assert printed["run"]["dt"] == 2e-4

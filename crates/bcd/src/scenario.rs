@@ -268,8 +268,11 @@ fn msd_points() -> usize {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Trajectory {
-    /// Steps between frames.
+    /// Steps between frames (from the first production step).
     pub every: u64,
+    /// Also write frames during equilibration (from step 0).
+    #[serde(default)]
+    pub equilibration: bool,
 }
 
 /// External force as the engine sees it.

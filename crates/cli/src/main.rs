@@ -75,7 +75,8 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
-        /// No progress bar, no closing line.
+        /// No progress bar, no informational messages, no closing line (warnings and errors
+        /// are still printed, on stderr).
         #[arg(long)]
         quiet: bool,
         /// Write into an output folder that already holds files (the files of an earlier run
@@ -138,10 +139,13 @@ enum Command {
         #[command(flatten)]
         overrides: Overrides,
     },
-    /// Validate a scenario and print the resolved parameters.
+    /// Validate a scenario and print its keys with their values and units (defaults marked).
     Check {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        /// Print instead the resolved parameters as JSON (summary.json's `parameters`).
+        #[arg(long)]
+        json: bool,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -218,7 +222,7 @@ impl Progress for Bar {
             ProgressBar::with_draw_target(Some(total), indicatif::ProgressDrawTarget::hidden());
         pb.set_style(
             ProgressStyle::with_template(&format!(
-                "{label} {{bar:40}} {{percent:>3}}% {{elapsed_precise}} eta {{eta}} {{msg}}"
+                "{label} {{bar:30}} {{percent:>3}}% {{elapsed_precise}} eta {{eta}} {{msg}}"
             ))
             .expect("static template"),
         );
@@ -238,7 +242,31 @@ impl Progress for Bar {
         self.with(|pb| pb.set_position(done));
     }
 
+    fn status(&self, text: &str) {
+        self.with(|pb| pb.set_message(text.to_string()));
+    }
+
     fn message(&self, text: &str) {
+        if self.quiet {
+            return;
+        }
+        self.print(text);
+    }
+
+    fn warning(&self, text: &str) {
+        self.print(&format!("warning: {text}"));
+    }
+
+    fn end(&self) {
+        if let Some(pb) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            pb.finish_and_clear();
+        }
+    }
+}
+
+impl Bar {
+    /// A line on stderr, above the progress bar when one is shown.
+    fn print(&self, text: &str) {
         let mut shown = false;
         self.with(|pb| {
             pb.suspend(|| eprintln!("{text}"));
@@ -246,16 +274,6 @@ impl Progress for Bar {
         });
         if !shown {
             eprintln!("{text}");
-        }
-    }
-
-    fn warning(&self, text: &str) {
-        self.message(&format!("warning: {text}"));
-    }
-
-    fn end(&self) {
-        if let Some(pb) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
-            pb.finish_and_clear();
         }
     }
 }
@@ -444,6 +462,7 @@ fn run_cli() -> Result<()> {
         }
         Command::Check {
             scenario: path,
+            json,
             overrides,
         } => {
             let sc = scenario(&path, &overrides)?;
@@ -451,7 +470,12 @@ fn run_cli() -> Result<()> {
             for w in &checked.warnings {
                 eprintln!("warning: {w}");
             }
-            println!("{}", serde_json::to_string_pretty(&checked.resolved)?);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&checked.resolved)?);
+            } else {
+                let keys = colloidsim_run::keys(&sc.method()?)?;
+                print!("{}", colloidsim_run::keys::values(&sc.table()?, &keys));
+            }
             println!("scenario {} is valid", path.display());
             Ok(())
         }

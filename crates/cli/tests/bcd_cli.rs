@@ -189,6 +189,39 @@ fn interrupted_run_restarts_bitwise() {
     assert!(!o.status.success());
 }
 
+/// Read `out/trajectory.gsd` with the `gsd` package and run `checks` (Python, with `t` the
+/// trajectory, `f` its last frame, `x` the final configuration's positions and `gsd`, `np`
+/// imported) on it.
+fn check_gsd(out: &Path, checks: &str) {
+    let script = format!(
+        r#"
+import sys, gsd.hoomd, gsd.fl, numpy as np
+with gsd.fl.open(sys.argv[1], 'r') as fl:
+    application = fl.application
+t = gsd.hoomd.open(sys.argv[1], 'r')
+f = t[-1]
+x = np.loadtxt(sys.argv[2], delimiter=',', skiprows=1, ndmin=1)
+{checks}
+print('gsd ok', len(t))
+"#
+    );
+    let o = Command::new("python3")
+        .args([
+            "-c",
+            &script,
+            out.join("trajectory.gsd").to_str().unwrap(),
+            out.join("final_configuration.csv").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+}
+
+/// The trajectory looks like one HOOMD-blue writes: colloidsim as the application, types
+/// and typeids, positions in the box with their images (position + image L is the rod's
+/// unwrapped position), frames from the first production step (step 500) unless the
+/// equilibration is asked for; between walls a box twice as long, images zero and the walls
+/// logged.
 #[test]
 fn gsd_trajectory_is_readable_by_the_gsd_package() {
     if !colloidsim_core::tools::python_module_or_skip(
@@ -199,38 +232,65 @@ fn gsd_trajectory_is_readable_by_the_gsd_package() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let sc = write_scenario(tmp.path(), "small.toml", SMALL);
-    let out = tmp.path().join("out");
-    assert!(
-        run(&[
-            "run",
-            sc.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet"
-        ])
-        .status
-        .success()
-    );
-    let script = r#"
-import sys, gsd.hoomd, numpy as np
-t = gsd.hoomd.open(sys.argv[1], 'r')
-assert len(t) == 11, len(t)
-f = t[-1]
+    let go = |name: &str, set: &[&str]| {
+        let out = tmp.path().join(name);
+        let mut args = vec!["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.push("--quiet");
+        for s in set {
+            args.extend(["--set", s]);
+        }
+        assert!(run(&args).status.success());
+        out
+    };
+    let common = r#"
+assert application == 'colloidsim ' + application.split()[-1] and application.split()[-1][0].isdigit(), application
 assert f.configuration.step == 5500, f.configuration.step
 assert f.particles.N == 10
 assert f.configuration.dimensions == 2
+assert list(f.particles.types) == ['rod'], f.particles.types
+assert np.all(f.particles.typeid == 0)
+assert np.allclose(f.particles.diameter, 0.5)
+assert 'particles/x_unwrapped' not in f.log, list(f.log)
 L = f.configuration.box[0]
-x = f.particles.position[:, 0]
-assert np.all(np.abs(x) <= L / 2), x
-xu = f.log['particles/x_unwrapped']
-assert np.allclose(np.mod(xu + L / 2, L) - L / 2, x, atol=1e-4)
-print('gsd ok', len(t), L)
+assert np.all(f.particles.position[:, 0] >= -L / 2) and np.all(f.particles.position[:, 0] < L / 2)
+assert np.all(f.particles.position[:, 1:] == 0) and np.all(f.particles.image[:, 1:] == 0)
 "#;
-    let o = Command::new("python3")
-        .args(["-c", script, out.join("trajectory.gsd").to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", text(&o));
+    let ring = go("ring", &[]);
+    check_gsd(
+        &ring,
+        &format!(
+            "{common}
+assert len(t) == 11, len(t)
+assert [s.configuration.step for s in t] == list(range(500, 5501, 500))
+assert L == 20.0, L
+xu = f.particles.position[:, 0] + f.particles.image[:, 0] * L
+assert np.allclose(xu, x, atol=1e-4), (xu, x)
+assert np.any(np.concatenate([s.particles.image[:, 0] for s in t]) != 0)
+assert 'bcd/walls' not in f.log
+"
+        ),
+    );
+    let warmup = go("warmup", &["observe.trajectory.equilibration=true"]);
+    check_gsd(
+        &warmup,
+        &format!(
+            "{common}
+assert [s.configuration.step for s in t] == list(range(0, 5501, 500)), [s.configuration.step for s in t]
+"
+        ),
+    );
+    let walls = go("walls", &["system.boundary=\"walls\""]);
+    check_gsd(
+        &walls,
+        &format!(
+            "{common}
+assert L == 40.0, L
+assert np.all(f.particles.image == 0)
+assert np.allclose(f.particles.position[:, 0] + 10.0, x, atol=1e-4)
+assert np.allclose(f.log['bcd/walls'], [-10.0, 10.0]), f.log['bcd/walls']
+"
+        ),
+    );
 }
 
 #[test]
@@ -323,4 +383,39 @@ fn theory_writes_converged_profiles_on_the_simulation_bins() {
         tmp.path().join("d").to_str().unwrap(),
     ]);
     assert!(!o.status.success() && text(&o).contains("drive"));
+}
+
+/// `colloidsim check` prints the scenario's keys with their values and units, defaults
+/// marked, not the engine's names; `--json` the resolved parameters.
+#[test]
+fn check_prints_keys_values_and_units() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = write_scenario(tmp.path(), "small.toml", SMALL);
+    let o = run(&["check", sc.to_str().unwrap(), "--set", "run.dt=2e-3"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = |key: &str| {
+        out.lines()
+            .find(|l| l.starts_with(&format!("{key} ")))
+            .unwrap_or_else(|| panic!("no {key} in\n{out}"))
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    assert_eq!(
+        line("system.length"),
+        "system.length = 20.0 length",
+        "{out}"
+    );
+    assert_eq!(line("run.dt"), "run.dt = 0.002 time", "{out}");
+    assert!(line("system.boundary").ends_with("(default)"), "{out}");
+    assert!(
+        line("observe.trajectory.every").contains("= 500 steps"),
+        "{out}"
+    );
+    assert!(!out.contains("vectorised") && !out.contains('{'), "{out}");
+    let o = run(&["check", sc.to_str().unwrap(), "--json"]);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let v: serde_json::Value = serde_json::from_str(&out[..=out.rfind('}').unwrap()]).unwrap();
+    assert_eq!(v["run"]["dt"], 1e-3);
 }

@@ -346,3 +346,111 @@ fn a_restarted_run_stops_where_the_uninterrupted_one_does() {
     assert!(!o.status.success());
     assert!(text(&o).contains("stopped with an error"), "{}", text(&o));
 }
+
+/// `thermo.csv` is written as the run goes: a run killed at step 150 (after its checkpoint at
+/// 120, without one of its own) leaves the rows of steps 20 to 140, exactly the first rows
+/// of the finished run's file, and no summary.json; continued from its checkpoint, the run
+/// drops the row written after it and ends with every output of an uninterrupted run.
+#[test]
+fn a_killed_run_leaves_the_thermo_rows_written_so_far() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "a", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let full = std::fs::read_to_string(d.join("a/thermo.csv")).unwrap();
+    let o = run_env(
+        d,
+        &["run", &sc, "--out", "k", "--quiet"],
+        &[("COLLOIDSIM_KILL_AT_STEP", "150")],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(!d.join("k/summary.json").exists());
+    let part = std::fs::read_to_string(d.join("k/thermo.csv"))
+        .expect("thermo.csv of the rows written before the kill");
+    let lines: Vec<&str> = part.lines().collect();
+    assert_eq!(lines.len(), 1 + 7, "header and steps 20..=140:\n{part}");
+    assert!(lines[7].starts_with("140,"), "{part}");
+    assert!(
+        full.starts_with(&part),
+        "not the first rows of\n{full}\n{part}"
+    );
+    let o = run(d, &["run", &sc, "--restart", "k", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_same_outputs(&d.join("a"), &d.join("k"), TIMING);
+}
+
+/// DPD frames carry what HOOMD-blue's ThermodynamicQuantities logs (kinetic temperature,
+/// pressure, its tensor, potential energy), read with the `gsd` package: equal to the
+/// thermo.csv row of the same step, and the application is colloidsim.
+#[test]
+fn gsd_frames_carry_hoomd_thermodynamic_log_quantities() {
+    if !colloidsim_core::tools::python_module_or_skip(
+        "gsd.hoomd",
+        "gsd_frames_carry_hoomd_thermodynamic_log_quantities",
+    ) {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // Frames every 30 steps, thermo rows every 20: frames at 60, 120, ... meet a row.
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "a", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let script = r#"
+import sys, gsd.hoomd, gsd.fl, numpy as np
+with gsd.fl.open(sys.argv[1] + '/trajectory.gsd', 'r') as fl:
+    assert fl.application.startswith('colloidsim '), fl.application
+th = np.genfromtxt(sys.argv[1] + '/thermo.csv', delimiter=',', names=True)
+q = 'md/compute/ThermodynamicQuantities/'
+t = gsd.hoomd.open(sys.argv[1] + '/trajectory.gsd', 'r')
+assert len(t) == 14, len(t)
+checked = 0
+for f in t[1:]:
+    step = f.configuration.step
+    for k in ['kinetic_temperature', 'pressure', 'potential_energy']:
+        assert q + k in f.log, (step, list(f.log))
+    assert f.log[q + 'pressure_tensor'].shape == (6,), f.log[q + 'pressure_tensor'].shape
+    row = th[th['step'] == step]
+    if len(row):
+        assert np.isclose(f.log[q + 'kinetic_temperature'][0], row['T'][0], rtol=1e-12)
+        assert np.isclose(f.log[q + 'pressure'][0], row['p'][0], rtol=1e-12)
+        pt = f.log[q + 'pressure_tensor']
+        assert np.allclose(pt[[0, 3, 5, 1, 2, 4]], [row[c][0] for c in ['pxx', 'pyy', 'pzz', 'pxy', 'pxz', 'pyz']], rtol=1e-12)
+        assert np.isclose(f.log[q + 'potential_energy'][0], row['energy_potential'][0], rtol=1e-12)
+        checked += 1
+assert checked == 6, checked
+f0 = t[0].log
+assert f0[q + 'kinetic_temperature'][0] > 0 and np.isnan(f0[q + 'pressure'][0]), f0
+print('ok')
+"#;
+    let o = Command::new("python3")
+        .args(["-c", script, d.join("a").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+}
+
+/// `--quiet`: nothing on stdout, no informational line (here: that an interrupted run goes on
+/// to the next point where it can write a checkpoint), the error still printed.
+#[test]
+fn quiet_keeps_errors_and_drops_information() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sc = restart_scenario(d);
+    let o = run(d, &["run", &sc, "--out", "q", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(o.stdout.is_empty() && o.stderr.is_empty(), "{}", text(&o));
+    let hook = [("COLLOIDSIM_INTERRUPT_AT_STEP", "123")];
+    let o = run_env(d, &["run", &sc, "--out", "i", "--quiet"], &hook);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success() && o.stdout.is_empty(), "{}", text(&o));
+    assert!(err.contains("error: interrupted at step 123"), "{err}");
+    assert!(!err.contains("running on to step"), "{err}");
+    let o = run_env(d, &["run", &sc, "--out", "v"], &hook);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("running on to step 160"),
+        "{}",
+        text(&o)
+    );
+}

@@ -117,6 +117,17 @@ impl OutputDir {
         self.write_bytes(name, &bytes)
     }
 
+    /// Write rows of `header.len()` numbers as a CSV table ([`rows_bytes`]).
+    pub fn write_rows(
+        &self,
+        name: &str,
+        header: &[&str],
+        rows: &[Vec<f64>],
+    ) -> Result<PathBuf, OutputError> {
+        let bytes = rows_bytes(name, header, rows)?;
+        self.write_bytes(name, &bytes)
+    }
+
     /// Write `value` as pretty JSON.
     pub fn write_json<T: serde::Serialize>(
         &self,
@@ -151,7 +162,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 
 /// Encode columns as CSV with a header line. Numbers use Rust's shortest round-trip format.
 pub fn table_bytes(name: &str, columns: &[(&str, &[f64])]) -> Result<Vec<u8>, OutputError> {
-    let path = PathBuf::from(name);
     let rows = columns.first().map_or(0, |c| c.1.len());
     for (col, data) in columns {
         if data.len() != rows {
@@ -163,23 +173,157 @@ pub fn table_bytes(name: &str, columns: &[(&str, &[f64])]) -> Result<Vec<u8>, Ou
             });
         }
     }
+    let header: Vec<&str> = columns.iter().map(|c| c.0).collect();
+    encode(name, Some(&header), header.len(), rows, |i, j| {
+        columns[j].1[i]
+    })
+}
+
+/// The same CSV as [`table_bytes`], from rows of `header.len()` numbers.
+pub fn rows_bytes(name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<Vec<u8>, OutputError> {
+    check_row_lengths(name, header, rows)?;
+    encode(name, Some(header), header.len(), rows.len(), |i, j| {
+        rows[i][j]
+    })
+}
+
+fn check_row_lengths(name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<(), OutputError> {
+    match rows.iter().position(|r| r.len() != header.len()) {
+        Some(i) => Err(OutputError::Ragged {
+            file: name.to_string(),
+            column: format!("row {i}"),
+            got: rows[i].len(),
+            expected: header.len(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// CSV records: the header (when given) and `rows` rows of `width` numbers `cell(row, column)`.
+fn encode(
+    name: &str,
+    header: Option<&[&str]>,
+    width: usize,
+    rows: usize,
+    cell: impl Fn(usize, usize) -> f64,
+) -> Result<Vec<u8>, OutputError> {
+    let path = PathBuf::from(name);
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |source| OutputError::Csv {
         path: path.clone(),
         source,
     };
-    w.write_record(columns.iter().map(|c| c.0))
-        .map_err(csv_err)?;
-    let mut rec = Vec::with_capacity(columns.len());
+    if let Some(h) = header {
+        w.write_record(h).map_err(csv_err)?;
+    }
+    let mut rec = Vec::with_capacity(width);
     for i in 0..rows {
         rec.clear();
-        rec.extend(columns.iter().map(|c| c.1[i].to_string()));
+        rec.extend((0..width).map(|j| cell(i, j).to_string()));
         w.write_record(&rec).map_err(csv_err)?;
     }
     w.into_inner().map_err(|e| OutputError::Io {
         path: path.clone(),
         source: e.into_error(),
     })
+}
+
+/// A CSV table written row by row while a run goes on, so that a user can follow it
+/// (`tail -f`): each row is appended and handed to the operating system at once, as one
+/// write. Unlike the other outputs it is not written atomically: a run that stops leaves
+/// the rows written so far. The bytes are those [`rows_bytes`] gives for the same rows.
+#[derive(Debug)]
+pub struct CsvLog {
+    path: PathBuf,
+    header: Vec<String>,
+    file: Option<fs::File>,
+}
+
+impl CsvLog {
+    /// The log `path` with these columns; nothing is written until the first row (a run that
+    /// writes no row leaves no file).
+    pub fn new(path: impl Into<PathBuf>, header: &[&str]) -> Self {
+        Self {
+            path: path.into(),
+            header: header.iter().map(|h| h.to_string()).collect(),
+            file: None,
+        }
+    }
+
+    /// The log of a run continued from a checkpoint that kept `rows`: the file is brought to
+    /// exactly those rows ([`Self::reset`]) and the next row is appended after them.
+    pub fn resume(
+        path: impl Into<PathBuf>,
+        header: &[&str],
+        rows: &[Vec<f64>],
+    ) -> Result<Self, OutputError> {
+        let mut log = Self::new(path, header);
+        log.reset(rows)?;
+        Ok(log)
+    }
+
+    /// A fresh run's log ([`Self::new`]), or a continued run's ([`Self::resume`]).
+    pub fn start(
+        path: impl Into<PathBuf>,
+        header: &[&str],
+        fresh: bool,
+        rows: impl FnOnce() -> Vec<Vec<f64>>,
+    ) -> Result<Self, OutputError> {
+        if fresh {
+            Ok(Self::new(path, header))
+        } else {
+            Self::resume(path, header, &rows())
+        }
+    }
+
+    fn name(&self) -> String {
+        self.path.display().to_string()
+    }
+
+    /// Bring the file to exactly `rows` (a restart: rows a killed run wrote after its
+    /// checkpoint are dropped), atomically; without rows the file is removed.
+    pub fn reset(&mut self, rows: &[Vec<f64>]) -> Result<(), OutputError> {
+        self.file = None;
+        if rows.is_empty() {
+            match fs::remove_file(&self.path) {
+                Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                    return Err(io_err(&self.path)(e));
+                }
+                _ => return Ok(()),
+            }
+        }
+        let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
+        write_atomic(&self.path, &rows_bytes(&self.name(), &header, rows)?)?;
+        self.file = Some(
+            fs::OpenOptions::new()
+                .append(true)
+                .open(&self.path)
+                .map_err(io_err(&self.path))?,
+        );
+        Ok(())
+    }
+
+    /// Append one row (the first creates the file with its header line).
+    pub fn append(&mut self, row: &[f64]) -> Result<(), OutputError> {
+        let name = self.name();
+        if row.len() != self.header.len() {
+            return Err(OutputError::Ragged {
+                file: name,
+                column: "appended row".into(),
+                got: row.len(),
+                expected: self.header.len(),
+            });
+        }
+        let mut bytes = Vec::new();
+        if self.file.is_none() {
+            let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
+            bytes = encode(&name, Some(&header), 0, 0, |_, _| 0.0)?;
+            self.file = Some(fs::File::create(&self.path).map_err(io_err(&self.path))?);
+        }
+        bytes.extend(encode(&name, None, row.len(), 1, |_, j| row[j])?);
+        let f = self.file.as_mut().expect("opened above");
+        f.write_all(&bytes).map_err(io_err(&self.path))
+    }
 }
 
 /// Read a numeric CSV table with a header line; returns the header and the columns.
@@ -236,5 +380,39 @@ mod tests {
             dir.write_table("bad.csv", &[("x", &x), ("y", &y[..2])])
                 .is_err()
         );
+    }
+
+    #[test]
+    fn csv_log_is_readable_after_every_row_and_ends_as_the_table() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("thermo.csv");
+        let header = ["step", "T"];
+        let rows = [
+            vec![10.0, 1.0 / 3.0],
+            vec![20.0, f64::NAN],
+            vec![30.0, 1e-300],
+        ];
+        let mut log = CsvLog::new(&path, &header);
+        assert!(!path.exists(), "nothing is written before the first row");
+        for (k, r) in rows.iter().enumerate() {
+            log.append(r).unwrap();
+            // Every row is on disk as soon as it is appended, with nothing after it.
+            let now = fs::read(&path).unwrap();
+            assert_eq!(now, rows_bytes("thermo.csv", &header, &rows[..=k]).unwrap());
+        }
+        let t: Vec<f64> = rows.iter().map(|r| r[1]).collect();
+        let steps: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+        let table = table_bytes("thermo.csv", &[("step", &steps), ("T", &t)]).unwrap();
+        assert_eq!(fs::read(&path).unwrap(), table);
+        // A restart keeps the checkpoint's rows only, then appends after them.
+        log.reset(&rows[..1]).unwrap();
+        log.append(&rows[1]).unwrap();
+        assert_eq!(
+            fs::read(&path).unwrap(),
+            rows_bytes("thermo.csv", &header, &rows[..2]).unwrap()
+        );
+        log.reset(&[]).unwrap();
+        assert!(!path.exists());
+        assert!(log.append(&[1.0]).is_err());
     }
 }

@@ -118,7 +118,24 @@ impl GsdWriter {
         exact: bool,
         log: &[(&str, f64)],
     ) -> Result<(), GsdError> {
-        self.write_inner(step, sbox, p, exact, None, log)
+        let log = scalars(log);
+        self.write_inner(step, sbox, p, exact, None, &log)
+            .map_err(|message| GsdError::Write {
+                path: self.path.clone(),
+                message,
+            })
+    }
+
+    /// Append one frame whose logged quantities may be arrays (`log/NAME` with one value per
+    /// row, as HOOMD-blue writes e.g. `pressure_tensor`).
+    pub fn write_frame_log(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        log: &[(&str, &[f64])],
+    ) -> Result<(), GsdError> {
+        self.write_inner(step, sbox, p, false, None, log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
@@ -136,7 +153,8 @@ impl GsdWriter {
         list: &ListState,
         log: &[(&str, f64)],
     ) -> Result<(), GsdError> {
-        self.write_inner(step, sbox, p, true, Some(list), log)
+        let log = scalars(log);
+        self.write_inner(step, sbox, p, true, Some(list), &log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
@@ -150,7 +168,7 @@ impl GsdWriter {
         p: &Particles,
         exact: bool,
         list: Option<&ListState>,
-        log: &[(&str, f64)],
+        log: &[(&str, &[f64])],
     ) -> Result<(), String> {
         let f = &mut self.file;
         let e = |e: hoomd_gsd::file_layer::WriteError| chain(&e);
@@ -222,7 +240,8 @@ impl GsdWriter {
                 .map_err(e)?;
         }
         for (name, v) in log {
-            f.write_scalars(&format!("log/{name}"), [*v]).map_err(e)?;
+            f.write_scalars(&format!("log/{name}"), v.iter().copied())
+                .map_err(e)?;
         }
         f.end_frame().map_err(|x| chain(&x))?;
         Ok(())
@@ -235,6 +254,13 @@ impl GsdWriter {
             message: chain(&e),
         })
     }
+}
+
+/// Scalar log quantities as one-value arrays.
+fn scalars<'a>(log: &'a [(&'a str, f64)]) -> Vec<(&'a str, &'a [f64])> {
+    log.iter()
+        .map(|(name, v)| (*name, std::slice::from_ref(v)))
+        .collect()
 }
 
 /// A configuration read from a GSD frame.

@@ -17,6 +17,7 @@ use colloidsim_bcd::{Bcd, BcdState, Boundary};
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};
+use hoomd_gsd::file_layer::{GsdFile, Mode};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::time::Instant;
@@ -75,11 +76,11 @@ impl Method for BcdMethod {
         let r = resolve(src, &sc, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if sc.observe.trajectory.is_some() {
-            let (l, sigma) = (r.config.length, r.config.sigma);
+            let b = RodBox::of(&r.config);
             saved
                 .digest
                 .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, l, sigma)
+                    trim_trajectory(path, frames, &b)
                 })?;
         }
         session(sc, r, Some(saved))
@@ -268,8 +269,10 @@ struct Triggers {
     every: u64,
     /// The particle current: every this many sampled steps.
     current_every: u64,
-    /// GSD frames: every this many steps (of the whole run).
+    /// GSD frames: every this many steps from the first production step.
     trajectory: Option<u64>,
+    /// GSD frames also during equilibration (every `trajectory` steps from step 0).
+    trajectory_equilibration: bool,
     /// Regular checkpoints.
     checkpoint_every: u64,
 }
@@ -283,8 +286,40 @@ impl Triggers {
             every: sc.observe.every.unwrap_or(1),
             current_every: (r.sampled_steps / 200).max(1),
             trajectory: sc.observe.trajectory.as_ref().map(|t| t.every),
+            trajectory_equilibration: sc
+                .observe
+                .trajectory
+                .as_ref()
+                .is_some_and(|t| t.equilibration),
             checkpoint_every: sc.run.checkpoint_every.unwrap_or((total / 10).max(1000)),
         }
+    }
+}
+
+impl Triggers {
+    /// Is a GSD frame due at step `s`? At the first production step (`equilibrate`) and
+    /// every `trajectory` steps after it; during equilibration only when asked, from step 0.
+    fn frame_due(&self, s: u64) -> bool {
+        let Some(e) = self.trajectory else {
+            return false;
+        };
+        if s >= self.equilibrate {
+            (s - self.equilibrate).is_multiple_of(e)
+        } else {
+            self.trajectory_equilibration && s.is_multiple_of(e)
+        }
+    }
+
+    /// The first step after `s` at which a GSD frame is due.
+    fn next_frame_after(&self, s: u64) -> Option<u64> {
+        let e = self.trajectory?;
+        Some(if s >= self.equilibrate {
+            self.equilibrate + next_multiple_after(s - self.equilibrate, e)
+        } else if self.trajectory_equilibration {
+            next_multiple_after(s, e).min(self.equilibrate)
+        } else {
+            self.equilibrate
+        })
     }
 }
 
@@ -301,7 +336,7 @@ struct BcdSession<P: PairForce> {
     obs: Observers,
     frames: u64,
     digest: FrameDigest,
-    gsd: Option<hoomd_gsd::hoomd::HoomdGsdFile>,
+    gsd: Option<GsdFile>,
     triggers: Triggers,
     /// The next sampled step the MSD uses (from [`Msd::next_due`], kept between samples).
     msd_due: u64,
@@ -313,8 +348,8 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         let t = &self.triggers;
         let o = &self.obs;
         let mut next = t.total;
-        if let Some(e) = t.trajectory {
-            next = next.min(next_multiple_after(s, e));
+        if let Some(f) = t.next_frame_after(s) {
+            next = next.min(f);
         }
         if s < t.equilibrate {
             if o.current.is_some() {
@@ -383,16 +418,18 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         {
             c.x0_sum = self.bcd.positions().iter().sum::<f64>() / n;
         }
-        if let (Some(g), Some(e)) = (self.gsd.as_mut(), t.trajectory)
-            && s.is_multiple_of(e)
-        {
-            write_frame(
-                g,
-                self.bcd.steps(),
-                self.bcd.config().length,
-                self.bcd.config().sigma,
-                self.bcd.positions(),
-            )?;
+        if t.frame_due(s) {
+            self.write_frame()?;
+        }
+        Ok(())
+    }
+
+    /// A GSD frame of the current configuration.
+    fn write_frame(&mut self) -> Result<()> {
+        if let Some(g) = self.gsd.as_mut() {
+            let b = RodBox::of(self.bcd.config());
+            let (x, image) = b.place(self.bcd.positions());
+            write_frame(g, self.bcd.steps(), &b, &x, &image)?;
             self.frames += 1;
         }
         Ok(())
@@ -414,6 +451,10 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
 
     fn seed(&self) -> u64 {
         self.r.config.seed as u64
+    }
+
+    fn status(&self) -> String {
+        format!("t = {}", crate::driver::significant(self.bcd.time()))
     }
 
     fn parameters(&self) -> serde_json::Value {
@@ -441,12 +482,15 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
         .contains(&name)
     }
 
-    fn begin(&mut self, out: &OutputDir, _fresh: bool) -> Result<()> {
+    fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         if self.triggers.trajectory.is_some() {
             self.gsd = Some(open_trajectory(
                 out,
                 self.frames > 0 || self.bcd.steps() > 0,
             )?);
+            if fresh && self.triggers.frame_due(0) {
+                self.write_frame()?;
+            }
         }
         Ok(())
     }
@@ -514,62 +558,113 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
     }
 }
 
-fn open_trajectory(out: &OutputDir, append: bool) -> Result<hoomd_gsd::hoomd::HoomdGsdFile> {
+fn open_trajectory(out: &OutputDir, append: bool) -> Result<GsdFile> {
     let path = out.join("trajectory.gsd");
     Ok(if append && path.exists() {
-        colloidsim_md::gsd::quietly(|| hoomd_gsd::hoomd::HoomdGsdFile::open(&path))
-            .map_err(|_| {
-                anyhow::anyhow!(
-                    "{}: damaged GSD file: its index names data past the end of the file (truncated?)",
-                    path.display()
-                )
-            })??
+        colloidsim_md::gsd::open_checked(&path, Mode::Write)?
     } else {
-        hoomd_gsd::hoomd::HoomdGsdFile::create(&path)?
+        create_trajectory(&path)?
     })
 }
 
-/// Name of the unwrapped rod positions in a BCD trajectory frame.
-const X_UNWRAPPED: &str = "particles/x_unwrapped";
+fn create_trajectory(path: &std::path::Path) -> Result<GsdFile> {
+    GsdFile::create(path, &crate::software(), "hoomd", (1, 4))
+        .with_context(|| path.display().to_string())
+}
 
-/// One GSD frame in the HOOMD schema: rods (diameter `sigma`) on the x axis of a 2D box of size
-/// L x L, positions wrapped into [-L/2, L/2); the unwrapped positions `x` go to
-/// `log/particles/x_unwrapped`.
-fn write_frame(
-    g: &mut hoomd_gsd::hoomd::HoomdGsdFile,
-    step: u64,
-    l: f64,
+/// What the frames of a BCD trajectory look like in the HOOMD schema (`docs/bcd.md`).
+#[derive(Debug, Clone, Copy)]
+struct RodBox {
+    /// L.
+    length: f64,
+    /// Hard walls at 0 and L (else a ring).
+    walls: bool,
     sigma: f64,
-    x: &[f64],
-) -> Result<()> {
-    g.append_frame(step)?
-        .configuration_dimensions(hoomd_gsd::hoomd::Dimensions::Two)?
-        .configuration_box([l, l, 0.0, 0.0, 0.0, 0.0])?
-        .particles_position(x.iter().map(|&xi| {
-            let w = (xi + 0.5 * l).rem_euclid(l) - 0.5 * l;
-            [w, 0.0, 0.0].into()
-        }))?
-        .particles_diameter(x.iter().map(|_| sigma))?
-        .log_scalars(X_UNWRAPPED, x.iter().copied())?
-        .end()?;
+}
+
+impl RodBox {
+    fn of(c: &colloidsim_bcd::BcdConfig) -> Self {
+        Self {
+            length: c.length,
+            walls: c.boundary == Boundary::Walls,
+            sigma: c.sigma,
+        }
+    }
+
+    /// Edge of the (periodic) GSD box along x: L on a ring; 2L between walls, so that no rod
+    /// sits within L of a periodic image of another (HOOMD boxes are always periodic).
+    fn edge(&self) -> f64 {
+        if self.walls {
+            2.0 * self.length
+        } else {
+            self.length
+        }
+    }
+
+    /// Positions in the box and their images: on a ring wrapped into [-L/2, L/2) with the
+    /// image counting the turns (x = position + image L); between walls shifted by -L/2,
+    /// image 0.
+    fn place(&self, x: &[f64]) -> (Vec<f32>, Vec<i32>) {
+        let l = self.length;
+        let half = (0.5 * l) as f32;
+        x.iter()
+            .map(|&xi| {
+                if self.walls {
+                    return ((xi - 0.5 * l) as f32, 0);
+                }
+                let turns = ((xi + 0.5 * l) / l).floor();
+                let mut w = (xi - turns * l) as f32;
+                let mut image = turns as i32;
+                if w >= half {
+                    w -= 2.0 * half;
+                    image += 1;
+                } else if w < -half {
+                    w += 2.0 * half;
+                    image -= 1;
+                }
+                (w, image)
+            })
+            .unzip()
+    }
+}
+
+/// One GSD frame in the HOOMD schema: rods of type `rod` (diameter `sigma`) on the x axis of a
+/// 2D box, positions in the box with their images (`RodBox::place`); between walls the walls'
+/// x positions go to `log/bcd/walls`.
+fn write_frame(g: &mut GsdFile, step: u64, b: &RodBox, x: &[f32], image: &[i32]) -> Result<()> {
+    let e = b.edge() as f32;
+    let n = u32::try_from(x.len()).context("too many rods for a GSD frame")?;
+    let mut name = [0u8; 64];
+    name[..3].copy_from_slice(b"rod");
+    g.write_scalars("configuration/step", [step])?;
+    g.write_scalars("configuration/dimensions", [2u8])?;
+    g.write_scalars("configuration/box", [e, e, 0.0, 0.0, 0.0, 0.0])?;
+    g.write_scalars("particles/N", [n])?;
+    g.write_arrays("particles/types", [name])?;
+    g.write_scalars("particles/typeid", x.iter().map(|_| 0u32))?;
+    g.write_scalars("particles/diameter", x.iter().map(|_| b.sigma as f32))?;
+    g.write_arrays("particles/position", x.iter().map(|&w| [w, 0.0, 0.0]))?;
+    g.write_arrays("particles/image", image.iter().map(|&i| [i, 0, 0]))?;
+    if b.walls {
+        let h = 0.5 * b.length;
+        g.write_scalars("log/bcd/walls", [-h, h])?;
+    }
+    g.end_frame()?;
     Ok(())
 }
 
 /// Keep the first `frames` frames of a BCD trajectory (a run killed after its last checkpoint
-/// may have written more), rewritten from their steps and unwrapped positions exactly as
+/// may have written more), rewritten from their steps, positions and images exactly as
 /// [`write_frame`] wrote them, so that the continuation appends where the checkpoint stood.
-fn trim_trajectory(path: &std::path::Path, frames: u64, l: f64, sigma: f64) -> Result<()> {
-    use colloidsim_md::gsd::open_checked;
-    use hoomd_gsd::file_layer::Mode;
-    let file = open_checked(path, Mode::Read)?;
+fn trim_trajectory(path: &std::path::Path, frames: u64, b: &RodBox) -> Result<()> {
+    let file = colloidsim_md::gsd::open_checked(path, Mode::Read)?;
     if file.n_frames() == frames {
         return Ok(());
     }
     let tmp = path.with_extension("gsd.trim");
     let _ = std::fs::remove_file(&tmp);
     {
-        let mut g = hoomd_gsd::hoomd::HoomdGsdFile::create(&tmp)?;
-        let log = format!("log/{X_UNWRAPPED}");
+        let mut g = create_trajectory(&tmp)?;
         for k in 0..frames {
             let e = |e: hoomd_gsd::file_layer::ReadError| {
                 anyhow::anyhow!("{}: frame {k}: {e}", path.display())
@@ -579,8 +674,17 @@ fn trim_trajectory(path: &std::path::Path, frames: u64, l: f64, sigma: f64) -> R
                 .map_err(e)?
                 .next()
                 .with_context(|| format!("{}: frame {k}: no step", path.display()))?;
-            let x: Vec<f64> = file.iter_scalars::<f64>(k, &log).map_err(e)?.collect();
-            write_frame(&mut g, step, l, sigma, &x)?;
+            let x: Vec<f32> = file
+                .iter_arrays::<f32, 3>(k, "particles/position")
+                .map_err(e)?
+                .map(|p| p[0])
+                .collect();
+            let image: Vec<i32> = file
+                .iter_arrays::<i32, 3>(k, "particles/image")
+                .map_err(e)?
+                .map(|i| i[0])
+                .collect();
+            write_frame(&mut g, step, b, &x, &image)?;
         }
         g.sync_all()?;
     }

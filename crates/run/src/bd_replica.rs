@@ -304,7 +304,7 @@ pub(crate) trait Observe<E: External> {
 pub(crate) struct Replicas<E: External> {
     /// Steps per replica.
     pub(crate) steps: u64,
-    replicas: usize,
+    pub(crate) replicas: usize,
     /// Steps between trajectory frames of replica 0 (0: none).
     trajectory_every: u64,
     /// The running replica (or the next one, when `sim` is `None`).
@@ -553,6 +553,21 @@ where
 
     fn seed(&self) -> u64 {
         self.obs.seed()
+    }
+
+    fn status(&self) -> String {
+        let r = &self.run;
+        let mut s = match &r.sim {
+            Some((sim, _)) => format!("t = {}", crate::driver::significant(sim.time())),
+            None => String::new(),
+        };
+        if r.replicas > 1 {
+            if !s.is_empty() {
+                s.push_str(", ");
+            }
+            s.push_str(&format!("replica {}/{}", r.rep + 1, r.replicas));
+        }
+        s
     }
 
     fn parameters(&self) -> serde_json::Value {

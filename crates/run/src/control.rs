@@ -14,6 +14,9 @@ pub trait Progress: Send + Sync {
     fn begin(&self, _label: &str, _total: u64, _done: u64) {}
     /// `done` units are done.
     fn advance(&self, _done: u64) {}
+    /// Where the run stands, in one line (step, simulated time, temperature where the method
+    /// has one, throughput); the CLI shows it beside its progress bar.
+    fn status(&self, _text: &str) {}
     /// A message for the user (e.g. why the run goes on after Ctrl-C).
     fn message(&self, _text: &str) {}
     /// A warning (the CLI prints `warning: ...`); every warning is also in the run's report.

@@ -14,7 +14,7 @@ use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
     pair_distribution, structure_factor_windowed,
 };
-use colloidsim_core::output::OutputDir;
+use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
 use colloidsim_md::dpd::{Dpd, Thermo};
 use colloidsim_md::gsd::GsdWriter;
@@ -96,7 +96,7 @@ impl Method for DpdMethod {
         ck.obs
             .digest
             .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &["time_tau"], true)
+                trim_trajectory(path, frames, &FRAME_LOGS, true)
             })?;
         // Restoring builds the lists the interrupted run built at this step: count them once.
         let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
@@ -146,6 +146,10 @@ struct DpdSession {
     solvent_tags: Vec<u32>,
     radii: Vec<f64>,
     gsd: Option<GsdWriter>,
+    /// `thermo.csv`, appended row by row as the run goes.
+    thermo_log: Option<CsvLog>,
+    /// The thermodynamics of the step just taken when a GSD frame is due at it.
+    frame_thermo: Option<Thermo>,
     monitor: TemperatureMonitor,
 }
 
@@ -182,6 +186,8 @@ impl DpdSession {
             solvent_tags,
             radii,
             gsd: None,
+            thermo_log: None,
+            frame_thermo: None,
             monitor,
         })
     }
@@ -239,13 +245,34 @@ impl DpdSession {
             && step.is_multiple_of(o.trajectory_every)
         {
             let snap = sim.snapshot();
-            w.write_frame(
-                step,
-                &sim.sbox,
-                &snap,
-                false,
-                &[("time_tau", step as f64 * dt / tau)],
-            )?;
+            // What HOOMD-blue's ThermodynamicQuantities compute logs, under its names
+            // (FRAME_LOGS). The virial parts exist only for a step taken with them: at step 0
+            // the pressure and the potential energy are NaN (every frame carries every
+            // quantity, as the gsd package expects).
+            let th = self.frame_thermo.take().filter(|t| t.step == step);
+            let kinetic = th
+                .as_ref()
+                .map_or_else(|| sim.thermo().temperature, |t| t.temperature);
+            let (pressure, tensor, potential) = match &th {
+                Some(t) => {
+                    let q = &t.pressure;
+                    (
+                        (q[0] + q[1] + q[2]) / 3.0,
+                        [q[0], q[3], q[4], q[1], q[5], q[2]],
+                        t.potential_energy,
+                    )
+                }
+                None => (f64::NAN, [f64::NAN; 6], f64::NAN),
+            };
+            let values: [&[f64]; 5] = [
+                &[step as f64 * dt / tau],
+                &[kinetic],
+                &[pressure],
+                &tensor,
+                &[potential],
+            ];
+            let log: Vec<(&str, &[f64])> = FRAME_LOGS.iter().copied().zip(values).collect();
+            w.write_frame_log(step, &sim.sbox, &snap, &log)?;
             obs.frames += 1;
         }
         Ok(())
@@ -257,15 +284,27 @@ impl DpdSession {
         let o = &self.s.observe;
         let dt = self.s.params.dt;
         let next = self.sim.step + 1;
-        let result = if o.thermo_every > 0 && next.is_multiple_of(o.thermo_every) {
-            self.sim
-                .advance_with_thermo()
-                .map(|th| self.obs.thermo.push((next as f64 * dt, th)))
+        let thermo_due = o.thermo_every > 0 && next.is_multiple_of(o.thermo_every);
+        let frame_due = o.trajectory_every > 0 && next.is_multiple_of(o.trajectory_every);
+        let result = if thermo_due || frame_due {
+            self.sim.advance_with_thermo().map(|th| {
+                if thermo_due {
+                    self.obs.thermo.push((next as f64 * dt, th.clone()));
+                }
+                if frame_due {
+                    self.frame_thermo = Some(th);
+                }
+            })
         } else {
             self.sim.advance()
         };
         if let Err(e) = result {
             return Ok(Some(e.to_string()));
+        }
+        if let Some(log) = self.thermo_log.as_mut()
+            && let Some((time, th)) = self.obs.thermo.last().filter(|(_, th)| th.step == next)
+        {
+            log.append(&thermo_row(*time, th, self.sim.sbox.volume(), self.s.tau))?;
         }
         let check_every = if o.thermo_every > 0 {
             o.thermo_every
@@ -307,6 +346,15 @@ impl Session for DpdSession {
         self.s.params.seed as u64
     }
 
+    fn status(&self) -> String {
+        let t = self.sim.step as f64 * self.s.params.dt / self.s.tau;
+        let mut s = format!("t = {} tau_D", crate::driver::significant(t));
+        if let Some((_, th)) = self.obs.thermo.last() {
+            s.push_str(&format!(", T = {:.4}", th.temperature));
+        }
+        s
+    }
+
     fn parameters(&self) -> serde_json::Value {
         describe(&self.s)
     }
@@ -331,6 +379,15 @@ impl Session for DpdSession {
     }
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        if self.s.observe.thermo_every > 0 {
+            let (vol, tau) = (self.sim.sbox.volume(), self.s.tau);
+            self.thermo_log = Some(CsvLog::start(
+                out.join("thermo.csv"),
+                &THERMO_COLUMNS,
+                fresh,
+                || thermo_rows_of(&self.obs, vol, tau),
+            )?);
+        }
         if self.s.observe.trajectory_every > 0 {
             let traj = out.join("trajectory.gsd");
             // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
@@ -657,6 +714,86 @@ fn msd(frames: &[Vec<[f64; 3]>]) -> Vec<f64> {
         .collect()
 }
 
+/// The log quantities of every GSD frame: the time in tau_D, then HOOMD-blue's names for the
+/// kinetic temperature, the pressure, the pressure tensor (xx, xy, xz, yy, yz, zz) and the
+/// potential energy.
+const FRAME_LOGS: [&str; 5] = [
+    "time_tau",
+    "md/compute/ThermodynamicQuantities/kinetic_temperature",
+    "md/compute/ThermodynamicQuantities/pressure",
+    "md/compute/ThermodynamicQuantities/pressure_tensor",
+    "md/compute/ThermodynamicQuantities/potential_energy",
+];
+
+/// The columns of `thermo.csv`.
+const THERMO_COLUMNS: [&str; 24] = [
+    "step",
+    "time",
+    "time_tau",
+    "T",
+    "T_solvent",
+    "T_colloid",
+    "p",
+    "pxx",
+    "pyy",
+    "pzz",
+    "pxy",
+    "pxz",
+    "pyz",
+    "p_kinetic",
+    "p_conservative",
+    "p_dissipative",
+    "p_random",
+    "p_contact",
+    "p_morse",
+    "p_lubrication",
+    "energy_conservative",
+    "energy_contact",
+    "energy_morse",
+    "energy_potential",
+];
+
+/// One row of `thermo.csv`: the thermodynamics `t` at simulated time `time`, in a box of
+/// volume `vol`, with the colloid diffusion time `tau`.
+fn thermo_row(time: f64, t: &Thermo, vol: f64, tau: f64) -> Vec<f64> {
+    let tr = |v: &[f64; 6]| (v[0] + v[1] + v[2]) / (3.0 * vol);
+    let v = &t.virial;
+    let p = &t.pressure;
+    vec![
+        t.step as f64,
+        time,
+        time / tau,
+        t.temperature,
+        t.temperature_by_type[0],
+        t.temperature_by_type.get(1).copied().unwrap_or(f64::NAN),
+        (p[0] + p[1] + p[2]) / 3.0,
+        p[0],
+        p[1],
+        p[2],
+        p[3],
+        p[4],
+        p[5],
+        (t.kinetic[0] + t.kinetic[1] + t.kinetic[2]) / 3.0,
+        tr(&v.conservative),
+        tr(&v.dissipative),
+        tr(&v.random),
+        tr(&v.contact),
+        tr(&v.morse),
+        tr(&v.lubrication),
+        v.energy_conservative,
+        v.energy_contact,
+        v.energy_morse,
+        t.potential_energy,
+    ]
+}
+
+fn thermo_rows_of(obs: &Observed, vol: f64, tau: f64) -> Vec<Vec<f64>> {
+    obs.thermo
+        .iter()
+        .map(|(time, t)| thermo_row(*time, t, vol, tau))
+        .collect()
+}
+
 /// The tables and pictures of what has been observed so far; returns their names and the
 /// long-time colloid diffusion coefficient.
 fn write_outputs(
@@ -670,59 +807,10 @@ fn write_outputs(
     let tau = s.tau;
     let mut files = Vec::new();
     let vol = sim.sbox.volume();
-    // thermo.csv
+    // thermo.csv (also written row by row as the run goes: `DpdSession::step`)
     if !obs.thermo.is_empty() {
-        let rows = &obs.thermo;
-        let col = |f: &dyn Fn(&Thermo) -> f64| rows.iter().map(|(_, t)| f(t)).collect::<Vec<_>>();
-        let tr = |v: &[f64; 6]| (v[0] + v[1] + v[2]) / (3.0 * vol);
-        let step = col(&|t| t.step as f64);
-        let time: Vec<f64> = rows.iter().map(|(t, _)| *t).collect();
-        let time_tau: Vec<f64> = time.iter().map(|t| t / tau).collect();
-        let tt = col(&|t| t.temperature);
-        let ts = col(&|t| t.temperature_by_type[0]);
-        let tc = col(&|t| t.temperature_by_type.get(1).copied().unwrap_or(f64::NAN));
-        let pk: Vec<Vec<f64>> = (0..6).map(|k| col(&|t| t.pressure[k])).collect();
-        let p = col(&|t| (t.pressure[0] + t.pressure[1] + t.pressure[2]) / 3.0);
-        let pkin = col(&|t| (t.kinetic[0] + t.kinetic[1] + t.kinetic[2]) / 3.0);
-        let pc = col(&|t| tr(&t.virial.conservative));
-        let pd = col(&|t| tr(&t.virial.dissipative));
-        let pr = col(&|t| tr(&t.virial.random));
-        let pcon = col(&|t| tr(&t.virial.contact));
-        let pm = col(&|t| tr(&t.virial.morse));
-        let pl = col(&|t| tr(&t.virial.lubrication));
-        let ec = col(&|t| t.virial.energy_conservative);
-        let econ = col(&|t| t.virial.energy_contact);
-        let em = col(&|t| t.virial.energy_morse);
-        let ep = col(&|t| t.potential_energy);
-        out.write_table(
-            "thermo.csv",
-            &[
-                ("step", &step),
-                ("time", &time),
-                ("time_tau", &time_tau),
-                ("T", &tt),
-                ("T_solvent", &ts),
-                ("T_colloid", &tc),
-                ("p", &p),
-                ("pxx", &pk[0]),
-                ("pyy", &pk[1]),
-                ("pzz", &pk[2]),
-                ("pxy", &pk[3]),
-                ("pxz", &pk[4]),
-                ("pyz", &pk[5]),
-                ("p_kinetic", &pkin),
-                ("p_conservative", &pc),
-                ("p_dissipative", &pd),
-                ("p_random", &pr),
-                ("p_contact", &pcon),
-                ("p_morse", &pm),
-                ("p_lubrication", &pl),
-                ("energy_conservative", &ec),
-                ("energy_contact", &econ),
-                ("energy_morse", &em),
-                ("energy_potential", &ep),
-            ],
-        )?;
+        let rows = thermo_rows_of(obs, vol, tau);
+        out.write_rows("thermo.csv", &THERMO_COLUMNS, &rows)?;
         files.push("thermo.csv".to_string());
     }
     // msd.csv

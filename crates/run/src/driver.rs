@@ -236,6 +236,32 @@ fn save(s: &mut dyn Session, out: &OutputDir, env: &mut Envelope, wall: f64) -> 
     Ok(())
 }
 
+/// The progress line: step and total, the session's own status (simulated time,
+/// temperature) and the throughput since this process took the run up at `pos0`.
+fn status_line(s: &dyn Session, pos0: u64, seconds: f64) -> String {
+    let pos = s.position();
+    let mut line = format!("step {pos}/{}", s.total());
+    let own = s.status();
+    if !own.is_empty() {
+        line.push_str(", ");
+        line.push_str(&own);
+    }
+    if seconds > 0.0 {
+        let rate = (pos - pos0) as f64 / seconds;
+        line.push_str(&format!(", {} steps/s", significant(rate)));
+    }
+    line
+}
+
+/// `x` to three significant digits, without an exponent below a million.
+pub(crate) fn significant(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 || x.abs() >= 1e6 || x.abs() < 1e-3 {
+        return format!("{x:.3e}");
+    }
+    let digits = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
+}
+
 /// Work units per chunk are adapted so that a chunk takes about this long: interrupts are
 /// seen within it and the progress moves. Outputs never depend on the chunks.
 const CHUNK_SECONDS: f64 = 0.2;
@@ -251,6 +277,7 @@ fn drive(
     let hooks = Hooks::from_env();
     ctl.progress().begin(&s.label(), total, s.position());
     let start = Instant::now();
+    let pos0 = s.position();
     let wall0 = env.wall_seconds;
     let wall = || wall0 + start.elapsed().as_secs_f64();
     // The steps run on a worker of the thread pool, so that each step's parallel passes start
@@ -321,6 +348,8 @@ fn drive(
                 save(&mut *s, &out, &mut env, wall())?;
             }
             ctl.progress().advance(s.position());
+            ctl.progress()
+                .status(&status_line(&*s, pos0, start.elapsed().as_secs_f64()));
         }
     });
     ctl.progress().end();

@@ -639,16 +639,19 @@ pub(crate) fn trim_trajectory(
             }
             let values = logs
                 .iter()
-                .map(|name| -> Result<(&str, f64)> {
-                    let v = file
+                .map(|name| -> Result<(&str, Vec<f64>)> {
+                    let v: Vec<f64> = file
                         .iter_scalars::<f64>(k, &format!("log/{name}"))
                         .map_err(e)?
-                        .next()
-                        .with_context(|| format!("{}: frame {k}: no log/{name}", path.display()))?;
+                        .collect();
+                    if v.is_empty() {
+                        bail!("{}: frame {k}: no log/{name}", path.display());
+                    }
                     Ok((*name, v))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            w.write_frame(f.step, &f.sbox, &f.particles, false, &values)?;
+            let values: Vec<(&str, &[f64])> = values.iter().map(|(n, v)| (*n, &v[..])).collect();
+            w.write_frame_log(f.step, &f.sbox, &f.particles, &values)?;
         }
         w.sync()?;
     }

@@ -588,7 +588,14 @@ pub static BCD: &[Spec] = &[
         "steps",
         "required",
         Integer(1, COUNT),
-        "steps between frames",
+        "steps between frames, the first at the first production step",
+    ),
+    key(
+        "observe.trajectory.equilibration",
+        "-",
+        "false",
+        Bool,
+        "also write frames during equilibration (every `every` steps from step 0)",
     ),
 ];
 
@@ -1954,6 +1961,48 @@ pub fn text(keys: &[Key]) -> String {
             "{:<w$}  {}\n{:<w$}  unit: {}; default: {}; allowed: {}\n",
             k.path, k.doc, "", k.unit, k.default, k.range
         ));
+    }
+    s
+}
+
+/// A scenario's keys with their values and units, as `colloidsim check` prints them: every
+/// key the scenario sets, then beside them the defaults it leaves (marked `(default)`), in the
+/// order of the key table; keys inside an optional table the scenario leaves out, and
+/// required keys it lacks, are not listed. Tables themselves are listed by their keys.
+pub fn values(table: &toml::Table, keys: &[Key]) -> String {
+    let lookup = |path: &str| -> Option<&toml::Value> {
+        let mut parts = path.split('.');
+        let mut v = table.get(parts.next()?)?;
+        for p in parts {
+            v = v.as_table()?.get(p)?;
+        }
+        Some(v)
+    };
+    let is_table = |k: &Key| k.range == Allowed::Table.describe();
+    let tables: Vec<&Key> = keys.iter().filter(|k| is_table(k)).collect();
+    let mut rows = Vec::new();
+    for k in keys.iter().filter(|k| !is_table(k)) {
+        let unit = if k.unit == "-" { "" } else { &k.unit };
+        match lookup(&k.path) {
+            Some(v) => rows.push((k.path.as_str(), v.to_string(), unit, "")),
+            None => {
+                let inside_absent = tables.iter().any(|t| {
+                    k.path.starts_with(&format!("{}.", t.path)) && lookup(&t.path).is_none()
+                });
+                if !inside_absent && k.default != "required" {
+                    rows.push((k.path.as_str(), k.default.clone(), unit, "(default)"));
+                }
+            }
+        }
+    }
+    let wp = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
+    let wv = rows.iter().map(|r| r.1.len()).max().unwrap_or(0).min(40);
+    let wu = rows.iter().map(|r| r.2.len()).max().unwrap_or(0);
+    let mut s = String::new();
+    for (path, value, unit, mark) in rows {
+        let line = format!("{path:<wp$} = {value:<wv$}  {unit:<wu$}  {mark}");
+        s.push_str(line.trim_end());
+        s.push('\n');
     }
     s
 }

@@ -85,6 +85,12 @@ pub trait Session: Send {
     fn position(&self) -> u64;
     /// The run's seed.
     fn seed(&self) -> u64;
+    /// Where the run stands beyond its position, for the progress line: the simulated time
+    /// with its unit, and the temperature where the method has one (e.g. `t = 0.12 tau_D,
+    /// T = 1.003`).
+    fn status(&self) -> String {
+        String::new()
+    }
     /// The resolved parameters (JSON; `parameters` of `summary.json`).
     fn parameters(&self) -> serde_json::Value;
     /// Warnings about the scenario, printed before the run.

@@ -18,7 +18,7 @@ use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
-use colloidsim_core::output::OutputDir;
+use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region};
 use colloidsim_md::mpcd::drying::{SolventProfile, remove_excess};
@@ -326,6 +326,7 @@ impl Method for MpcdBulk {
             colloids,
             acc,
             gsd: None,
+            thermo_log: None,
             com_scratch: Vec::new(),
         }))
     }
@@ -361,6 +362,7 @@ impl Method for MpcdBulk {
             colloids,
             acc: saved.acc,
             gsd: None,
+            thermo_log: None,
             com_scratch: Vec::new(),
         }))
     }
@@ -457,6 +459,8 @@ struct BulkSession {
     colloids: Option<DiscreteColloids>,
     acc: BulkAccum,
     gsd: Option<GsdWriter>,
+    /// `thermo.csv`, appended row by row as the run goes.
+    thermo_log: Option<CsvLog>,
     /// The colloids' centre-of-mass velocities of the current collision (reused).
     com_scratch: Vec<[f64; 3]>,
 }
@@ -499,6 +503,9 @@ impl BulkSession {
                     .as_ref()
                     .map_or(f64::NAN, |c| c.com_temperature()),
             });
+            if let (Some(log), Some(row)) = (self.thermo_log.as_mut(), self.acc.rows.last()) {
+                log.append(&row.values(p.solvent.srd.tau))?;
+            }
             if c > p.equilibrate {
                 self.acc.temperature.push(temperature);
                 let slabs = self.acc.flow_profile.len();
@@ -541,6 +548,15 @@ impl Session for BulkSession {
         self.p.seed as u64
     }
 
+    fn status(&self) -> String {
+        let t = self.srd.step() as f64 * self.p.solvent.srd.tau;
+        let mut s = format!("t = {}", crate::driver::significant(t));
+        if let Some(r) = self.acc.rows.last() {
+            s.push_str(&format!(", T = {:.4}", r.temperature));
+        }
+        s
+    }
+
     fn parameters(&self) -> serde_json::Value {
         serde_json::to_value(&self.p).unwrap_or_default()
     }
@@ -558,6 +574,12 @@ impl Session for BulkSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+        self.thermo_log = Some(CsvLog::start(
+            out.join("thermo.csv"),
+            &BULK_THERMO,
+            fresh,
+            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
+        )?);
         if fresh {
             self.record(0)?;
         }
@@ -646,7 +668,7 @@ impl Session for BulkSession {
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
-        write_bulk_thermo(out, &self.p, &self.acc.rows)?;
+        write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
 
@@ -660,7 +682,7 @@ impl Session for BulkSession {
         let p = &self.p;
         let mut files = Vec::new();
         let mut warnings = Vec::new();
-        write_bulk_thermo(out, p, &self.acc.rows)?;
+        write_thermo(out, p.solvent.srd.tau, &self.acc.rows)?;
         files.push("thermo.csv".into());
         let collisions = self.srd.step();
         let sampled = collisions.saturating_sub(p.equilibrate);
@@ -834,22 +856,49 @@ impl Session for BulkSession {
     }
 }
 
-fn write_bulk_thermo(out: &OutputDir, p: &BulkRun, rows: &[BulkRow]) -> Result<()> {
-    let col = |f: &dyn Fn(&BulkRow) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
-    let tau = p.solvent.srd.tau;
-    out.write_table(
-        "thermo.csv",
-        &[
-            ("collision", &col(&|r| r.collision as f64)),
-            ("time", &col(&|r| r.collision as f64 * tau)),
-            ("temperature", &col(&|r| r.temperature)),
-            ("flow_amplitude", &col(&|r| r.flow)),
-            ("px", &col(&|r| r.momentum[0])),
-            ("py", &col(&|r| r.momentum[1])),
-            ("pz", &col(&|r| r.momentum[2])),
-            ("colloid_temperature", &col(&|r| r.colloid_temperature)),
-        ],
-    )?;
+/// The columns of a bulk run's `thermo.csv`.
+const BULK_THERMO: [&str; 8] = [
+    "collision",
+    "time",
+    "temperature",
+    "flow_amplitude",
+    "px",
+    "py",
+    "pz",
+    "colloid_temperature",
+];
+
+impl ThermoRow for BulkRow {
+    const COLUMNS: &'static [&'static str] = &BULK_THERMO;
+    fn values(&self, tau: f64) -> Vec<f64> {
+        vec![
+            self.collision as f64,
+            self.collision as f64 * tau,
+            self.temperature,
+            self.flow,
+            self.momentum[0],
+            self.momentum[1],
+            self.momentum[2],
+            self.colloid_temperature,
+        ]
+    }
+}
+
+/// A row of `thermo.csv` (bulk or droplet).
+trait ThermoRow {
+    /// The columns.
+    const COLUMNS: &'static [&'static str];
+    /// The row, with the collision time `tau`.
+    fn values(&self, tau: f64) -> Vec<f64>;
+}
+
+fn thermo_rows<R: ThermoRow>(tau: f64, rows: &[R]) -> Vec<Vec<f64>> {
+    rows.iter().map(|r| r.values(tau)).collect()
+}
+
+/// `thermo.csv` complete (it is also appended row by row as the run goes).
+fn write_thermo<R: ThermoRow>(out: &OutputDir, tau: f64, rows: &[R]) -> Result<()> {
+    out.write_rows("thermo.csv", R::COLUMNS, &thermo_rows(tau, rows))?;
     Ok(())
 }
 
@@ -940,6 +989,7 @@ impl Method for DropletMpcd {
             colloids,
             acc,
             gsd: None,
+            thermo_log: None,
             scratch: Vec::new(),
         }))
     }
@@ -975,6 +1025,7 @@ impl Method for DropletMpcd {
             colloids,
             acc: saved.acc,
             gsd: None,
+            thermo_log: None,
             scratch: Vec::new(),
         }))
     }
@@ -1097,6 +1148,8 @@ struct DropletSession {
     colloids: Option<DiscreteColloids>,
     acc: DropletAccum,
     gsd: Option<GsdWriter>,
+    /// `thermo.csv`, appended row by row as the run goes.
+    thermo_log: Option<CsvLog>,
     scratch: Vec<u32>,
 }
 
@@ -1181,6 +1234,9 @@ impl DropletSession {
                     .as_ref()
                     .map_or(f64::NAN, |c| c.com_temperature()),
             });
+            if let (Some(log), Some(row)) = (self.thermo_log.as_mut(), self.acc.rows.last()) {
+                log.append(&row.values(p.solvent.srd.tau))?;
+            }
         }
         if let Some(w) = self.gsd.as_mut()
             && c.is_multiple_of(p.trajectory_every)
@@ -1214,6 +1270,15 @@ impl Session for DropletSession {
         self.p.seed as u64
     }
 
+    fn status(&self) -> String {
+        let t = self.srd.step() as f64 * self.p.solvent.srd.tau;
+        let mut s = format!("t = {}", crate::driver::significant(t));
+        if let Some(r) = self.acc.rows.last() {
+            s.push_str(&format!(", R = {:.4}, T = {:.4}", r.radius, r.temperature));
+        }
+        s
+    }
+
     fn parameters(&self) -> serde_json::Value {
         serde_json::to_value(&self.p).unwrap_or_default()
     }
@@ -1236,6 +1301,12 @@ impl Session for DropletSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+        self.thermo_log = Some(CsvLog::start(
+            out.join("thermo.csv"),
+            &DROPLET_THERMO,
+            fresh,
+            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
+        )?);
         if fresh && let Some(why) = self.record(0, 0)? {
             bail!("{why}");
         }
@@ -1304,7 +1375,7 @@ impl Session for DropletSession {
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
-        write_droplet_thermo(out, &self.p, &self.acc.rows)?;
+        write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
 
@@ -1320,7 +1391,7 @@ impl Session for DropletSession {
         let n0 = p.solvent.number_density;
         let mut files = Vec::new();
         let mut warnings = Vec::new();
-        write_droplet_thermo(out, p, &self.acc.rows)?;
+        write_thermo(out, p.solvent.srd.tau, &self.acc.rows)?;
         files.push("thermo.csv".into());
         let collisions = self.srd.step();
         let boundary = match p.boundary {
@@ -1559,24 +1630,34 @@ impl Session for DropletSession {
 /// One solvent profile drawn: label, r/R, n/n0, <v_r>.
 type Curve = (String, Vec<f64>, Vec<f64>, Vec<f64>);
 
-fn write_droplet_thermo(out: &OutputDir, p: &DropletRun, rows: &[DropletRow]) -> Result<()> {
-    let col = |f: &dyn Fn(&DropletRow) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
-    let tau = p.solvent.srd.tau;
-    out.write_table(
-        "thermo.csv",
-        &[
-            ("collision", &col(&|r| r.collision as f64)),
-            ("time", &col(&|r| r.collision as f64 * tau)),
-            ("radius", &col(&|r| r.radius)),
-            ("solvent", &col(&|r| r.solvent as f64)),
-            ("expected", &col(&|r| r.expected as f64)),
-            ("removed", &col(&|r| r.removed as f64)),
-            ("bounced", &col(&|r| r.bounced as f64)),
-            ("temperature", &col(&|r| r.temperature)),
-            ("colloid_temperature", &col(&|r| r.colloid_temperature)),
-        ],
-    )?;
-    Ok(())
+/// The columns of a drying run's `thermo.csv`.
+const DROPLET_THERMO: [&str; 9] = [
+    "collision",
+    "time",
+    "radius",
+    "solvent",
+    "expected",
+    "removed",
+    "bounced",
+    "temperature",
+    "colloid_temperature",
+];
+
+impl ThermoRow for DropletRow {
+    const COLUMNS: &'static [&'static str] = &DROPLET_THERMO;
+    fn values(&self, tau: f64) -> Vec<f64> {
+        vec![
+            self.collision as f64,
+            self.collision as f64 * tau,
+            self.radius,
+            self.solvent as f64,
+            self.expected as f64,
+            self.removed as f64,
+            self.bounced as f64,
+            self.temperature,
+            self.colloid_temperature,
+        ]
+    }
 }
 
 // ------------------------------------------------------------------------------------------

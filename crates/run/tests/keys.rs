@@ -40,7 +40,7 @@ clusters = false
 density = { bins = 10 }
 contact_density = { bins = 10, window = 0.1 }
 msd = { points = 40, max_lag = 0.005 }
-trajectory = { every = 10 }
+trajectory = { every = 10, equilibration = false }
 "#;
 
 const DROPLET: &str = r#"
