@@ -18,7 +18,9 @@ pub mod equilibrium;
 mod functional;
 mod grid;
 
-pub use ddft::{DdftFrame, DdftProblem, DdftSummary, InitialProfile, ddft};
+pub use ddft::{
+    DdftFrame, DdftProblem, DdftSummary, InitialProfile, ddft, ideal_washboard_current,
+};
 pub use equilibrium::{BinnedProfile, Equilibrium, EquilibriumSummary, equilibrium};
 
 use colloidsim_core::param::{self, ParamError};

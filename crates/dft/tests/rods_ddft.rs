@@ -5,7 +5,7 @@
 mod rods {
     use colloidsim_dft::rods::{
         BetaPotential, DdftProblem, Domain, InitialProfile, RodInteraction, RodsError, RodsProblem,
-        ddft, equilibrium,
+        ddft, equilibrium, ideal_washboard_current,
     };
     use std::f64::consts::TAU;
 
@@ -129,26 +129,6 @@ mod rods {
         assert!(d > 1e-3, "{d}");
     }
 
-    /// Exact stationary current of ideal Brownian particles in the tilted potential
-    /// `U(x) - f x` with period 1 (e.g. Risken, *The Fokker–Planck Equation*, Sec. 11.3):
-    /// `J = rho L D (1 - e^{-beta f L}) / int_0^L dx e^{-beta V(x)} int_x^{x+L} e^{beta V(y)} dy`.
-    fn ideal_current(u0: f64, f: f64, rho: f64) -> f64 {
-        let n = 2000;
-        let h = 1.0 / n as f64;
-        let v = |x: f64| 0.5 * u0 * (TAU * x).cos() - f * x;
-        let mut denom = 0.0;
-        for i in 0..n {
-            let x = (i as f64 + 0.5) * h;
-            let mut inner = 0.0;
-            for j in 0..n {
-                let y = x + (j as f64 + 0.5) * h;
-                inner += (v(y) - v(x)).exp();
-            }
-            denom += inner * h * h;
-        }
-        rho * (1.0 - (-f).exp()) / denom
-    }
-
     #[test]
     fn driven_steady_state_current_tends_to_the_ideal_limit() {
         // Tilted washboard, short rods: the current differs from the exact ideal-gas result at
@@ -156,7 +136,7 @@ mod rods {
         // sigma halves (ratio in [1.7, 2.3]); the state must be stationary and N conserved
         // (flux form: rounding only, below 1e-14 per step).
         let (u0, f, rho) = (2.0, 3.0, 0.5);
-        let exact = ideal_current(u0, f, rho);
+        let exact = ideal_washboard_current(u0, f, rho, 1.0);
         let mut prev: Option<f64> = None;
         for &sigma in &[0.01, 0.005] {
             let rods = RodsProblem::new(sigma, rho, Domain::Periodic { period: 1.0 })

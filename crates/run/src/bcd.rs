@@ -967,7 +967,8 @@ fn default_dx(r: &Resolved) -> f64 {
     (r.config.sigma / 200.0).min(r.period / 2000.0)
 }
 
-fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
+/// The rods, potential, domain and grid of a scenario for the exact theory and the DDFT.
+fn rods_problem(r: &Resolved, dx: Option<f64>) -> RodsProblem {
     let c = &r.config;
     let n = r.initial.len() as f64;
     let domain = match c.boundary {
@@ -978,12 +979,223 @@ fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
         Some(s) => RodInteraction::Sticky { gamma: s.gamma },
         None => RodInteraction::Hard,
     };
-    let dx = dx.unwrap_or(default_dx(r));
-    let problem = RodsProblem::new(c.sigma, n / c.length, domain)
-        .with_dx(dx)
+    RodsProblem::new(c.sigma, n / c.length, domain)
+        .with_dx(dx.unwrap_or(default_dx(r)))
         .with_potential(BetaPotential::from_field(&r.field, c.kt))
-        .with_interaction(interaction);
-    Ok(rods::equilibrium(&problem)?)
+        .with_interaction(interaction)
+}
+
+/// Relative change of the density (max-norm over `max rho`) and of the mean current between
+/// two DDFT states one relaxation time apart below which the state counts as steady.
+const STEADY_TOLERANCE: f64 = 1e-8;
+
+/// Longest DDFT run for a steady state, in relaxation times `period^2 / D`.
+const STEADY_MAX_TIMES: usize = 400;
+
+/// The steady state of a driven scenario by 1D DDFT (`rods::ddft`, adiabatic approximation):
+/// from the Boltzmann profile, one relaxation time `period^2 / D` at a time, until the density
+/// and the mean current change by less than [`STEADY_TOLERANCE`] over one. Returns the grid,
+/// the density, the mean current, the time run and the last changes; an error when no steady
+/// state is reached within [`STEADY_MAX_TIMES`] relaxation times.
+fn driven_steady_state(r: &Resolved, dx: Option<f64>) -> Result<DrivenState> {
+    let c = &r.config;
+    let diffusion = c.mobility * c.kt;
+    let tau = r.period * r.period / diffusion;
+    let mut problem = rods::DdftProblem {
+        rods: rods_problem(r, dx),
+        diffusion,
+        beta_drive: r.field.drive / c.kt,
+        dt: 1e-3 * tau,
+        step_tolerance: Some(1e-6),
+        output_times: vec![tau],
+        initial: rods::InitialProfile::Boltzmann,
+    };
+    let (mut x, mut rho, mut current) = (Vec::new(), Vec::new(), f64::NAN);
+    let mut steps = 0;
+    for k in 1..=STEADY_MAX_TIMES {
+        let (mut new_rho, mut new_current) = (Vec::new(), f64::NAN);
+        let s = rods::ddft(&problem, |f| {
+            x = f.x.to_vec();
+            new_rho = f.rho.to_vec();
+            new_current = f.mean_current;
+        })?;
+        steps += s.steps;
+        if !new_rho.iter().all(|v| v.is_finite()) || !new_current.is_finite() {
+            bail!("the DDFT went non-finite after {k} relaxation times ({steps} steps)");
+        }
+        if k > 1 {
+            let top = new_rho.iter().fold(0.0f64, |m, &v| m.max(v.abs()));
+            let drho = new_rho
+                .iter()
+                .zip(&rho)
+                .fold(0.0f64, |m, (a, b): (&f64, &f64)| m.max((a - b).abs()))
+                / top;
+            let dj = (new_current - current).abs() / new_current.abs().max(f64::MIN_POSITIVE);
+            if drho < STEADY_TOLERANCE && dj < STEADY_TOLERANCE {
+                return Ok(DrivenState {
+                    x,
+                    rho: new_rho,
+                    current: new_current,
+                    time: k as f64 * tau,
+                    relaxation_time: tau,
+                    steps,
+                    density_change: drho,
+                    current_change: dj,
+                });
+            }
+        }
+        rho = new_rho;
+        current = new_current;
+        problem.initial = rods::InitialProfile::Given(rho.clone());
+    }
+    bail!(
+        "the DDFT reached no steady state in {STEADY_MAX_TIMES} relaxation times (period^2 / D = {tau}): the density still changes by more than {STEADY_TOLERANCE} (relative) per relaxation time"
+    )
+}
+
+/// A DDFT steady state ([`driven_steady_state`]).
+struct DrivenState {
+    x: Vec<f64>,
+    rho: Vec<f64>,
+    current: f64,
+    time: f64,
+    relaxation_time: f64,
+    steps: usize,
+    density_change: f64,
+    current_change: f64,
+}
+
+/// Mean of the periodic piecewise-linear interpolant of `(x, y)` (grid spacing uniform, period
+/// `period`) over `bins` equal bins of `[0, period)`, from 16 points per bin.
+fn bin_means(x: &[f64], y: &[f64], period: f64, bins: usize) -> (Vec<f64>, Vec<f64>) {
+    let m = y.len();
+    let h = period / m as f64;
+    let x0 = x.first().copied().unwrap_or(0.0);
+    let at = |t: f64| {
+        let u = ((t - x0) / h).rem_euclid(m as f64);
+        let i = (u.floor() as usize).min(m - 1);
+        let w = u - i as f64;
+        (1.0 - w) * y[i] + w * y[(i + 1) % m]
+    };
+    let width = period / bins as f64;
+    let centres: Vec<f64> = (0..bins).map(|k| (k as f64 + 0.5) * width).collect();
+    let means = (0..bins)
+        .map(|k| {
+            (0..16)
+                .map(|j| at((k as f64 + (j as f64 + 0.5) / 16.0) * width))
+                .sum::<f64>()
+                / 16.0
+        })
+        .collect();
+    (centres, means)
+}
+
+/// The output folder of `colloidsim theory` (`--out`, or the scenario's name and `-theory`).
+fn theory_outdir(src: &Source, opts: &TheoryOptions) -> Result<OutputDir> {
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
+    Ok(OutputDir::create(&out, opts.force)?)
+}
+
+/// Write `summary.json` last and report `what` with the folder.
+fn theory_report(
+    outdir: &OutputDir,
+    summary: serde_json::Value,
+    files: Vec<String>,
+    warnings: Vec<String>,
+    what: String,
+) -> Result<Report> {
+    outdir.write_json("summary.json", &summary)?;
+    Ok(Report {
+        out: outdir.path().to_path_buf(),
+        message: format!("{what}; outputs in {}", outdir.path().display()),
+        summary,
+        files,
+        warnings,
+    })
+}
+
+/// `colloidsim theory` of a driven scenario: the DDFT steady state on the simulation's bins.
+fn driven_theory(
+    src: &Source,
+    sc: &Scenario,
+    r: &Resolved,
+    opts: &TheoryOptions,
+) -> Result<Report> {
+    let c = &r.config;
+    if c.boundary != Boundary::Periodic {
+        bail!(
+            "potential.drive = {} between walls: the steady state is the equilibrium in the tilted potential, which the exact theory does not take yet; drive a ring (system.boundary = \"periodic\")",
+            r.field.drive
+        );
+    }
+    let start = Instant::now();
+    let st = driven_steady_state(r, opts.dx)?;
+    let wall = start.elapsed().as_secs_f64();
+    let outdir = theory_outdir(src, opts)?;
+    let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
+    let (centres, means) = bin_means(&st.x, &st.rho, r.period, bins);
+    outdir.write_table("density.csv", &[("x", &centres), ("rho", &means)])?;
+    outdir.write_table("profile_grid.csv", &[("x", &st.x), ("rho", &st.rho)])?;
+    let mut files: Vec<String> = vec!["density.csv".into(), "profile_grid.csv".into()];
+    let mut warnings = Vec::new();
+    picture(
+        line_plot(
+            &outdir.join("density.png"),
+            &format!(
+                "DDFT steady state, sigma = {}, drive f = {} kT/length",
+                c.sigma,
+                r.field.drive / c.kt
+            ),
+            "x (length)",
+            "rho(x) (1/length)",
+            &[Series {
+                label: "1D DDFT steady state",
+                x: &st.x,
+                y: &st.rho,
+                points: false,
+            }],
+            Scale::Linear,
+        ),
+        "density.png",
+        &mut files,
+        &mut warnings,
+    );
+    let mean_density = r.initial.len() as f64 / c.length;
+    let summary = json!({
+        "software": crate::software(),
+        "method": "1D DDFT steady state of a driven system (exact Percus / Baxter functional, adiabatic approximation: not exact out of equilibrium)",
+        "parameters": resolved_json(sc, r),
+        "dx": st.x.get(1).map_or(f64::NAN, |x1| x1 - st.x[0]),
+        "grid_points": st.x.len(),
+        "mean_current": st.current,
+        "mean_velocity": st.current / mean_density,
+        "time": st.time,
+        "relaxation_time": st.relaxation_time,
+        "steps": st.steps,
+        "density_change_last_relaxation_time": st.density_change,
+        "current_change_last_relaxation_time": st.current_change,
+        "steady_tolerance": STEADY_TOLERANCE,
+        "converged": true,
+        "wall_seconds": wall,
+        "files": files,
+        "warnings": warnings,
+    });
+    let what = format!(
+        "DDFT steady state: mean current {:.6e} (mean velocity {:.6e}) after {:.3} relaxation times, {} grid points, in {:.3} s",
+        st.current,
+        st.current / mean_density,
+        st.time / st.relaxation_time,
+        st.x.len(),
+        wall,
+    );
+    theory_report(&outdir, summary, files, warnings, what)
+}
+
+fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
+    Ok(rods::equilibrium(&rods_problem(r, dx))?)
 }
 
 /// `colloidsim theory`: the exact equilibrium of a BCD scenario on the simulation's bins.
@@ -992,12 +1204,6 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
     let r = resolve(src, &sc, None)?;
     let dx = opts.dx;
     let c = &r.config;
-    if r.field.drive != 0.0 {
-        bail!(
-            "potential.drive = {}: a driven system has no equilibrium; the exact theory needs drive = 0",
-            r.field.drive
-        );
-    }
     if c.kt <= 0.0 {
         bail!("system.kT = 0: the exact theory is an equilibrium at kT > 0");
     }
@@ -1009,14 +1215,14 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
     if let Some(dx) = dx {
         colloidsim_core::param::positive("--dx", dx)?;
     }
+    if r.field.drive != 0.0 {
+        // No equilibrium: the steady state by DDFT.
+        return driven_theory(src, &sc, &r, opts);
+    }
     let start = Instant::now();
     let eq = solve_theory(&r, dx)?;
     let wall = start.elapsed().as_secs_f64();
-    let out = opts
-        .out
-        .clone()
-        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
-    let outdir = OutputDir::create(&out, opts.force)?;
+    let outdir = theory_outdir(src, opts)?;
     let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
     let b = eq.bin_average(bins, r.period)?;
     let mut files = vec!["density.csv"];
@@ -1081,22 +1287,14 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
             "files": files,
             "warnings": warnings,
     });
-    outdir.write_json("summary.json", &summary)?;
-    let message = format!(
-        "exact equilibrium: {} grid points, residual {:.2e} after {} iterations in {:.3} s; outputs in {}",
+    let what = format!(
+        "exact equilibrium: {} grid points, residual {:.2e} after {} iterations in {:.3} s",
         eq.x.len(),
         eq.residual,
         eq.iterations,
         wall,
-        outdir.path().display()
     );
-    Ok(Report {
-        out: outdir.path().to_path_buf(),
-        summary,
-        files,
-        warnings,
-        message,
-    })
+    theory_report(&outdir, summary, files, warnings, what)
 }
 
 #[cfg(test)]
