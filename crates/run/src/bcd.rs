@@ -6,7 +6,7 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, picture};
+use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
@@ -787,8 +787,8 @@ where
                     "density profile, N = {n}, L = {}, sigma = {}",
                     c.length, c.sigma
                 ),
-                "x",
-                "rho(x)",
+                "x (length)",
+                "rho(x) (1/length)",
                 &series,
                 Scale::Linear,
             ),
@@ -850,13 +850,16 @@ where
                     points: false,
                 });
             }
+            // Error bars on the BCD points (msd.csv's err); the theory curves have none.
+            let errors = [Some(err.as_slice()), None, None];
             picture(
-                line_plot(
+                line_plot_with_errors(
                     &out.join("msd.png"),
-                    "mean-square displacement",
-                    "t",
-                    "MSD",
+                    "mean-square displacement (bars: standard error)",
+                    "t (time)",
+                    "MSD (length^2)",
                     &series,
+                    &errors[..series.len()],
                     Scale::LogLog,
                 ),
                 "msd.png",
@@ -1257,8 +1260,8 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
         line_plot(
             &outdir.join("density.png"),
             &format!("exact equilibrium density, sigma = {}", c.sigma),
-            "x",
-            "rho(x)",
+            "x (length)",
+            "rho(x) (1/length)",
             &[Series {
                 label: "exact theory",
                 x: &eq.x,
