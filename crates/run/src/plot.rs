@@ -110,7 +110,7 @@ fn draw_line_plot(
         return Err(anyhow!("no finite data to draw"));
     }
     if yr.0 >= yr.1 {
-        yr = (yr.0 - 1.0, yr.1 + 1.0);
+        yr = flat_range(yr.0);
     }
     let root = BitMapBackend::new(path, (800, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
@@ -296,5 +296,29 @@ pub fn picture(
     match result {
         Ok(()) => files.push(name.to_string()),
         Err(e) => warnings.push(format!("{name} not drawn: {e:#}")),
+    }
+}
+
+/// The y range of a flat curve at `y`: 10 % of its value either side (a flat density keeps a
+/// positive axis), or [-1, 1] around zero.
+fn flat_range(y: f64) -> (f64, f64) {
+    let m = y.abs();
+    if m > 0.0 {
+        (y - 0.1 * m, y + 0.1 * m)
+    } else {
+        (-1.0, 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::flat_range;
+
+    #[test]
+    fn a_flat_positive_curve_keeps_a_positive_axis() {
+        assert_eq!(flat_range(0.5), (0.45, 0.55));
+        assert!(flat_range(1e-6).0 > 0.0);
+        assert_eq!(flat_range(0.0), (-1.0, 1.0));
+        assert!(flat_range(-2.0).1 < 0.0);
     }
 }
