@@ -6,7 +6,9 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
+use crate::plot::{
+    Labels, Scale, Series, line_plot, line_plot_with_errors, linear_picture, picture,
+};
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
@@ -801,6 +803,12 @@ where
         let (x, rho2) = cd.profile();
         out.write_table("contact_density.csv", &[("x", &x), ("rho2", &rho2)])?;
         files.push("contact_density.csv".into());
+        let mut series = vec![Series {
+            label: "BCD (window estimator)",
+            x: &x,
+            y: &rho2,
+            points: true,
+        }];
         if let Some((t, hard)) = &theory
             && *hard
         {
@@ -809,7 +817,27 @@ where
                 &[("x", &t.centres), ("rho2", &t.contact_density)],
             )?;
             files.push("contact_density_theory.csv".into());
+            series.push(Series {
+                label: "exact theory",
+                x: &t.centres,
+                y: &t.contact_density,
+                points: false,
+            });
         }
+        let title = format!("two-particle density at contact, sigma = {}", c.sigma);
+        let labels = Labels {
+            title: &title,
+            x: "x (length)",
+            y: "rho2(x, x + sigma) (1/length^2)",
+        };
+        linear_picture(
+            out.path(),
+            "contact_density.png",
+            &labels,
+            &series,
+            &mut files,
+            &mut warnings,
+        );
     }
     if let Some(m) = &obs.msd {
         let rows = m.rows();
@@ -889,6 +917,29 @@ where
         )?;
         files.push("current.csv".into());
         mean_velocity = v.last().copied();
+        let title = format!(
+            "particle current (running mean since sampling began), drive f = {} energy/length",
+            r.field.drive
+        );
+        let labels = Labels {
+            title: &title,
+            x: "t (time)",
+            y: "current rho v (1/time)",
+        };
+        let series = [Series {
+            label: "BCD",
+            x: &cur.t,
+            y: &j,
+            points: false,
+        }];
+        linear_picture(
+            out.path(),
+            "current.png",
+            &labels,
+            &series,
+            &mut files,
+            &mut warnings,
+        );
     }
     if let Some(cl) = &obs.clusters {
         let (s, p) = cl.rows();

@@ -299,6 +299,36 @@ pub fn picture(
     }
 }
 
+/// The labels of a picture: title, x axis, y axis (each with its unit).
+pub struct Labels<'a> {
+    /// Title.
+    pub title: &'a str,
+    /// x axis.
+    pub x: &'a str,
+    /// y axis.
+    pub y: &'a str,
+}
+
+/// [`line_plot`] of `series` into `dir/name` as a [`picture`] of the run's outputs.
+pub fn linear_picture(
+    dir: &std::path::Path,
+    name: &str,
+    labels: &Labels,
+    series: &[Series],
+    files: &mut Vec<String>,
+    warnings: &mut Vec<String>,
+) {
+    let drawn = line_plot(
+        &dir.join(name),
+        labels.title,
+        labels.x,
+        labels.y,
+        series,
+        Scale::Linear,
+    );
+    picture(drawn, name, files, warnings);
+}
+
 /// The y range of a flat curve at `y`: 10 % of its value either side (a flat density keeps a
 /// positive axis), or [-1, 1] around zero.
 fn flat_range(y: f64) -> (f64, f64) {
