@@ -1192,16 +1192,7 @@ impl RealSpace<'_> {
                 let xi = pos[self.row_particle[r] as usize];
                 let mut k = off[r] - base;
                 for &j in &cand[off[r]..off[r + 1]] {
-                    let xj = pos[j as usize];
-                    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-                    for c in d.iter_mut() {
-                        if *c >= 0.5 * l {
-                            *c -= l;
-                        } else if *c < -0.5 * l {
-                            *c += l;
-                        }
-                    }
-                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    let (d, r2) = nearest_image(xi, pos[j as usize], l);
                     if r2 < rc2 {
                         // One division per pair (the tensors are most of `set_positions`).
                         let inv_r = 1.0 / r2.sqrt();
@@ -1282,6 +1273,21 @@ struct Cells<'a> {
     rc2: f64,
 }
 
+/// `x_i - x_j` to the nearest periodic image in a cube of edge `l` (positions in
+/// `[-L/2, L/2)`: one shift at most per axis) and its square length.
+#[inline(always)]
+fn nearest_image(xi: [f64; 3], xj: [f64; 3], l: f64) -> ([f64; 3], f64) {
+    let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+    for c in d.iter_mut() {
+        if *c >= 0.5 * l {
+            *c -= l;
+        } else if *c < -0.5 * l {
+            *c += l;
+        }
+    }
+    (d, d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+}
+
 impl Cells<'_> {
     /// Call `f(j, x_i − x_j, r^2)` (nearest image) for the particles `j != i` within the
     /// cut-off, in a fixed order: the 27 cells around i's (all particles when there are fewer
@@ -1291,17 +1297,7 @@ impl Cells<'_> {
         let (nc, l, rc2, pos) = (self.nc, self.l, self.rc2, self.pos);
         let xi = pos[i];
         let mut pair = |j: u32| {
-            let xj = pos[j as usize];
-            let mut d = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-            for c in d.iter_mut() {
-                // Positions lie in [-L/2, L/2): one shift at most.
-                if *c >= 0.5 * l {
-                    *c -= l;
-                } else if *c < -0.5 * l {
-                    *c += l;
-                }
-            }
-            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let (d, r2) = nearest_image(xi, pos[j as usize], l);
             if r2 < rc2 && j as usize != i {
                 f(j, d, r2);
             }
