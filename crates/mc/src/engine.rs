@@ -419,7 +419,15 @@ pub struct HardSphereMc {
     slot_of: Vec<u32>,
     local: [Vec<f64>; 3],
     corner: [Vec<f64>; 3],
+    /// Scratch of the parallel binning: per part and cell, the part's count and its running
+    /// count; per cell, the running count of the cell's filler.
+    part_count: Vec<u32>,
+    part_seen: Vec<u32>,
+    cell_seen: Vec<u32>,
 }
+
+/// Fewest particles per part of the parallel binning.
+const REBIN_PART_MIN: usize = 1024;
 
 /// Smallest cell side, in diameters (see [`HardSphereMc::new`]).
 const CELL_MIN: f64 = 2.0;
@@ -493,6 +501,9 @@ impl HardSphereMc {
             slot_of: vec![0; n],
             local: std::array::from_fn(|_| vec![0.0; n]),
             corner: std::array::from_fn(|_| vec![0.0; n]),
+            part_count: Vec::new(),
+            part_seen: Vec::new(),
+            cell_seen: vec![0; nc_cells],
         };
         mc.delta = mc.delta.min(mc.max_delta());
         let max = params.geometry.confinement(d);
@@ -636,12 +647,33 @@ impl HardSphereMc {
         }
     }
 
-    /// Bin every particle into the grid shifted by `offset` (particle order), growing the cell
-    /// capacity when a cell overflows.
+    /// Bin every particle into the grid shifted by `offset`, growing the cell capacity when a
+    /// cell overflows. A parallel counting sort that keeps particle order within each cell, so
+    /// the slots do not depend on the number of threads:
+    ///
+    /// 1. parts of the particle range (one per thread), in parallel: each particle's cell, its
+    ///    position relative to the cell's corner and the corner; the part's count per cell;
+    /// 2. serially, per cell: the total over parts (`count`), the capacity check;
+    /// 3. in parallel, two jobs side by side: each part writes its particles' slot indices
+    ///    (the cell's first slot, plus the counts of the earlier parts in that cell, plus its own
+    ///    running count), while each range of cells fills its own slots by walking all particles
+    ///    in order and taking those in its cells (then pads to a whole vector with [`EMPTY`]).
     fn rebin(&mut self, offset: [f64; 3]) {
         self.offset = offset;
         let (l, s, nc) = (self.edge, self.side, self.nc);
         let pass = self.pass();
+        let n = self.len();
+        let cells = self.count.len();
+        if n == 0 {
+            self.count.fill(0);
+            return;
+        }
+        let parts = rayon::current_num_threads().min(n.div_ceil(REBIN_PART_MIN));
+        let part_len = n.div_ceil(parts.max(1));
+        // Exactly as many parts as chunks of `part_len`.
+        let parts = n.div_ceil(part_len);
+        self.part_count.resize(parts * cells, 0);
+        self.part_seen.resize(parts * cells, 0);
         let locate = |x: f64, a: usize| -> (usize, f64, f64) {
             let mut t = x + 0.5 * l - offset[a];
             if t < 0.0 {
@@ -651,56 +683,104 @@ impl HardSphereMc {
             let u = (t - j as f64 * s).clamp(0.0, s);
             (j, u, -0.5 * l + offset[a] + j as f64 * s)
         };
-        // In parallel: each particle's cell, its position relative to the cell's corner, and
-        // the corner (for the write-back).
+        // 1. Per part: cells, local positions, corners, counts per cell.
         let [px, py, pz] = &self.pos;
         let [lx, ly, lz] = &mut self.local;
         let [cx, cy, cz] = &mut self.corner;
         self.cell_of
-            .par_iter_mut()
+            .par_chunks_mut(part_len)
+            .zip(self.part_count.par_chunks_mut(cells))
             .zip(
-                lx.par_iter_mut()
-                    .zip(ly.par_iter_mut())
-                    .zip(lz.par_iter_mut()),
+                lx.par_chunks_mut(part_len)
+                    .zip(ly.par_chunks_mut(part_len))
+                    .zip(lz.par_chunks_mut(part_len)),
             )
             .zip(
-                cx.par_iter_mut()
-                    .zip(cy.par_iter_mut())
-                    .zip(cz.par_iter_mut()),
+                cx.par_chunks_mut(part_len)
+                    .zip(cy.par_chunks_mut(part_len))
+                    .zip(cz.par_chunks_mut(part_len)),
             )
             .enumerate()
-            .with_min_len(1024)
-            .for_each(|(i, ((cell, ((ux, uy), uz)), ((ox, oy), oz)))| {
-                let (jx, x, cxx) = locate(px[i], 0);
-                let (jy, y, cyy) = locate(py[i], 1);
-                let (jz, z, czz) = locate(pz[i], 2);
-                *cell = pass.id([jx, jy, jz]) as u32;
-                (*ux, *uy, *uz) = (x, y, z);
-                (*ox, *oy, *oz) = (cxx, cyy, czz);
+            .for_each(|(k, (((cell, counts), ((ux, uy), uz)), ((ox, oy), oz)))| {
+                counts.fill(0);
+                for j in 0..cell.len() {
+                    let i = k * part_len + j;
+                    let (jx, x, cxx) = locate(px[i], 0);
+                    let (jy, y, cyy) = locate(py[i], 1);
+                    let (jz, z, czz) = locate(pz[i], 2);
+                    let id = pass.id([jx, jy, jz]);
+                    cell[j] = id as u32;
+                    counts[id] += 1;
+                    (ux[j], uy[j], uz[j]) = (x, y, z);
+                    (ox[j], oy[j], oz[j]) = (cxx, cyy, czz);
+                }
             });
-        // Serially, in particle order: the slots.
-        'retry: loop {
-            self.count.fill(0);
-            for a in &mut self.slot {
-                a.fill(EMPTY);
-            }
-            for i in 0..self.len() {
-                let id = self.cell_of[i] as usize;
-                let c = self.count[id] as usize;
-                if c == self.cap {
-                    self.grow();
-                    continue 'retry;
-                }
-                let k = id * self.cap + c;
-                for a in 0..3 {
-                    self.slot[a][k] = self.local[a][i];
-                }
-                self.tag[k] = i as u32;
-                self.slot_of[i] = k as u32;
-                self.count[id] += 1;
-            }
-            return;
+        // 2. Totals per cell and the capacity.
+        let mut fullest = 0;
+        for (c, total) in self.count.iter_mut().enumerate() {
+            *total = (0..parts).map(|k| self.part_count[k * cells + c]).sum();
+            fullest = fullest.max(*total as usize);
         }
+        while fullest > self.cap {
+            self.grow();
+        }
+        let part_count = &self.part_count[..parts * cells];
+        // 3. Slot indices per part, and the slots per range of cells.
+        let cap = self.cap;
+        let cell_of = &self.cell_of;
+        let local = &self.local;
+        let range = cells.div_ceil(parts);
+        let [sx, sy, sz] = &mut self.slot;
+        let (tag, cell_seen) = (&mut self.tag, &mut self.cell_seen);
+        rayon::join(
+            || {
+                self.slot_of
+                    .par_chunks_mut(part_len)
+                    .zip(self.part_seen.par_chunks_mut(cells))
+                    .enumerate()
+                    .for_each(|(k, (slot_of, seen))| {
+                        seen.fill(0);
+                        for (j, out) in slot_of.iter_mut().enumerate() {
+                            let id = cell_of[k * part_len + j] as usize;
+                            let before: u32 = (0..k).map(|q| part_count[q * cells + id]).sum();
+                            *out = (id * cap) as u32 + before + seen[id];
+                            seen[id] += 1;
+                        }
+                    })
+            },
+            || {
+                sx.par_chunks_mut(range * cap)
+                    .zip(sy.par_chunks_mut(range * cap))
+                    .zip(sz.par_chunks_mut(range * cap))
+                    .zip(tag.par_chunks_mut(range * cap))
+                    .zip(cell_seen.par_chunks_mut(range))
+                    .enumerate()
+                    .for_each(|(k, ((((x, y), z), tag), seen))| {
+                        let first = k * range;
+                        seen.fill(0);
+                        for (i, &id) in cell_of.iter().enumerate() {
+                            let c = (id as usize).wrapping_sub(first);
+                            if c >= seen.len() {
+                                continue;
+                            }
+                            let slot = c * cap + seen[c] as usize;
+                            seen[c] += 1;
+                            x[slot] = local[0][i];
+                            y[slot] = local[1][i];
+                            z[slot] = local[2][i];
+                            tag[slot] = i as u32;
+                        }
+                        // Pad each cell to a whole vector of eight (the scans read that far).
+                        for (c, &m) in seen.iter().enumerate() {
+                            let pad =
+                                c * cap + m as usize..c * cap + (m as usize).next_multiple_of(8);
+                            x[pad.clone()].fill(EMPTY);
+                            y[pad.clone()].fill(EMPTY);
+                            z[pad].fill(EMPTY);
+                        }
+                    })
+            },
+        );
     }
 
     /// Eight more slots per cell (a multiple of eight keeps the scans in whole vectors).
@@ -716,18 +796,21 @@ impl HardSphereMc {
     /// Write the slots back into the particle-order positions (in parallel).
     fn scatter(&mut self) {
         let l = self.edge;
-        let slot_of = &self.slot_of;
-        for a in 0..3 {
-            let (slot, corner) = (&self.slot[a], &self.corner[a]);
-            self.pos[a]
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(1024)
-                .for_each(|(i, x)| {
-                    let v = corner[i] + slot[slot_of[i] as usize];
-                    *x = if v >= 0.5 * l { v - l } else { v };
-                });
-        }
+        let (slot_of, slot, corner) = (&self.slot_of, &self.slot, &self.corner);
+        let [px, py, pz] = &mut self.pos;
+        px.par_iter_mut()
+            .zip(py.par_iter_mut())
+            .zip(pz.par_iter_mut())
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, ((x, y), z))| {
+                let k = slot_of[i] as usize;
+                let back = |a: usize| {
+                    let v = corner[a][i] + slot[a][k];
+                    if v >= 0.5 * l { v - l } else { v }
+                };
+                (*x, *y, *z) = (back(0), back(1), back(2));
+            });
     }
 
     /// One sweep: N trial moves (see the module documentation).
