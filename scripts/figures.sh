@@ -8,6 +8,7 @@ set -euo pipefail
 out=${1:?usage: bash scripts/figures.sh OUT [BINARY]}
 bin=${2:-target/release/colloidsim}
 here=$(cd "$(dirname "$0")/.." && pwd)
+[ -x "$bin" ] && bin=$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")
 [ -x "$bin" ] || { echo "no colloidsim binary at $bin: cargo build --release -p colloidsim-cli" >&2; exit 2; }
 [ -e "$out" ] && { echo "$out exists; choose a new folder (nothing is overwritten)" >&2; exit 2; }
 mkdir -p "$out"
@@ -22,6 +23,17 @@ fig() {
     printf '%s\tcolloidsim %s\t%d\n' "$name" "$*" $((SECONDS - start)) >> "$out/times.tsv"
 }
 
+# A droplet run and its DDFT, which draws the run's profiles beside its own when the run's
+# folder (the scenario's stem) is in the working directory: both go into OUT/<name>/.
+run_and_theory() {
+    local name=$1 scenario=$2
+    local start=$SECONDS
+    echo "== $name: colloidsim run and theory $scenario" >&2
+    mkdir -p "$out/$name"
+    (cd "$out/$name" && "$bin" run "$scenario" --quiet && "$bin" theory "$scenario" >/dev/null)
+    printf '%s\tcolloidsim run + theory %s\t%d\n' "$name" "$scenario" $((SECONDS - start)) >> "$out/times.tsv"
+}
+
 ex=$here/examples
 # Hard-rods paper.
 fig hard-rods-fig3 run "$ex/bcd/hard-rods-cosine.toml"
@@ -31,8 +43,7 @@ fig hard-rods-fig7-gamma0 run "$ex/bcd/single-file.toml"
 fig hard-rods-fig7-gamma1 run "$ex/bcd/sticky-single-file.toml"
 # Drying-droplet paper.
 fig droplet-fig2a-phi0.2 run "$ex/droplet/static-equilibrium.toml"
-fig droplet-fig2b-bd run "$ex/droplet/drying-bd.toml"
-fig droplet-fig2b-ddft theory "$ex/droplet/drying-bd.toml"
+run_and_theory droplet-fig2b "$ex/droplet/drying-bd.toml"
 fig droplet-figS4 run "$ex/droplet/drying-mpcd-solvent.toml"
 fig droplet-fig7 run "$ex/mc/droplet-static.toml"
 
