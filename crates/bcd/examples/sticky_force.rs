@@ -9,14 +9,6 @@ use plotters::prelude::*;
 
 static FONT: &[u8] = include_bytes!("../../run/assets/DejaVuSans.ttf");
 
-const COLOURS: [RGBColor; 5] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-];
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let output = std::env::args()
         .nth(1)
@@ -46,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .draw()?;
     for (k, &p) in orders.iter().enumerate() {
         let st = sticky(p, 0.05)?;
-        let colour = COLOURS[k % COLOURS.len()];
+        let colour = Palette99::pick(k).to_rgba();
         let curve = (0..=600).map(|i| {
             let r = sigma + 0.06 * i as f64 / 600.0;
             (r, st.force(r))
@@ -76,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .y_desc("max |f_p| (kT / length)")
         .draw()?;
     for (k, &eps) in [0.025, 0.05, 0.1].iter().enumerate() {
-        let colour = COLOURS[k % COLOURS.len()];
+        let colour = Palette99::pick(k).to_rgba();
         let curve: Vec<(f64, f64)> = (0..=680)
             .map(|i| {
                 let p = 1.2 + i as f64 / 100.0;
