@@ -40,6 +40,11 @@ pub struct DensityProfile {
     counts: Vec<u64>,
     samples: u64,
     folds: f64,
+    /// Samples per block of the block standard errors ([`DensityProfile::with_blocks`]; 0:
+    /// no blocks).
+    block: u64,
+    /// The cumulative counts at the end of each full block.
+    marks: Vec<Vec<u64>>,
     /// Scratch: the configuration in contiguous parts, one per worker, each binned (a
     /// vectorised pass) and counted on its own; integer counts, so the sum does not depend on
     /// the number of parts.
@@ -78,8 +83,56 @@ impl DensityProfile {
             counts: vec![0; bins],
             samples: 0,
             folds: length / period,
+            block: 0,
+            marks: Vec::new(),
             parts: Vec::new(),
         }
+    }
+
+    /// Keep the counts of every `samples / blocks` samples (at least one) apart, for the block
+    /// standard errors of [`DensityProfile::errors`]; `samples` is the number of samples the
+    /// run will take. The blocks hold integer counts, so the errors do not depend on the number
+    /// of workers either.
+    pub fn with_blocks(mut self, samples: u64, blocks: u64) -> Self {
+        self.block = (samples / blocks.max(1)).max(1);
+        self
+    }
+
+    /// Close a block when its last sample has just been taken.
+    fn close_block(&mut self) {
+        if self.block > 0 && self.samples.is_multiple_of(self.block) {
+            self.marks.push(self.counts.clone());
+        }
+    }
+
+    /// Standard error of each bin's density from the spread of the full blocks' profiles
+    /// (`s / sqrt(B)` with `s` the sample standard deviation of the `B` block means); NaN
+    /// where fewer than two blocks are full. The blocks are consecutive stretches of the run,
+    /// so they are independent when a block is longer than the density's correlation time.
+    pub fn errors(&self) -> Vec<f64> {
+        let m = self.counts.len();
+        let b = self.marks.len();
+        if b < 2 {
+            return vec![f64::NAN; m];
+        }
+        let dx = self.period / m as f64;
+        let norm = 1.0 / (self.block as f64 * dx * self.folds);
+        (0..m)
+            .map(|a| {
+                let block = |k: usize| {
+                    let before = if k == 0 { 0 } else { self.marks[k - 1][a] };
+                    (self.marks[k][a] - before) as f64 * norm
+                };
+                let mean = (0..b).map(block).sum::<f64>() / b as f64;
+                let ss = (0..b).map(|k| (block(k) - mean).powi(2)).sum::<f64>();
+                (ss / (b * (b - 1)) as f64).sqrt()
+            })
+            .collect()
+    }
+
+    /// Full blocks of [`DensityProfile::errors`] so far.
+    pub fn blocks(&self) -> usize {
+        self.marks.len()
     }
 
     fn binning(&self) -> Binning {
@@ -123,6 +176,7 @@ impl DensityProfile {
             }
         }
         self.samples += 1;
+        self.close_block();
     }
 
     /// Add one configuration.
@@ -226,6 +280,18 @@ impl ContactDensity {
             }
         }
         self.inner.samples += 1;
+        self.inner.close_block();
+    }
+
+    /// Block standard errors as [`DensityProfile::with_blocks`] for the density.
+    pub fn with_blocks(mut self, samples: u64, blocks: u64) -> Self {
+        self.inner = self.inner.with_blocks(samples, blocks);
+        self
+    }
+
+    /// Standard error of each bin's contact density ([`DensityProfile::errors`]).
+    pub fn errors(&self) -> Vec<f64> {
+        self.inner.errors().into_iter().map(|e| e / self.window).collect()
     }
 
     /// Bin centres and contact densities.
