@@ -291,7 +291,11 @@ impl ContactDensity {
 
     /// Standard error of each bin's contact density ([`DensityProfile::errors`]).
     pub fn errors(&self) -> Vec<f64> {
-        self.inner.errors().into_iter().map(|e| e / self.window).collect()
+        self.inner
+            .errors()
+            .into_iter()
+            .map(|e| e / self.window)
+            .collect()
     }
 
     /// Bin centres and contact densities.

@@ -392,6 +392,27 @@ fn theory_writes_converged_profiles_on_the_simulation_bins() {
         serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap();
     assert!(s["mean_current"].as_f64().unwrap() > 0.0);
     assert_eq!(s["converged"], true);
+    // A driven run draws that steady state beside its density, on the same bins.
+    let dr = tmp.path().join("dr");
+    let o = run(&[
+        "run",
+        driven.to_str().unwrap(),
+        "--out",
+        dr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(dr.join("density.png").exists());
+    let ddft = columns(&dr.join("density_ddft.csv"));
+    let theory = columns(&d.join("density.csv"));
+    assert_eq!(ddft[1].len(), 50);
+    for (a, b) in ddft[1].iter().zip(&theory[1]) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} vs {b}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dr.join("summary.json")).unwrap()).unwrap();
+    assert!(s["ddft"]["mean_current"].as_f64().unwrap() > 0.0, "{s}");
+    assert!(!dr.join("density_theory.csv").exists());
 }
 
 /// Columns of a CSV file (after its header) as numbers.
@@ -419,7 +440,10 @@ fn density_errors_cover_the_exact_profile_and_shrink_with_the_run() {
             .replace("time = 5.0", &format!("time = {time}"))
             .replace("checkpoint_every = 1000", "")
             .replace("particles = 10", "particles = 20")
-            .replace("density = { bins = 50 }", "density = { bins = 20 }\nevery = 10")
+            .replace(
+                "density = { bins = 50 }",
+                "density = { bins = 20 }\nevery = 10",
+            )
     };
     let mut mean_err = Vec::new();
     for time in [50.0, 200.0] {
@@ -440,13 +464,24 @@ fn density_errors_cover_the_exact_profile_and_shrink_with_the_run() {
         let within = (0..rho.len())
             .filter(|&a| (rho[a] - exact[a]).abs() < 4.0 * err[a])
             .count();
-        assert!(within >= rho.len() - 1, "{within} of {} bins within 4 SE", rho.len());
+        assert!(
+            within >= rho.len() - 1,
+            "{within} of {} bins within 4 SE",
+            rho.len()
+        );
         mean_err.push(err.iter().sum::<f64>() / err.len() as f64);
         let c = columns(&out.join("contact_density.csv"));
-        assert!(c[2].iter().all(|e| e.is_finite() && *e >= 0.0), "{:?}", c[2]);
+        assert!(
+            c[2].iter().all(|e| e.is_finite() && *e >= 0.0),
+            "{:?}",
+            c[2]
+        );
     }
     let ratio = mean_err[0] / mean_err[1];
-    assert!((1.4..2.8).contains(&ratio), "errors shrank by {ratio} over a 4 times longer run");
+    assert!(
+        (1.4..2.8).contains(&ratio),
+        "errors shrank by {ratio} over a 4 times longer run"
+    );
 }
 
 /// `colloidsim check` prints the scenario's keys with their values and units, defaults

@@ -791,7 +791,7 @@ where
         out.write_table("density.csv", &[("x", &x), ("rho", &rho), ("err", &err)])?;
         files.push("density.csv".into());
         let mut series = vec![Series {
-            label: "BCD",
+            label: "BCD (bars: standard error)",
             x: &x,
             y: &rho,
             points: true,
@@ -824,7 +824,7 @@ where
             line_plot_with_errors(
                 &out.join("density.png"),
                 &format!(
-                    "density of {rods}, N = {n}, L = {}, sigma = {} (bars: standard error)",
+                    "density of {rods}, N = {n}, L = {}, sigma = {}",
                     c.length, c.sigma
                 ),
                 "x (length)",
@@ -847,7 +847,7 @@ where
         )?;
         files.push("contact_density.csv".into());
         let mut series = vec![Series {
-            label: "BCD (window estimator)",
+            label: "BCD, window estimator (bars: standard error)",
             x: &x,
             y: &rho2,
             points: true,
@@ -871,10 +871,7 @@ where
         picture(
             line_plot_with_errors(
                 &out.join("contact_density.png"),
-                &format!(
-                    "two-particle density at contact of {rods}, sigma = {} (bars: standard error)",
-                    c.sigma
-                ),
+                &format!("contact density of {rods}, sigma = {}", c.sigma),
                 "x (length)",
                 "rho2(x, x + sigma) (1/length^2)",
                 &series,
