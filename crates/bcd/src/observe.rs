@@ -394,6 +394,56 @@ mod bin_tests {
         assert_eq!(a.samples, b.samples);
     }
 
+    /// The block errors are the same bit for bit on 1, 2 and 3 workers, equal the spread of the
+    /// block profiles computed by hand, and are NaN until two blocks are full.
+    #[test]
+    fn density_block_errors_do_not_depend_on_the_number_of_workers() {
+        let (m, period, sigma, n) = (17, 1.0, 0.99, 2 * PART_MIN + 5);
+        let config = |t: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| ((i * 7 + t * 13) as f64 * 0.618).sin() * 5.0)
+                .collect()
+        };
+        let mut runs = Vec::new();
+        for workers in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(workers)
+                .build()
+                .unwrap();
+            let mut d = DensityProfile::new(m, period, 1e4).with_blocks(12, 4);
+            pool.install(|| {
+                for t in 0..3 {
+                    d.sample_reduced(&config(t), sigma);
+                }
+                assert!(d.errors().iter().all(|e| e.is_nan()), "one block only");
+                for t in 3..12 {
+                    d.sample_reduced(&config(t), sigma);
+                }
+            });
+            assert_eq!(d.blocks(), 4);
+            runs.push(d.errors());
+        }
+        let bits = |v: &Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&runs[0]), bits(&runs[1]));
+        assert_eq!(bits(&runs[0]), bits(&runs[2]));
+        // By hand: four blocks of three samples each.
+        let mut blocks = vec![vec![0.0f64; m]; 4];
+        for t in 0..12 {
+            let mut one = DensityProfile::new(m, period, 1e4);
+            one.sample_reduced(&config(t), sigma);
+            let (_, rho) = one.profile();
+            for a in 0..m {
+                blocks[t / 3][a] += rho[a] / 3.0;
+            }
+        }
+        for a in 0..m {
+            let mean = blocks.iter().map(|b| b[a]).sum::<f64>() / 4.0;
+            let var = blocks.iter().map(|b| (b[a] - mean).powi(2)).sum::<f64>() / 3.0;
+            let want = (var / 4.0).sqrt();
+            assert!((runs[0][a] - want).abs() <= 1e-12 * (want + mean), "{a}");
+        }
+    }
+
     /// Counts in parts over a pool of 1, 2 and 3 workers equal the counts of the plain loop.
     #[test]
     fn density_counts_do_not_depend_on_the_number_of_workers() {
