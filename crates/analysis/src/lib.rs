@@ -13,7 +13,9 @@ pub use network::{
     BondTracker, ClusterStats, cluster_labels, cluster_stats, coordination_histogram,
     coordination_numbers,
 };
-pub use structure::{Window, default_q_grid, structure_factor, structure_factor_windowed};
+pub use structure::{
+    Window, default_q_grid, percus_yevick_g, structure_factor, structure_factor_windowed,
+};
 
 use colloidsim_md::gsd::{GsdError, frame_count, read_frame};
 use rayon::prelude::*;

@@ -103,8 +103,92 @@ pub fn default_q_grid(r_max: f64, bins: usize) -> Vec<f64> {
     (2..=bins).map(|k| k as f64 * PI / r_max).collect()
 }
 
+/// Percus–Yevick g(r) of hard spheres of diameter 1 at packing fraction `eta` (< 0.6), at the
+/// distances `r` (in diameters; 0 inside the core). The PY direct correlation function is
+/// Wertheim's closed form, `c(x) = -l1 + 6 eta l2 x - eta l1 x^3 / 2` inside the core with
+/// `l1 = (1 + 2 eta)^2 / (1 - eta)^4`, `l2 = (1 + eta / 2)^2 / (1 - eta)^4`, 0 outside; the
+/// indirect part `gamma = h - c` follows from Ornstein–Zernike in Fourier space,
+/// `gamma(k) = rho c(k)^2 / (1 - rho c(k))`, by discrete sine transforms on a grid of 1/200
+/// diameter up to 20 diameters, and `g = 1 + gamma` outside the core (linear interpolation).
+/// The contact value is `(1 + eta / 2) / (1 - eta)^2` to 0.3 % (tested).
+pub fn percus_yevick_g(eta: f64, r: &[f64]) -> Vec<f64> {
+    let n = 4096usize;
+    let dr = 1.0 / 200.0;
+    let rho = 6.0 * eta / PI;
+    let w = (1.0 - eta).powi(4);
+    let (l1, l2) = ((1.0 + 2.0 * eta).powi(2) / w, (1.0 + 0.5 * eta).powi(2) / w);
+    let c_of = |x: f64| -l1 + 6.0 * eta * l2 * x - 0.5 * eta * l1 * x * x * x;
+    // r_i = i dr, i = 1 .. n - 1; the core edge (i = 200) takes the mean of both sides.
+    let c: Vec<f64> = (1..n)
+        .map(|i| match i.cmp(&200) {
+            std::cmp::Ordering::Less => c_of(i as f64 * dr),
+            std::cmp::Ordering::Equal => 0.5 * c_of(1.0),
+            std::cmp::Ordering::Greater => 0.0,
+        })
+        .collect();
+    let dk = PI / (n as f64 * dr);
+    let sines = |f: &[f64], j: usize| -> f64 {
+        f.iter()
+            .enumerate()
+            .map(|(m, v)| v * (PI * ((m + 1) * j) as f64 / n as f64).sin())
+            .sum()
+    };
+    // c(k_j) = 4 pi dr / k_j sum_i r_i c_i sin(k_j r_i).
+    let rc: Vec<f64> = c
+        .iter()
+        .enumerate()
+        .map(|(m, v)| (m + 1) as f64 * dr * v)
+        .collect();
+    let kgamma: Vec<f64> = (1..n)
+        .into_par_iter()
+        .map(|j| {
+            let k = j as f64 * dk;
+            let ck = 4.0 * PI * dr / k * sines(&rc, j);
+            k * rho * ck * ck / (1.0 - rho * ck)
+        })
+        .collect();
+    // gamma(r_i) = dk / (2 pi^2 r_i) sum_j k_j gamma(k_j) sin(k_j r_i).
+    let gamma: Vec<f64> = (1..n)
+        .into_par_iter()
+        .map(|i| dk / (2.0 * PI * PI * i as f64 * dr) * sines(&kgamma, i))
+        .collect();
+    r.iter()
+        .map(|&x| {
+            if x < 1.0 {
+                return 0.0;
+            }
+            let u = x / dr;
+            let i = (u.floor() as usize).max(200);
+            if i + 1 >= n {
+                return 1.0;
+            }
+            // Outside the core g = 1 + gamma; at the edge from the outside value.
+            let at = |i: usize| 1.0 + gamma[i - 1];
+            let t = (u - i as f64).clamp(0.0, 1.0);
+            (1.0 - t) * at(i) + t * at(i + 1)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
+    /// The Percus–Yevick g(r): Wertheim's contact value (1 + eta / 2) / (1 - eta)^2, zero in
+    /// the core, and 1 far away.
+    #[test]
+    fn percus_yevick_contact_values() {
+        for eta in [0.1, 0.2, 0.3, 0.4] {
+            let g = super::percus_yevick_g(eta, &[0.9, 1.0, 10.0]);
+            let contact = (1.0 + 0.5 * eta) / (1.0 - eta).powi(2);
+            assert_eq!(g[0], 0.0);
+            assert!(
+                (g[1] / contact - 1.0).abs() < 3e-3,
+                "eta {eta}: {} vs {contact}",
+                g[1]
+            );
+            assert!((g[2] - 1.0).abs() < 1e-3, "eta {eta}: {}", g[2]);
+        }
+    }
+
     use super::*;
 
     #[test]

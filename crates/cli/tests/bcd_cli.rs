@@ -87,8 +87,8 @@ fn run_writes_documented_outputs_and_refuses_to_overwrite() {
             .unwrap()
             .to_string()
     };
-    assert_eq!(head("density.csv"), "x,rho");
-    assert_eq!(head("contact_density.csv"), "x,rho2");
+    assert_eq!(head("density.csv"), "x,rho,err");
+    assert_eq!(head("contact_density.csv"), "x,rho2,err");
     assert_eq!(head("msd.csv"), "t,msd,err");
     assert_eq!(head("clusters.csv"), "size,probability");
     let summary: serde_json::Value =
@@ -392,6 +392,136 @@ fn theory_writes_converged_profiles_on_the_simulation_bins() {
         serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap();
     assert!(s["mean_current"].as_f64().unwrap() > 0.0);
     assert_eq!(s["converged"], true);
+    // A driven run draws that steady state beside its density, on the same bins.
+    let dr = tmp.path().join("dr");
+    let o = run(&[
+        "run",
+        driven.to_str().unwrap(),
+        "--out",
+        dr.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(dr.join("density.png").exists());
+    let ddft = columns(&dr.join("density_ddft.csv"));
+    let theory = columns(&d.join("density.csv"));
+    assert_eq!(ddft[1].len(), 50);
+    for (a, b) in ddft[1].iter().zip(&theory[1]) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} vs {b}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dr.join("summary.json")).unwrap()).unwrap();
+    assert!(s["ddft"]["mean_current"].as_f64().unwrap() > 0.0, "{s}");
+    assert!(!dr.join("density_theory.csv").exists());
+}
+
+/// Columns of a CSV file (after its header) as numbers.
+fn columns(path: &Path) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (0..rows[0].len())
+        .map(|j| rows.iter().map(|r| r[j]).collect())
+        .collect()
+}
+
+/// The density's block standard errors (density.csv's `err`) are sane: the exact profile lies
+/// within 4 of them in nearly every bin of a run that samples its equilibrium (low barriers),
+/// and a run 4 times longer has errors about half as large.
+#[test]
+fn density_errors_cover_the_exact_profile_and_shrink_with_the_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text_of = |time: f64| {
+        SMALL
+            .replace("amplitude = 6.0", "amplitude = 1.0")
+            .replace("time = 5.0", &format!("time = {time}"))
+            .replace("checkpoint_every = 1000", "")
+            .replace("particles = 10", "particles = 20")
+            .replace(
+                "density = { bins = 50 }",
+                "density = { bins = 20 }\nevery = 10",
+            )
+    };
+    let mut mean_err = Vec::new();
+    for time in [50.0, 200.0] {
+        let sc = write_scenario(tmp.path(), &format!("t{time}.toml"), &text_of(time));
+        let out = tmp.path().join(format!("out{time}"));
+        let o = run(&[
+            "run",
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let d = columns(&out.join("density.csv"));
+        let t = columns(&out.join("density_theory.csv"));
+        let (rho, err, exact) = (&d[1], &d[2], &t[1]);
+        assert!(err.iter().all(|e| e.is_finite() && *e > 0.0), "{err:?}");
+        let within = (0..rho.len())
+            .filter(|&a| (rho[a] - exact[a]).abs() < 4.0 * err[a])
+            .count();
+        assert!(
+            within >= rho.len() - 1,
+            "{within} of {} bins within 4 SE",
+            rho.len()
+        );
+        mean_err.push(err.iter().sum::<f64>() / err.len() as f64);
+        let c = columns(&out.join("contact_density.csv"));
+        assert!(
+            c[2].iter().all(|e| e.is_finite() && *e >= 0.0),
+            "{:?}",
+            c[2]
+        );
+    }
+    let ratio = mean_err[0] / mean_err[1];
+    assert!(
+        (1.4..2.8).contains(&ratio),
+        "errors shrank by {ratio} over a 4 times longer run"
+    );
+}
+
+/// A run large enough that the density is binned in parts over the workers (10,000 rods) writes
+/// the same density.csv and contact_density.csv, errors included, on 1 and 2 threads.
+#[test]
+fn density_errors_are_the_same_on_one_and_two_threads() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = SMALL
+        .replace("length = 20.0", "length = 20000.0")
+        .replace("particles = 10", "particles = 10000")
+        .replace("time = 5.0", "time = 1.0")
+        .replace("equilibrate = 0.5", "equilibrate = 0.1")
+        .replace("checkpoint_every = 1000", "")
+        .replace("trajectory = { every = 500 }", "")
+        .replace("msd = { points = 10 }", "")
+        .replace(
+            "density = { bins = 50 }",
+            "density = { bins = 50 }\nevery = 10",
+        );
+    let sc = write_scenario(tmp.path(), "big.toml", &scenario);
+    let mut outs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = tmp.path().join(format!("t{threads}"));
+        let o = run(&[
+            "run",
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            threads,
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        outs.push(out);
+    }
+    for f in ["density.csv", "contact_density.csv"] {
+        let a = std::fs::read(outs[0].join(f)).unwrap();
+        assert_eq!(a, std::fs::read(outs[1].join(f)).unwrap(), "{f}");
+        assert!(!String::from_utf8_lossy(&a).contains("NaN"), "{f}");
+    }
 }
 
 /// `colloidsim check` prints the scenario's keys with their values and units, defaults

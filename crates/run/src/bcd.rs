@@ -232,6 +232,10 @@ struct Saved {
     digest: FrameDigest,
 }
 
+/// Blocks of the production run whose spread gives the density's and the contact density's
+/// standard errors (`err` in density.csv and contact_density.csv).
+const DENSITY_BLOCKS: u64 = 20;
+
 fn observers(sc: &Scenario, r: &Resolved) -> Observers {
     let c = &r.config;
     let o = &sc.observe;
@@ -243,13 +247,15 @@ fn observers(sc: &Scenario, r: &Resolved) -> Observers {
         // ~100 time origins over the sampled run.
         Msd::new(lags, (r.sampled_steps / 100).max(1))
     });
+    // Density and contact density samples over the run, in DENSITY_BLOCKS blocks.
+    let samples = r.sampled_steps / o.every.unwrap_or(1).max(1);
     Observers {
-        density: o
-            .density
-            .as_ref()
-            .map(|d| DensityProfile::new(d.bins, r.period, c.length)),
+        density: o.density.as_ref().map(|d| {
+            DensityProfile::new(d.bins, r.period, c.length).with_blocks(samples, DENSITY_BLOCKS)
+        }),
         contact: o.contact_density.as_ref().map(|d| {
             ContactDensity::new(d.bins, d.window, r.period, c.sigma, c.length, c.boundary)
+                .with_blocks(samples, DENSITY_BLOCKS)
         }),
         msd,
         clusters: o.clusters.then(ClusterSizes::default),
@@ -472,6 +478,7 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
             "final_configuration.csv",
             "density.csv",
             "density_theory.csv",
+            "density_ddft.csv",
             "density.png",
             "contact_density.csv",
             "contact_density_theory.csv",
@@ -663,6 +670,12 @@ fn trim_trajectory(path: &std::path::Path, frames: u64, b: &RodBox) -> Result<()
     if file.n_frames() == frames {
         return Ok(());
     }
+    if frames > 0 && file.find_chunk(0, "particles/image").is_none() {
+        bail!(
+            "{}: its frames have no particles/image chunk (written by a colloidsim from before the HOOMD-style BCD trajectory, which kept unwrapped positions in a log chunk), and the run stopped after its last checkpoint, so the file would have to be cut back to {frames} frames, which this build does not do for that layout. Start the run again in a new folder, or continue it with the build that wrote it",
+            path.display()
+        );
+    }
     let tmp = path.with_extension("gsd.trim");
     let _ = std::fs::remove_file(&tmp);
     {
@@ -762,12 +775,23 @@ where
             (None, Some(format!("{e:#}")))
         }
     };
+    let rods = rods_label(r);
+    // A driven ring: its DDFT steady state beside the density, when it comes cheaply.
+    let ddft = match (&obs.density, driven_companion(r)) {
+        (Some(_), Some(Ok(st))) => Some(st),
+        (Some(_), Some(Err(e))) => {
+            warnings.push(format!("no DDFT steady state beside the density: {e:#}"));
+            None
+        }
+        _ => None,
+    };
     if let Some(d) = &obs.density {
         let (x, rho) = d.profile();
-        out.write_table("density.csv", &[("x", &x), ("rho", &rho)])?;
+        let err = d.errors();
+        out.write_table("density.csv", &[("x", &x), ("rho", &rho), ("err", &err)])?;
         files.push("density.csv".into());
         let mut series = vec![Series {
-            label: "BCD",
+            label: "BCD (bars: standard error)",
             x: &x,
             y: &rho,
             points: true,
@@ -776,22 +800,37 @@ where
             out.write_table("density_theory.csv", &[("x", &t.centres), ("rho", &t.rho)])?;
             files.push("density_theory.csv".into());
             series.push(Series {
-                label: "exact theory",
+                label: theory_label(r),
                 x: &t.centres,
                 y: &t.rho,
                 points: false,
             });
         }
+        let ddft_bins = ddft
+            .as_ref()
+            .map(|st| bin_means(&st.x, &st.rho, r.period, x.len()));
+        if let Some((centres, means)) = &ddft_bins {
+            out.write_table("density_ddft.csv", &[("x", centres), ("rho", means)])?;
+            files.push("density_ddft.csv".into());
+            series.push(Series {
+                label: "1D DDFT steady state (adiabatic)",
+                x: centres,
+                y: means,
+                points: false,
+            });
+        }
+        let errors = [Some(err.as_slice()), None];
         picture(
-            line_plot(
+            line_plot_with_errors(
                 &out.join("density.png"),
                 &format!(
-                    "density profile, N = {n}, L = {}, sigma = {}",
+                    "density of {rods}, N = {n}, L = {}, sigma = {}",
                     c.length, c.sigma
                 ),
                 "x (length)",
                 "rho(x) (1/length)",
                 &series,
+                &errors[..series.len().min(2)],
                 Scale::Linear,
             ),
             "density.png",
@@ -801,10 +840,14 @@ where
     }
     if let Some(cd) = &obs.contact {
         let (x, rho2) = cd.profile();
-        out.write_table("contact_density.csv", &[("x", &x), ("rho2", &rho2)])?;
+        let err = cd.errors();
+        out.write_table(
+            "contact_density.csv",
+            &[("x", &x), ("rho2", &rho2), ("err", &err)],
+        )?;
         files.push("contact_density.csv".into());
         let mut series = vec![Series {
-            label: "BCD (window estimator)",
+            label: "BCD, window estimator (bars: standard error)",
             x: &x,
             y: &rho2,
             points: true,
@@ -818,23 +861,24 @@ where
             )?;
             files.push("contact_density_theory.csv".into());
             series.push(Series {
-                label: "exact theory",
+                label: theory_label(r),
                 x: &t.centres,
                 y: &t.contact_density,
                 points: false,
             });
         }
-        let title = format!("two-particle density at contact, sigma = {}", c.sigma);
-        let labels = Labels {
-            title: &title,
-            x: "x (length)",
-            y: "rho2(x, x + sigma) (1/length^2)",
-        };
-        linear_picture(
-            out.path(),
+        let errors = [Some(err.as_slice()), None];
+        picture(
+            line_plot_with_errors(
+                &out.join("contact_density.png"),
+                &format!("contact density of {rods}, sigma = {}", c.sigma),
+                "x (length)",
+                "rho2(x, x + sigma) (1/length^2)",
+                &series,
+                &errors[..series.len()],
+                Scale::Linear,
+            ),
             "contact_density.png",
-            &labels,
-            &series,
             &mut files,
             &mut warnings,
         );
@@ -870,7 +914,8 @@ where
                         * (4.0 * c.diffusion() * t / std::f64::consts::PI).sqrt()
                 })
                 .collect();
-            if r.field.is_zero() && c.boundary == Boundary::Periodic {
+            // The single-file law holds for hard rods (sticky rods move in clusters).
+            if r.field.is_zero() && c.boundary == Boundary::Periodic && r.pair.range() == 0.0 {
                 series.push(Series {
                     label: "single file (1-rho sigma)/rho sqrt(4Dt/pi)",
                     x: &t,
@@ -883,7 +928,7 @@ where
             picture(
                 line_plot_with_errors(
                     &out.join("msd.png"),
-                    "mean-square displacement (bars: standard error)",
+                    &format!("mean-square displacement of {rods} (bars: standard error)"),
                     "t (time)",
                     "MSD (length^2)",
                     &series,
@@ -918,7 +963,7 @@ where
         files.push("current.csv".into());
         mean_velocity = v.last().copied();
         let title = format!(
-            "particle current (running mean since sampling began), drive f = {} energy/length",
+            "current of {rods} (running mean since sampling began), drive f = {} energy/length",
             r.field.drive
         );
         let labels = Labels {
@@ -963,6 +1008,12 @@ where
         "mean_velocity": mean_velocity,
         "particle_current": mean_velocity.map(|v| v * n as f64 / c.length),
         "theory": theory.as_ref().map(|(_, _)| "density_theory.csv: exact equilibrium (colloidsim theory) on the same bins"),
+        "ddft": ddft.as_ref().map(|st| json!({
+            "file": "density_ddft.csv: 1D DDFT steady state (colloidsim theory, adiabatic approximation) on the same bins",
+            "mean_current": st.current,
+            "mean_velocity": st.current * c.length / n as f64,
+            "relaxation_times": st.time / st.relaxation_time,
+        })),
         "theory_error": theory_error,
         "warnings": warnings,
     });
@@ -978,6 +1029,64 @@ where
         message,
         warnings,
     })
+}
+
+/// What the rods are, for titles: "hard rods", or the sticky rods with their parameters, or
+/// the rods with a soft pair force.
+fn rods_label(r: &Resolved) -> String {
+    let p = &r.pair;
+    let mut parts = Vec::new();
+    if let Some(s) = &p.sticky {
+        parts.push(format!(
+            "gamma = {}, eps = {}, p = {}",
+            s.gamma, s.eps, s.order
+        ));
+    }
+    if p.yukawa.is_some() {
+        parts.push("Yukawa".to_string());
+    }
+    if p.table.is_some() {
+        parts.push("tabulated pair force".to_string());
+    }
+    match (p.sticky.is_some(), parts.is_empty()) {
+        (_, true) => "hard rods".to_string(),
+        (true, false) => format!("sticky rods ({})", parts.join(", ")),
+        (false, false) => format!("rods ({})", parts.join(", ")),
+    }
+}
+
+/// The legend of the exact theory's curve.
+fn theory_label(r: &Resolved) -> &'static str {
+    if r.pair.sticky.is_some() {
+        "exact theory (Baxter sticky rods, eps -> 0)"
+    } else {
+        "exact theory (Percus hard rods)"
+    }
+}
+
+/// Wall-clock budget of the DDFT steady state drawn beside a driven run's density.
+const DRIVEN_COMPANION_SECONDS: f64 = 5.0;
+
+/// The DDFT steady state beside a driven run (`None` when the run is not a driven ring of hard
+/// or sticky rods at kT > 0); an error when it fails or takes longer than
+/// [`DRIVEN_COMPANION_SECONDS`].
+fn driven_companion(r: &Resolved) -> Option<Result<DrivenState>> {
+    let c = &r.config;
+    if r.field.drive == 0.0
+        || c.kt <= 0.0
+        || c.boundary != Boundary::Periodic
+        || r.pair.yukawa.is_some()
+        || r.pair.table.is_some()
+    {
+        return None;
+    }
+    let points = r.period / default_dx(r);
+    if points > MAX_COMPANION_POINTS {
+        return Some(Err(anyhow::anyhow!(
+            "its grid would have {points:.2e} points; compute it with colloidsim theory"
+        )));
+    }
+    Some(driven_steady_state(r, None, Some(DRIVEN_COMPANION_SECONDS)))
 }
 
 /// The exact equilibrium profile averaged over the scenario's density bins, when the scenario
@@ -1051,7 +1160,12 @@ const STEADY_MAX_TIMES: usize = 400;
 /// and the mean current change by less than [`STEADY_TOLERANCE`] over one. Returns the grid,
 /// the density, the mean current, the time run and the last changes; an error when no steady
 /// state is reached within [`STEADY_MAX_TIMES`] relaxation times.
-fn driven_steady_state(r: &Resolved, dx: Option<f64>) -> Result<DrivenState> {
+fn driven_steady_state(
+    r: &Resolved,
+    dx: Option<f64>,
+    budget_seconds: Option<f64>,
+) -> Result<DrivenState> {
+    let start = Instant::now();
     let c = &r.config;
     let diffusion = c.mobility * c.kt;
     let tau = r.period * r.period / diffusion;
@@ -1097,6 +1211,13 @@ fn driven_steady_state(r: &Resolved, dx: Option<f64>) -> Result<DrivenState> {
                     current_change: dj,
                 });
             }
+        }
+        if let Some(b) = budget_seconds
+            && start.elapsed().as_secs_f64() > b
+        {
+            bail!(
+                "not steady after {k} relaxation times and {b} s (the budget beside a run); compute it with colloidsim theory"
+            );
         }
         rho = new_rho;
         current = new_current;
@@ -1186,7 +1307,7 @@ fn driven_theory(
         );
     }
     let start = Instant::now();
-    let st = driven_steady_state(r, opts.dx)?;
+    let st = driven_steady_state(r, opts.dx, None)?;
     let wall = start.elapsed().as_secs_f64();
     let outdir = theory_outdir(src, opts)?;
     let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
@@ -1199,7 +1320,8 @@ fn driven_theory(
         line_plot(
             &outdir.join("density.png"),
             &format!(
-                "DDFT steady state, sigma = {}, drive f = {} kT/length",
+                "DDFT steady state of {}, sigma = {}, drive f = {} kT/length",
+                rods_label(r),
                 c.sigma,
                 r.field.drive / c.kt
             ),
@@ -1310,11 +1432,15 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
     picture(
         line_plot(
             &outdir.join("density.png"),
-            &format!("exact equilibrium density, sigma = {}", c.sigma),
+            &format!(
+                "exact equilibrium density of {}, sigma = {}",
+                rods_label(&r),
+                c.sigma
+            ),
             "x (length)",
             "rho(x) (1/length)",
             &[Series {
-                label: "exact theory",
+                label: theory_label(&r),
                 x: &eq.x,
                 y: &eq.rho,
                 points: false,
@@ -1356,6 +1482,41 @@ mod tests {
     use super::*;
     use colloidsim_bcd::forces::NoField;
     use colloidsim_bcd::{BcdConfig, Update, init};
+
+    /// A trajectory of the layout before the image chunk (positions only, unwrapped x in a
+    /// log chunk) that would need trimming is refused with the file's name and what to do,
+    /// and left as it was.
+    #[test]
+    fn trimming_a_trajectory_without_images_is_refused_by_name() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("trajectory.gsd");
+        {
+            let mut g = GsdFile::create(&path, "hoomd-rs 1.4.0", "hoomd", (1, 4)).unwrap();
+            for step in [0u64, 100, 200] {
+                g.write_scalars("configuration/step", [step]).unwrap();
+                g.write_scalars("particles/N", [2u32]).unwrap();
+                g.write_arrays("particles/position", [[0.5f32, 0.0, 0.0], [1.5, 0.0, 0.0]])
+                    .unwrap();
+                g.write_scalars("log/particles/x_unwrapped", [0.5f64, 1.5])
+                    .unwrap();
+                g.end_frame().unwrap();
+            }
+            g.sync_all().unwrap();
+        }
+        let before = std::fs::read(&path).unwrap();
+        let b = RodBox {
+            length: 10.0,
+            walls: false,
+            sigma: 1.0,
+        };
+        // Nothing to trim: accepted as it is.
+        trim_trajectory(&path, 3, &b).unwrap();
+        let e = format!("{:#}", trim_trajectory(&path, 2, &b).unwrap_err());
+        assert!(e.contains("trajectory.gsd"), "{e}");
+        assert!(e.contains("particles/image"), "{e}");
+        assert!(e.contains("Start the run again"), "{e}");
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+    }
 
     /// Engine states round-trip through the checkpoint encoding bit for bit, with and without
     /// the ring update's reduced coordinates (bincode is not self-describing, so every field

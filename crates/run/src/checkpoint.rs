@@ -16,8 +16,9 @@ pub const CHECKPOINT: &str = "checkpoint.bin";
 /// Checkpoint format: bumped whenever a checkpoint's layout, or the random streams that a
 /// continuation draws, change, so that a restart across such a change is refused instead of
 /// silently continuing a different run. 2: the 1024-strip ziggurat; 3: the run path's
-/// envelope with a checksum; 4: the CRC-32 of the trajectory frames written so far.
-pub const FORMAT: u32 = 4;
+/// envelope with a checksum; 4: the CRC-32 of the trajectory frames written so far; 5: the BCD
+/// density and contact density keep their block counts (for the standard errors).
+pub const FORMAT: u32 = 5;
 
 /// The version string that leads every checkpoint: the package version and the format.
 pub fn version() -> String {

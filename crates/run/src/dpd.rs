@@ -7,12 +7,12 @@ use crate::droplet::trim_trajectory;
 use crate::engine::flat;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, picture};
+use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
-    pair_distribution, structure_factor_windowed,
+    pair_distribution, percus_yevick_g, structure_factor_windowed,
 };
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
@@ -217,10 +217,12 @@ impl DpdSession {
             let (r, g) = pair_distribution(&pos, sim.sbox.l, s.gr_max, o.gr_bins);
             if obs.gr_sum.is_empty() {
                 obs.gr_sum = vec![0.0; g.len()];
+                obs.gr_sum_sq = vec![0.0; g.len()];
                 obs.gr_r = r;
             }
-            for (a, b) in obs.gr_sum.iter_mut().zip(&g) {
+            for ((a, q), b) in obs.gr_sum.iter_mut().zip(&mut obs.gr_sum_sq).zip(&g) {
                 *a += b;
+                *q += b * b;
             }
             obs.gr_samples += 1;
             let bonds = contacts(&pos, &self.radii, sim.sbox.l, s.contact_gap);
@@ -369,6 +371,7 @@ impl Session for DpdSession {
             "msd.csv",
             "msd.png",
             "gr.csv",
+            "gr_percus_yevick.csv",
             "gr.png",
             "sq.csv",
             "coordination.csv",
@@ -579,6 +582,8 @@ struct Observed {
     colloid_frames: Vec<Vec<[f64; 3]>>,
     solvent_frames: Vec<Vec<[f64; 3]>>,
     gr_sum: Vec<f64>,
+    /// Sums of g(r)^2 over the samples, for the standard error of g(r).
+    gr_sum_sq: Vec<f64>,
     gr_r: Vec<f64>,
     gr_samples: usize,
     coordination: Vec<u64>,
@@ -893,9 +898,29 @@ fn write_outputs(
             .collect();
         let r = &obs.gr_r;
         let r_over_d: Vec<f64> = r.iter().map(|x| x / (2.0 * s.radius)).collect();
+        // Standard error of the mean over the structure samples (their scatter; samples closer
+        // than the structural relaxation time are correlated, so this is a lower bound then).
+        let m = obs.gr_samples as f64;
+        let err: Vec<f64> = obs
+            .gr_sum_sq
+            .iter()
+            .zip(&g)
+            .map(|(q, mean)| {
+                if obs.gr_samples < 2 {
+                    f64::NAN
+                } else {
+                    ((q / m - mean * mean).max(0.0) / (m - 1.0)).sqrt()
+                }
+            })
+            .collect();
         out.write_table(
             "gr.csv",
-            &[("r", r), ("r_over_diameter", &r_over_d), ("g", &g)],
+            &[
+                ("r", r),
+                ("r_over_diameter", &r_over_d),
+                ("g", &g),
+                ("err", &err),
+            ],
         )?;
         files.push("gr.csv".into());
         let rho = s.colloids as f64 / vol;
@@ -904,19 +929,41 @@ fn write_outputs(
         let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.radius).collect();
         out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;
         files.push("sq.csv".into());
+        // The hard-sphere reference: Percus–Yevick at the colloids' volume fraction (the
+        // contact force is hard to 1e-3 diameters; docs/dpd.md).
+        let phi = s.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3) / vol;
+        let py = (phi > 0.0 && phi < 0.6).then(|| percus_yevick_g(phi, &r_over_d));
+        let mut series = vec![Series {
+            label: "colloids (bars: standard error)",
+            x: &r_over_d,
+            y: &g,
+            points: false,
+        }];
+        if let Some(py) = &py {
+            out.write_table(
+                "gr_percus_yevick.csv",
+                &[("r", r), ("r_over_diameter", &r_over_d), ("g", py)],
+            )?;
+            files.push("gr_percus_yevick.csv".into());
+            series.push(Series {
+                label: "hard spheres, Percus-Yevick",
+                x: &r_over_d,
+                y: py,
+                points: false,
+            });
+        }
         picture(
-            line_plot(
+            line_plot_styled(
                 &out.join("gr.png"),
-                &format!("Colloid g(r), {} samples", obs.gr_samples),
-                "r / (2 R_c)",
+                &format!("Colloid g(r), phi = {phi:.3}, {} samples", obs.gr_samples),
+                "r / (2 R_c) (colloid diameters)",
                 "g(r)",
-                &[Series {
-                    label: "colloids",
-                    x: &r_over_d,
-                    y: &g,
-                    points: false,
-                }],
+                &series,
+                &[Some(err.as_slice()), None],
                 Scale::Linear,
+                Style {
+                    legend_outside: true,
+                },
             ),
             "gr.png",
             &mut files,

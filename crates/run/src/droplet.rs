@@ -11,7 +11,10 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Disc, Scale, Series, cross_section, line_plot, picture};
+use crate::plot::{
+    Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
+    picture,
+};
 use crate::theory_droplet::profile_name;
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
@@ -422,15 +425,28 @@ impl BdMethod<HarmonicInterface> for DropletObs {
             .iter()
             .map(|&j| format!("t = {:.0} % (R = {:.2})", p.fractions[j] * 100.0, radii[j]))
             .collect();
-        let xs: Vec<Vec<f64>> = drawn
+        // The picture merges the small inner shells (plot::merged_shells); the CSV files keep
+        // every shell.
+        let vp = std::f64::consts::PI / 6.0 * p.diameter.powi(3);
+        let merged: Vec<(Vec<f64>, Vec<f64>)> = drawn
             .iter()
-            .map(|&j| r_axes[j].iter().map(|x| x / radii[j]).collect())
+            .enumerate()
+            .map(|(k, &j)| {
+                let (x, y) = merged_shells(
+                    &r_axes[j],
+                    &means[k],
+                    vp,
+                    p.replicas as f64,
+                    SHELL_PARTICLES,
+                );
+                (x.iter().map(|x| x / radii[j]).collect(), y)
+            })
             .collect();
         let series: Vec<Series> = (0..drawn.len())
             .map(|k| Series {
                 label: &labels[k],
-                x: &xs[k],
-                y: &means[k],
+                x: &merged[k].0,
+                y: &merged[k].1,
                 points: false,
             })
             .collect();
@@ -484,13 +500,17 @@ impl BdMethod<HarmonicInterface> for DropletObs {
             }
         }
         picture(
-            line_plot(
+            line_plot_styled(
                 &out.join("profiles.png"),
                 &title,
-                "r / R(t)",
+                "r / R(t) (inner shells merged to >= 10 particles)",
                 "volume fraction phi(r)",
                 &series,
+                &[],
                 Scale::Linear,
+                Style {
+                    legend_outside: true,
+                },
             ),
             "profiles.png",
             &mut files,

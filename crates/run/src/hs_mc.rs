@@ -9,7 +9,7 @@ use crate::droplet::trim_trajectory;
 use crate::engine::flat;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, picture};
+use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
@@ -485,18 +485,19 @@ impl Session for McSession {
                     p.geometry, p.volume_fraction
                 );
                 let series = [Series {
-                    label: "equilibrium",
+                    label: "equilibrium (bars: standard error over the blocks)",
                     x: &x,
                     y: &phi,
                     points: false,
                 }];
                 picture(
-                    line_plot(
+                    line_plot_with_errors(
                         &out.join("profiles.png"),
                         &title,
                         "r / R",
                         "volume fraction phi(r)",
                         &series,
+                        &[Some(err.as_slice())],
                         Scale::Linear,
                     ),
                     "profiles.png",

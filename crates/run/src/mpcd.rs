@@ -15,7 +15,9 @@ use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, picture};
+use crate::plot::{
+    SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
+};
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::output::{CsvLog, OutputDir};
@@ -1414,35 +1416,37 @@ impl Session for DropletSession {
                     p.profile.fractions[j] * 100.0,
                     cp.radius[j]
                 ));
-                xs.push(
-                    cp.r[j]
-                        .iter()
-                        .map(|x| x / cp.radius[j])
-                        .collect::<Vec<f64>>(),
-                );
+                // The picture merges the small inner shells (plot::merged_shells).
+                let vp = std::f64::consts::PI / 6.0 * p.diameter.powi(3);
+                let (x, y) = merged_shells(&cp.r[j], &cp.phi[j], vp, 1.0, SHELL_PARTICLES);
+                xs.push((x.iter().map(|x| x / cp.radius[j]).collect::<Vec<f64>>(), y));
                 drawn.push(j);
             }
             let series: Vec<Series> = drawn
                 .iter()
                 .enumerate()
-                .map(|(k, &j)| Series {
+                .map(|(k, _)| Series {
                     label: &labels[k],
-                    x: &xs[k],
-                    y: &cp.phi[j],
+                    x: &xs[k].0,
+                    y: &xs[k].1,
                     points: false,
                 })
                 .collect();
             picture(
-                line_plot(
+                line_plot_styled(
                     &out.join("profiles.png"),
                     &format!(
                         "Drying droplet, MPCD ({boundary}): N = {}, Pe = {}",
                         p.particles, p.peclet
                     ),
-                    "r / R(t)",
+                    "r / R(t) (inner shells merged to >= 10 particles)",
                     "volume fraction phi(r)",
                     &series,
+                    &[],
                     Scale::Linear,
+                    Style {
+                        legend_outside: true,
+                    },
                 ),
                 "profiles.png",
                 &mut files,

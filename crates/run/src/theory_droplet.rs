@@ -246,7 +246,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
             },
         };
         plot::picture(
-            draw(Path::new(src.name()), &dir, &written, tag),
+            draw(Path::new(src.name()), &dir, &written, tag, p.diameter),
             "profiles.png",
             &mut files,
             &mut warnings,
@@ -308,7 +308,15 @@ fn write_snapshot(
 }
 
 /// `profiles.png`: theory lines, BD points from the run folder (`<scenario stem>/`) when present.
-fn draw(run_dir: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Result<()> {
+/// The BD points merge the run's small inner shells ([`plot::merged_shells`], over the replicas
+/// its summary.json names) and the legend stands beside the axes.
+fn draw(
+    run_dir: &Path,
+    dir: &OutputDir,
+    written: &[Written],
+    tag: &str,
+    diameter: f64,
+) -> Result<()> {
     let labels: Vec<String> = written
         .iter()
         .map(|w| format!("DDFT {:.0}%", 100.0 * w.fraction))
@@ -324,6 +332,12 @@ fn draw(run_dir: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Resu
         })
         .collect();
     let run_dir = run_dir.to_path_buf();
+    let replicas = std::fs::read_to_string(run_dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v["parameters"]["replicas"].as_f64())
+        .unwrap_or(1.0);
+    let vp = PI / 6.0 * diameter.powi(3);
     let bd: Vec<(String, Vec<f64>, Vec<f64>)> = written
         .iter()
         .filter_map(|w| {
@@ -331,11 +345,8 @@ fn draw(run_dir: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Resu
             let (h, c) = read_table(&path).ok()?;
             let ir = h.iter().position(|x| x == "r")?;
             let ip = h.iter().position(|x| x == "phi")?;
-            Some((
-                format!("BD {:.0}%", 100.0 * w.fraction),
-                c[ir].clone(),
-                c[ip].clone(),
-            ))
+            let (x, y) = plot::merged_shells(&c[ir], &c[ip], vp, replicas, plot::SHELL_PARTICLES);
+            Some((format!("BD {:.0}%", 100.0 * w.fraction), x, y))
         })
         .collect();
     for (l, x, y) in &bd {
@@ -354,13 +365,17 @@ fn draw(run_dir: &Path, dir: &OutputDir, written: &[Written], tag: &str) -> Resu
             run_dir.display()
         )
     };
-    plot::line_plot(
+    plot::line_plot_styled(
         &dir.join("profiles.png"),
         &title,
-        "r",
+        "r (length; BD: inner shells merged to >= 10 particles)",
         "phi (bin average of pi d^3 rho / 6)",
         &series,
+        &[],
         Scale::Linear,
+        plot::Style {
+            legend_outside: true,
+        },
     )
 }
 
