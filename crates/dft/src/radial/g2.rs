@@ -31,6 +31,7 @@
 use std::f64::consts::PI;
 
 use colloidsim_core::ParamError;
+use rayon::prelude::*;
 
 use super::rpy::RpyKernel;
 use super::{RadialError, RadialGrid};
@@ -45,12 +46,16 @@ pub struct TabulatedPair {
     s_bins: usize,
     /// `h[(i * r_bins + j) * s_bins + k]`.
     h: Vec<f64>,
+    /// Cumulative moments `int_d^{e_k} s^p h ds`, `p = 0, 2, -2, -4`, at the bin edges from
+    /// contact (`e_k = d + k s_bin`), per radial pair: `[(i * r_bins + j) * (outer + 1) + k]`.
+    moments: Vec<[f64; 4]>,
 }
 
 impl TabulatedPair {
     /// A table of `r_bins x r_bins x s_bins` values (`h[(i * r_bins + j) * s_bins + k]`, bins of
     /// `r1`, `r2` of width `r_bin` from 0 and of `s` of width `s_bin` from 0). `d / s_bin` must be
-    /// an integer (a bin edge at contact) and `h = -1` below it (hard spheres). Keys in errors:
+    /// an integer (a bin edge at contact); values below contact are not read (hard spheres:
+    /// `h = -1` there). Keys in errors:
     /// `pair.r_bin`, `pair.s_bin`, `pair.table`.
     pub fn new(
         diameter: f64,
@@ -85,6 +90,26 @@ impl TabulatedPair {
                 format!("needs {want} finite values of h >= -1, got {}", h.len()),
             ));
         }
+        let first = per.round() as usize;
+        let outer = s_bins - first;
+        let mut moments = Vec::with_capacity(r_bins * r_bins * (outer + 1));
+        for ij in 0..r_bins * r_bins {
+            let row = &h[ij * s_bins..][..s_bins];
+            let mut acc = [0.0; 4];
+            moments.push(acc);
+            for k in 0..outer {
+                let (e0, e1) = (
+                    diameter + k as f64 * s_bin,
+                    diameter + (k + 1) as f64 * s_bin,
+                );
+                let f0 = power_antiderivatives(e0);
+                let f1 = power_antiderivatives(e1);
+                for p in 0..4 {
+                    acc[p] += row[first + k] * (f1[p] - f0[p]);
+                }
+                moments.push(acc);
+            }
+        }
         Ok(Self {
             diameter,
             r_bin,
@@ -92,6 +117,7 @@ impl TabulatedPair {
             s_bin,
             s_bins,
             h,
+            moments,
         })
     }
 
@@ -139,6 +165,17 @@ impl TabulatedPair {
     /// `r + shift`. The result is applied like the dilute kernel (a banded matrix-vector product
     /// per fixed-point iteration).
     pub fn kernel(&self, grid: &RadialGrid, shift: f64) -> Result<RpyKernel, RadialError> {
+        self.kernel_active(grid, shift, grid.len())
+    }
+
+    /// [`Self::kernel`] with the rows of the faces `1..active` only (the cells a
+    /// [`super::Ddft`] still computes, `Ddft::active_cells`); the other rows stay 0.
+    pub fn kernel_active(
+        &self,
+        grid: &RadialGrid,
+        shift: f64,
+        active: usize,
+    ) -> Result<RpyKernel, RadialError> {
         if !(shift.is_finite() && shift >= 0.0) {
             return Err(ParamError::new(
                 "pair.shift",
@@ -147,7 +184,6 @@ impl TabulatedPair {
             .into());
         }
         let d = self.diameter;
-        let a = 0.5 * d;
         let dr = grid.dr();
         let faces = grid.faces();
         let n = grid.len();
@@ -161,69 +197,95 @@ impl TabulatedPair {
         )?;
         let mut start = vec![0; nf];
         let mut weights = vec![0.0; nf * bw];
+        let edges: Vec<f64> = (0..=self.s_bins).map(|k| k as f64 * self.s_bin).collect();
+        // Rows (faces) in parallel; each row is computed serially, so the result does not
+        // depend on the thread count.
+        weights
+            .par_chunks_mut(bw)
+            .zip(start.par_iter_mut())
+            .enumerate()
+            .filter(|(f, _)| *f >= 1 && *f + 1 < nf && *f < active)
+            .for_each_init(
+                || Vec::with_capacity(16),
+                |cuts, (f, (row, st))| {
+                    *st = self.row(f, faces, n, dr, reach, shift, &edges, cuts, row);
+                },
+            );
+        Ok(RpyKernel::from_banded(bw, start, weights))
+    }
+
+    /// Row `f` of the kernel (face `x = faces[f]`) into `row`; returns its first cell.
+    #[allow(clippy::too_many_arguments)]
+    fn row(
+        &self,
+        f: usize,
+        faces: &[f64],
+        n: usize,
+        dr: f64,
+        reach: f64,
+        shift: f64,
+        edges: &[f64],
+        cuts: &mut Vec<f64>,
+        row: &mut [f64],
+    ) -> usize {
+        let a = 0.5 * self.diameter;
         let gl = [
             (-(0.6f64).sqrt(), 5.0 / 9.0),
             (0.0, 8.0 / 9.0),
             ((0.6f64).sqrt(), 5.0 / 9.0),
         ];
-        let edges: Vec<f64> = (0..=self.s_bins).map(|k| k as f64 * self.s_bin).collect();
-        let mut cuts = Vec::with_capacity(16);
-        for f in 1..nf.saturating_sub(1) {
-            let x = faces[f];
-            let ix = ((x + shift) / self.r_bin).floor() as usize;
-            let lo_y = (x - reach).max(0.0);
-            let hi_y = x + reach;
-            let s0 = (lo_y / dr).floor() as usize;
-            start[f] = s0;
-            let pre = 3.0 * PI * a / (8.0 * x * x);
-            for kk in 0..bw {
-                let j = s0 + kk;
-                if j >= n {
-                    break;
-                }
-                let lo = faces[j].max(lo_y);
-                let hi = faces[j + 1].min(hi_y);
-                if hi <= lo {
-                    continue;
-                }
-                cuts.clear();
-                cuts.push(lo);
-                // `|x - y|` and `x + y` at an `s` bin edge.
-                for e in &edges {
-                    for c in [x - e, x + e, e - x] {
-                        if c > lo && c < hi {
-                            cuts.push(c);
-                        }
-                    }
-                }
-                // `y + shift` at a radial bin edge.
-                let first = ((lo + shift) / self.r_bin).floor() as usize + 1;
-                let mut b = first;
-                while (b as f64) * self.r_bin - shift < hi {
-                    let c = b as f64 * self.r_bin - shift;
-                    if c > lo {
+        let x = faces[f];
+        let ix = ((x + shift) / self.r_bin).floor() as usize;
+        let lo_y = (x - reach).max(0.0);
+        let hi_y = x + reach;
+        let s0 = (lo_y / dr).floor() as usize;
+        let pre = 3.0 * PI * a / (8.0 * x * x);
+        for (kk, out) in row.iter_mut().enumerate() {
+            let j = s0 + kk;
+            if j >= n {
+                break;
+            }
+            let lo = faces[j].max(lo_y);
+            let hi = faces[j + 1].min(hi_y);
+            if hi <= lo {
+                continue;
+            }
+            cuts.clear();
+            cuts.push(lo);
+            // `|x - y|` and `x + y` at an `s` bin edge.
+            for e in edges {
+                for c in [x - e, x + e, e - x] {
+                    if c > lo && c < hi {
                         cuts.push(c);
                     }
-                    b += 1;
                 }
-                cuts.push(hi);
-                cuts.sort_by(f64::total_cmp);
-                let mut acc = 0.0;
-                for piece in cuts.windows(2) {
-                    let (c, hw) = (0.5 * (piece[0] + piece[1]), 0.5 * (piece[1] - piece[0]));
-                    if hw <= 0.0 {
-                        continue;
-                    }
-                    let iy = ((c + shift) / self.r_bin).floor() as usize;
-                    for (t, w) in gl {
-                        let y = c + hw * t;
-                        acc += w * hw * pre * self.tail(x, y, a, ix, iy);
-                    }
-                }
-                weights[f * bw + kk] = acc;
             }
+            // `y + shift` at a radial bin edge.
+            let mut b = ((lo + shift) / self.r_bin).floor() as usize + 1;
+            while (b as f64) * self.r_bin - shift < hi {
+                let c = b as f64 * self.r_bin - shift;
+                if c > lo {
+                    cuts.push(c);
+                }
+                b += 1;
+            }
+            cuts.push(hi);
+            cuts.sort_by(f64::total_cmp);
+            let mut acc = 0.0;
+            for piece in cuts.windows(2) {
+                let (c, hw) = (0.5 * (piece[0] + piece[1]), 0.5 * (piece[1] - piece[0]));
+                if hw <= 0.0 {
+                    continue;
+                }
+                let iy = ((c + shift) / self.r_bin).floor() as usize;
+                for (t, w) in gl {
+                    let y = c + hw * t;
+                    acc += w * hw * pre * self.tail(x, y, a, ix, iy);
+                }
+            }
+            *out = acc;
         }
-        Ok(RpyKernel::from_banded(bw, start, weights))
+        s0
     }
 
     /// `int w h ds` over `|x - y| < s < x + y` for the radial bins `ix`, `iy` (module docs).
@@ -242,26 +304,41 @@ impl TabulatedPair {
             let hi = (x + y).min(self.diameter);
             return if hi > lo { w_lo - big_w(hi) } else { 0.0 };
         }
-        let hi = (x + y).min(self.s_max());
-        if hi <= lo {
-            return 0.0;
-        }
-        let row = &self.h[(ix * self.r_bins + iy) * self.s_bins..][..self.s_bins];
-        let k0 = ((lo / self.s_bin).floor() as usize).min(self.s_bins - 1);
+        // The core (h = -1 exactly for hard spheres), then the moments beyond contact:
+        // `int_lo^hi w h ds = sum_p c_p [M_p(hi) - M_p(lo)]` with `w = c0 + c1 s^2 + c2' s^-2 +
+        // c4' s^-4` (module docs).
+        let d = self.diameter;
         let mut sum = 0.0;
-        let mut w_lo = w_lo;
-        for (k, hk) in row.iter().enumerate().skip(k0) {
-            let e1 = (k + 1) as f64 * self.s_bin;
-            let top = e1.min(hi);
-            let w_hi = big_w(top);
-            sum += hk * (w_hi - w_lo);
-            if e1 >= hi {
-                break;
-            }
-            w_lo = w_hi;
+        let core_hi = (x + y).min(d);
+        if core_hi > lo {
+            sum -= big_w(core_hi) - w_lo;
+        }
+        let hi = (x + y).min(self.s_max());
+        let from = lo.max(d);
+        if hi > from {
+            let outer = self.s_bins - (d / self.s_bin).round() as usize;
+            let base = (ix * self.r_bins + iy) * (outer + 1);
+            let row = &self.h[(ix * self.r_bins + iy) * self.s_bins..][..self.s_bins];
+            let first = self.s_bins - outer;
+            let at = |s: f64| -> [f64; 4] {
+                let k = (((s - d) / self.s_bin) as usize).min(outer - 1);
+                let e = d + k as f64 * self.s_bin;
+                let (fs, fe) = (power_antiderivatives(s), power_antiderivatives(e));
+                let m = &self.moments[base + k];
+                std::array::from_fn(|p| m[p] + row[first + k] * (fs[p] - fe[p]))
+            };
+            let (mh, ml) = (at(hi), at(from));
+            let c = [c0, -3.0, c2, -3.0 * c4];
+            sum += (0..4).map(|p| c[p] * (mh[p] - ml[p])).sum::<f64>();
         }
         sum
     }
+}
+
+/// Antiderivatives of `s^p`, `p = 0, 2, -2, -4`: `s`, `s^3 / 3`, `-1 / s`, `-1 / (3 s^3)`.
+#[inline]
+fn power_antiderivatives(s: f64) -> [f64; 4] {
+    [s, s * s * s / 3.0, -1.0 / s, -1.0 / (3.0 * s * s * s)]
 }
 
 #[cfg(test)]
