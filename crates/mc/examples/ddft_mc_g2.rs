@@ -11,9 +11,11 @@
 //! [0.5]; `pe` [10]; `dr` [0.02] (DDFT grid, d); `stages` [10]; `warmup` [2000], `sweeps` [4000],
 //! `every` [5] (MC sweeps per stage, sweeps between samples); `r_bin` [0.1], `s_bin` [0.1],
 //! `s_max` [3] (the g2 table, d); `min_pairs` [50]; `range` [8] (trokhymchuk mode's h range);
-//! `seed` [1].
+//! `seed` [1]; `spacing` [phi] = phi | time (stage boundaries equally spaced in ln(mean phi), so
+//! that the dense end, where the density changes fastest, gets as many stages as the start; or
+//! equally in time).
 //!
-//! Modes: `mc` — at the start of each of `stages` equal stretches of the drying time, the
+//! Modes: `mc` — at the start of each of `stages` stages (see `spacing`), the
 //! DDFT's profile `rho(r)` at radius `R_s` is made an equilibrium profile by the potential
 //! `beta U = -ln rho - beta mu_ex[rho]` (Rosenfeld FMT; held at its value where the interface
 //! potential passes 20 kT, plus the interface potential; a hard wall where that reaches 40 kT);
@@ -69,6 +71,8 @@ struct Config {
     min_pairs: f64,
     range: f64,
     seed: u32,
+    /// Stage boundaries equally spaced in ln(mean phi) (else in time).
+    log_phi: bool,
 }
 
 fn fail(msg: String) -> ! {
@@ -94,6 +98,7 @@ fn parse(args: &[String]) -> Config {
         min_pairs: 50.0,
         range: 8.0,
         seed: 1,
+        log_phi: true,
     };
     let mut phi0 = 0.05;
     let mut n = None;
@@ -135,6 +140,13 @@ fn parse(args: &[String]) -> Config {
             "min_pairs" => c.min_pairs = num(0.0, 1e9),
             "range" => c.range = num(2.0, 30.0),
             "seed" => c.seed = num(0.0, u32::MAX as f64) as u32,
+            "spacing" => {
+                c.log_phi = match v {
+                    "phi" => true,
+                    "time" => false,
+                    _ => fail(format!("spacing must be phi or time, got {v:?}")),
+                }
+            }
             _ => fail(format!("unknown key {k:?}")),
         }
     }
@@ -425,7 +437,14 @@ fn main() {
         let mut stage: Option<Stage> = None;
         let mut shift_built = f64::NAN;
         let mut next_stage = 0usize;
-        let boundary = |k: usize| k as f64 / c.stages as f64 * t_end;
+        let boundary = |k: usize| {
+            if c.log_phi {
+                let phi = phi0 * (c.phi_end / phi0).powf(k as f64 / c.stages as f64);
+                schedule.time_at_radius(c.r0 * (phi0 / phi).cbrt())
+            } else {
+                k as f64 / c.stages as f64 * t_end
+            }
+        };
         for pct in 1..=100 {
             let t_out = pct as f64 / 100.0 * t_end;
             while ddft.time() < t_out * (1.0 - 1e-14) {
