@@ -11,10 +11,12 @@ Usage:
       measurement against Eq. 17 (Trokhymchuk's g at the mean packing fraction), in the
       densest bin near the interface and in a bin a third of the way out
   plot_ddft_mc_g2.py bd PICTURE.png DIR=LABEL [DIR=LABEL ...]
-      fractions of the particles beyond 0.7 R(t) and 0.85 R(t) against the drying time, with
-      the BD+RPY droplet of docs/theory-droplet.md (N = 1000, one droplet, binomial errors)
+      fractions of the particles beyond 0.7 R(t) and 0.85 R(t) at 25/50/75/100 % of the drying
+      time (counted as in the table of docs/theory-droplet.md: see outer_fractions), with the
+      BD+RPY droplet of that table (N = 1000, one droplet, binomial errors)
 """
 import csv
+import math
 import os
 import sys
 
@@ -43,21 +45,28 @@ def specs(args):
     return out
 
 
+COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
+STYLES = ["-", "--", "-.", ":", "-", "--"]
+
+
 def profiles(picture, args):
     fracs = [0.25, 0.5, 0.75, 1.0]
     fig, axes = plt.subplots(1, 4, figsize=(15, 3.8), sharey=True)
-    for d, label in specs(args):
+    for i, (d, label) in enumerate(specs(args)):
         for ax, f in zip(axes, fracs):
             p = os.path.join(d, f"profile_{f:.2f}.csv")
             if not os.path.exists(p):
                 continue
             r = rows(p)
-            ax.plot([float(x["r_over_R"]) for x in r], [float(x["phi"]) for x in r], label=label)
+            ax.plot([float(x["r_over_R"]) for x in r], [float(x["phi"]) for x in r], label=label,
+                    color=COLOURS[i % 6], ls=STYLES[i % 6], lw=1.5)
     for ax, f in zip(axes, fracs):
         ax.set_title(f"{100 * f:.0f} % of the drying time")
         ax.set_xlabel("r / R(t)")
     axes[0].set_ylabel("volume fraction")
-    axes[0].legend(fontsize=8)
+    handles = [plt.Line2D([], [], color=COLOURS[i % 6], ls=STYLES[i % 6])
+               for i in range(len(specs(args)))]
+    axes[0].legend(handles, [label for _, label in specs(args)], fontsize=8)
     fig.tight_layout()
     fig.savefig(picture, dpi=110)
 
@@ -72,7 +81,9 @@ def pairs(picture, d, stage):
         return sum(float(x["expected"]) for x in by_r[rr])
 
     outer = max(by_r, key=weight)
-    inner = min(by_r, key=lambda rr: abs(rr - outer / 3))
+    # A bin about a third of the way out among those the Monte Carlo measured.
+    measured = [rr for rr in by_r if sum(1 for x in by_r[rr] if x["h_mc"]) >= 10] or list(by_r)
+    inner = min(measured, key=lambda rr: abs(rr - outer / 3))
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
     for ax, rr in zip(axes, [inner, outer]):
         xs = [x for x in by_r[rr] if float(x["s"]) > 1.0]
@@ -89,17 +100,47 @@ def pairs(picture, d, stage):
     fig.savefig(picture, dpi=110)
 
 
+def outer_fractions(d):
+    """Fractions of the particles beyond 0.7 R(t) and "0.85 R(t)" as the table of
+    docs/theory-droplet.md counts them: 30 equal bins of [0, R(t)], the bins whose centre lies
+    beyond c R(t), normalised by the particles in all 30 bins. For c = 0.85 the bin centred at
+    exactly 0.85 R fell out at 25 and 50 % and in at 75 and 100 % (floating-point rounding), so
+    "0.85" means r > 0.867 R at 25/50 % and r > 0.833 R at 75/100 %; reproduced here so that the
+    DDFT is counted exactly as the BD droplet was (this reproduces that table's Trokhymchuk
+    column to 3 digits)."""
+    fr = {x["fraction"]: x for x in rows(os.path.join(d, "fractions.csv"))}
+    out = {}
+    for f, first85 in [("0.25", 26), ("0.50", 26), ("0.75", 25), ("1.00", 25)]:
+        p = os.path.join(d, f"theory_profile_{f}.csv")
+        if not os.path.exists(p):
+            continue
+        prof = [(float(x["r"]), float(x["rho"])) for x in rows(p)]
+        radius = float(fr[f]["R"])
+        dr = prof[1][0] - prof[0][0]
+        edges = [k * radius / 30 for k in range(31)]
+        counts = [0.0] * 30
+        for r, rho in prof:
+            for k in range(30):
+                a, b = max(r - dr / 2, edges[k]), min(r + dr / 2, edges[k + 1])
+                if b > a:
+                    counts[k] += rho * 4 * math.pi / 3 * (b ** 3 - a ** 3)
+        total = sum(counts)
+        out[float(f)] = (sum(counts[21:]) / total, sum(counts[first85:]) / total)
+    return out
+
+
 def bd(picture, args):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-    for ax, c in zip(axes, [0.7, 0.85]):
+    runs = [(label, outer_fractions(d)) for d, label in specs(args)]
+    for i, (ax, c) in enumerate(zip(axes, [0.7, 0.85])):
         pts = BD[c]
         ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], fmt="ko",
                     label="BD+RPY (one droplet)")
-        for d, label in specs(args):
-            r = rows(os.path.join(d, "fractions.csv"))
-            ax.plot([float(x["fraction"]) for x in r], [float(x[f"beyond_{c}R"]) for x in r],
-                    label=label)
-        ax.set_title(f"particles beyond {c} R(t)")
+        for j, (label, fr) in enumerate(runs):
+            ts = sorted(fr)
+            ax.plot(ts, [fr[t][i] for t in ts], "-s", ms=4, label=label, color=COLOURS[j % 6],
+                    ls=STYLES[j % 6])
+        ax.set_title(f"particles beyond {c} R(t) (binned as in the BD table)")
         ax.set_xlabel("fraction of the drying time")
     axes[0].legend(fontsize=8)
     fig.tight_layout()
