@@ -484,7 +484,7 @@ fn main() {
                 }
                 if let Some(s) = &stage {
                     let shift = s.radius - ddft.radius()?;
-                    if !((shift - shift_built).abs() <= 0.25 * c.r_bin) {
+                    if shift_built.is_nan() || (shift - shift_built).abs() > 0.25 * c.r_bin {
                         let kt = Instant::now();
                         let kern =
                             s.table

@@ -91,7 +91,7 @@ impl RadialPairs {
             (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt()
         }));
         let s_max = self.s_max();
-        self.add(&radii, |f| mc.for_each_pair(s_max, |i, j, r2| f(i, j, r2)));
+        self.add(&radii, |f| mc.for_each_pair(s_max, f));
         self.radii = radii;
     }
 
