@@ -138,7 +138,7 @@ def bd(picture, args):
                     label="BD+RPY (one droplet)")
         for j, (label, fr) in enumerate(runs):
             ts = sorted(fr)
-            ax.plot(ts, [fr[t][i] for t in ts], "-s", ms=4, label=label, color=COLOURS[j % 6],
+            ax.plot(ts, [fr[t][i] for t in ts], marker="s", ms=4, label=label, color=COLOURS[j % 6],
                     ls=STYLES[j % 6])
         ax.set_title(f"particles beyond {c} R(t) (binned as in the BD table)")
         ax.set_xlabel("fraction of the drying time")
