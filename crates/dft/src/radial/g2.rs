@@ -382,6 +382,7 @@ mod tests {
         // h = -1 inside the core, 0 outside: the closed-form dilute kernel. The s integral is
         // exact and the closed form is a quartic in y (Gauss-Legendre exact), so only rounding
         // is left: bound 1e-12 of the largest weight.
+        // Broken on purpose (the `Q^2` term 10 % too large): 1.30 against a scale of 0.098.
         let grid = RadialGrid::new(0.05, 160).unwrap();
         let table = TabulatedPair::from_fn(1.0, 0.37, 30, 0.25, 12, |_, _, _| 0.0).unwrap();
         let k = table.kernel(&grid, 0.0).unwrap();
@@ -398,6 +399,8 @@ mod tests {
     /// `O(ds^2)`. Bound: the Richardson estimate of the fine table's error from two tables
     /// (`|K(d/40) - K(d/80)| / 3`), times 1.5, plus 1e-9 of the largest weight (the reference's own
     /// quadrature); and the ratio of the two errors must be that of second order (3 to 5).
+    /// Measured: 7.7e-4 and 1.9e-4 (largest weight 0.33), ratio 4.0. Broken on purpose: the
+    /// `s^-4` antiderivative with 1/2 for 1/3 gives 0.23, the `Q^2` term 10 % off 0.81.
     #[test]
     fn bulk_trokhymchuk_table_gives_the_trokhymchuk_kernel() {
         let (d, eta, range) = (1.0, 0.3, 3.0);
@@ -439,6 +442,7 @@ mod tests {
     #[test]
     fn shifted_table_reads_the_bins_further_out() {
         // A table read at r + 2 b equals the table whose bins are moved in by two.
+        // Broken on purpose (the y bin read without the shift): 0.054.
         let (d, b) = (1.0, 0.25);
         let grid = RadialGrid::new(0.05, 120).unwrap();
         let hf = |r1: f64, r2: f64, s: f64| 0.3 * (r1 - 2.0 * r2).sin() / s + 0.01 * r1 * r2;
