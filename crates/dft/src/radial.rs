@@ -10,6 +10,7 @@
 //! - [`ddft`]: implicit-Euler DDFT on spherical shells, free-draining or with pairwise RPY flux.
 //! - [`droplet`]: a drying droplet end to end (setup validation, equilibrium start, snapshots).
 //! - [`rpy`]: the radial RPY kernel of the hydrodynamic flux (dilute or Trokhymchuk pair correlation).
+//! - [`g2`]: the RPY kernel of a tabulated inhomogeneous pair correlation `g2(r1, r2, s)`.
 //! - [`pair`]: bulk hard-sphere pair correlation `g(r; eta)` (Trokhymchuk et al. 2005).
 //! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
 //!
@@ -44,6 +45,7 @@ pub mod ddft;
 pub mod droplet;
 pub mod equilibrium;
 pub mod fmt;
+pub mod g2;
 pub mod grid;
 pub mod interface;
 pub mod pair;
@@ -55,9 +57,10 @@ pub use droplet::{
 };
 pub use equilibrium::{Equilibrium, EquilibriumOptions, solve_equilibrium};
 pub use fmt::Rosenfeld;
+pub use g2::TabulatedPair;
 pub use grid::RadialGrid;
 pub use interface::{DryingSchedule, HarmonicInterface};
-pub use rpy::{PairCorrelation, PairTable};
+pub use rpy::{PairCorrelation, PairTable, RpyKernel};
 
 use colloidsim_core::ParamError;
 use thiserror::Error;

@@ -346,7 +346,7 @@ impl Pass {
         let half_side = 0.5 * s;
         let at =
             |u: [f64; 3]| -> [f64; 3] { std::array::from_fn(|a| centre[a] + u[a] - half_side) };
-        let soft = matches!(self.geometry, Geometry::Interface { .. });
+        let soft = self.geometry.is_soft();
         let (mut accepted, mut left) = (0u64, 0u64);
         let range = |u: f64| (usize::from(u >= d), 1 + usize::from(u > s - d));
         for _ in 0..n {

@@ -16,6 +16,53 @@ use colloidsim_md::potential::{External, HarmonicInterface, SphereAreaLaw};
 /// Boltzmann factor of 4e-18, so no sampled configuration can tell.
 pub const INTERFACE_CUT_KT: f64 = 40.0;
 
+/// A tabulated spherically symmetric external potential `beta U(r)` (in kT), linear between the
+/// nodes `r_k = k dr`, with a hard outer wall at `cutoff` (issue #15 item 4: the potential that
+/// makes a DDFT profile the equilibrium one, `beta U = beta mu - ln rho - beta mu_ex[rho]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadialPotential {
+    dr: f64,
+    values: Vec<f64>,
+    cutoff: f64,
+    radius: f64,
+}
+
+impl RadialPotential {
+    /// Nodes `values[k] = beta U(k dr)`; beyond the last node the last value; centres beyond
+    /// `cutoff` are refused; `radius` is the droplet radius of the mean volume fraction
+    /// `N d^3 / (8 R^3)`. Keys in errors: `potential.dr`, `potential.values`, `potential.cutoff`.
+    pub fn new(dr: f64, values: Vec<f64>, cutoff: f64, radius: f64) -> Result<Self, ParamError> {
+        positive("potential.dr", dr)?;
+        positive("potential.cutoff", cutoff)?;
+        positive("system.radius", radius)?;
+        if values.len() < 2 || values.iter().any(|v| !v.is_finite()) {
+            return Err(ParamError::new(
+                "potential.values",
+                format!("needs at least 2 finite values, got {}", values.len()),
+            ));
+        }
+        Ok(Self {
+            dr,
+            values,
+            cutoff,
+            radius,
+        })
+    }
+
+    /// `beta U` at distance `r` from the centre.
+    #[inline]
+    pub fn at(&self, r: f64) -> f64 {
+        let t = r / self.dr;
+        let last = self.values.len() - 1;
+        if t >= last as f64 {
+            return self.values[last];
+        }
+        let k = t as usize;
+        let f = t - k as f64;
+        self.values[k] + f * (self.values[k + 1] - self.values[k])
+    }
+}
+
 /// Where the hard spheres live.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Geometry {
@@ -39,6 +86,13 @@ pub enum Geometry {
         kt: f64,
         /// Largest centre distance from the origin ever accepted.
         cutoff: f64,
+    },
+    /// A tabulated radial potential, sampled by Metropolis on its energy (built once per table
+    /// with [`Geometry::tabulated`], which keeps the table for the rest of the program so that
+    /// the geometry stays `Copy`).
+    Tabulated {
+        /// The potential.
+        potential: &'static RadialPotential,
     },
 }
 
@@ -101,12 +155,30 @@ impl Geometry {
         })
     }
 
+    /// The tabulated geometry of `potential`. The table is leaked (kept until the program ends):
+    /// a few kilobytes per table, for programs that build a handful of them.
+    pub fn tabulated(potential: RadialPotential) -> Self {
+        Geometry::Tabulated {
+            potential: Box::leak(Box::new(potential)),
+        }
+    }
+
+    /// Does a move pay an external energy (Metropolis), beyond the hard constraints?
+    #[inline(always)]
+    pub fn is_soft(&self) -> bool {
+        matches!(
+            self,
+            Geometry::Interface { .. } | Geometry::Tabulated { .. }
+        )
+    }
+
     /// Largest distance of a centre from the origin (`None` in bulk).
     pub fn confinement(&self, diameter: f64) -> Option<f64> {
         match *self {
             Geometry::Bulk { .. } => None,
             Geometry::HardWall { radius } => Some(radius - 0.5 * diameter),
             Geometry::Interface { cutoff, .. } => Some(cutoff),
+            Geometry::Tabulated { potential } => Some(potential.cutoff),
         }
     }
 
@@ -130,15 +202,74 @@ impl Geometry {
             Geometry::Interface { interface, .. } => {
                 4.0 / 3.0 * std::f64::consts::PI * interface.radius.r0.powi(3)
             }
+            Geometry::Tabulated { potential } => {
+                4.0 / 3.0 * std::f64::consts::PI * potential.radius.powi(3)
+            }
         }
     }
 
-    /// Interface energy / kT at distance `r` from the centre (0 unless [`Geometry::Interface`]).
+    /// External energy / kT at position `r` (0 unless [`Geometry::Interface`] or
+    /// [`Geometry::Tabulated`]).
     #[inline(always)]
     pub fn beta_energy(&self, r: [f64; 3]) -> f64 {
         match self {
             Geometry::Interface { interface, kt, .. } => interface.energy(r, 0.0) / kt,
+            Geometry::Tabulated { potential } => {
+                potential.at((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt())
+            }
             _ => 0.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{HardSphereMc, McParams, init};
+
+    /// Nearly ideal spheres (N = 10, d = 0.1 in a ball of radius 1: centre packing 0.005) in the
+    /// tabulated `beta U = 2 r` (nodes every 0.25, exact under linear interpolation): the
+    /// fraction of centres within r < 0.5 is the Boltzmann one,
+    /// `int_0^0.5 r^2 e^{-2r} / int_0^1 r^2 e^{-2r} = 0.248` (uniform: 0.125), within 4 standard
+    /// errors of 20 blocks of 1000 sweeps after 1000 of warm-up (measured 0.2425 +- 0.0086; 40
+    /// blocks with another seed 0.2472 +- 0.0076). Broken on purpose (the tabulated geometry not
+    /// treated as soft: no Metropolis step): 0.113 +- 0.006, fails.
+    #[test]
+    fn tabulated_potential_samples_its_boltzmann_distribution() {
+        let dr = 0.25;
+        let values: Vec<f64> = (0..=4).map(|k| 2.0 * k as f64 * dr).collect();
+        let potential = RadialPotential::new(dr, values, 1.0, 1.0).unwrap();
+        assert!((potential.at(0.3) - 0.6).abs() < 1e-12);
+        assert_eq!(potential.at(10.0), 2.0);
+        let params = McParams {
+            diameter: 0.1,
+            geometry: Geometry::tabulated(potential),
+            seed: 5,
+            delta: 0.05,
+        };
+        let start = init::fcc_in_sphere(10, 0.1, 0.95).unwrap();
+        let mut mc = HardSphereMc::new(&params, &start, "system.initial").unwrap();
+        mc.warm_up(1000, 100, 0.4);
+        let mut blocks = Vec::new();
+        for _ in 0..20 {
+            let (mut inside, mut total) = (0usize, 0usize);
+            for _ in 0..100 {
+                mc.run(10);
+                for i in 0..mc.len() {
+                    let p = mc.position(i);
+                    let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                    assert!(r <= 1.0 + 1e-12);
+                    inside += usize::from(r < 0.5);
+                    total += 1;
+                }
+            }
+            blocks.push(inside as f64 / total as f64);
+        }
+        let (f, se) = crate::observe::mean_and_error(&blocks);
+        // int_0^x r^2 e^{-2r} dr = 1/4 - e^{-2x} (x^2/2 + x/2 + 1/4).
+        let cum = |x: f64| 0.25 - (-2.0 * x).exp() * (0.5 * x * x + 0.5 * x + 0.25);
+        let p = cum(0.5) / cum(1.0);
+        println!("fraction within r < 0.5: {f:.4} +- {se:.4} vs {p:.4}");
+        assert!((f - p).abs() < 4.0 * se, "{f} +- {se} vs {p}");
     }
 }

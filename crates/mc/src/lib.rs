@@ -9,6 +9,8 @@
 //! - [`init`]: lattice starting configurations (melted by the warm-up).
 //! - [`observe`]: pair-distance and radial histograms, contact values extrapolated to contact,
 //!   block-average errors, the Carnahan–Starling reference.
+//! - [`radial_pairs`]: the droplet's two-body density in the `(r1, r2, s)` bins of the DDFT's RPY
+//!   flux kernel (issue #15 item 4).
 //! - [`scenario`]: the `method = "hs-mc"` scenario and its validation.
 //! - [`bench`]: trial moves per second (`colloidsim bench mc`).
 //!
@@ -19,7 +21,8 @@ pub mod engine;
 pub mod geometry;
 pub mod init;
 pub mod observe;
+pub mod radial_pairs;
 pub mod scenario;
 
 pub use engine::{HardSphereMc, McError, McParams, SweepStats};
-pub use geometry::Geometry;
+pub use geometry::{Geometry, RadialPotential};

@@ -255,6 +255,39 @@ impl Ddft {
         self.active
     }
 
+    /// Replace the RPY kernel (e.g. one of [`super::g2::TabulatedPair::kernel`] for the current
+    /// stage of a drying run); only with [`Hydrodynamics::Rpy`] and a kernel of this grid.
+    pub fn set_rpy_kernel(&mut self, kernel: RpyKernel) -> Result<(), RadialError> {
+        if self.rpy.is_none() || kernel.faces() != self.grid.len() + 1 {
+            return Err(colloidsim_core::ParamError::new(
+                "theory.hydrodynamics",
+                format!(
+                    "an RPY kernel of {} faces needs RPY hydrodynamics on a grid of {} cells",
+                    kernel.faces(),
+                    kernel.faces().saturating_sub(1)
+                ),
+            )
+            .into());
+        }
+        self.rpy = Some(kernel);
+        Ok(())
+    }
+
+    /// Droplet radius `R(t)` at the current time.
+    pub fn radius(&self) -> Result<f64, RadialError> {
+        self.schedule.radius(self.t)
+    }
+
+    /// `beta mu_ex[rho](r)` of the current density at the cell centres (active cells; 0 beyond).
+    pub fn excess_chemical_potential(&mut self) -> Result<Vec<f64>, RadialError> {
+        self.fmt
+            .evaluate(&self.rho, self.active)
+            .map_err(|e| self.at_time(e))?;
+        let mut v = self.fmt.mu_ex().to_vec();
+        v[self.active..].iter_mut().for_each(|x| *x = 0.0);
+        Ok(v)
+    }
+
     /// Local packing fraction `n3` of the current density at the cell centres.
     pub fn packing_fraction(&mut self) -> Result<Vec<f64>, RadialError> {
         self.fmt

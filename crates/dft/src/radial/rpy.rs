@@ -230,6 +230,25 @@ impl RpyKernel {
         .expect("the dilute kernel has no parameters to refuse")
     }
 
+    /// A kernel given as banded weights: row `f` (face `f`) holds `bw` cell integrals starting at
+    /// cell `start[f]` (`weights[f * bw + k]`, the dilute layout), as built by
+    /// [`super::g2::TabulatedPair::kernel`].
+    pub(super) fn from_banded(bw: usize, start: Vec<usize>, weights: Vec<f64>) -> Self {
+        debug_assert_eq!(start.len() * bw, weights.len());
+        Self {
+            bw,
+            nodes: 1,
+            rho_to_node: 0.0,
+            start,
+            weights,
+        }
+    }
+
+    /// Number of faces the kernel was built for (cells + 1).
+    pub fn faces(&self) -> usize {
+        self.start.len()
+    }
+
     /// The bytes [`Self::with_pair`] will hold.
     pub fn memory_bytes(
         grid: &RadialGrid,
@@ -367,7 +386,7 @@ impl RpyKernel {
     pub fn velocities(&self, g: &[f64], rho: &[f64], active: usize, out: &mut [f64]) {
         out[0] = 0.0;
         out[active] = 0.0;
-        if self.nodes == 1 {
+        if self.nodes == 1 && self.bw * active < 100_000 {
             for f in 1..active {
                 out[f] = self.face_velocity(f, g, rho, active);
             }
