@@ -488,11 +488,16 @@ impl Sticky {
         })
     }
 
-    /// Largest |f| over the range, found on a fine grid (for the time-step criterion Eq. 34).
+    /// Largest |f| over the range (for the time-step criterion Eq. 34), in closed form: with
+    /// `u = eps + sigma - r` and `A = eps^(p+1) / (p+1)`, `|f| = kT gamma p u^(p-1) / (A + gamma u^p)`
+    /// is largest where `gamma u^p = (p - 1) A`, with the value `kT gamma u^(p-1) / A`, or at the
+    /// contact `u = eps` when that point lies beyond it. The hard-rods paper's Fig. 5(b): at
+    /// `eps = 0.05`, `gamma = 1` it is smallest for `p = 2.95`.
     pub fn max_force(&self) -> f64 {
-        (0..=4000)
-            .map(|i| self.force(self.sigma + self.eps * i as f64 / 4000.0).abs())
-            .fold(0.0, f64::max)
+        let (p, eps) = (self.order, self.eps);
+        let a = eps.powf(p + 1.0) / (p + 1.0);
+        let u = ((p - 1.0) * a / self.gamma).powf(1.0 / p).min(eps);
+        self.kt * self.gamma * p * u.powf(p - 1.0) / (a + self.gamma * u.powf(p))
     }
 }
 
@@ -642,6 +647,43 @@ impl<A: PairForce, B: PairForce> PairForce for PairSum<A, B> {
 mod tests {
     use super::*;
     use colloidsim_core::field1d::FieldTerm;
+
+    /// The closed-form maximum of the sticky force equals a fine scan of Eq. 33, and (the
+    /// hard-rods paper's Fig. 5b) over the order p it is smallest at p = 2.95 for eps = 0.05,
+    /// gamma = 1, at 136.78 kT per unit length; at eps = 0.1 the best order is 2.46 instead.
+    #[test]
+    fn sticky_force_maximum_is_smallest_at_p_2_95() {
+        let sticky = |p: f64, eps: f64| Sticky::new(1.0, eps, p, 0.2, 1.0).unwrap();
+        for (p, eps) in [(1.5, 0.05), (2.95, 0.05), (6.0, 0.05), (3.0, 0.1)] {
+            let st = sticky(p, eps);
+            let scan = (0..=200_000)
+                .map(|i| st.force(0.2 + eps * i as f64 / 200_000.0).abs())
+                .fold(0.0, f64::max);
+            let exact = st.max_force();
+            assert!(
+                exact >= scan && exact - scan < 1e-6 * exact,
+                "p {p}: {exact} vs {scan}"
+            );
+        }
+        // Golden-section search for the order with the smallest maximum.
+        let best = |eps: f64| {
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let (mut a, mut b) = (1.1, 10.0);
+            for _ in 0..100 {
+                let (c, d) = (b - g * (b - a), a + g * (b - a));
+                if sticky(c, eps).max_force() < sticky(d, eps).max_force() {
+                    b = d;
+                } else {
+                    a = c;
+                }
+            }
+            0.5 * (a + b)
+        };
+        let p = best(0.05);
+        assert!((p - 2.95).abs() < 0.01, "best order {p}");
+        assert!((sticky(p, 0.05).max_force() - 136.78).abs() < 0.01);
+        assert!((best(0.1) - 2.46).abs() < 0.01, "eps 0.1: {}", best(0.1));
+    }
 
     #[test]
     fn table_matches_exact_cosine_force() {

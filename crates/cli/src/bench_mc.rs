@@ -7,16 +7,19 @@ use std::time::Instant;
 /// Arguments of `colloidsim bench mc`.
 #[derive(clap::Args)]
 pub struct BenchArgs {
-    /// Number of spheres (an FCC lattice of 4 m^3 sites is filled evenly).
-    #[arg(long, default_value_t = 10_976)]
-    pub n: usize,
+    /// Numbers of spheres (FCC lattices of 4 m^3 sites are filled evenly): a droplet-sized
+    /// system, where the two parallel passes per sweep dominate, and a larger one.
+    #[arg(long, value_delimiter = ',', default_value = "10976,87808")]
+    pub n: Vec<usize>,
     /// Volume fractions to measure.
     #[arg(long, value_delimiter = ',', default_value = "0.3,0.5")]
     pub phi: Vec<f64>,
-    /// Timed sweeps (N trial moves each) per measurement.
+    /// Timed sweeps (N trial moves each) per measurement at N = 10,976; scaled by 10,976 / N
+    /// for other N (at least 10), so every measurement makes about the same number of moves.
     #[arg(long, default_value_t = 200)]
     pub sweeps: u64,
-    /// Warm-up sweeps before timing (delta tuned every 100 towards acceptance 0.3, then frozen).
+    /// Warm-up sweeps before timing at N = 10,976 (delta tuned every 100 towards acceptance
+    /// 0.3, then frozen); scaled like `--sweeps` (at least 300).
     #[arg(long, default_value_t = 1000)]
     pub warmup: u64,
     /// Repetitions per case, alternating the thread counts; the median is reported.
@@ -33,12 +36,12 @@ pub struct BenchArgs {
 /// time, medians, and the speed-up over the first thread count.
 pub fn bench(a: &BenchArgs) -> Result<()> {
     println!(
-        "# colloidsim bench mc: hard spheres d = 1, N = {}, periodic cube, checkerboard cells; {} sweeps per run, median (min-max) of {}",
-        a.n, a.sweeps, a.repeats
+        "# colloidsim bench mc: hard spheres d = 1, periodic cube, cells updated in two parallel passes of z layers; {} sweeps per run at N = 10976 (scaled by 10976/N), median (min-max) of {}",
+        a.sweeps, a.repeats
     );
     println!("# cpu_rate: trial moves per second of CPU time (user + system, all threads)");
     println!(
-        "phi\tthreads\tmoves_per_s\tmin\tmax\tcpu_rate\tacceptance\tdelta\tleft_cell\tspeedup"
+        "n\tphi\tthreads\tmoves_per_s\tmin\tmax\tcpu_rate\tacceptance\tdelta\tleft_cell\tspeedup"
     );
     let pools = a
         .threads
@@ -50,8 +53,10 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .context("thread pool")
         })
         .collect::<Result<Vec<_>>>()?;
-    for &phi in &a.phi {
-        let warm = colloidsim_mc::bench::bulk_system(a.n, phi, 1, a.warmup)?;
+    for (&n, &phi) in a.n.iter().flat_map(|n| a.phi.iter().map(move |p| (n, p))) {
+        let scale = |sweeps: u64, least: u64| (sweeps * 10_976 / n.max(1) as u64).max(least);
+        let (sweeps, warmup) = (scale(a.sweeps, 10), scale(a.warmup, 300));
+        let warm = colloidsim_mc::bench::bulk_system(n, phi, 1, warmup)?;
         let mut rates = vec![Vec::new(); pools.len()];
         let mut cpu_rates = vec![Vec::new(); pools.len()];
         let mut stats = vec![Default::default(); pools.len()];
@@ -60,7 +65,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 let mut mc = warm.clone();
                 let c0 = cpu_seconds();
                 let start = Instant::now();
-                let s: colloidsim_mc::SweepStats = pool.install(|| mc.run(a.sweeps));
+                let s: colloidsim_mc::SweepStats = pool.install(|| mc.run(sweeps));
                 let wall = start.elapsed().as_secs_f64();
                 let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
                 rates[k].push(s.trials as f64 / wall);
@@ -75,7 +80,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             let base = *first.get_or_insert(m);
             let s: colloidsim_mc::SweepStats = stats[k];
             println!(
-                "{phi}\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{:.3}\t{:.4}\t{:.3}\t{:.2}",
+                "{n}\t{phi}\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{:.3}\t{:.4}\t{:.3}\t{:.2}",
                 s.acceptance(),
                 warm.delta(),
                 s.left_cell as f64 / s.trials as f64,

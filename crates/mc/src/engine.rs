@@ -1,5 +1,5 @@
-//! The hard-sphere NVT Monte Carlo engine: single-particle displacement moves on a checkerboard
-//! of cells.
+//! The hard-sphere NVT Monte Carlo engine: single-particle displacement moves on a grid of
+//! cells, updated layer by layer in parallel.
 //!
 //! # Algorithm
 //!
@@ -7,34 +7,40 @@
 //! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` even (at least 2).
 //! A sweep is:
 //!
-//! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the eight colours
-//!    `(ix mod 2, iy mod 2, iz mod 2)` from the stream `(seed, sweep, Moves, 0)`;
-//! 2. bin every particle (in particle order) into the shifted grid, storing its position
-//!    relative to its cell's corner;
-//! 3. for each colour in turn, every cell of that colour (concurrently, with rayon) makes as many
-//!    trial moves as it holds particles: pick one of its particles uniformly, displace it
-//!    uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre leaves the
-//!    cell, leaves the container, or overlaps any sphere, and (interface geometry) accept it
-//!    with the Metropolis probability `min(1, exp(-beta dV))`. Cells of one colour are a cell
-//!    apart, `s >= d`, so a sphere moving inside one can touch only spheres of its own cell and of
-//!    its 26 neighbours, which belong to other colours and stay fixed during the colour's pass;
+//! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the two parities of
+//!    the z layers (even `iz`, odd `iz`) from the stream `(seed, sweep, Moves, 0)`;
+//! 2. bin every particle into the shifted grid (a parallel counting sort that keeps particle
+//!    order within each cell), storing its position relative to its cell's corner;
+//! 3. for each parity in turn, every layer of that parity (concurrently, with rayon, one task per
+//!    layer) visits its `nc^2` cells in storage order, and each cell makes as many trial moves as
+//!    it holds particles: pick one of its particles uniformly, displace it uniformly in the cube
+//!    `[-delta, delta)^3`, reject the move if the new centre leaves the cell, leaves the
+//!    container, or overlaps any sphere, and (interface geometry) accept it with the Metropolis
+//!    probability `min(1, exp(-beta dV))`. Layers of one parity are a layer apart, `s >= d`, so
+//!    a sphere moving in one can touch only spheres of its own layer (updated in turn by the same
+//!    task) and of the two layers beside it, which have the other parity and stay fixed during
+//!    the pass;
 //! 4. write the positions back in particle order.
 //!
-//! This is the checkerboard scheme of Anderson, Jankowski, Grubb, Engel, Glotzer, J. Comput.
-//! Phys. 254, 27 (2013) (HOOMD-blue HPMC on GPUs). Each elementary move keeps detailed balance
-//! with respect to the hard-sphere Boltzmann distribution: with the grid fixed, the number of
-//! particles in a cell does not change during its pass, so the pick is symmetric; the
-//! displacement is symmetric; moves out of the cell are rejected in both directions. The sweep
-//! is a composition of such moves (balance holds), and the random offset and colour order make
-//! it ergodic. A sweep makes exactly N trial moves.
+//! This is a domain form of the checkerboard scheme of Anderson, Jankowski, Grubb, Engel,
+//! Glotzer, J. Comput. Phys. 254, 27 (2013) (HOOMD-blue HPMC): two colours of whole layers
+//! instead of eight colours of cells, so a sweep has two parallel passes instead of eight, and
+//! a task's work is a whole layer. Each elementary move keeps detailed balance with respect to
+//! the hard-sphere Boltzmann distribution: with the grid fixed, the number of particles in a
+//! cell does not change during the sweep, so the pick is symmetric; the displacement is
+//! symmetric; moves out of the cell are rejected in both directions. The sweep is a composition
+//! of such moves (balance holds), and the random offset and parity order make it ergodic. A
+//! sweep makes exactly N trial moves.
 //!
-//! Random numbers: cell `c` draws from the stream `(seed, sweep, Moves, 1 + c)`, so a run is a
-//! pure function of its seed and the result does not depend on the number of threads.
+//! Random numbers: layer `k` of parity `p` draws from the stream `(seed, sweep, Moves,
+//! 1 + p nc/2 + k)`, so a run is a pure function of its seed and the result does not depend on
+//! the number of threads.
 //!
 //! Memory: positions live twice, in particle order (`pos`, structure of arrays) and in the cell
-//! slots (`slot`, fixed capacity per cell, colours stored one after another so that a colour's
-//! cells are one contiguous mutable range while the other colours are read-only). Nothing is
-//! allocated per move or per sweep (only when a cell overflows its capacity, which grows).
+//! slots (`slot`, fixed capacity per cell, the even layers stored before the odd ones so that a
+//! parity's layers are one contiguous mutable range while the other parity is read-only). Per
+//! particle the binning keeps only its cell and slot. Nothing is allocated per move or per
+//! sweep (only when a cell overflows its capacity, which grows).
 
 use crate::geometry::Geometry;
 use colloidsim_core::ParamError;
@@ -162,6 +168,10 @@ struct Pass {
     seed: u32,
     sweep: u64,
     offset: [f64; 3],
+    /// Distance of the box's lower face from the shifted grid's origin, per axis
+    /// (`L/2 - offset`), and `1/s`.
+    shift: [f64; 3],
+    inv_side: f64,
     geometry: Geometry,
     /// Squared largest centre distance from the droplet centre (infinite in bulk).
     confine2: f64,
@@ -180,23 +190,45 @@ fn below(bits: u64, n: usize) -> usize {
 }
 
 impl Pass {
-    /// Grid coordinates of cell `k` of colour `colour`.
+    /// Grid coordinates of the cell with storage index `id` (see [`Self::id`]).
     #[inline(always)]
-    fn coords(&self, colour: usize, k: usize) -> [usize; 3] {
-        let h = self.half;
-        [
-            2 * (k % h) + (colour & 1),
-            2 * ((k / h) % h) + ((colour >> 1) & 1),
-            2 * (k / (h * h)) + (colour >> 2),
-        ]
+    fn coords(&self, id: usize) -> [usize; 3] {
+        let (nc, h) = (self.nc, self.half);
+        let layer = id / (nc * nc);
+        [id % nc, (id / nc) % nc, 2 * (layer % h) + layer / h]
     }
 
-    /// Storage index of the cell at grid coordinates `c` (colour-major).
+    /// Storage index of the cell at grid coordinates `c`: layer by layer along z, the even
+    /// layers first, each layer row by row (`(parity h + iz / 2) nc^2 + iy nc + ix`).
     #[inline(always)]
     fn id(&self, c: [usize; 3]) -> usize {
-        let h = self.half;
-        let colour = (c[0] & 1) | ((c[1] & 1) << 1) | ((c[2] & 1) << 2);
-        colour * h * h * h + ((c[2] >> 1) * h + (c[1] >> 1)) * h + (c[0] >> 1)
+        let (nc, h) = (self.nc, self.half);
+        ((c[2] & 1) * h + (c[2] >> 1)) * nc * nc + c[1] * nc + c[0]
+    }
+
+    /// The shifted grid's cell index along axis `a` of the coordinate `x` (relative to the box
+    /// centre, in `[-L/2, L/2)`), the position relative to that cell's lower face (in
+    /// `[0, s]`), and the face's coordinate. The binning and the write-back both call it on the
+    /// same inputs, so they agree to the bit.
+    #[inline(always)]
+    fn locate(&self, x: f64, a: usize) -> (usize, f64, f64) {
+        let mut t = x + self.shift[a];
+        if t < 0.0 {
+            t += self.edge;
+        }
+        let j = ((t * self.inv_side) as usize).min(self.nc - 1);
+        let face = j as f64 * self.side;
+        (j, (t - face).clamp(0.0, self.side), face - self.shift[a])
+    }
+
+    /// The cell (storage index) of the point `(x, y, z)` and its position relative to the
+    /// cell's corner.
+    #[inline(always)]
+    fn bin(&self, x: f64, y: f64, z: f64) -> (usize, [f64; 3]) {
+        let (jx, ux, _) = self.locate(x, 0);
+        let (jy, uy, _) = self.locate(y, 1);
+        let (jz, uz, _) = self.locate(z, 2);
+        (self.id([jx, jy, jz]), [ux, uy, uz])
     }
 
     /// Position of the centre of the cell at grid coordinates `c` relative to the box centre
@@ -212,20 +244,21 @@ impl Pass {
         })
     }
 
-    /// The trial moves of one row of active cells: the `h = nc/2` cells of colour `colour` with
-    /// row index `row` (`= kz h + ky`), whose slots are `own`; one random stream per row,
-    /// `(seed, sweep, Moves, 1 + colour h^2 + row)`. Returns (accepted, left their cell).
-    fn row_moves(
+    /// The trial moves of one active layer: the `k`-th layer of parity `parity` (grid layer
+    /// `iz = 2 k + parity`), whose `nc^2` cells' slots are `layer`, cell after cell in storage
+    /// order; one random stream per layer, `(seed, sweep, Moves, 1 + parity h + k)`. Returns
+    /// (accepted, left their cell).
+    fn layer_moves(
         &self,
-        colour: usize,
-        row: usize,
-        own: [&mut [f64]; 3],
+        parity: usize,
+        k: usize,
+        layer: [&mut [f64]; 3],
         counts: &[u32],
         frozen: &Frozen<'_>,
     ) -> (u64, u64) {
         let (h, nc, cap) = (self.half, self.nc, self.cap);
-        let first = colour * h * h * h + row * h;
-        if counts[first..first + h].iter().all(|&c| c == 0) {
+        let first = (parity * h + k) * nc * nc;
+        if counts[first..first + nc * nc].iter().all(|&c| c == 0) {
             return (0, 0);
         }
         let around = |i: usize| {
@@ -235,60 +268,66 @@ impl Pass {
                 if i + 1 == nc { 0 } else { i + 1 },
             ]
         };
-        let ys = around(2 * (row % h) + ((colour >> 1) & 1));
-        let zs = around(2 * (row / h) + (colour >> 2));
+        let zs = around(2 * k + parity);
         let mut rng = stream(
             self.seed,
             self.sweep,
             Purpose::Moves,
-            1 + (colour * h * h + row) as u64,
+            1 + (parity * h + k) as u64,
         );
-        let [ox, oy, oz] = own;
+        let [mut lx, mut ly, mut lz] = layer;
         let (mut accepted, mut left) = (0, 0);
-        for kx in 0..h {
-            let n = counts[first + kx] as usize;
-            if n == 0 {
-                continue;
+        for iy in 0..nc {
+            let ys = around(iy);
+            for ix in 0..nc {
+                let n = counts[first + iy * nc + ix] as usize;
+                if n == 0 {
+                    continue;
+                }
+                let xs = around(ix);
+                let (a, l) = self.cell_moves(
+                    [&xs, &ys, &zs],
+                    [&mut lx, &mut ly, &mut lz],
+                    first * cap,
+                    n,
+                    counts,
+                    frozen,
+                    &mut rng,
+                );
+                accepted += a;
+                left += l;
             }
-            let xs = around(2 * kx + (colour & 1));
-            let cell = kx * cap..(kx + 1) * cap;
-            let (a, l) = self.cell_moves(
-                [xs[1], ys[1], zs[1]],
-                [&xs, &ys, &zs],
-                [&mut ox[cell.clone()], &mut oy[cell.clone()], &mut oz[cell]],
-                n,
-                counts,
-                frozen,
-                &mut rng,
-            );
-            accepted += a;
-            left += l;
         }
         (accepted, left)
     }
 
-    /// The trial moves of one active cell at grid coordinates `c` (`around`: the grid
-    /// coordinates below, at and above it along each axis, wrapped): as many as it holds
-    /// particles (`own`: its `cap` slots, positions relative to its corner, the `n` occupied
-    /// ones first and [`EMPTY`] beyond). Returns (accepted, left the cell).
+    /// The trial moves of one active cell (`around`: the grid coordinates below, at and above
+    /// it along each axis, wrapped): as many as it holds particles. `layer` holds the slots of
+    /// its layer, whose first slot has global index `layer_base`: the cell's own `cap` slots
+    /// (positions relative to its corner, the `n` occupied ones first and [`EMPTY`] beyond)
+    /// and those of its eight neighbours in the layer, which the same task updates in turn; the
+    /// neighbours above and below are read from `frozen`. Returns (accepted, left the cell).
     ///
     /// A move to `u` can touch only the neighbour cells within `d` of `u`: along each axis the
     /// lower one when `u < d`, the upper one when `u > s - d` (with `s >= 2 d` about 7 of the
     /// 27 cells). Each is scanned over all its slots (empty ones hold [`EMPTY`], far from
     /// everything), a fixed-length loop that vectorises and never mispredicts its end.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn cell_moves(
         &self,
-        c: [usize; 3],
         around: [&[usize; 3]; 3],
-        own: [&mut [f64]; 3],
+        layer: [&mut [f64]; 3],
+        layer_base: usize,
         n: usize,
         counts: &[u32],
         frozen: &Frozen<'_>,
         rng: &mut impl Rng,
     ) -> (u64, u64) {
-        let [ox, oy, oz] = own;
+        let [lx, ly, lz] = layer;
         let (s, cap, d) = (self.side, self.cap, self.d2.sqrt());
+        let c = [around[0][1], around[1][1], around[2][1]];
+        let own = self.id(c) * cap - layer_base;
         // Slots of the 27 cells around (index 9 dz + 3 dy + dx, own cell at 13), and whether
         // each holds anyone.
         let mut base = [0usize; 27];
@@ -311,12 +350,12 @@ impl Pass {
         let (mut accepted, mut left) = (0u64, 0u64);
         let range = |u: f64| (usize::from(u >= d), 1 + usize::from(u > s - d));
         for _ in 0..n {
-            let p = below(rng.next_u64(), n);
+            let p = own + below(rng.next_u64(), n);
             let step = |b: u64| self.delta * (2.0 * unit(b) - 1.0);
             let new = [
-                ox[p] + step(rng.next_u64()),
-                oy[p] + step(rng.next_u64()),
-                oz[p] + step(rng.next_u64()),
+                lx[p] + step(rng.next_u64()),
+                ly[p] + step(rng.next_u64()),
+                lz[p] + step(rng.next_u64()),
             ];
             if !new.iter().all(|&u| (0.0..s).contains(&u)) {
                 left += 1;
@@ -328,8 +367,8 @@ impl Pass {
             }
             // The own cell, without p itself.
             let mut hit = false;
-            for q in 0..len[13] {
-                let (a, b, cc) = (new[0] - ox[q], new[1] - oy[q], new[2] - oz[q]);
+            for q in own..own + len[13] {
+                let (a, b, cc) = (new[0] - lx[q], new[1] - ly[q], new[2] - lz[q]);
                 hit |= (a * a + b * b + cc * cc < self.d2) & (q != p);
             }
             let (xr, yr, zr) = (range(new[0]), range(new[1]), range(new[2]));
@@ -343,7 +382,12 @@ impl Pass {
                         if k == 13 || len[k] == 0 {
                             continue;
                         }
-                        let [x, y, z] = frozen.cell(base[k], len[k]);
+                        let [x, y, z] = if dz == 1 {
+                            let b = base[k] - layer_base..base[k] - layer_base + len[k];
+                            [&lx[b.clone()], &ly[b.clone()], &lz[b]]
+                        } else {
+                            frozen.cell(base[k], len[k])
+                        };
                         // The sphere's position relative to our corner is its own plus the
                         // offset of its cell; move the offset to the trial position instead.
                         let q = [
@@ -360,14 +404,14 @@ impl Pass {
             }
             if soft {
                 let du = self.geometry.beta_energy(r)
-                    - self.geometry.beta_energy(at([ox[p], oy[p], oz[p]]));
+                    - self.geometry.beta_energy(at([lx[p], ly[p], lz[p]]));
                 if du > 0.0 && unit(rng.next_u64()) >= (-du).exp() {
                     continue;
                 }
             }
-            ox[p] = new[0];
-            oy[p] = new[1];
-            oz[p] = new[2];
+            lx[p] = new[0];
+            ly[p] = new[1];
+            lz[p] = new[2];
             accepted += 1;
         }
         (accepted, left)
@@ -413,13 +457,23 @@ pub struct HardSphereMc {
     tag: Vec<u32>,
     /// Grid offset of the current binning.
     offset: [f64; 3],
-    /// Per particle: its cell, its slot, its position relative to the cell's corner, and the
-    /// corner (scratch of the binning, kept to avoid allocating per sweep).
+    /// Per particle: its cell and its slot (scratch of the binning, kept to avoid allocating
+    /// per sweep).
     cell_of: Vec<u32>,
     slot_of: Vec<u32>,
-    local: [Vec<f64>; 3],
-    corner: [Vec<f64>; 3],
+    /// Scratch of the parallel binning: per part and cell, the part's count and its running
+    /// count; per cell, the running count of the cell's filler.
+    part_count: Vec<u32>,
+    part_seen: Vec<u32>,
+    cell_seen: Vec<u32>,
+    /// Per part, its particles grouped by the range of cells they fall in, and where each
+    /// range's group ends.
+    bucket: Vec<u32>,
+    bucket_end: Vec<u32>,
 }
+
+/// Fewest particles per part of the parallel binning.
+const REBIN_PART_MIN: usize = 1024;
 
 /// Smallest cell side, in diameters (see [`HardSphereMc::new`]).
 const CELL_MIN: f64 = 2.0;
@@ -491,8 +545,11 @@ impl HardSphereMc {
             offset: [0.0; 3],
             cell_of: vec![0; n],
             slot_of: vec![0; n],
-            local: std::array::from_fn(|_| vec![0.0; n]),
-            corner: std::array::from_fn(|_| vec![0.0; n]),
+            part_count: Vec::new(),
+            part_seen: Vec::new(),
+            cell_seen: vec![0; nc_cells],
+            bucket: Vec::new(),
+            bucket_end: Vec::new(),
         };
         mc.delta = mc.delta.min(mc.max_delta());
         let max = params.geometry.confinement(d);
@@ -631,76 +688,149 @@ impl HardSphereMc {
             seed: self.seed,
             sweep: self.sweep,
             offset: self.offset,
+            shift: self.offset.map(|o| 0.5 * self.edge - o),
+            inv_side: 1.0 / self.side,
             geometry: self.geometry,
             confine2: confine.map_or(f64::INFINITY, |r| r * r),
         }
     }
 
-    /// Bin every particle into the grid shifted by `offset` (particle order), growing the cell
-    /// capacity when a cell overflows.
+    /// Bin every particle into the grid shifted by `offset`, growing the cell capacity when a
+    /// cell overflows. A parallel counting sort that keeps particle order within each cell, so
+    /// the slots do not depend on the number of threads:
+    ///
+    /// 1. parts of the particle range (one per thread), in parallel: each particle's cell, the
+    ///    part's count per cell, and the part's particles grouped by the range of cells (one
+    ///    range per part) they fall in;
+    /// 2. serially, per cell: the total over parts (`count`), the capacity check;
+    /// 3. in parallel, two jobs side by side: each part writes its particles' slot indices
+    ///    (the cell's first slot, plus the counts of the earlier parts in that cell, plus its own
+    ///    running count), while each range of cells fills its own slots from its group of every
+    ///    part in turn (so in particle order), binning each particle again for its position in
+    ///    the cell, and pads each cell to a whole vector with [`EMPTY`].
+    ///
+    /// Per particle only its cell and slot are stored; the write-back ([`Self::scatter`])
+    /// finds the cell's corner again from the position it binned.
     fn rebin(&mut self, offset: [f64; 3]) {
         self.offset = offset;
-        let (l, s, nc) = (self.edge, self.side, self.nc);
         let pass = self.pass();
-        let locate = |x: f64, a: usize| -> (usize, f64, f64) {
-            let mut t = x + 0.5 * l - offset[a];
-            if t < 0.0 {
-                t += l;
-            }
-            let j = ((t / s) as usize).min(nc - 1);
-            let u = (t - j as f64 * s).clamp(0.0, s);
-            (j, u, -0.5 * l + offset[a] + j as f64 * s)
-        };
-        // In parallel: each particle's cell, its position relative to the cell's corner, and
-        // the corner (for the write-back).
-        let [px, py, pz] = &self.pos;
-        let [lx, ly, lz] = &mut self.local;
-        let [cx, cy, cz] = &mut self.corner;
-        self.cell_of
-            .par_iter_mut()
-            .zip(
-                lx.par_iter_mut()
-                    .zip(ly.par_iter_mut())
-                    .zip(lz.par_iter_mut()),
-            )
-            .zip(
-                cx.par_iter_mut()
-                    .zip(cy.par_iter_mut())
-                    .zip(cz.par_iter_mut()),
-            )
-            .enumerate()
-            .with_min_len(1024)
-            .for_each(|(i, ((cell, ((ux, uy), uz)), ((ox, oy), oz)))| {
-                let (jx, x, cxx) = locate(px[i], 0);
-                let (jy, y, cyy) = locate(py[i], 1);
-                let (jz, z, czz) = locate(pz[i], 2);
-                *cell = pass.id([jx, jy, jz]) as u32;
-                (*ux, *uy, *uz) = (x, y, z);
-                (*ox, *oy, *oz) = (cxx, cyy, czz);
-            });
-        // Serially, in particle order: the slots.
-        'retry: loop {
+        let n = self.len();
+        let cells = self.count.len();
+        if n == 0 {
             self.count.fill(0);
-            for a in &mut self.slot {
-                a.fill(EMPTY);
-            }
-            for i in 0..self.len() {
-                let id = self.cell_of[i] as usize;
-                let c = self.count[id] as usize;
-                if c == self.cap {
-                    self.grow();
-                    continue 'retry;
-                }
-                let k = id * self.cap + c;
-                for a in 0..3 {
-                    self.slot[a][k] = self.local[a][i];
-                }
-                self.tag[k] = i as u32;
-                self.slot_of[i] = k as u32;
-                self.count[id] += 1;
-            }
             return;
         }
+        let parts = rayon::current_num_threads().min(n.div_ceil(REBIN_PART_MIN));
+        let part_len = n.div_ceil(parts.max(1));
+        // Exactly as many parts as chunks of `part_len`.
+        let parts = n.div_ceil(part_len);
+        self.part_count.resize(parts * cells, 0);
+        self.part_seen.resize(parts * cells, 0);
+        // Ranges of cells, one filler each.
+        let range = cells.div_ceil(parts);
+        let ranges = cells.div_ceil(range);
+        self.bucket.resize(n, 0);
+        self.bucket_end.resize(parts * (ranges + 1), 0);
+        // 1. Per part: cells, counts per cell, and the part's particles grouped by range.
+        {
+            let [px, py, pz] = &self.pos;
+            self.cell_of
+                .par_chunks_mut(part_len)
+                .zip(self.part_count.par_chunks_mut(cells))
+                .zip(self.bucket.par_chunks_mut(part_len))
+                .zip(self.bucket_end.par_chunks_mut(ranges + 1))
+                .enumerate()
+                .for_each(|(k, (((cell, counts), bucket), end))| {
+                    counts.fill(0);
+                    end.fill(0);
+                    let first = k * part_len;
+                    for (j, out) in cell.iter_mut().enumerate() {
+                        let i = first + j;
+                        let (id, _) = pass.bin(px[i], py[i], pz[i]);
+                        *out = id as u32;
+                        counts[id] += 1;
+                        end[id / range + 1] += 1;
+                    }
+                    for r in 1..=ranges {
+                        end[r] += end[r - 1];
+                    }
+                    // Counting sort by range: afterwards end[r] is where range r ends.
+                    for (j, &id) in cell.iter().enumerate() {
+                        let r = id as usize / range;
+                        bucket[end[r] as usize] = (first + j) as u32;
+                        end[r] += 1;
+                    }
+                });
+        }
+        // 2. Totals per cell and the capacity.
+        let mut fullest = 0;
+        for (c, total) in self.count.iter_mut().enumerate() {
+            *total = (0..parts).map(|k| self.part_count[k * cells + c]).sum();
+            fullest = fullest.max(*total as usize);
+        }
+        while fullest > self.cap {
+            self.grow();
+        }
+        let part_count = &self.part_count[..parts * cells];
+        // 3. Slot indices per part, and the slots per range of cells.
+        let cap = self.cap;
+        let cell_of = &self.cell_of;
+        let [px, py, pz] = &self.pos;
+        let (bucket, bucket_end) = (&self.bucket, &self.bucket_end);
+        let [sx, sy, sz] = &mut self.slot;
+        let (tag, cell_seen) = (&mut self.tag, &mut self.cell_seen);
+        rayon::join(
+            || {
+                self.slot_of
+                    .par_chunks_mut(part_len)
+                    .zip(self.part_seen.par_chunks_mut(cells))
+                    .enumerate()
+                    .for_each(|(k, (slot_of, seen))| {
+                        seen.fill(0);
+                        for (j, out) in slot_of.iter_mut().enumerate() {
+                            let id = cell_of[k * part_len + j] as usize;
+                            let before: u32 = (0..k).map(|q| part_count[q * cells + id]).sum();
+                            *out = (id * cap) as u32 + before + seen[id];
+                            seen[id] += 1;
+                        }
+                    })
+            },
+            || {
+                sx.par_chunks_mut(range * cap)
+                    .zip(sy.par_chunks_mut(range * cap))
+                    .zip(sz.par_chunks_mut(range * cap))
+                    .zip(tag.par_chunks_mut(range * cap))
+                    .zip(cell_seen.par_chunks_mut(range))
+                    .enumerate()
+                    .for_each(|(k, ((((x, y), z), tag), seen))| {
+                        let first = k * range;
+                        seen.fill(0);
+                        // This range's particles, part after part: particle order.
+                        let mine = (0..parts).flat_map(|q| {
+                            let end = &bucket_end[q * (ranges + 1)..(q + 1) * (ranges + 1)];
+                            let begin = if k == 0 { 0 } else { end[k - 1] as usize };
+                            &bucket[q * part_len + begin..q * part_len + end[k] as usize]
+                        });
+                        for &i in mine {
+                            let i = i as usize;
+                            let c = cell_of[i] as usize - first;
+                            let slot = c * cap + seen[c] as usize;
+                            seen[c] += 1;
+                            let (_, u) = pass.bin(px[i], py[i], pz[i]);
+                            (x[slot], y[slot], z[slot]) = (u[0], u[1], u[2]);
+                            tag[slot] = i as u32;
+                        }
+                        // Pad each cell to a whole vector of eight (the scans read that far).
+                        for (c, &m) in seen.iter().enumerate() {
+                            let pad =
+                                c * cap + m as usize..c * cap + (m as usize).next_multiple_of(8);
+                            x[pad.clone()].fill(EMPTY);
+                            y[pad.clone()].fill(EMPTY);
+                            z[pad].fill(EMPTY);
+                        }
+                    })
+            },
+        );
     }
 
     /// Eight more slots per cell (a multiple of eight keeps the scans in whole vectors).
@@ -713,21 +843,27 @@ impl HardSphereMc {
         self.tag.resize(total, 0);
     }
 
-    /// Write the slots back into the particle-order positions (in parallel).
+    /// Write the slots back into the particle-order positions (in parallel): each particle's
+    /// new position is its cell's corner (found again from the position it was binned at) plus
+    /// its slot, wrapped into the box.
     fn scatter(&mut self) {
+        let pass = self.pass();
         let l = self.edge;
-        let slot_of = &self.slot_of;
-        for a in 0..3 {
-            let (slot, corner) = (&self.slot[a], &self.corner[a]);
-            self.pos[a]
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(1024)
-                .for_each(|(i, x)| {
-                    let v = corner[i] + slot[slot_of[i] as usize];
-                    *x = if v >= 0.5 * l { v - l } else { v };
-                });
-        }
+        let (slot_of, slot) = (&self.slot_of, &self.slot);
+        let [px, py, pz] = &mut self.pos;
+        px.par_iter_mut()
+            .zip(py.par_iter_mut())
+            .zip(pz.par_iter_mut())
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, ((x, y), z))| {
+                let k = slot_of[i] as usize;
+                let back = |a: usize, old: f64| {
+                    let v = pass.locate(old, a).2 + slot[a][k];
+                    if v >= 0.5 * l { v - l } else { v }
+                };
+                (*x, *y, *z) = (back(0, *x), back(1, *y), back(2, *z));
+            });
     }
 
     /// One sweep: N trial moves (see the module documentation).
@@ -739,20 +875,20 @@ impl HardSphereMc {
             s * unit(rng.next_u64()),
             s * unit(rng.next_u64()),
         ];
-        let mut colours = [0usize, 1, 2, 3, 4, 5, 6, 7];
-        for i in (1..8).rev() {
-            colours.swap(i, below(rng.next_u64(), i + 1));
-        }
+        // The two parities of the z layers, in random order.
+        let parities = if rng.next_u64() >> 63 == 0 {
+            [0usize, 1]
+        } else {
+            [1, 0]
+        };
         self.rebin(offset);
         let pass = self.pass();
-        let h3 = pass.half.pow(3);
-        let cap = self.cap;
-        let span = h3 * cap;
-        let row = pass.half * cap;
+        let layer = pass.nc * pass.nc * self.cap;
+        let span = pass.half * layer;
         let (mut accepted, mut left) = (0, 0);
         let counts = &self.count;
-        for colour in colours {
-            let (lo, hi) = (colour * span, (colour + 1) * span);
+        for parity in parities {
+            let (lo, hi) = (parity * span, (parity + 1) * span);
             let [sx, sy, sz] = &mut self.slot;
             let (xb, rest) = sx.split_at_mut(lo);
             let (xc, xa) = rest.split_at_mut(span);
@@ -767,12 +903,11 @@ impl HardSphereMc {
                 hi,
             };
             let (a, b) = xc
-                .par_chunks_mut(row)
-                .zip(yc.par_chunks_mut(row))
-                .zip(zc.par_chunks_mut(row))
+                .par_chunks_mut(layer)
+                .zip(yc.par_chunks_mut(layer))
+                .zip(zc.par_chunks_mut(layer))
                 .enumerate()
-                .with_min_len(4)
-                .map(|(k, ((x, y), z))| pass.row_moves(colour, k, [x, y, z], counts, &frozen))
+                .map(|(k, ((x, y), z))| pass.layer_moves(parity, k, [x, y, z], counts, &frozen))
                 .reduce(|| (0, 0), |p, q| (p.0 + q.0, p.1 + q.1));
             accepted += a;
             left += b;
@@ -828,9 +963,8 @@ impl HardSphereMc {
         let rcut = rcut.min(0.5 * self.edge);
         let reach = ((rcut / s).ceil() as isize).max(1);
         let rc2 = rcut * rcut;
-        let h3 = pass.half.pow(3);
         for a in 0..self.count.len() {
-            let ca = pass.coords(a / h3, a % h3);
+            let ca = pass.coords(a);
             let na = self.count[a] as usize;
             if na == 0 {
                 continue;

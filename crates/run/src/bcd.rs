@@ -19,7 +19,7 @@ use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
 use colloidsim_bcd::{Bcd, BcdState, Boundary};
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
-use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};
+use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem, bulk};
 use hoomd_gsd::file_layer::{GsdFile, Mode};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -910,18 +910,29 @@ where
                     points: false,
                 },
             ];
+            // The long-time single-file law (2/rho) sqrt(S(0) D t / pi) (Kollmann 2003) on a
+            // ring without a field, for hard rods (S(0) = (1 - rho sigma)^2) and for sticky rods
+            // (S(0) of the simulated finite-range contact, colloidsim_dft::rods::bulk).
             let rho = n as f64 / c.length;
-            let sf: Vec<f64> = t
-                .iter()
-                .map(|t| {
-                    (1.0 - rho * c.sigma) / rho
-                        * (4.0 * c.diffusion() * t / std::f64::consts::PI).sqrt()
-                })
-                .collect();
-            // The single-file law holds for hard rods (sticky rods move in clusters).
-            if r.field.is_zero() && c.boundary == Boundary::Periodic && r.pair.range() == 0.0 {
+            let s0 = match (&r.pair.sticky, &r.pair.yukawa, &r.pair.table) {
+                (None, None, None) => Some(bulk::structure_factor_zero(c.sigma, 0.0, rho)),
+                (Some(st), None, None) => Some(bulk::structure_factor_zero_finite_range(
+                    c.sigma, st.gamma, st.eps, st.order, rho,
+                )),
+                _ => None,
+            };
+            let sf: Vec<f64> = s0.map_or(Vec::new(), |s0| {
+                t.iter()
+                    .map(|&t| bulk::single_file_msd(s0, rho, c.diffusion(), t))
+                    .collect()
+            });
+            let label = format!(
+                "single file (2/rho) sqrt(S(0) D t/pi), S(0) = {:.4}",
+                s0.unwrap_or(f64::NAN)
+            );
+            if r.field.is_zero() && c.boundary == Boundary::Periodic && s0.is_some() {
                 series.push(Series {
-                    label: "single file (1-rho sigma)/rho sqrt(4Dt/pi)",
+                    label: &label,
                     x: &t,
                     y: &sf,
                     points: false,
