@@ -7,7 +7,8 @@ use crate::control::Control;
 use crate::keys::Key;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{
-    Labels, Scale, Series, line_plot, line_plot_with_errors, linear_picture, picture,
+    Labels, Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors,
+    linear_picture, picture,
 };
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
@@ -869,7 +870,7 @@ where
         }
         let errors = [Some(err.as_slice()), None];
         picture(
-            line_plot_with_errors(
+            line_plot_styled(
                 &out.join("contact_density.png"),
                 &format!("contact density of {rods}, sigma = {}", c.sigma),
                 "x (length)",
@@ -877,6 +878,9 @@ where
                 &series,
                 &errors[..series.len()],
                 Scale::Linear,
+                Style {
+                    legend_outside: true,
+                },
             ),
             "contact_density.png",
             &mut files,

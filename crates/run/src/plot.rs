@@ -130,16 +130,7 @@ fn draw_line_plot(
 ) -> Result<()> {
     register_font();
     let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
-    let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
-    for s in series {
-        for (&x, &y) in s.x.iter().zip(s.y) {
-            if finite(x) && finite(y) {
-                xr = (xr.0.min(x), xr.1.max(x));
-                yr = (yr.0.min(y), yr.1.max(y));
-            }
-        }
-    }
+    let (xr, mut yr) = data_ranges(series, errors, scale);
     if xr.0 >= xr.1 {
         return Err(anyhow!("no finite data to draw"));
     }
@@ -323,6 +314,37 @@ pub fn merged_shells(
 /// about 30 % in a dilute shell and far less in a dense one.
 pub const SHELL_PARTICLES: f64 = 10.0;
 
+/// The x and y ranges of the finite points of `series` (positive ones on log axes), the y range
+/// widened to hold their error bars.
+fn data_ranges(
+    series: &[Series],
+    errors: &[Option<&[f64]>],
+    scale: Scale,
+) -> ((f64, f64), (f64, f64)) {
+    let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
+    let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
+    for (k, s) in series.iter().enumerate() {
+        let err = errors.get(k).copied().flatten();
+        for (i, (&x, &y)) in s.x.iter().zip(s.y).enumerate() {
+            if finite(x) && finite(y) {
+                xr = (xr.0.min(x), xr.1.max(x));
+                yr = (yr.0.min(y), yr.1.max(y));
+                // The error bars stay inside the axes (on a log axis only their upper ends).
+                if let Some(e) = err.and_then(|e| e.get(i)).filter(|e| e.is_finite()) {
+                    if finite(y + e) {
+                        yr.1 = yr.1.max(y + e);
+                    }
+                    if finite(y - e) {
+                        yr.0 = yr.0.min(y - e);
+                    }
+                }
+            }
+        }
+    }
+    (xr, yr)
+}
+
 /// One disc of a cross-section: centre and radius in data units, and which colour (an index
 /// into the palette).
 pub struct Disc {
@@ -471,7 +493,25 @@ fn flat_range(y: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::{flat_range, merged_shells};
+    use super::{Scale, Series, data_ranges, flat_range, merged_shells};
+
+    /// The y axis holds the error bars, not only the points; a series without errors and the
+    /// lower ends on a log axis that would reach zero leave it as the points make it.
+    #[test]
+    fn the_axes_hold_the_error_bars() {
+        let (x, y, e) = ([1.0, 2.0, 3.0], [1.0, 2.0, 1.5], [0.5, 0.25, 2.0]);
+        let s = [Series {
+            label: "",
+            x: &x,
+            y: &y,
+            points: true,
+        }];
+        let (xr, yr) = data_ranges(&s, &[Some(&e)], Scale::Linear);
+        assert_eq!(xr, (1.0, 3.0));
+        assert_eq!(yr, (-0.5, 3.5));
+        assert_eq!(data_ranges(&s, &[None], Scale::Linear).1, (1.0, 2.0));
+        assert_eq!(data_ranges(&s, &[Some(&e)], Scale::LogLog).1, (0.5, 3.5));
+    }
 
     /// Merging keeps a uniform profile uniform, keeps the volume-weighted total, merges only
     /// the small inner shells, and draws a single particle in the first shell at a sane value.
