@@ -48,6 +48,7 @@ __all__ = [
     "Result",
     "Table",
     "check",
+    "ensemble",
     "keys",
     "methods",
     "resume",
@@ -110,18 +111,25 @@ def _warn(report: Dict[str, Any]) -> None:
         warnings.warn(w, stacklevel=3)
 
 
+def _column(values: List[str]) -> np.ndarray:
+    """A CSV column as floats, or as strings when it holds text (``observables.csv`` of an
+    ensemble names its observables and may sweep text values)."""
+    try:
+        return np.array([float(x) for x in values], dtype=float)
+    except ValueError:
+        return np.array([x.strip() for x in values], dtype=str)
+
+
 class Table(Mapping[str, np.ndarray]):
     """A CSV table of a run: its columns as numpy arrays, by header name (``t["rho"]`` or
-    ``t.rho``)."""
+    ``t.rho``); numbers as floats, a column holding text as strings."""
 
     def __init__(self, path: Union[str, "os.PathLike[str]"]):
         self.path = Path(path)
         with open(self.path, newline="") as f:
             rows = list(csv.reader(f))
         self.columns: List[str] = [c.strip() for c in rows[0]] if rows else []
-        data = np.array([[float(x) for x in r] for r in rows[1:]], dtype=float)
-        data = data.reshape(len(rows) - 1, len(self.columns)) if rows else data
-        self._data = {c: data[:, k] for k, c in enumerate(self.columns)}
+        self._data = {c: _column([r[k] for r in rows[1:]]) for k, c in enumerate(self.columns)}
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self._data[key]
@@ -202,6 +210,44 @@ def run(
     report = json.loads(
         _colloidsim.run(
             text, base, name, origin, _overrides(overrides), _out(out), seed, threads, force
+        )
+    )
+    _warn(report)
+    return Result(report)
+
+
+def ensemble(
+    scenario: ScenarioLike,
+    replicas: int = 4,
+    vary: Optional[Mapping[str, Sequence[Any]]] = None,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
+    threads: Optional[int] = None,
+    force: bool = False,
+) -> Result:
+    """Replicas of a scenario (seeds ``seed, seed + 1, ...``) at every point of a sweep (as
+    ``colloidsim ensemble``): ``vary={"system.particles": [4, 6]}`` runs every combination of the
+    listed values. Each member is a plain run in ``out/replica-R`` (``out/point-P/replica-R`` with
+    a sweep); the tables the replicas share are written beside them with each column's mean and
+    standard error (``COLUMN_err``), and the summaries' numbers into ``observables.csv``.
+    ``out`` defaults to a new temporary folder. Spreading members over MPI ranks is the CLI's
+    (``mpirun -n 4 colloidsim ensemble ...``, docs/parallel.md)."""
+    text, base, name, origin = _scenario(scenario)
+    if out is None:
+        out = tempfile.mkdtemp(prefix=f"colloidsim-{name}-ensemble-")
+    pairs = [[k, list(v)] for k, v in (vary or {}).items()]
+    report = json.loads(
+        _colloidsim.ensemble(
+            text,
+            base,
+            name,
+            origin,
+            _overrides(overrides),
+            json.dumps(pairs),
+            replicas,
+            _out(out),
+            threads,
+            force,
         )
     )
     _warn(report)

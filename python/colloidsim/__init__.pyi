@@ -39,6 +39,15 @@ def run(
     threads: Optional[int] = None,
     force: bool = False,
 ) -> Result: ...
+def ensemble(
+    scenario: ScenarioLike,
+    replicas: int = 4,
+    vary: Optional[Mapping[str, Sequence[Any]]] = None,
+    out: Optional[Union[str, PathLike[str]]] = None,
+    overrides: Overrides = None,
+    threads: Optional[int] = None,
+    force: bool = False,
+) -> Result: ...
 def resume(
     folder: Union[str, PathLike[str]],
     seed: Optional[int] = None,

@@ -147,6 +147,37 @@ fn run(
     Ok(report_json(&r))
 }
 
+/// Replicas and sweeps of a scenario (`colloidsim ensemble`, in this process); `vary_json` is a
+/// JSON list of `[key, [values...]]`. Returns the report as JSON.
+#[pyfunction]
+#[pyo3(signature = (text, base, name, origin, overrides_json, vary_json, replicas=4, out=None, threads=None, force=false))]
+#[allow(clippy::too_many_arguments)]
+fn ensemble(
+    py: Python<'_>,
+    text: &str,
+    base: &str,
+    name: &str,
+    origin: Option<&str>,
+    overrides_json: &str,
+    vary_json: &str,
+    replicas: u32,
+    out: Option<PathBuf>,
+    threads: Option<usize>,
+    force: bool,
+) -> PyResult<String> {
+    let sc = scenario(text, base, name, origin, overrides_json).map_err(to_py)?;
+    let vary: Vec<(String, Vec<toml::Value>)> =
+        serde_json::from_str(vary_json).map_err(|e| PyValueError::new_err(format!("vary: {e}")))?;
+    let opts = colloidsim_run::EnsembleOptions {
+        out,
+        replicas,
+        vary,
+        force,
+    };
+    let r = blocking(py, threads, |ctl| colloidsim_run::ensemble(&sc, &opts, ctl))?;
+    Ok(report_json(&r))
+}
+
 /// Continue the interrupted run in `folder`; returns the report as JSON.
 #[pyfunction]
 #[pyo3(signature = (folder, seed=None, threads=None))]
@@ -363,6 +394,7 @@ fn _colloidsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("version", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(resume, m)?)?;
+    m.add_function(wrap_pyfunction!(ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(theory, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(keys, m)?)?;

@@ -215,3 +215,31 @@ def test_keys_and_methods_are_listed():
     assert keys["run.dt"]["unit"] and keys["run.dt"]["range"]
     with pytest.raises(colloidsim.ColloidsimError, match="unknown method"):
         colloidsim.keys("nope")
+
+
+def test_ensemble_equals_the_cli_and_averages_the_replicas(tmp_path, cli):
+    scenario = {
+        "method": "bcd",
+        "seed": 11,
+        "system": {"length": 10.0, "particles": 5, "diameter": 0.5},
+        "potential": {"cosine": {"amplitude": 2.0, "wavelength": 1.0}},
+        "run": {"dt": 1e-3, "equilibrate": 0.2, "time": 2.0},
+        "observe": {"density": {"bins": 20}},
+    }
+    path = tmp_path / "tiny.toml"
+    path.write_text(colloidsim._colloidsim.toml_from_json(json.dumps(scenario)))
+    cli("ensemble", path, "--out", tmp_path / "cli", "--replicas", "3", "--quiet")
+    r = colloidsim.ensemble(path, replicas=3, out=tmp_path / "py")
+    for sub in ["replica-0", "replica-1", "replica-2"]:
+        assert_same_outputs(tmp_path / "cli" / sub, tmp_path / "py" / sub)
+    assert (tmp_path / "cli" / "density.csv").read_bytes() == (r.out / "density.csv").read_bytes()
+    members = np.array([colloidsim.Table(r.out / f"replica-{k}/density.csv")["rho"] for k in range(3)])
+    np.testing.assert_allclose(r.density["rho"], members.mean(axis=0), rtol=1e-12)
+    np.testing.assert_allclose(
+        r.density["rho_err"], members.std(axis=0, ddof=1) / np.sqrt(3), rtol=1e-9, atol=1e-15
+    )
+    obs = r.observables
+    assert set(obs["observable"]) >= {"steps"} and np.all(obs["n"] == 3)
+    with pytest.raises(colloidsim.ColloidsimError, match="vary seed"):
+        colloidsim.ensemble(path, vary={"seed": [1, 2]}, out=tmp_path / "bad")
+    assert not (tmp_path / "bad").exists()

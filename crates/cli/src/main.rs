@@ -7,10 +7,12 @@ mod bench_mc;
 mod bench_mpcd;
 mod common;
 mod dpd_bench;
+mod parallel;
 mod rpy_bench;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use colloidsim_run::ensemble::{Ensemble, parse_vary};
 use colloidsim_run::{Control, Progress, RunOptions, Scenario, TheoryOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -136,6 +138,39 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        #[command(flatten)]
+        overrides: Overrides,
+    },
+    /// Run replicas of a scenario (seeds seed, seed + 1, ...) and sweeps of its keys, each
+    /// member in its own folder, and write their averages with errors; spreads the members over
+    /// MPI ranks under `mpirun` (built with `--features mpi`).
+    Ensemble {
+        /// Scenario file (TOML); not with --restart.
+        #[arg(required_unless_present = "restart")]
+        scenario: Option<PathBuf>,
+        /// Output folder (default: the scenario's name followed by `-ensemble`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replicas per sweep point (1 ..= 10000; the errors come from their spread).
+        #[arg(long, default_value_t = 4)]
+        replicas: u32,
+        /// Sweep a key over a TOML array of values, e.g. `--vary system.phi=[0.1,0.2]`
+        /// (repeatable: the points are all combinations).
+        #[arg(long, value_name = "KEY=[V1,V2,...]")]
+        vary: Vec<String>,
+        /// Worker threads per rank (default: the node's cores shared among its ranks).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress bar, no informational messages, no closing line.
+        #[arg(long)]
+        quiet: bool,
+        /// Write into an output folder that already holds files.
+        #[arg(long)]
+        force: bool,
+        /// Continue the interrupted ensemble in this folder (on any number of ranks): completed
+        /// members are kept, interrupted ones continue from their checkpoints.
+        #[arg(long, conflicts_with_all = ["scenario", "out", "force", "vary", "replicas"])]
+        restart: Option<PathBuf>,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -301,6 +336,9 @@ fn main() -> std::process::ExitCode {
     quiet_on_closed_pipe();
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<parallel::FailedElsewhere>().is_some() => {
+            std::process::ExitCode::FAILURE
+        }
         Err(e) => {
             eprintln!("error: {}", error_chain(&e));
             std::process::ExitCode::FAILURE
@@ -393,6 +431,8 @@ fn run_cli() -> Result<()> {
             restart,
             overrides,
         } => {
+            let ranks = parallel::Ranks::init()?;
+            parallel::single_rank(&ranks, "run")?;
             thread_pool(threads)?;
             let sc = path
                 .as_deref()
@@ -460,6 +500,34 @@ fn run_cli() -> Result<()> {
             println!("{}", report.message);
             Ok(())
         }
+        Command::Ensemble {
+            scenario: path,
+            out,
+            replicas,
+            vary,
+            threads,
+            quiet,
+            force,
+            restart,
+            overrides,
+        } => {
+            let create = restart.is_none();
+            let plan = move || match (&restart, &path) {
+                (Some(dir), _) if overrides.set.is_empty() => Ensemble::reopen(dir),
+                (Some(_), _) => bail!("--set cannot change an ensemble that is continued"),
+                (None, Some(path)) => Ensemble::plan(
+                    &scenario(path, &overrides)?,
+                    &colloidsim_run::EnsembleOptions {
+                        out,
+                        replicas,
+                        vary: vary.iter().map(|v| parse_vary(v)).collect::<Result<_>>()?,
+                        force,
+                    },
+                ),
+                (None, None) => unreachable!("clap requires a scenario without --restart"),
+            };
+            ensemble(plan, create, threads, quiet)
+        }
         Command::Check {
             scenario: path,
             json,
@@ -497,4 +565,72 @@ fn run_cli() -> Result<()> {
             BenchKind::Mpcd(args) => bench_mpcd::bench(&args),
         },
     }
+}
+
+/// `colloidsim ensemble`: every rank plans the same ensemble (and stops alike on bad input),
+/// rank 0 creates the folder (unless the ensemble is continued), member `k` runs on rank
+/// `k mod size`, and rank 0 combines.
+fn ensemble(
+    plan: impl FnOnce() -> Result<Ensemble>,
+    create: bool,
+    threads: Option<usize>,
+    quiet: bool,
+) -> Result<()> {
+    let start = std::time::Instant::now();
+    let ranks = parallel::Ranks::init()?;
+    let (rank, size) = (ranks.rank(), ranks.size());
+    ranks.agree(thread_pool(threads.or(ranks.default_threads())))?;
+    let plan = ranks.agree(plan())?;
+    ranks.agree(if rank == 0 && create {
+        plan.create()
+    } else {
+        Ok(())
+    })?;
+    let ctl = control(quiet || rank != 0);
+    let mut mine = serde_json::Map::new();
+    for k in (rank..plan.members().len()).step_by(size) {
+        if ctl.interrupted() {
+            break;
+        }
+        if let Err(e) = plan.run_member(k, &ctl) {
+            mine.insert(k.to_string(), format!("{e:#}").into());
+        }
+    }
+    ranks.agree(if ctl.interrupted() {
+        Err(anyhow::anyhow!(
+            "interrupted; continue with: {}colloidsim ensemble --restart {}",
+            if size > 1 { "mpirun -n N " } else { "" },
+            shell_word(&plan.out().display().to_string())
+        ))
+    } else {
+        Ok(())
+    })?;
+    let mut errors = vec![None; plan.members().len()];
+    for text in ranks.all_gather(&serde_json::Value::Object(mine).to_string()) {
+        let failed: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text)?;
+        for (k, e) in failed {
+            errors[k.parse::<usize>()?] = Some(e.as_str().unwrap_or("?").to_string());
+        }
+    }
+    let report = ranks.agree(if rank == 0 {
+        plan.finish(&errors, start.elapsed().as_secs_f64())
+            .map(Some)
+    } else {
+        Ok(None)
+    })?;
+    if let Some(report) = report.filter(|_| !quiet) {
+        for w in &report.warnings {
+            eprintln!("warning: {w}");
+        }
+        println!(
+            "{}{}",
+            report.message,
+            if size > 1 {
+                format!(" ({size} MPI ranks)")
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
 }

@@ -9,11 +9,11 @@
 //! errors from the spread between seeds, propagated through the extrapolation.
 
 use crate::control::Control;
+use crate::ensemble::{Pooled, pool, write_pooled};
 use crate::{Report, RunOptions, Scenario};
 use anyhow::{Context, Result, bail};
-use colloidsim_core::output::{OutputDir, read_table};
+use colloidsim_core::output::OutputDir;
 use serde_json::json;
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// Options of an extrapolation.
@@ -47,50 +47,6 @@ fn time_step(sc: &Scenario) -> Result<f64> {
         .as_f64()
         .or_else(|| r["dt"].as_f64())
         .context("the scenario's resolved parameters name no time step (run.dt)")
-}
-
-/// Mean and standard error over seeds of each column, per table: `tables[name] = (header,
-/// first column, means, errors)`.
-type Pooled = BTreeMap<String, (Vec<String>, Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>)>;
-
-fn pool(folders: &[PathBuf]) -> Result<Pooled> {
-    let mut out = Pooled::new();
-    let names: Vec<String> = std::fs::read_dir(&folders[0])?
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".csv"))
-        .collect();
-    'table: for name in names {
-        let mut runs = Vec::new();
-        for f in folders {
-            match read_table(&f.join(&name)) {
-                Ok(t) => runs.push(t),
-                Err(_) => continue 'table,
-            }
-        }
-        let (header, first) = (&runs[0].0, &runs[0].1);
-        if header.len() < 2 || runs.iter().any(|(h, c)| h != header || c[0] != first[0]) {
-            continue;
-        }
-        let rows = first[0].len();
-        let k = runs.len() as f64;
-        let mut means = Vec::new();
-        let mut errors = Vec::new();
-        for c in 1..header.len() {
-            let (mut m, mut e) = (vec![0.0; rows], vec![0.0; rows]);
-            for i in 0..rows {
-                let v: Vec<f64> = runs.iter().map(|r| r.1[c][i]).collect();
-                let mean = v.iter().sum::<f64>() / k;
-                let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0);
-                m[i] = mean;
-                e[i] = (var / k).sqrt();
-            }
-            means.push(m);
-            errors.push(e);
-        }
-        out.insert(name, (header.clone(), first[0].clone(), means, errors));
-    }
-    Ok(out)
 }
 
 /// Run `sc` at its time step and at half of it, `opts.seeds` seeds each, and write every table
@@ -148,45 +104,42 @@ pub fn extrapolate(sc: &Scenario, opts: &ExtrapolateOptions, ctl: &Control) -> R
     let gain = 2f64.powf(opts.order);
     let mut files = Vec::new();
     let mut skipped = Vec::new();
-    for (name, (header, x, m1, e1)) in &coarse {
-        let Some((h2, x2, m2, e2)) = fine.get(name) else {
+    for (name, c) in &coarse {
+        let Some(f) = fine.get(name) else {
             skipped.push(name.clone());
             continue;
         };
-        if h2 != header || x2 != x {
+        if f.header != c.header || f.x != c.x {
             // e.g. an MSD whose lags are whole steps: other times at another dt.
             skipped.push(name.clone());
             continue;
         }
-        let mut cols: Vec<(String, Vec<f64>)> = vec![(header[0].clone(), x.clone())];
-        for c in 0..m1.len() {
-            let a: Vec<f64> = (0..x.len())
-                .map(|i| (gain * m2[c][i] - m1[c][i]) / (gain - 1.0))
-                .collect();
-            let e: Vec<f64> = (0..x.len())
-                .map(|i| (gain * gain * e2[c][i].powi(2) + e1[c][i].powi(2)).sqrt() / (gain - 1.0))
-                .collect();
-            cols.push((header[c + 1].clone(), a));
-            cols.push((format!("{}_err", header[c + 1]), e));
-        }
-        let refs: Vec<(&str, &[f64])> = cols
-            .iter()
-            .map(|(n, v)| (n.as_str(), v.as_slice()))
-            .collect();
-        out.write_table(name, &refs)?;
+        let extrapolated = Pooled {
+            header: c.header.clone(),
+            x: c.x.clone(),
+            means: (0..c.means.len())
+                .map(|j| {
+                    (0..c.x.len())
+                        .map(|i| (gain * f.means[j][i] - c.means[j][i]) / (gain - 1.0))
+                        .collect()
+                })
+                .collect(),
+            errors: (0..c.means.len())
+                .map(|j| {
+                    (0..c.x.len())
+                        .map(|i| {
+                            (gain * gain * f.errors[j][i].powi(2) + c.errors[j][i].powi(2)).sqrt()
+                                / (gain - 1.0)
+                        })
+                        .collect()
+                })
+                .collect(),
+        };
+        write_pooled(&out, name, &extrapolated)?;
         files.push(name.clone());
-        for (sub, m, e) in [("dt", m1, e1), ("half-dt", m2, e2)] {
-            let mut cols: Vec<(String, Vec<f64>)> = vec![(header[0].clone(), x.clone())];
-            for c in 0..m.len() {
-                cols.push((header[c + 1].clone(), m[c].clone()));
-                cols.push((format!("{}_err", header[c + 1]), e[c].clone()));
-            }
-            let refs: Vec<(&str, &[f64])> = cols
-                .iter()
-                .map(|(n, v)| (n.as_str(), v.as_slice()))
-                .collect();
+        for (sub, p) in [("dt", c), ("half-dt", f)] {
             std::fs::create_dir_all(out.join(sub))?;
-            OutputDir::reopen(out.join(sub))?.write_table(name, &refs)?;
+            write_pooled(&OutputDir::reopen(out.join(sub))?, name, p)?;
         }
     }
     if !skipped.is_empty() {

@@ -110,3 +110,74 @@ pub fn restarts_bitwise(
         assert_same_outputs(a, &b, volatile);
     }
 }
+
+/// Every file under `dir`, by path relative to it.
+fn tree(dir: &Path, rel: &str, out: &mut Vec<(String, Vec<u8>)>) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir.join(rel))
+        .unwrap()
+        .map(|e| e.unwrap())
+        .collect();
+    entries.sort_by_key(|e| e.file_name());
+    for e in entries {
+        let name = format!("{rel}{}", e.file_name().to_string_lossy());
+        if e.file_type().unwrap().is_dir() {
+            tree(dir, &format!("{name}/"), out);
+        } else {
+            out.push((name, std::fs::read(e.path()).unwrap()));
+        }
+    }
+}
+
+/// Two folder trees (ensembles) hold the same files, byte for byte, but for the timings in
+/// the `summary.json` files (`threads`, `*seconds`, `*_per_second`).
+pub fn assert_same_tree(a: &Path, b: &Path) {
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    tree(a, "", &mut ta);
+    tree(b, "", &mut tb);
+    let names = |t: &[(String, Vec<u8>)]| t.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&ta), names(&tb));
+    for ((name, x), (_, y)) in ta.iter().zip(&tb) {
+        if name.ends_with("summary.json") {
+            let strip = |b: &[u8]| {
+                let mut v: serde_json::Value = serde_json::from_slice(b).unwrap();
+                v.as_object_mut()
+                    .unwrap()
+                    .retain(|k, _| !colloidsim_run::ensemble::is_timing(k));
+                v
+            };
+            assert_eq!(strip(x), strip(y), "{name}");
+        } else {
+            assert!(x == y, "{name} differs");
+        }
+    }
+}
+
+/// A BCD scenario of a fraction of a second (five rods), for the ensemble and MPI tests.
+pub const TINY_BCD: &str = r#"
+method = "bcd"
+seed = 11
+[system]
+length = 10.0
+particles = 5
+diameter = 0.5
+[potential]
+cosine = { amplitude = 2.0, wavelength = 1.0 }
+[run]
+dt = 1e-3
+equilibrate = 0.2
+time = 2.0
+[observe]
+density = { bins = 20 }
+msd = { points = 5 }
+"#;
+
+/// `colloidsim ARGS` with extra environment variables; its output is echoed for the log.
+pub fn cli(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_colloidsim"))
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    eprintln!("{}", text(&o));
+    o
+}

@@ -1,0 +1,194 @@
+//! The MPI ranks of a command (cargo feature `mpi`), or a single rank without it.
+//!
+//! Every collective step goes through [`Ranks::agree`]: each rank brings its own outcome, and
+//! either every rank goes on or every rank stops, the lowest failing rank printing its message
+//! and the others exiting quietly ([`FailedElsewhere`]), so bad input or a failed member on
+//! one rank never leaves the others waiting. A panic on any rank aborts all of them.
+
+use anyhow::{Result, bail};
+
+/// Another rank failed and printed why; this rank stops without a message of its own.
+#[derive(Debug, thiserror::Error)]
+#[error("rank {0} failed (its message is above)")]
+pub struct FailedElsewhere(pub usize);
+
+/// The ranks of this process's job.
+pub struct Ranks {
+    rank: usize,
+    size: usize,
+    local: usize,
+    #[cfg(feature = "mpi")]
+    world: mpi::topology::SimpleCommunicator,
+    #[cfg(feature = "mpi")]
+    _universe: mpi::environment::Universe,
+}
+
+/// The number of ranks a launcher (mpirun, srun) says this process belongs to, if any.
+#[cfg(not(feature = "mpi"))]
+fn launched_size() -> Option<usize> {
+    [
+        "OMPI_COMM_WORLD_SIZE",
+        "PMI_SIZE",
+        "PMIX_SIZE",
+        "SLURM_NTASKS",
+    ]
+    .iter()
+    .find_map(|v| std::env::var(v).ok()?.parse().ok())
+}
+
+impl Ranks {
+    /// Join the job's ranks (one rank when not launched by mpirun).
+    #[cfg(feature = "mpi")]
+    pub fn init() -> Result<Self> {
+        use mpi::traits::Communicator;
+        let Some(universe) = mpi::initialize() else {
+            bail!("MPI was initialised twice");
+        };
+        let world = universe.world();
+        let local = world.split_shared(0).size() as usize;
+        let ranks = Self {
+            rank: world.rank() as usize,
+            size: world.size() as usize,
+            local,
+            world,
+            _universe: universe,
+        };
+        if ranks.size > 1 {
+            let default = std::panic::take_hook();
+            std::panic::set_hook(Box::new(move |info| {
+                default(info);
+                mpi::topology::SimpleCommunicator::world().abort(70);
+            }));
+        }
+        Ok(ranks)
+    }
+
+    /// One rank; refused when a launcher started several copies of this MPI-less build.
+    #[cfg(not(feature = "mpi"))]
+    pub fn init() -> Result<Self> {
+        if let Some(n) = launched_size().filter(|&n| n > 1) {
+            bail!(
+                "started as one of {n} MPI ranks, but this colloidsim was built without MPI: \
+                 build it with `cargo build --release --features mpi` (docs/parallel.md)"
+            );
+        }
+        Ok(Self {
+            rank: 0,
+            size: 1,
+            local: 1,
+        })
+    }
+
+    /// This rank (0 ..< size).
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// The number of ranks.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Worker threads per rank when `--threads` is not given: the cores shared by the ranks on
+    /// this node (all cores with one rank).
+    pub fn default_threads(&self) -> Option<usize> {
+        if self.local <= 1 {
+            return None;
+        }
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Some((cores / self.local).max(1))
+    }
+
+    /// Go on together or stop together: `Ok` on every rank when `local` is `Ok` on every rank;
+    /// otherwise the lowest failing rank returns its own error and every other rank
+    /// [`FailedElsewhere`].
+    pub fn agree<T>(&self, local: Result<T>) -> Result<T> {
+        let mine = if local.is_err() { self.rank } else { self.size };
+        let first = self.min(mine);
+        match local {
+            Ok(v) if first == self.size => Ok(v),
+            Err(e) if first == self.rank => Err(e),
+            _ => Err(FailedElsewhere(first).into()),
+        }
+    }
+
+    /// The smallest of every rank's `x`.
+    #[cfg(feature = "mpi")]
+    fn min(&self, x: usize) -> usize {
+        use mpi::collective::{CommunicatorCollectives, SystemOperation};
+        let mut out = 0u64;
+        self.world
+            .all_reduce_into(&(x as u64), &mut out, SystemOperation::min());
+        out as usize
+    }
+
+    #[cfg(not(feature = "mpi"))]
+    fn min(&self, x: usize) -> usize {
+        x
+    }
+
+    /// Every rank's `text`, in rank order, on every rank.
+    #[cfg(feature = "mpi")]
+    pub fn all_gather(&self, text: &str) -> Vec<String> {
+        use mpi::collective::CommunicatorCollectives;
+        use mpi::datatype::PartitionMut;
+        let bytes = text.as_bytes();
+        let mut counts = vec![0i32; self.size];
+        self.world
+            .all_gather_into(&(bytes.len() as i32), &mut counts[..]);
+        let displs: Vec<i32> = counts
+            .iter()
+            .scan(0, |acc, &c| {
+                let d = *acc;
+                *acc += c;
+                Some(d)
+            })
+            .collect();
+        let mut buf = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+        {
+            let mut part = PartitionMut::new(&mut buf[..], &counts[..], &displs[..]);
+            self.world.all_gather_varcount_into(bytes, &mut part);
+        }
+        (0..self.size)
+            .map(|r| {
+                let (d, c) = (displs[r] as usize, counts[r] as usize);
+                String::from_utf8_lossy(&buf[d..d + c]).into_owned()
+            })
+            .collect()
+    }
+
+    #[cfg(not(feature = "mpi"))]
+    pub fn all_gather(&self, text: &str) -> Vec<String> {
+        vec![text.to_string()]
+    }
+}
+
+/// Refuse a command that does not spread over ranks when launched on several.
+pub fn single_rank(ranks: &Ranks, command: &str) -> Result<()> {
+    if ranks.size() > 1 {
+        bail!(
+            "`colloidsim {command}` runs on one rank: the engines are not decomposed over MPI ranks \
+             yet (issue #20); spread replicas and sweeps over ranks with `colloidsim ensemble`"
+        );
+    }
+    Ok(())
+}
+
+#[cfg(all(test, not(feature = "mpi")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_rank_agrees_with_itself() {
+        let r = Ranks {
+            rank: 0,
+            size: 1,
+            local: 1,
+        };
+        assert_eq!(r.agree(Ok(3)).unwrap(), 3);
+        let e = r.agree::<()>(Err(anyhow::anyhow!("bad key"))).unwrap_err();
+        assert_eq!(e.to_string(), "bad key");
+        assert_eq!(r.all_gather("x"), ["x"]);
+        assert!(single_rank(&r, "run").is_ok());
+    }
+}

@@ -1,0 +1,672 @@
+//! Ensembles: replicas of a scenario (seeds `seed, seed + 1, ...`) and parameter sweeps (the
+//! Cartesian product of `--vary key=[v1, v2, ...]` lists), each member an ordinary run in its own
+//! folder, then averaged.
+//!
+//! The members are independent runs, so an ensemble spreads over MPI ranks without changing a
+//! bit of any member (the CLI deals member `k` to rank `k mod size`, `docs/parallel.md`); this
+//! module plans, runs one member and combines, and [`ensemble`] does all three in one process.
+//!
+//! Averages: at each sweep point, every CSV table the replicas share (same header, same first
+//! column) is written with each column's mean over replicas and its standard error
+//! `s / sqrt(n)` (`COLUMN_err`, `s` the sample standard deviation between replicas; a run's own
+//! error columns, `err` and `NAME_err`, are replaced by this spread), and every
+//! number in the members' `summary.json` (outside `parameters`) is averaged the same way into
+//! `observables.csv` and the ensemble's `summary.json`.
+
+use crate::control::Control;
+use crate::{Report, RunOptions, Scenario};
+use anyhow::{Context, Result, bail};
+use colloidsim_core::output::{OutputDir, read_table};
+use serde_json::{Value, json};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Options of an ensemble.
+#[derive(Debug, Clone)]
+pub struct EnsembleOptions {
+    /// Output folder (default: the scenario's name followed by `-ensemble`).
+    pub out: Option<PathBuf>,
+    /// Replicas per sweep point (seeds `seed .. seed + replicas`), 1 ..= 10000.
+    pub replicas: u32,
+    /// Swept keys and their values; the points are the Cartesian product, the last key
+    /// varying fastest.
+    pub vary: Vec<(String, Vec<toml::Value>)>,
+    /// Write into a folder that already holds files.
+    pub force: bool,
+}
+
+impl Default for EnsembleOptions {
+    fn default() -> Self {
+        Self {
+            out: None,
+            replicas: 4,
+            vary: Vec::new(),
+            force: false,
+        }
+    }
+}
+
+/// One member: a scenario at a sweep point with a replica's seed, and its folder.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// Sweep point (0 without a sweep).
+    pub point: usize,
+    /// Replica at that point.
+    pub replica: u32,
+    /// The member's seed.
+    pub seed: u64,
+    /// The member's folder, relative to the ensemble's.
+    pub folder: String,
+    scenario: Scenario,
+}
+
+/// A planned ensemble: every member validated, nothing written yet.
+#[derive(Debug, Clone)]
+pub struct Ensemble {
+    scenario: Scenario,
+    out: PathBuf,
+    force: bool,
+    replicas: u32,
+    vary: Vec<(String, Vec<toml::Value>)>,
+    points: Vec<Vec<(String, toml::Value)>>,
+    members: Vec<Member>,
+    seed_first: u64,
+}
+
+/// The plan of an ensemble in its folder, and the version of its layout.
+const PLAN: &str = "ensemble.json";
+const PLAN_FORMAT: &str = "colloidsim-ensemble-1";
+
+/// A folder's `summary.json`.
+fn read_summary(dir: &Path) -> Result<Value> {
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))
+}
+
+/// Parse `key=[v1, v2, ...]` (a TOML array of at least one value) for `--vary`.
+pub fn parse_vary(text: &str) -> Result<(String, Vec<toml::Value>)> {
+    let (key, value) = text.split_once('=').with_context(|| {
+        format!("--vary {text}: expected KEY=[V1, V2, ...], e.g. system.phi=[0.1, 0.2]")
+    })?;
+    let key = key.trim().to_string();
+    let table: toml::Table =
+        toml::from_str(&format!("v = {}", value.trim())).with_context(|| {
+            format!("--vary {key}: the values must be a TOML array, e.g. [0.1, 0.2]")
+        })?;
+    match table.get("v") {
+        Some(toml::Value::Array(a)) if !a.is_empty() => Ok((key, a.clone())),
+        _ => bail!("--vary {key}: the values must be a non-empty TOML array, e.g. [0.1, 0.2]"),
+    }
+}
+
+/// A TOML value as written in a table cell (strings without quotes).
+fn cell(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+impl Ensemble {
+    /// Plan the ensemble of `sc`: every member's scenario is built and validated (as
+    /// `colloidsim check` would) before anything is written, so that bad input stops every
+    /// rank alike.
+    pub fn plan(sc: &Scenario, opts: &EnsembleOptions) -> Result<Self> {
+        if !(1..=10_000).contains(&opts.replicas) {
+            bail!("--replicas: must lie in 1 ..= 10000, got {}", opts.replicas);
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        for (key, values) in &opts.vary {
+            if !seen.insert(key.as_str()) {
+                bail!("--vary {key}: the key is given twice");
+            }
+            if key == "seed" {
+                bail!("--vary seed: the seeds of an ensemble are its replicas (--replicas)");
+            }
+            if values.is_empty() {
+                bail!("--vary {key}: no values");
+            }
+        }
+        let mut points: Vec<Vec<(String, toml::Value)>> = vec![Vec::new()];
+        for (key, values) in &opts.vary {
+            points = points
+                .into_iter()
+                .flat_map(|p| {
+                    values.iter().map(move |v| {
+                        let mut q = p.clone();
+                        q.push((key.clone(), v.clone()));
+                        q
+                    })
+                })
+                .collect();
+        }
+        if points.len() * opts.replicas as usize > 100_000 {
+            bail!(
+                "--vary/--replicas: {} points x {} replicas is more than 100000 members",
+                points.len(),
+                opts.replicas
+            );
+        }
+        let checked = crate::check(sc)?;
+        let seed_first = checked
+            .resolved
+            .get("seed")
+            .and_then(Value::as_u64)
+            .unwrap_or(1);
+        crate::seed32(seed_first + opts.replicas as u64 - 1).context(
+            "--replicas: the replicas' seeds (seed, seed + 1, ...) must stay below 2^32",
+        )?;
+        let mut members = Vec::new();
+        for (p, values) in points.iter().enumerate() {
+            let at = sc
+                .with_values(values)
+                .with_context(|| format!("sweep point {p}"))?;
+            crate::check(&at).with_context(|| {
+                let set: Vec<String> = values.iter().map(|(k, v)| format!("{k}={v}")).collect();
+                format!("sweep point {p} ({})", set.join(", "))
+            })?;
+            for r in 0..opts.replicas {
+                let folder = if opts.vary.is_empty() {
+                    format!("replica-{r}")
+                } else {
+                    format!("point-{p}/replica-{r}")
+                };
+                members.push(Member {
+                    point: p,
+                    replica: r,
+                    seed: seed_first + r as u64,
+                    folder,
+                    scenario: at.clone(),
+                });
+            }
+        }
+        let out = opts
+            .out
+            .clone()
+            .unwrap_or_else(|| format!("{}-ensemble", sc.name()).into());
+        Ok(Self {
+            scenario: sc.clone(),
+            out,
+            force: opts.force,
+            replicas: opts.replicas,
+            vary: opts.vary.clone(),
+            points,
+            members,
+            seed_first,
+        })
+    }
+
+    /// The members, in the order of their index.
+    pub fn members(&self) -> &[Member] {
+        &self.members
+    }
+
+    /// The ensemble's folder.
+    pub fn out(&self) -> &Path {
+        &self.out
+    }
+
+    /// Create the ensemble's folder (refused when it holds files, unless `force`) and write
+    /// the plan into it (`ensemble.json`: the scenario, its folder, the replicas and the sweep),
+    /// from which [`Ensemble::reopen`] continues an interrupted ensemble.
+    pub fn create(&self) -> Result<()> {
+        let dir = OutputDir::create(&self.out, self.force)?;
+        let plan = json!({
+            "format": PLAN_FORMAT,
+            "scenario": self.scenario.text(),
+            "base": self.scenario.base(),
+            "name": self.scenario.name(),
+            "replicas": self.replicas,
+            "vary": self.vary.iter().map(|(k, v)| json!([k, v])).collect::<Vec<_>>(),
+        });
+        dir.write_json(PLAN, &plan)?;
+        Ok(())
+    }
+
+    /// The ensemble planned in folder `dir` by an earlier [`Ensemble::create`], to be
+    /// continued: refused when the folder has no plan or the ensemble completed.
+    pub fn reopen(dir: &Path) -> Result<Self> {
+        let path = dir.join(PLAN);
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "--restart {}: no {PLAN} (not the folder of `colloidsim ensemble`)",
+                dir.display()
+            )
+        })?;
+        let v: Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+        if v["format"] != PLAN_FORMAT {
+            bail!(
+                "{}: format {} is not {PLAN_FORMAT}",
+                path.display(),
+                v["format"]
+            );
+        }
+        let summary = read_summary(dir).ok();
+        if summary.as_ref().is_some_and(|s| s["completed"] == true) {
+            bail!(
+                "--restart {}: this ensemble is complete (summary.json); nothing to continue",
+                dir.display()
+            );
+        }
+        let field = |k: &str| {
+            v[k].as_str()
+                .with_context(|| format!("{}: no {k}", path.display()))
+        };
+        let sc = Scenario::from_toml(field("scenario")?, Path::new(field("base")?))?
+            .named(field("name")?);
+        let vary: Vec<(String, Vec<toml::Value>)> = serde_json::from_value(v["vary"].clone())
+            .with_context(|| format!("{}: vary", path.display()))?;
+        let replicas = v["replicas"]
+            .as_u64()
+            .with_context(|| format!("{}: no replicas", path.display()))?;
+        Self::plan(
+            &sc,
+            &EnsembleOptions {
+                out: Some(dir.to_path_buf()),
+                replicas: replicas as u32,
+                vary,
+                force: false,
+            },
+        )
+    }
+
+    /// Run member `k` into its folder (after [`Ensemble::create`]). A member that already
+    /// completed is left as it is, one with a checkpoint is continued from it (bitwise the
+    /// uninterrupted run), and one that failed or stopped before its first checkpoint is run
+    /// again from its start.
+    pub fn run_member(&self, k: usize, ctl: &Control) -> Result<()> {
+        let m = &self.members[k];
+        let dir = self.out.join(&m.folder);
+        let summary = read_summary(&dir).ok();
+        let outcome = if summary.as_ref().is_some_and(|s| s["completed"] == true) {
+            Ok(())
+        } else if summary.is_none() && dir.join(crate::checkpoint::CHECKPOINT).exists() {
+            crate::resume(&dir, Some(&m.scenario), Some(m.seed), ctl).map(|_| ())
+        } else {
+            let force = self.force || dir.exists();
+            let opts = RunOptions {
+                out: Some(dir),
+                seed: Some(m.seed),
+                force,
+            };
+            crate::run(&m.scenario, &opts, ctl).map(|_| ())
+        };
+        outcome.with_context(|| format!("member {} ({})", k, m.folder))
+    }
+
+    /// Combine the members' outputs: `errors[k]` is member `k`'s error, if it failed. Writes
+    /// the averages and `summary.json`; with a failed member, the summary says `completed =
+    /// false`, names the failures and no averages are written, and the result is an error.
+    pub fn finish(&self, errors: &[Option<String>], wall_seconds: f64) -> Result<Report> {
+        let out = OutputDir::reopen(&self.out)?;
+        let failed: Vec<Value> = errors
+            .iter()
+            .enumerate()
+            .filter_map(|(k, e)| {
+                e.as_ref()
+                    .map(|e| json!({"member": k, "folder": self.members[k].folder, "error": e}))
+            })
+            .collect();
+        let mut summary = json!({
+            "software": crate::software(),
+            "method": "ensemble",
+            "scenario_method": self.scenario.method()?,
+            "replicas": self.replicas,
+            "seed_first": self.seed_first,
+            "vary": self.vary.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "members": self.members.len(),
+            "averages": "mean over replicas; errors: standard error s / sqrt(n) between replicas",
+            "wall_seconds": wall_seconds,
+        });
+        if !failed.is_empty() {
+            summary["completed"] = json!(false);
+            summary["error"] = json!(format!(
+                "{} of {} members failed",
+                failed.len(),
+                self.members.len()
+            ));
+            summary["failed"] = Value::Array(failed.clone());
+            out.write_json("summary.json", &summary)?;
+            let lines: Vec<String> = failed
+                .iter()
+                .map(|f| {
+                    format!(
+                        "{}: {}",
+                        f["folder"].as_str().unwrap_or("?"),
+                        f["error"].as_str().unwrap_or("?")
+                    )
+                })
+                .collect();
+            bail!(
+                "{} of {} members failed (no averages written; summary.json says completed = false):\n{}",
+                failed.len(),
+                self.members.len(),
+                lines.join("\n")
+            );
+        }
+        let mut files = Vec::new();
+        let mut warnings = Vec::new();
+        let mut observables = Vec::new();
+        for (p, values) in self.points.iter().enumerate() {
+            let folders: Vec<PathBuf> = self
+                .members
+                .iter()
+                .filter(|m| m.point == p)
+                .map(|m| self.out.join(&m.folder))
+                .collect();
+            let prefix = if self.vary.is_empty() {
+                String::new()
+            } else {
+                format!("point-{p}/")
+            };
+            if folders.len() >= 2 {
+                let dir = OutputDir::reopen(self.out.join(&prefix))?;
+                for (name, pooled) in pool(&folders)? {
+                    write_pooled(&dir, &name, &pooled)?;
+                    files.push(format!("{prefix}{name}"));
+                }
+            }
+            let obs = pool_summaries(&folders)?;
+            observables.push(json!({
+                "point": p,
+                "set": values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "observables": obs.iter().map(|(k, (m, e, n))| (k.clone(), json!({"mean": m, "err": e, "n": n}))).collect::<serde_json::Map<_, _>>(),
+            }));
+        }
+        if self.replicas < 2 {
+            warnings.push("one replica per point: no errors, and no averaged tables".to_string());
+        }
+        out.write_bytes(
+            "observables.csv",
+            self.observables_csv(&observables).as_bytes(),
+        )?;
+        files.push("observables.csv".into());
+        summary["completed"] = json!(true);
+        summary["error"] = Value::Null;
+        summary["points"] = Value::Array(observables);
+        summary["files"] = json!(files);
+        summary["warnings"] = json!(warnings);
+        out.write_json("summary.json", &summary)?;
+        let message = format!(
+            "ran {} member(s) ({} point(s) x {} replica(s)) and wrote their averages into {}",
+            self.members.len(),
+            self.points.len(),
+            self.replicas,
+            self.out.display()
+        );
+        Ok(Report {
+            out: self.out.clone(),
+            summary,
+            files,
+            warnings,
+            message,
+        })
+    }
+
+    /// `observables.csv`: one row per sweep point and observable: the point, the swept keys'
+    /// values, the observable, its mean, standard error and number of replicas.
+    fn observables_csv(&self, points: &[Value]) -> String {
+        let quote = |s: &str| {
+            if s.contains([',', '"', '\n']) {
+                format!("\"{}\"", s.replace('"', "\"\""))
+            } else {
+                s.to_string()
+            }
+        };
+        let mut s = String::from("point");
+        for (k, _) in &self.vary {
+            s.push(',');
+            s.push_str(&quote(k));
+        }
+        s.push_str(",observable,mean,err,n\n");
+        for (p, point) in points.iter().enumerate() {
+            let set: Vec<String> = self.points[p]
+                .iter()
+                .map(|(_, v)| quote(&cell(v)))
+                .collect();
+            if let Some(obs) = point["observables"].as_object() {
+                for (name, v) in obs {
+                    let num =
+                        |x: &Value| x.as_f64().map_or("nan".to_string(), |x| format!("{x:e}"));
+                    s.push_str(&format!("{p}"));
+                    for c in &set {
+                        s.push(',');
+                        s.push_str(c);
+                    }
+                    s.push_str(&format!(
+                        ",{},{},{},{}\n",
+                        quote(name),
+                        num(&v["mean"]),
+                        num(&v["err"]),
+                        v["n"]
+                    ));
+                }
+            }
+        }
+        s
+    }
+}
+
+/// Run every member of `sc`'s ensemble in this process, one after the other (each member
+/// uses the process's threads), and combine them.
+pub fn ensemble(sc: &Scenario, opts: &EnsembleOptions, ctl: &Control) -> Result<Report> {
+    let start = std::time::Instant::now();
+    let plan = Ensemble::plan(sc, opts)?;
+    plan.create()?;
+    plan.run_all(start, ctl)
+}
+
+/// Continue the interrupted ensemble in `dir` in this process (members that completed are
+/// kept, interrupted ones continue from their checkpoints).
+pub fn resume_ensemble(dir: &Path, ctl: &Control) -> Result<Report> {
+    let start = std::time::Instant::now();
+    Ensemble::reopen(dir)?.run_all(start, ctl)
+}
+
+impl Ensemble {
+    /// Run every member in turn and combine them; an interrupt stops after the member running.
+    fn run_all(&self, start: std::time::Instant, ctl: &Control) -> Result<Report> {
+        let mut errors = Vec::with_capacity(self.members.len());
+        for k in 0..self.members.len() {
+            let outcome = self.run_member(k, ctl);
+            if ctl.interrupted() {
+                bail!(
+                    "interrupted in member {k}; continue with: colloidsim ensemble --restart {}",
+                    self.out.display()
+                );
+            }
+            errors.push(outcome.err().map(|e| format!("{e:#}")));
+        }
+        self.finish(&errors, start.elapsed().as_secs_f64())
+    }
+}
+
+/// One table pooled over runs: header, first column, and per further column the means and
+/// standard errors.
+pub(crate) struct Pooled {
+    pub header: Vec<String>,
+    pub x: Vec<f64>,
+    pub means: Vec<Vec<f64>>,
+    pub errors: Vec<Vec<f64>>,
+}
+
+/// Whether a table column is a run's own error estimate (`err`, `NAME_err`): the pooled
+/// tables replace it by the spread between runs.
+fn is_error_column(name: &str) -> bool {
+    name == "err" || name.ends_with("_err")
+}
+
+/// Mean and standard error over runs of each column (but their own error columns) of every
+/// CSV table that all `folders` hold with the same header and first column (at least two runs).
+pub(crate) fn pool(folders: &[PathBuf]) -> Result<BTreeMap<String, Pooled>> {
+    let mut out = BTreeMap::new();
+    let mut names: Vec<String> = std::fs::read_dir(&folders[0])
+        .with_context(|| format!("cannot read {}", folders[0].display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".csv"))
+        .collect();
+    names.sort();
+    'table: for name in names {
+        let mut runs = Vec::new();
+        for f in folders {
+            match read_table(&f.join(&name)) {
+                Ok(t) => runs.push(t),
+                Err(_) => continue 'table,
+            }
+        }
+        let (header, first) = (&runs[0].0, &runs[0].1);
+        if header.len() < 2 || runs.iter().any(|(h, c)| h != header || c[0] != first[0]) {
+            continue;
+        }
+        let columns: Vec<usize> = (1..header.len())
+            .filter(|&c| !is_error_column(&header[c]))
+            .collect();
+        let rows = first[0].len();
+        let k = runs.len() as f64;
+        let mut means = Vec::new();
+        let mut errors = Vec::new();
+        for &c in &columns {
+            let (mut m, mut e) = (vec![0.0; rows], vec![0.0; rows]);
+            for i in 0..rows {
+                let (mean, err) = mean_err(runs.iter().map(|r| r.1[c][i]), k);
+                m[i] = mean;
+                e[i] = err;
+            }
+            means.push(m);
+            errors.push(e);
+        }
+        out.insert(
+            name,
+            Pooled {
+                header: std::iter::once(0)
+                    .chain(columns)
+                    .map(|c| header[c].clone())
+                    .collect(),
+                x: first[0].clone(),
+                means,
+                errors,
+            },
+        );
+    }
+    Ok(out)
+}
+
+/// Mean and standard error `s / sqrt(n)` of `n` values.
+fn mean_err(v: impl Iterator<Item = f64> + Clone, n: f64) -> (f64, f64) {
+    let mean = v.clone().sum::<f64>() / n;
+    let var = v.map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Write a pooled table: the first column, then each column and its error `COLUMN_err`.
+pub(crate) fn write_pooled(dir: &OutputDir, name: &str, p: &Pooled) -> Result<()> {
+    let mut cols: Vec<(String, &[f64])> = vec![(p.header[0].clone(), &p.x)];
+    for c in 0..p.means.len() {
+        cols.push((p.header[c + 1].clone(), &p.means[c]));
+        cols.push((format!("{}_err", p.header[c + 1]), &p.errors[c]));
+    }
+    let refs: Vec<(&str, &[f64])> = cols.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+    dir.write_table(name, &refs)?;
+    Ok(())
+}
+
+/// Whether a summary key is about the run rather than the physics: timings and thread counts.
+pub fn is_timing(key: &str) -> bool {
+    key == "threads" || key.ends_with("seconds") || key.ends_with("_per_second")
+}
+
+/// Every number in a summary outside its bookkeeping (`parameters`, `seed`, timings
+/// ([`is_timing`])), by its dotted path.
+fn numbers(v: &Value, path: &str, out: &mut BTreeMap<String, f64>) {
+    match v {
+        Value::Number(x) => {
+            if let Some(x) = x.as_f64() {
+                out.insert(path.to_string(), x);
+            }
+        }
+        Value::Object(map) => {
+            for (k, v) in map {
+                if is_timing(k) || (path.is_empty() && (k == "parameters" || k == "seed")) {
+                    continue;
+                }
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                numbers(v, &p, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Mean, standard error and count over `folders` of every number their `summary.json` files
+/// all hold.
+fn pool_summaries(folders: &[PathBuf]) -> Result<BTreeMap<String, (f64, f64, usize)>> {
+    let mut each = Vec::new();
+    for f in folders {
+        let path = f.join("summary.json");
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let v: Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+        let mut n = BTreeMap::new();
+        numbers(&v, "", &mut n);
+        each.push(n);
+    }
+    let n = each.len();
+    let mut out = BTreeMap::new();
+    for key in each[0].keys() {
+        if each.iter().all(|m| m.contains_key(key)) {
+            let (mean, err) = mean_err(each.iter().map(|m| m[key]), n as f64);
+            out.insert(key.clone(), (mean, if n >= 2 { err } else { f64::NAN }, n));
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vary_parses_toml_arrays_and_names_the_key_on_errors() {
+        let (k, v) = parse_vary("system.phi=[0.1, 0.2]").unwrap();
+        assert_eq!(k, "system.phi");
+        assert_eq!(v, vec![toml::Value::Float(0.1), toml::Value::Float(0.2)]);
+        let (_, v) = parse_vary("system.boundary=[\"walls\", \"periodic\"]").unwrap();
+        assert_eq!(cell(&v[1]), "periodic");
+        for bad in [
+            "system.phi",
+            "system.phi=0.1",
+            "system.phi=[]",
+            "system.phi=[0.1",
+        ] {
+            let e = format!("{:#}", parse_vary(bad).unwrap_err());
+            assert!(e.contains("--vary"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn mean_and_standard_error() {
+        let (m, e) = mean_err([1.0, 2.0, 3.0, 6.0].into_iter(), 4.0);
+        assert_eq!(m, 3.0);
+        // s^2 = (4 + 1 + 0 + 9) / 3
+        assert!((e - (14.0f64 / 3.0 / 4.0).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn summary_numbers_skip_the_bookkeeping() {
+        let v = json!({"seed": 3, "wall_seconds": 1.0, "parameters": {"dt": 1e-3}, "threads": 2,
+                       "particle_steps_per_second": 1e6,
+                       "msd": {"D": 0.5, "n": 2}, "files": ["a.csv"], "completed": true});
+        let mut n = BTreeMap::new();
+        numbers(&v, "", &mut n);
+        assert_eq!(n.keys().collect::<Vec<_>>(), ["msd.D", "msd.n"]);
+    }
+}
