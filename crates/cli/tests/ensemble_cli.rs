@@ -118,6 +118,15 @@ fn sweeps_are_validated_before_anything_is_written() {
         (vec!["--vary", "run.dt"], "--vary"),
         (vec!["--vary", "seed=[1, 2]"], "--replicas"),
         (vec!["--replicas", "0"], "--replicas"),
+        (
+            vec![
+                "--replicas",
+                "10000",
+                "--vary",
+                "run.dt=[1e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3, 7e-3, 8e-3, 9e-3, 1e-2, 2e-2]",
+            ],
+            "more than 100000 members",
+        ),
     ] {
         let mut a = vec!["ensemble", s, "--out", o];
         a.extend(args);

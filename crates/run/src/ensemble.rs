@@ -129,6 +129,14 @@ impl Ensemble {
                 bail!("--vary {key}: no values");
             }
         }
+        let members = opts
+            .vary
+            .iter()
+            .try_fold(opts.replicas as usize, |n, (_, v)| n.checked_mul(v.len()))
+            .filter(|&n| n <= 100_000);
+        if members.is_none() {
+            bail!("--vary/--replicas: more than 100000 members (points x replicas)");
+        }
         let mut points: Vec<Vec<(String, toml::Value)>> = vec![Vec::new()];
         for (key, values) in &opts.vary {
             points = points
@@ -141,13 +149,6 @@ impl Ensemble {
                     })
                 })
                 .collect();
-        }
-        if points.len() * opts.replicas as usize > 100_000 {
-            bail!(
-                "--vary/--replicas: {} points x {} replicas is more than 100000 members",
-                points.len(),
-                opts.replicas
-            );
         }
         let checked = crate::check(sc)?;
         let seed_first = checked
