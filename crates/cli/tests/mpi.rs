@@ -3,6 +3,7 @@
 //! of ranks, and a failure on one rank stops every rank with its message instead of a hang.
 #![cfg(feature = "mpi")]
 
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
@@ -34,17 +35,34 @@ fn mpirun(ranks: usize, args: &[&str]) -> Output {
     mpirun_env(ranks, args, &[])
 }
 
-fn serial(args: &[&str]) -> Output {
-    common::cli(args, &[])
+/// The tiny scenario, written into `dir`.
+fn tiny(dir: &Path) -> PathBuf {
+    let sc = dir.join("tiny.toml");
+    std::fs::write(&sc, TINY).unwrap();
+    sc
+}
+
+/// The tiny scenario written into `dir`, and its ensemble with `args` run in one process on one
+/// thread into `dir/serial`: (scenario path, reference folder).
+fn serial_reference(dir: &Path, args: &[&str]) -> (String, PathBuf) {
+    let sc = tiny(dir);
+    let (s, reference) = (sc.to_str().unwrap().to_string(), dir.join("serial"));
+    let mut a = vec![
+        "ensemble",
+        &s,
+        "--out",
+        reference.to_str().unwrap(),
+        "--threads",
+        "1",
+    ];
+    a.extend(args);
+    assert!(common::cli(&a, &[]).status.success());
+    (s, reference)
 }
 
 #[test]
 fn an_ensemble_on_1_2_and_4_ranks_is_the_single_process_one() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("tiny.toml");
-    std::fs::write(&sc, TINY).unwrap();
-    let s = sc.to_str().unwrap();
-    let reference = tmp.path().join("serial");
     let common_args = [
         "--replicas",
         "3",
@@ -52,16 +70,8 @@ fn an_ensemble_on_1_2_and_4_ranks_is_the_single_process_one() {
         "system.particles=[4, 5]",
         "--quiet",
     ];
-    let mut args = vec![
-        "ensemble",
-        s,
-        "--out",
-        reference.to_str().unwrap(),
-        "--threads",
-        "1",
-    ];
-    args.extend(common_args);
-    assert!(serial(&args).status.success());
+    let (s, reference) = serial_reference(tmp.path(), &common_args);
+    let s = s.as_str();
     for ranks in [1, 2, 4] {
         let out = tmp.path().join(format!("ranks-{ranks}"));
         let mut args = vec!["ensemble", s, "--out", out.to_str().unwrap()];
@@ -75,8 +85,7 @@ fn an_ensemble_on_1_2_and_4_ranks_is_the_single_process_one() {
 #[test]
 fn bad_input_stops_every_rank_with_one_message() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("tiny.toml");
-    std::fs::write(&sc, TINY).unwrap();
+    let sc = tiny(tmp.path());
     let out = tmp.path().join("ens");
     let o = mpirun(
         3,
@@ -99,8 +108,7 @@ fn bad_input_stops_every_rank_with_one_message() {
 #[test]
 fn a_member_failing_on_one_rank_stops_all_ranks_without_averages() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("tiny.toml");
-    std::fs::write(&sc, TINY).unwrap();
+    let sc = tiny(tmp.path());
     let out = tmp.path().join("ens");
     // Member 1 (rank 1 of 2) cannot create its folder: a file holds its name.
     std::fs::create_dir_all(&out).unwrap();
@@ -141,8 +149,7 @@ fn a_member_failing_on_one_rank_stops_all_ranks_without_averages() {
 #[test]
 fn run_refuses_several_ranks_until_the_engines_are_decomposed() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("tiny.toml");
-    std::fs::write(&sc, TINY).unwrap();
+    let sc = tiny(tmp.path());
     let out = tmp.path().join("run");
     let o = mpirun(
         2,
@@ -167,40 +174,14 @@ fn run_refuses_several_ranks_until_the_engines_are_decomposed() {
 #[test]
 fn an_ensemble_interrupted_on_2_ranks_continues_on_1_and_4() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("tiny.toml");
-    std::fs::write(&sc, TINY).unwrap();
-    let s = sc.to_str().unwrap();
-    let reference = tmp.path().join("serial");
     let args = ["--replicas", "5", "--quiet"];
-    let mut a = vec![
-        "ensemble",
-        s,
-        "--out",
-        reference.to_str().unwrap(),
-        "--threads",
-        "1",
-    ];
-    a.extend(args);
-    assert!(serial(&a).status.success());
+    let (s, reference) = serial_reference(tmp.path(), &args);
+    let s = s.as_str();
     for ranks in [1, 4] {
         let out = tmp.path().join(format!("continued-on-{ranks}"));
         let mut a = vec!["ensemble", s, "--out", out.to_str().unwrap()];
         a.extend(args);
-        let o = Command::new("timeout")
-            .args([
-                "120",
-                "mpirun",
-                "--allow-run-as-root",
-                "--oversubscribe",
-                "-n",
-                "2",
-            ])
-            .arg(env!("CARGO_BIN_EXE_colloidsim"))
-            .args(&a)
-            .env("COLLOIDSIM_INTERRUPT_AT_STEP", "1000")
-            .output()
-            .unwrap();
-        eprintln!("{}", text(&o));
+        let o = mpirun_env(2, &a, &[("COLLOIDSIM_INTERRUPT_AT_STEP", "1000")]);
         assert!(!o.status.success());
         assert!(text(&o).contains("--restart"), "{}", text(&o));
         assert!(out.join("replica-1/checkpoint.bin").exists());
