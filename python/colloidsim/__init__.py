@@ -260,7 +260,15 @@ def resume(
     threads: Optional[int] = None,
 ) -> Result:
     """Continue the interrupted run in ``folder`` from its checkpoint (as
-    ``colloidsim run --restart folder``); the result is bitwise that of an uninterrupted run."""
+    ``colloidsim run --restart folder``); the result is bitwise that of an uninterrupted run.
+    An ensemble's folder (it holds ``ensemble.json``) is continued as ``colloidsim ensemble
+    --restart folder``: completed members kept, interrupted ones resumed, the rest run."""
+    if os.path.exists(os.path.join(os.fspath(folder), "ensemble.json")):
+        if seed is not None:
+            raise ColloidsimError("resume: an ensemble's seeds are its replicas; give no seed")
+        report = json.loads(_colloidsim.resume_ensemble(os.fspath(folder), threads))
+        _warn(report)
+        return Result(report)
     report = json.loads(_colloidsim.resume(os.fspath(folder), seed, threads))
     _warn(report)
     return Result(report)

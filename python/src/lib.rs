@@ -178,6 +178,17 @@ fn ensemble(
     Ok(report_json(&r))
 }
 
+/// Continue the interrupted ensemble in `folder` (`colloidsim ensemble --restart`); returns
+/// the report as JSON.
+#[pyfunction]
+#[pyo3(signature = (folder, threads=None))]
+fn resume_ensemble(py: Python<'_>, folder: PathBuf, threads: Option<usize>) -> PyResult<String> {
+    let r = blocking(py, threads, |ctl| {
+        colloidsim_run::resume_ensemble(&folder, ctl)
+    })?;
+    Ok(report_json(&r))
+}
+
 /// Continue the interrupted run in `folder`; returns the report as JSON.
 #[pyfunction]
 #[pyo3(signature = (folder, seed=None, threads=None))]
@@ -395,6 +406,7 @@ fn _colloidsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(resume, m)?)?;
     m.add_function(wrap_pyfunction!(ensemble, m)?)?;
+    m.add_function(wrap_pyfunction!(resume_ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(theory, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(keys, m)?)?;

@@ -243,3 +243,31 @@ def test_ensemble_equals_the_cli_and_averages_the_replicas(tmp_path, cli):
     with pytest.raises(colloidsim.ColloidsimError, match="vary seed"):
         colloidsim.ensemble(path, vary={"seed": [1, 2]}, out=tmp_path / "bad")
     assert not (tmp_path / "bad").exists()
+
+
+def test_an_interrupted_ensemble_resumes_to_the_cli_folder(tmp_path, cli):
+    path = tmp_path / "tiny.toml"
+    path.write_text(
+        colloidsim._colloidsim.toml_from_json(
+            json.dumps(
+                {
+                    "method": "bcd",
+                    "seed": 11,
+                    "system": {"length": 10.0, "particles": 5, "diameter": 0.5},
+                    "run": {"dt": 1e-3, "equilibrate": 0.2, "time": 2.0},
+                    "observe": {"density": {"bins": 20}},
+                }
+            )
+        )
+    )
+    cli("ensemble", path, "--out", tmp_path / "cli", "--replicas", "2", "--quiet")
+    stopped = cli(
+        "ensemble", path, "--out", tmp_path / "py", "--replicas", "2",
+        env={"COLLOIDSIM_INTERRUPT_AT_STEP": "1000"}, check=False,
+    )
+    assert stopped.returncode != 0 and "--restart" in stopped.stderr
+    r = colloidsim.resume(tmp_path / "py")
+    assert r.summary["completed"] is True
+    assert (tmp_path / "cli" / "density.csv").read_bytes() == (r.out / "density.csv").read_bytes()
+    for sub in ["replica-0", "replica-1"]:
+        assert_same_outputs(tmp_path / "cli" / sub, tmp_path / "py" / sub)
