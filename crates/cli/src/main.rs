@@ -587,15 +587,11 @@ fn ensemble(
         Ok(())
     })?;
     let ctl = control(quiet || rank != 0);
-    let mut mine = serde_json::Map::new();
-    for k in (rank..plan.members().len()).step_by(size) {
-        if ctl.interrupted() {
-            break;
-        }
-        if let Err(e) = plan.run_member(k, &ctl) {
-            mine.insert(k.to_string(), format!("{e:#}").into());
-        }
-    }
+    let mine: serde_json::Map<String, serde_json::Value> = plan
+        .run_share(rank, size, &ctl)
+        .into_iter()
+        .map(|(k, e)| (k.to_string(), e.into()))
+        .collect();
     ranks.agree(if ctl.interrupted() {
         Err(anyhow::anyhow!(
             "interrupted; continue with: {}colloidsim ensemble --restart {}",

@@ -468,19 +468,34 @@ pub fn resume_ensemble(dir: &Path, ctl: &Control) -> Result<Report> {
 }
 
 impl Ensemble {
+    /// Run the members `k` with `k mod size == rank` in turn (an MPI rank's share; all of them
+    /// for `rank = 0, size = 1`), stopping before the next member once interrupted; returns
+    /// the errors of the members that failed, by index.
+    pub fn run_share(&self, rank: usize, size: usize, ctl: &Control) -> BTreeMap<usize, String> {
+        let mut failed = BTreeMap::new();
+        for k in (rank..self.members.len()).step_by(size.max(1)) {
+            if ctl.interrupted() {
+                break;
+            }
+            if let Err(e) = self.run_member(k, ctl) {
+                failed.insert(k, format!("{e:#}"));
+            }
+        }
+        failed
+    }
+
     /// Run every member in turn and combine them; an interrupt stops after the member running.
     fn run_all(&self, start: std::time::Instant, ctl: &Control) -> Result<Report> {
-        let mut errors = Vec::with_capacity(self.members.len());
-        for k in 0..self.members.len() {
-            let outcome = self.run_member(k, ctl);
-            if ctl.interrupted() {
-                bail!(
-                    "interrupted in member {k}; continue with: colloidsim ensemble --restart {}",
-                    self.out.display()
-                );
-            }
-            errors.push(outcome.err().map(|e| format!("{e:#}")));
+        let failed = self.run_share(0, 1, ctl);
+        if ctl.interrupted() {
+            bail!(
+                "interrupted; continue with: colloidsim ensemble --restart {}",
+                self.out.display()
+            );
         }
+        let errors: Vec<Option<String>> = (0..self.members.len())
+            .map(|k| failed.get(&k).cloned())
+            .collect();
         self.finish(&errors, start.elapsed().as_secs_f64())
     }
 }
