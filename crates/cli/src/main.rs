@@ -336,14 +336,18 @@ fn main() -> std::process::ExitCode {
     quiet_on_closed_pipe();
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) if e.downcast_ref::<parallel::FailedElsewhere>().is_some() => {
-            std::process::ExitCode::FAILURE
-        }
         Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
+            if e.downcast_ref::<parallel::Reported>().is_none() {
+                report(&e);
+            }
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+/// `error: ` and the error's chain on stderr.
+fn report(e: &anyhow::Error) {
+    eprintln!("error: {}", error_chain(e));
 }
 
 /// `--threads N`: the global pool of N workers (default: all cores).

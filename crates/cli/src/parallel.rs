@@ -2,15 +2,16 @@
 //!
 //! Every collective step goes through [`Ranks::agree`]: each rank brings its own outcome, and
 //! either every rank goes on or every rank stops, the lowest failing rank printing its message
-//! and the others exiting quietly ([`FailedElsewhere`]), so bad input or a failed member on
-//! one rank never leaves the others waiting. A panic on any rank aborts all of them.
+//! before any rank exits ([`Reported`]), so bad input or a failed member on one rank never
+//! leaves the others waiting, and its message is not lost when mpirun ends the job at the first
+//! non-zero exit. A panic on any rank aborts all of them.
 
 use anyhow::{Result, bail};
 
-/// Another rank failed and printed why; this rank stops without a message of its own.
+/// A rank failed and has printed why on stderr; every rank stops without another message.
 #[derive(Debug, thiserror::Error)]
 #[error("rank {0} failed (its message is above)")]
-pub struct FailedElsewhere(pub usize);
+pub struct Reported(pub usize);
 
 /// The ranks of this process's job.
 pub struct Ranks {
@@ -99,18 +100,37 @@ impl Ranks {
         Some((cores / self.local).max(1))
     }
 
-    /// Go on together or stop together: `Ok` on every rank when `local` is `Ok` on every rank;
-    /// otherwise the lowest failing rank returns its own error and every other rank
-    /// [`FailedElsewhere`].
+    /// Go on together or stop together: `Ok` on every rank when `local` is `Ok` on every rank.
+    /// Otherwise, on one rank, its error; on several, the lowest failing rank prints its error
+    /// and, only once it has, every rank returns [`Reported`]: mpirun ends the whole job at the
+    /// first rank that exits non-zero, which must not come before the message.
     pub fn agree<T>(&self, local: Result<T>) -> Result<T> {
         let mine = if local.is_err() { self.rank } else { self.size };
         let first = self.min(mine);
         match local {
             Ok(v) if first == self.size => Ok(v),
-            Err(e) if first == self.rank => Err(e),
-            _ => Err(FailedElsewhere(first).into()),
+            Err(e) if self.size == 1 => Err(e),
+            local => {
+                if let Err(e) = &local
+                    && first == self.rank
+                {
+                    crate::report(e);
+                }
+                self.barrier();
+                Err(Reported(first).into())
+            }
         }
     }
+
+    /// Wait until every rank is here.
+    #[cfg(feature = "mpi")]
+    fn barrier(&self) {
+        use mpi::collective::CommunicatorCollectives;
+        self.world.barrier();
+    }
+
+    #[cfg(not(feature = "mpi"))]
+    fn barrier(&self) {}
 
     /// The smallest of every rank's `x`.
     #[cfg(feature = "mpi")]
