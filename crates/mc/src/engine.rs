@@ -730,7 +730,10 @@ impl HardSphereMc {
         let range = cells.div_ceil(parts);
         let ranges = cells.div_ceil(range);
         self.bucket.resize(n, 0);
-        self.bucket_end.resize(parts * (ranges + 1), 0);
+        // Each part's `ranges + 1` ends on cache lines of their own (the parts count into them
+        // concurrently).
+        let stride = (ranges + 1).next_multiple_of(16);
+        self.bucket_end.resize(parts * stride, 0);
         // 1. Per part: cells, counts per cell, and the part's particles grouped by range.
         {
             let [px, py, pz] = &self.pos;
@@ -738,7 +741,7 @@ impl HardSphereMc {
                 .par_chunks_mut(part_len)
                 .zip(self.part_count.par_chunks_mut(cells))
                 .zip(self.bucket.par_chunks_mut(part_len))
-                .zip(self.bucket_end.par_chunks_mut(ranges + 1))
+                .zip(self.bucket_end.par_chunks_mut(stride))
                 .enumerate()
                 .for_each(|(k, (((cell, counts), bucket), end))| {
                     counts.fill(0);
@@ -749,10 +752,12 @@ impl HardSphereMc {
                         let (id, _) = pass.bin(px[i], py[i], pz[i]);
                         *out = id as u32;
                         counts[id] += 1;
-                        end[id / range + 1] += 1;
                     }
-                    for r in 1..=ranges {
-                        end[r] += end[r - 1];
+                    // Where each range's group ends (from the counts per cell: the parts'
+                    // `end` arrays share cache lines, so they are not counted into per
+                    // particle).
+                    for (r, c) in counts.chunks(range).enumerate() {
+                        end[r + 1] = end[r] + c.iter().sum::<u32>();
                     }
                     // Counting sort by range: afterwards end[r] is where range r ends.
                     for (j, &id) in cell.iter().enumerate() {
@@ -807,7 +812,7 @@ impl HardSphereMc {
                         seen.fill(0);
                         // This range's particles, part after part: particle order.
                         let mine = (0..parts).flat_map(|q| {
-                            let end = &bucket_end[q * (ranges + 1)..(q + 1) * (ranges + 1)];
+                            let end = &bucket_end[q * stride..q * stride + ranges + 1];
                             let begin = if k == 0 { 0 } else { end[k - 1] as usize };
                             &bucket[q * part_len + begin..q * part_len + end[k] as usize]
                         });
