@@ -14,8 +14,9 @@ pub struct BenchArgs {
     /// Volume fractions to measure.
     #[arg(long, value_delimiter = ',', default_value = "0.3,0.5")]
     pub phi: Vec<f64>,
-    /// Timed sweeps (N trial moves each) per measurement at N = 10,976; scaled by 10,976 / N
-    /// for other N (at least 10), so every measurement makes about the same number of moves.
+    /// Timed sweeps of one trial move per sphere per measurement at N = 10,976; scaled by
+    /// 10,976 / (N nselect) otherwise (at least 10), so every measurement makes about the same
+    /// number of moves.
     #[arg(long, default_value_t = 200)]
     pub sweeps: u64,
     /// Warm-up sweeps before timing at N = 10,976 (delta tuned every 100 towards acceptance
@@ -28,6 +29,10 @@ pub struct BenchArgs {
     /// Thread counts to measure.
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub threads: Vec<usize>,
+    /// Trial moves per sphere per sweep (HOOMD-blue's nselect: moves per binning of the
+    /// cells) to measure; the warm-up is at 1.
+    #[arg(long, value_delimiter = ',', default_value = "1,4")]
+    pub nselect: Vec<usize>,
 }
 
 /// `colloidsim bench mc`: for each volume fraction, one warmed-up system (FCC start, delta
@@ -36,12 +41,12 @@ pub struct BenchArgs {
 /// time, medians, and the speed-up over the first thread count.
 pub fn bench(a: &BenchArgs) -> Result<()> {
     println!(
-        "# colloidsim bench mc: hard spheres d = 1, periodic cube, cells updated in two parallel passes of z layers; {} sweeps per run at N = 10976 (scaled by 10976/N), median (min-max) of {}",
+        "# colloidsim bench mc: hard spheres d = 1, periodic cube, cells updated in two parallel passes of z layers; {} N trial moves per run at N = 10976 (scaled by 10976/N), median (min-max) of {}",
         a.sweeps, a.repeats
     );
     println!("# cpu_rate: trial moves per second of CPU time (user + system, all threads)");
     println!(
-        "n\tphi\tthreads\tmoves_per_s\tmin\tmax\tcpu_rate\tacceptance\tdelta\tleft_cell\tspeedup"
+        "n\tphi\tnselect\tthreads\tmoves_per_s\tmin\tmax\tcpu_rate\tacceptance\tdelta\tleft_cell\tspeedup"
     );
     let pools = a
         .threads
@@ -53,39 +58,47 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .context("thread pool")
         })
         .collect::<Result<Vec<_>>>()?;
+    if let Some(bad) = a.nselect.iter().find(|&&k| !(1..=1000).contains(&k)) {
+        anyhow::bail!("--nselect must be integers in [1, 1000], got {bad}");
+    }
     for (&n, &phi) in a.n.iter().flat_map(|n| a.phi.iter().map(move |p| (n, p))) {
         let scale = |sweeps: u64, least: u64| (sweeps * 10_976 / n.max(1) as u64).max(least);
-        let (sweeps, warmup) = (scale(a.sweeps, 10), scale(a.warmup, 300));
-        let warm = colloidsim_mc::bench::bulk_system(n, phi, 1, warmup)?;
-        let mut rates = vec![Vec::new(); pools.len()];
-        let mut cpu_rates = vec![Vec::new(); pools.len()];
-        let mut stats = vec![Default::default(); pools.len()];
-        for _ in 0..a.repeats.max(1) {
-            for (k, pool) in pools.iter().enumerate() {
-                let mut mc = warm.clone();
-                let c0 = cpu_seconds();
-                let start = Instant::now();
-                let s: colloidsim_mc::SweepStats = pool.install(|| mc.run(sweeps));
-                let wall = start.elapsed().as_secs_f64();
-                let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
-                rates[k].push(s.trials as f64 / wall);
-                cpu_rates[k].push(cpu.map_or(f64::NAN, |c| s.trials as f64 / c));
-                stats[k] = s;
+        let warmup = scale(a.warmup, 300);
+        let warmed = colloidsim_mc::bench::bulk_system(n, phi, 1, warmup)?;
+        for &nselect in &a.nselect {
+            let sweeps = scale(a.sweeps / nselect as u64, 10);
+            let mut warm = warmed.clone();
+            warm.set_nselect(nselect);
+            let mut rates = vec![Vec::new(); pools.len()];
+            let mut cpu_rates = vec![Vec::new(); pools.len()];
+            let mut stats = vec![Default::default(); pools.len()];
+            for _ in 0..a.repeats.max(1) {
+                for (k, pool) in pools.iter().enumerate() {
+                    let mut mc = warm.clone();
+                    let c0 = cpu_seconds();
+                    let start = Instant::now();
+                    let s: colloidsim_mc::SweepStats = pool.install(|| mc.run(sweeps));
+                    let wall = start.elapsed().as_secs_f64();
+                    let cpu = cpu_seconds().zip(c0).map(|(c1, c0)| c1 - c0);
+                    rates[k].push(s.trials as f64 / wall);
+                    cpu_rates[k].push(cpu.map_or(f64::NAN, |c| s.trials as f64 / c));
+                    stats[k] = s;
+                }
             }
-        }
-        let mut first = None;
-        for (k, &t) in a.threads.iter().enumerate() {
-            let (m, lo, hi) = median(rates[k].clone());
-            let (mc, _, _) = median(cpu_rates[k].clone());
-            let base = *first.get_or_insert(m);
-            let s: colloidsim_mc::SweepStats = stats[k];
-            println!(
-                "{n}\t{phi}\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{:.3}\t{:.4}\t{:.3}\t{:.2}",
-                s.acceptance(),
-                warm.delta(),
-                s.left_cell as f64 / s.trials as f64,
-                m / base
-            );
+            let mut first = None;
+            for (k, &t) in a.threads.iter().enumerate() {
+                let (m, lo, hi) = median(rates[k].clone());
+                let (mc, _, _) = median(cpu_rates[k].clone());
+                let base = *first.get_or_insert(m);
+                let s: colloidsim_mc::SweepStats = stats[k];
+                println!(
+                    "{n}\t{phi}\t{nselect}\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{:.3}\t{:.4}\t{:.3}\t{:.2}",
+                    s.acceptance(),
+                    warm.delta(),
+                    s.left_cell as f64 / s.trials as f64,
+                    m / base
+                );
+            }
         }
     }
     Ok(())

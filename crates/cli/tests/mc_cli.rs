@@ -147,6 +147,8 @@ fn bad_input_is_refused_naming_the_key_and_range() {
             wall("particles = 100", "target_acceptance = 0.0"),
             "mc.target_acceptance",
         ),
+        (wall("particles = 100", "nselect = 0"), "mc.nselect"),
+        (wall("particles = 100", "nselect = 1001"), "mc.nselect"),
         (wall("volume_fraction = 0.7", ""), "system.volume_fraction"),
         (wall("particles = 400", ""), "random close packing"),
         (

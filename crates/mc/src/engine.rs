@@ -12,9 +12,9 @@
 //! 2. bin every particle into the shifted grid (a parallel counting sort that keeps particle
 //!    order within each cell), storing its position relative to its cell's corner;
 //! 3. for each parity in turn, every layer of that parity (concurrently, with rayon, one task per
-//!    layer) visits its `nc^2` cells in storage order, and each cell makes as many trial moves as
-//!    it holds particles: pick one of its particles uniformly, displace it uniformly in the cube
-//!    `[-delta, delta)^3`, reject the move if the new centre leaves the cell, leaves the
+//!    layer) visits its `nc^2` cells in storage order, and each cell makes `nselect` (default 1)
+//!    times as many trial moves as it holds particles: pick one of its particles uniformly,
+//!    displace it uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre leaves the cell, leaves the
 //!    container, or overlaps any sphere, and (interface geometry) accept it with the Metropolis
 //!    probability `min(1, exp(-beta dV))`. Layers of one parity are a layer apart, `s >= d`, so
 //!    a sphere moving in one can touch only spheres of its own layer (updated in turn by the same
@@ -30,7 +30,9 @@
 //! cell does not change during the sweep, so the pick is symmetric; the displacement is
 //! symmetric; moves out of the cell are rejected in both directions. The sweep is a composition
 //! of such moves (balance holds), and the random offset and parity order make it ergodic. A
-//! sweep makes exactly N trial moves.
+//! sweep makes exactly `nselect N` trial moves (HOOMD-blue's `nselect`, default 1 here): more
+//! moves per binning share its cost (the binning and write-back are a third of a sweep at
+//! `nselect = 1` and scale worse than the moves); the offset is drawn anew every sweep.
 //!
 //! Random numbers: layer `k` of parity `p` draws from the stream `(seed, sweep, Moves,
 //! 1 + p nc/2 + k)`, so a run is a pure function of its seed and the result does not depend on
@@ -164,6 +166,8 @@ struct Pass {
     nc: usize,
     half: usize,
     cap: usize,
+    /// Trial moves per sphere per sweep.
+    nselect: usize,
     delta: f64,
     seed: u32,
     sweep: u64,
@@ -302,7 +306,7 @@ impl Pass {
     }
 
     /// The trial moves of one active cell (`around`: the grid coordinates below, at and above
-    /// it along each axis, wrapped): as many as it holds particles. `layer` holds the slots of
+    /// it along each axis, wrapped): `nselect` times as many as it holds particles. `layer` holds the slots of
     /// its layer, whose first slot has global index `layer_base`: the cell's own `cap` slots
     /// (positions relative to its corner, the `n` occupied ones first and [`EMPTY`] beyond)
     /// and those of its eight neighbours in the layer, which the same task updates in turn; the
@@ -349,7 +353,7 @@ impl Pass {
         let soft = self.geometry.is_soft();
         let (mut accepted, mut left) = (0u64, 0u64);
         let range = |u: f64| (usize::from(u >= d), 1 + usize::from(u > s - d));
-        for _ in 0..n {
+        for _ in 0..n * self.nselect {
             let p = own + below(rng.next_u64(), n);
             let step = |b: u64| self.delta * (2.0 * unit(b) - 1.0);
             let new = [
@@ -441,6 +445,8 @@ pub struct HardSphereMc {
     geometry: Geometry,
     seed: u32,
     delta: f64,
+    /// Trial moves per sphere per sweep (HOOMD-blue's `nselect`).
+    nselect: usize,
     sweep: u64,
     edge: f64,
     nc: usize,
@@ -533,6 +539,7 @@ impl HardSphereMc {
             geometry: params.geometry,
             seed: params.seed,
             delta: params.delta,
+            nselect: 1,
             sweep: 0,
             edge,
             nc,
@@ -645,6 +652,18 @@ impl HardSphereMc {
         self.delta = delta.clamp(1e-12 * self.diameter, self.max_delta());
     }
 
+    /// Trial moves per sphere per sweep (1 unless set).
+    pub fn nselect(&self) -> usize {
+        self.nselect
+    }
+
+    /// Make `nselect` trial moves per sphere per sweep (HOOMD-blue's `nselect`; at least 1):
+    /// each cell of a layer makes `nselect` times as many moves as it holds spheres, all on
+    /// one binning, so the binning and write-back are shared by `nselect N` moves.
+    pub fn set_nselect(&mut self, nselect: usize) {
+        self.nselect = nselect.max(1);
+    }
+
     /// Sweeps done.
     pub fn sweeps(&self) -> u64 {
         self.sweep
@@ -684,6 +703,7 @@ impl HardSphereMc {
             nc: self.nc,
             half: self.nc / 2,
             cap: self.cap,
+            nselect: self.nselect,
             delta: self.delta,
             seed: self.seed,
             sweep: self.sweep,
@@ -871,7 +891,7 @@ impl HardSphereMc {
             });
     }
 
-    /// One sweep: N trial moves (see the module documentation).
+    /// One sweep: `nselect N` trial moves (see the module documentation).
     pub fn sweep(&mut self) -> SweepStats {
         let mut rng = stream(self.seed, self.sweep, Purpose::Moves, 0);
         let s = self.side;
@@ -920,7 +940,7 @@ impl HardSphereMc {
         self.scatter();
         self.sweep += 1;
         SweepStats {
-            trials: self.len() as u64,
+            trials: (self.len() * self.nselect) as u64,
             accepted,
             left_cell: left,
         }

@@ -15,6 +15,9 @@ use std::path::PathBuf;
 /// Highest volume fraction accepted: random close packing.
 pub const MAX_PHI: f64 = 0.64;
 
+/// Largest `mc.nselect` (trial moves per sphere per sweep).
+pub const NSELECT_MAX: usize = 1000;
+
 /// An `hs-mc` scenario file.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -94,9 +97,12 @@ pub struct InterfaceSection {
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct McSection {
-    /// Sampling sweeps (N trial moves each), after the warm-up.
+    /// Sampling sweeps (`nselect N` trial moves each), after the warm-up.
     #[serde(default = "default_sweeps")]
     pub sweeps: u64,
+    /// Trial moves per sphere per sweep (HOOMD-blue's `nselect`).
+    #[serde(default = "default_nselect")]
+    pub nselect: usize,
     /// Warm-up sweeps, during which delta is tuned.
     #[serde(default = "default_warmup")]
     pub warmup_sweeps: u64,
@@ -120,6 +126,9 @@ pub struct McSection {
 fn default_sweeps() -> u64 {
     10_000
 }
+fn default_nselect() -> usize {
+    1
+}
 fn default_warmup() -> u64 {
     2_000
 }
@@ -140,6 +149,7 @@ impl Default for McSection {
     fn default() -> Self {
         Self {
             sweeps: default_sweeps(),
+            nselect: default_nselect(),
             warmup_sweeps: default_warmup(),
             target_acceptance: default_target(),
             tune_every: default_tune_every(),
@@ -222,6 +232,8 @@ pub struct McRun {
     pub interface: Option<[f64; 3]>,
     /// Sampling sweeps.
     pub sweeps: u64,
+    /// Trial moves per sphere per sweep.
+    pub nselect: usize,
     /// Warm-up sweeps.
     pub warmup_sweeps: u64,
     /// Target acceptance of the tuning.
@@ -391,6 +403,15 @@ impl McScenario {
         }
         let m = &self.mc;
         at_least("mc.sweeps", m.sweeps as usize, 1)?;
+        if !(1..=NSELECT_MAX).contains(&m.nselect) {
+            return Err(ParamError::new(
+                "mc.nselect",
+                format!(
+                    "must be an integer in [1, {NSELECT_MAX}], got {}",
+                    m.nselect
+                ),
+            ));
+        }
         at_least("mc.tune_every", m.tune_every as usize, 1)?;
         at_least("mc.sample_every", m.sample_every as usize, 1)?;
         if !(m.target_acceptance > 0.0 && m.target_acceptance < 1.0) {
@@ -454,6 +475,7 @@ impl McScenario {
             kt,
             interface,
             sweeps: m.sweeps,
+            nselect: m.nselect,
             warmup_sweeps: m.warmup_sweeps,
             target_acceptance: m.target_acceptance,
             tune_every: m.tune_every,
@@ -537,6 +559,8 @@ impl McRun {
             seed: self.seed,
             delta: self.delta,
         };
-        HardSphereMc::new(&params, pos, key)
+        let mut mc = HardSphereMc::new(&params, pos, key)?;
+        mc.set_nselect(self.nselect);
+        Ok(mc)
     }
 }

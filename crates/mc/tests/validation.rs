@@ -62,9 +62,24 @@ fn compressibility_blocks(
 /// (Z, standard error, Z_CS) at volume fraction `phi` for spheres of diameter `d` in the box
 /// of unit spheres at `phi`.
 fn bulk_z(n: usize, phi: f64, d: f64, blocks: usize, sweeps: u64) -> (f64, f64, f64) {
+    bulk_z_nselect(n, phi, d, blocks, sweeps, 1)
+}
+
+/// [`bulk_z`] with `nselect` trial moves per sphere per sweep (after a warm-up at 1), sampling
+/// every `5 / nselect` sweeps (at least 1), so the moves between samples stay about the same.
+fn bulk_z_nselect(
+    n: usize,
+    phi: f64,
+    d: f64,
+    blocks: usize,
+    sweeps: u64,
+    nselect: usize,
+) -> (f64, f64, f64) {
     let mut mc = bulk(n, phi, d, 7);
     mc.warm_up(2000, 100, 0.3);
-    let z = compressibility_blocks(&mut mc, phi, blocks, sweeps, 5);
+    mc.set_nselect(nselect);
+    let every = (5 / nselect as u64).max(1);
+    let z = compressibility_blocks(&mut mc, phi, blocks, sweeps, every);
     let (m, e) = mean_and_error(&z);
     eprintln!(
         "phi {phi} d {d}: Z = {m:.4} +- {e:.4}, CS {:.4}, delta {:.4}",
@@ -77,6 +92,16 @@ fn bulk_z(n: usize, phi: f64, d: f64, blocks: usize, sweeps: u64) -> (f64, f64, 
 #[test]
 fn bulk_pressure_from_contact_matches_carnahan_starling_at_phi_0_3() {
     let (z, e, cs) = bulk_z(500, 0.3, 1.0, 20, 500);
+    assert!(e > 0.0 && e < 0.02 * cs, "standard error {e} is estimated");
+    assert!((z - cs).abs() < 4.0 * e, "Z {z} +- {e} vs CS {cs}");
+}
+
+/// Several moves per sphere on one binning of the cells (`nselect = 4`) sample the same
+/// equilibrium: Z at phi = 0.3 within the run's error of Carnahan–Starling, with a quarter of
+/// the sweeps (the same number of moves).
+#[test]
+fn bulk_pressure_matches_carnahan_starling_with_four_moves_per_binning() {
+    let (z, e, cs) = bulk_z_nselect(500, 0.3, 1.0, 20, 125, 4);
     assert!(e > 0.0 && e < 0.02 * cs, "standard error {e} is estimated");
     assert!((z - cs).abs() < 4.0 * e, "Z {z} +- {e} vs CS {cs}");
 }
@@ -281,6 +306,22 @@ fn results_do_not_depend_on_the_thread_count_and_restarts_are_bitwise() {
         })
     };
     let one = run(1);
+    // Four moves per sphere per binning: 4 N trials a sweep, thread-independent too.
+    let four = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut mc = bulk(3000, 0.4, 1.0, 12);
+            mc.set_nselect(4);
+            let stats = mc.run(10);
+            assert_eq!(stats.trials, 4 * 3000 * 10);
+            mc.positions()
+                .map(|c| c.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+        })
+    };
+    assert_eq!(four(1), four(2), "nselect = 4: 1 vs 2 threads");
     for threads in [2, 3, 5] {
         let other = run(threads);
         assert!(

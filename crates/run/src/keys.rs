@@ -1372,7 +1372,14 @@ pub static MC: &[Spec] = &[
         "sweeps",
         "10000",
         Integer(1, COUNT),
-        "sampling sweeps (N trial moves each) after the warm-up",
+        "sampling sweeps (nselect N trial moves each) after the warm-up",
+    ),
+    key(
+        "mc.nselect",
+        "-",
+        "1",
+        Integer(1, 1000),
+        "trial moves per sphere per sweep, all on one binning of the cells (HOOMD-blue's nselect; docs/mc.md)",
     ),
     key(
         "mc.warmup_sweeps",
