@@ -288,14 +288,19 @@ fn no_overlaps_and_no_escape_after_any_sweep() {
     }
 }
 
+/// `f` on a pool of `threads` workers.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 #[test]
 fn results_do_not_depend_on_the_thread_count_and_restarts_are_bitwise() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             // 5000 spheres: up to five parts of the binning's counting sort (at least 1024
             // spheres per part), so 3 and 5 threads split the particles and the cells unevenly.
             let mut mc = bulk(5000, 0.4, 1.0, 11);
@@ -308,11 +313,7 @@ fn results_do_not_depend_on_the_thread_count_and_restarts_are_bitwise() {
     let one = run(1);
     // Four moves per sphere per binning: 4 N trials a sweep, thread-independent too.
     let four = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut mc = bulk(3000, 0.4, 1.0, 12);
             mc.set_nselect(4);
             let stats = mc.run(10);
