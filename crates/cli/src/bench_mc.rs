@@ -40,6 +40,10 @@ pub struct BenchArgs {
 /// each repetition (A/B on a shared machine); trial moves per second of wall time and of CPU
 /// time, medians, and the speed-up over the first thread count.
 pub fn bench(a: &BenchArgs) -> Result<()> {
+    use colloidsim_mc::scenario::NSELECT_MAX;
+    if let Some(bad) = a.nselect.iter().find(|&&k| !(1..=NSELECT_MAX).contains(&k)) {
+        anyhow::bail!("--nselect must be integers in [1, {NSELECT_MAX}], got {bad}");
+    }
     println!(
         "# colloidsim bench mc: hard spheres d = 1, periodic cube, cells updated in two parallel passes of z layers; {} N trial moves per run at N = 10976 (scaled by 10976/N), median (min-max) of {}",
         a.sweeps, a.repeats
@@ -58,9 +62,6 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 .context("thread pool")
         })
         .collect::<Result<Vec<_>>>()?;
-    if let Some(bad) = a.nselect.iter().find(|&&k| !(1..=1000).contains(&k)) {
-        anyhow::bail!("--nselect must be integers in [1, 1000], got {bad}");
-    }
     for (&n, &phi) in a.n.iter().flat_map(|n| a.phi.iter().map(move |p| (n, p))) {
         let scale = |sweeps: u64, least: u64| (sweeps * 10_976 / n.max(1) as u64).max(least);
         let warmup = scale(a.warmup, 300);

@@ -14,12 +14,12 @@
 //! 3. for each parity in turn, every layer of that parity (concurrently, with rayon, one task per
 //!    layer) visits its `nc^2` cells in storage order, and each cell makes `nselect` (default 1)
 //!    times as many trial moves as it holds particles: pick one of its particles uniformly,
-//!    displace it uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre leaves the cell, leaves the
-//!    container, or overlaps any sphere, and (interface geometry) accept it with the Metropolis
-//!    probability `min(1, exp(-beta dV))`. Layers of one parity are a layer apart, `s >= d`, so
-//!    a sphere moving in one can touch only spheres of its own layer (updated in turn by the same
-//!    task) and of the two layers beside it, which have the other parity and stay fixed during
-//!    the pass;
+//!    displace it uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre
+//!    leaves the cell, leaves the container, or overlaps any sphere, and (interface geometry)
+//!    accept it with the Metropolis probability `min(1, exp(-beta dV))`. Layers of one parity
+//!    are a layer apart, `s >= d`, so a sphere moving in one can touch only spheres of its own
+//!    layer (updated in turn by the same task) and of the two layers beside it, which have the
+//!    other parity and stay fixed during the pass;
 //! 4. write the positions back in particle order.
 //!
 //! This is a domain form of the checkerboard scheme of Anderson, Jankowski, Grubb, Engel,
@@ -306,11 +306,12 @@ impl Pass {
     }
 
     /// The trial moves of one active cell (`around`: the grid coordinates below, at and above
-    /// it along each axis, wrapped): `nselect` times as many as it holds particles. `layer` holds the slots of
-    /// its layer, whose first slot has global index `layer_base`: the cell's own `cap` slots
-    /// (positions relative to its corner, the `n` occupied ones first and [`EMPTY`] beyond)
-    /// and those of its eight neighbours in the layer, which the same task updates in turn; the
-    /// neighbours above and below are read from `frozen`. Returns (accepted, left the cell).
+    /// it along each axis, wrapped): `nselect` times as many as it holds particles. `layer`
+    /// holds the slots of its layer, whose first slot has global index `layer_base`: the cell's
+    /// own `cap` slots (positions relative to its corner, the `n` occupied ones first and
+    /// [`EMPTY`] beyond) and those of its eight neighbours in the layer, which the same task
+    /// updates in turn; the neighbours above and below are read from `frozen`. Returns
+    /// (accepted, left the cell).
     ///
     /// A move to `u` can touch only the neighbour cells within `d` of `u`: along each axis the
     /// lower one when `u < d`, the upper one when `u > s - d` (with `s >= 2 d` about 7 of the
@@ -773,9 +774,7 @@ impl HardSphereMc {
                         *out = id as u32;
                         counts[id] += 1;
                     }
-                    // Where each range's group ends (from the counts per cell: the parts'
-                    // `end` arrays share cache lines, so they are not counted into per
-                    // particle).
+                    // Where each range's group ends, from the counts per cell.
                     for (r, c) in counts.chunks(range).enumerate() {
                         end[r + 1] = end[r] + c.iter().sum::<u32>();
                     }

@@ -1378,7 +1378,7 @@ pub static MC: &[Spec] = &[
         "mc.nselect",
         "-",
         "1",
-        Integer(1, 1000),
+        Integer(1, colloidsim_mc::scenario::NSELECT_MAX as i64),
         "trial moves per sphere per sweep, all on one binning of the cells (HOOMD-blue's nselect; docs/mc.md)",
     ),
     key(
