@@ -626,7 +626,15 @@ impl Session for BulkSession {
                 let j = self.srd.step() - self.p.equilibrate - 1;
                 let n = self.p.collisions - self.p.equilibrate;
                 let b = ((j as u128 * self.p.blocks as u128) / n as u128) as usize;
+                // Relative to the solvent's mean velocity: the frame of Hasimoto's theory.
+                let (ps, ms) = (
+                    self.srd.momentum(),
+                    self.srd.len() as f64 * self.srd.params().mass,
+                );
                 col.com_velocities_into(&mut self.com_scratch);
+                for v in &mut self.com_scratch {
+                    *v = std::array::from_fn(|k| v[k] - ps[k] / ms);
+                }
                 vacf.push(&self.com_scratch, b);
             }
             if let Some(probe) = self.acc.probe.as_mut() {
@@ -803,7 +811,7 @@ impl Session for BulkSession {
             summary["colloid_diffusion"] = json!({
                 "value": d,
                 "standard_error": se,
-                "method": "Green-Kubo of the colloids' centre-of-mass velocities, D = (tau/3) (C_0/2 + sum_k C_k), blocks for the error",
+                "method": "Green-Kubo of the colloids' centre-of-mass velocities relative to the solvent's mean velocity, D = (tau/3) (C_0/2 + sum_k C_k), blocks for the error",
                 "lags": p.vacf_lags,
                 "stokes_einstein_hasimoto": theory,
                 "relative_deviation": d / theory - 1.0,

@@ -297,8 +297,9 @@ pub struct BulkRun {
     pub colloid: ColloidParams,
     /// Lags of the Green–Kubo sum of the colloids' centre-of-mass velocity autocorrelation.
     pub vacf_lags: u64,
-    /// Stokes–Einstein–Hasimoto diffusivity `kT / (3 pi eta d) (1 - 2.837297 a/L + (4 pi / 3)
-    /// (a/L)^3)` of a sphere of radius `a = d/2` with the theory's viscosity.
+    /// Stokes–Einstein–Hasimoto diffusivity `kT / (3 pi eta d) (1 - 2.837297 a/L)` of a sphere
+    /// of radius `a = d/2` with the theory's viscosity (Hasimoto's leading finite-size term, as
+    /// Dünweg & Kremer; docs/mpcd.md, "Colloids: diffusion").
     pub stokes_einstein_hasimoto: f64,
 }
 
@@ -445,8 +446,7 @@ impl BulkScenario {
             ));
         }
         let x = 0.5 * d / l;
-        let stokes_einstein_hasimoto =
-            srd.kt / (3.0 * PI * eta * d) * (1.0 - 2.837297 * x + 4.0 / 3.0 * PI * x.powi(3));
+        let stokes_einstein_hasimoto = srd.kt / (3.0 * PI * eta * d) * (1.0 - 2.837297 * x);
         Ok(BulkRun {
             seed,
             solvent,
