@@ -4,7 +4,7 @@
 //! # Algorithm
 //!
 //! The periodic box (the bulk cube, or a cube around the droplet with [`Geometry::box_edge`]'s
-//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` even (at least 2).
+//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` a multiple of 4 (or 2 in short boxes).
 //! A sweep is:
 //!
 //! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the two parities of
@@ -485,6 +485,17 @@ const REBIN_PART_MIN: usize = 1024;
 /// Smallest cell side, in diameters (see [`HardSphereMc::new`]).
 const CELL_MIN: f64 = 2.0;
 
+/// Cells per box edge: the largest multiple of 4 whose cells have side `>= CELL_MIN d` (fewer,
+/// fuller cells: fewer moves leave their cell, and the gathered neighbours amortise over more
+/// moves), or 2 in boxes too short for 4 such cells (then `s >= d`, the edge being `>= 2 d`).
+/// A multiple of 4 gives each parity an even number of layers, which two threads share
+/// equally (an odd number of 5 layers capped 2 threads at 5/3 = 1.67x; docs/mc.md, "Speed").
+/// A function of the geometry alone, so a run does not depend on the thread count.
+fn cells_per_edge(edge: f64, d: f64) -> usize {
+    let fit = (edge / (CELL_MIN * d)).floor() as usize;
+    (fit - fit % 4).max(2)
+}
+
 /// Largest delta the tuner may choose, in cell sides (a larger cube always leaves the cell).
 const MAX_DELTA_PER_SIDE: f64 = 0.5;
 
@@ -517,13 +528,7 @@ impl HardSphereMc {
             )
             .into());
         }
-        // Cells of side >= 2 d (fewer, fuller cells: fewer moves leave their cell, and the
-        // gathered neighbours amortise over more moves); >= d in boxes shorter than 4 d.
-        let mut nc = (edge / (CELL_MIN * d)).floor() as usize;
-        nc -= nc % 2;
-        if nc < 2 {
-            nc = 2;
-        }
+        let nc = cells_per_edge(edge, d);
         let cells = (nc as f64).powi(3);
         let n = positions.len();
         // Slots (3 coordinates, a tag) at the initial capacity, counts, particle arrays.
@@ -1038,5 +1043,38 @@ impl HardSphereMc {
             }
         });
         found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The grid: `nc` a multiple of 4 with cells of side `>= 2 d`, the largest such, or 2 with
+    /// cells `>= d` in short boxes; the benchmark's boxes (N = 10,976 at phi 0.5: 8 cells).
+    #[test]
+    fn cells_per_edge_gives_each_parity_an_even_number_of_layers() {
+        for k in 0..20_000 {
+            let edge = 2.0 + k as f64 * 0.01;
+            let nc = cells_per_edge(edge, 1.0);
+            let side = edge / nc as f64;
+            assert!(side >= 1.0, "{edge}: {nc}");
+            if nc == 2 {
+                assert!(edge < 4.0 * CELL_MIN, "{edge}");
+            } else {
+                assert_eq!(nc % 4, 0, "{edge}");
+                assert!(side >= CELL_MIN, "{edge}: {nc}");
+                assert!(
+                    edge / ((nc + 4) as f64) < CELL_MIN,
+                    "{edge}: {nc} is not the largest"
+                );
+            }
+        }
+        let bench = |n: f64, phi: f64| (n * std::f64::consts::PI / 6.0 / phi).cbrt();
+        assert_eq!(cells_per_edge(bench(10_976.0, 0.5), 1.0), 8);
+        assert_eq!(cells_per_edge(bench(10_976.0, 0.3), 1.0), 12);
+        assert_eq!(cells_per_edge(bench(87_808.0, 0.5), 1.0), 20);
+        assert_eq!(cells_per_edge(4.0, 0.5), 4);
+        assert_eq!(cells_per_edge(3.99, 0.5), 2);
     }
 }
