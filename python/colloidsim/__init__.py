@@ -453,7 +453,10 @@ class MonteCarlo(Engine):
 
 
 class MPCD(Engine):
-    """The MPCD solvent (``method = "mpcd"``, or a pure-solvent ``"droplet-mpcd"``); one step
-    is one streaming step and one collision, ``velocities`` the solvent's in storage order."""
+    """MPCD (``method = "mpcd"`` or ``"droplet-mpcd"``): one step is one streaming step, the
+    colloids' velocity-Verlet steps over it, and one collision. The arrays hold the solvent (in
+    storage order), then the colloids' centres (unwrapped), then their vertices (42 per colloid,
+    colloid by colloid); ``forces`` are zero on the solvent and, on the colloids, the bonds, the
+    WCA between centres and the droplet's interface."""
 
     _method = ("mpcd", "droplet-mpcd")

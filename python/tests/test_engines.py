@@ -117,6 +117,28 @@ def test_monte_carlo_and_mpcd_engines():
         colloidsim.MPCD(BCD_SCENARIO)
 
 
+def test_an_mpcd_engine_with_a_colloid():
+    over = {"system.box": 8.0, "system.diameter": 3.0, "run.collisions": 100, "run.equilibrate": 10,
+            "observe.vacf_lags": 5}
+    a = colloidsim.MPCD(EXAMPLES / "mpcd/colloid-diffusion.toml", overrides=over)
+    solvent = 5 * 8**3
+    assert a.particles == solvent + 43
+    x0 = a.positions.copy()
+    a.step(4)
+    b = colloidsim.MPCD(EXAMPLES / "mpcd/colloid-diffusion.toml", overrides=over)
+    b.step(1)
+    b.step(3)
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.velocities, b.velocities)
+    x, f = a.positions, a.forces
+    assert not np.array_equal(x0[solvent:], x[solvent:])
+    # The vertices lie on the sphere of diameter 3 about the centre, within the bond strain.
+    r = np.linalg.norm(x[solvent + 1:] - x[solvent], axis=1)
+    assert r.shape == (42,) and np.all(np.abs(r - 1.5) < 0.1)
+    assert np.all(f[:solvent] == 0.0) and np.abs(f[solvent:]).max() > 0.0
+    # One colloid's bonds are internal forces: they sum to zero.
+    assert np.abs(f[solvent:].sum(axis=0)).max() < 1e-9 * np.abs(f).max()
+
+
 def test_engine_classes_check_the_method():
     with pytest.raises(colloidsim.ColloidsimError, match="method = 'dpd'"):
         colloidsim.DPD(BCD_SCENARIO)

@@ -22,7 +22,7 @@ use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::gsd::GsdWriter;
-use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region};
+use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region, VERTICES};
 use colloidsim_md::mpcd::drying::{SolventProfile, remove_excess};
 use colloidsim_md::mpcd::measure::{BlockAverage, PoiseuilleProbe};
 use colloidsim_md::mpcd::scenario::{Boundary, BulkRun, BulkScenario, DropletRun, DropletScenario};
@@ -375,18 +375,14 @@ impl Method for MpcdBulk {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve_bulk(src, seed)?;
-        if p.colloids > 0 {
-            bail!(
-                "{}: an mpcd engine with colloids cannot be stepped by hand yet (only the solvent)",
-                src.label()
-            );
-        }
         let drive = p.drive.map(|g0| Acceleration::CosineX {
             amplitude: g0,
             wavenumber: 2.0 * PI / p.box_edge,
         });
         Ok(Box::new(SolventEngine {
             srd: build_bulk(&p)?,
+            colloids: build_bulk_colloids(&p)?,
+            interface: None,
             method: "mpcd",
             conf: Confinement::None,
             drive: drive.unwrap_or(Acceleration::None),
@@ -1046,14 +1042,10 @@ impl Method for DropletMpcd {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve_droplet(src, seed)?;
-        if p.particles > 0 {
-            bail!(
-                "{}: a droplet-mpcd engine with colloids cannot be stepped by hand yet (only a pure-solvent droplet)",
-                src.label()
-            );
-        }
         Ok(Box::new(SolventEngine {
             srd: build_droplet(&p)?,
+            colloids: build_colloids(&p)?,
+            interface: Some(p.harmonic()),
             method: "droplet-mpcd",
             conf: confinement(&p),
             drive: Acceleration::None,
@@ -1680,6 +1672,10 @@ impl ThermoRow for DropletRow {
 /// measurement's rescaling without the cell thermostat does not).
 struct SolventEngine {
     srd: Srd,
+    /// The discrete-particle colloids, if any.
+    colloids: Option<DiscreteColloids>,
+    /// The droplet's interface on the colloid centres (droplet-mpcd).
+    interface: Option<colloidsim_md::potential::HarmonicInterface>,
     method: &'static str,
     conf: Confinement,
     drive: Acceleration,
@@ -1695,6 +1691,10 @@ impl crate::Engine for SolventEngine {
     }
     fn particles(&self) -> usize {
         self.srd.len()
+            + self
+                .colloids
+                .as_ref()
+                .map_or(0, |c| c.len() * (1 + VERTICES))
     }
     fn step(&mut self, steps: u64) -> Result<()> {
         let tau = self.srd.params().tau;
@@ -1702,13 +1702,20 @@ impl crate::Engine for SolventEngine {
             let t = (self.srd.step() + 1) as f64 * tau;
             let step = self.srd.step();
             self.srd.stream(t, &self.conf, &self.drive)?;
+            if let Some(col) = self.colloids.as_mut() {
+                match &self.interface {
+                    Some(h) => col.advance(t - tau, tau, h)?,
+                    None => col.advance(t - tau, tau, &colloidsim_md::NoExternal)?,
+                }
+            }
             if !matches!(self.conf, Confinement::None) {
                 let l = self.srd.sbox().l;
                 let n = self.srd.params().density / self.srd.params().cell.powi(3);
                 let expected = (n * self.conf.volume(t, l)).round() as usize;
                 remove_excess(&mut self.srd, expected, step, &mut self.scratch);
             }
-            self.srd.collide(t, &self.conf, None);
+            let emb = self.colloids.as_mut().map(|c| c.embedded());
+            self.srd.collide(t, &self.conf, emb);
         }
         Ok(())
     }
@@ -1721,14 +1728,39 @@ impl crate::Engine for SolventEngine {
     fn dt(&self) -> f64 {
         self.srd.params().tau
     }
+    /// The solvent's, then the colloids' centres (unwrapped), then their vertices.
     fn positions(&self) -> Vec<f64> {
-        crate::engine::flat(&self.srd.positions())
+        let mut x = self.srd.positions();
+        if let Some(c) = &self.colloids {
+            x.extend(c.unwrapped_centres());
+            let (centres, unwrapped) = (c.centre_positions(), c.unwrapped_centres());
+            for (k, v) in c.vertex_positions().iter().enumerate() {
+                let (a, b) = (centres[k / VERTICES], unwrapped[k / VERTICES]);
+                x.push(std::array::from_fn(|i| v[i] - a[i] + b[i]));
+            }
+        }
+        crate::engine::flat(&x)
     }
     fn velocities(&self) -> Option<Vec<f64>> {
-        Some(crate::engine::flat(&self.srd.velocities()))
+        let mut v = self.srd.velocities();
+        if let Some(c) = &self.colloids {
+            v.extend_from_slice(c.centre_velocities());
+            v.extend_from_slice(c.vertex_velocities());
+        }
+        Some(crate::engine::flat(&v))
     }
+    /// Zero on the solvent (it streams freely between collisions); on the colloids' particles
+    /// the bonds, the WCA between centres and the droplet's interface.
     fn forces(&self) -> Result<Vec<f64>> {
-        Ok(vec![0.0; 3 * self.srd.len()])
+        let mut f = vec![[0.0; 3]; self.srd.len()];
+        if let Some(c) = &self.colloids {
+            let t = self.time();
+            f.extend(match &self.interface {
+                Some(h) => c.forces_at(t, h),
+                None => c.forces_at(t, &colloidsim_md::NoExternal),
+            });
+        }
+        Ok(crate::engine::flat(&f))
     }
     fn box_lengths(&self) -> Vec<f64> {
         self.srd.sbox().l.to_vec()

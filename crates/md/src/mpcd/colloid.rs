@@ -233,7 +233,7 @@ struct Edge {
 }
 
 /// `N` discrete-particle colloids in the periodic box of the solvent (see the module docs).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct DiscreteColloids {
     params: ColloidParams,
     sbox: SimBox,
@@ -573,6 +573,17 @@ impl DiscreteColloids {
     /// Vertex positions (42 per colloid, unwrapped about their centre).
     pub fn vertex_positions(&self) -> &[[f64; 3]] {
         &self.vertex_pos
+    }
+
+    /// The forces at the current positions at time `t` (bonds on all particles, WCA and
+    /// `external` on the centres), the centres' then the vertices' (colloid-major, 42 each);
+    /// computed on a copy, for readers (Python's engines), not in the time step.
+    pub fn forces_at<E: External>(&self, t: f64, external: &E) -> Vec<[f64; 3]> {
+        let mut copy = self.clone();
+        copy.compute_forces(t, external);
+        let mut f = copy.centre_force;
+        f.extend_from_slice(&copy.vertex_force);
+        f
     }
 
     /// Vertex velocities.
