@@ -527,6 +527,7 @@ fn the_green_kubo_viscosity_is_written_with_its_error() {
         assert!((last - v).abs() < 1e-6 * v, "{last} vs {v}");
         eta.push(std::fs::read(d.join(&out).join("stress_acf.csv")).unwrap());
     }
+    assert!(d.join("w1/stress_acf.png").is_file());
     // The correlator is serial and the engine bitwise: the same for 1 and 2 threads.
     assert!(
         eta[0] == eta[1],

@@ -394,6 +394,7 @@ impl Session for DpdSession {
             "coordination.csv",
             "clusters.csv",
             "stress_acf.csv",
+            "stress_acf.png",
             "trajectory.gsd",
         ]
         .contains(&name)
@@ -1029,6 +1030,37 @@ fn write_outputs(
             ],
         )?;
         files.push("stress_acf.csv".into());
+        let series = [
+            Series {
+                label: "all components (traceless stress)",
+                x: &t.time,
+                y: &t.integral,
+                points: false,
+            },
+            Series {
+                label: "off-diagonal components",
+                x: &t.time,
+                y: &t.integral_off_diagonal,
+                points: false,
+            },
+        ];
+        picture(
+            line_plot(
+                &out.join("stress_acf.png"),
+                &format!(
+                    "Green-Kubo viscosity, {} samples of {} steps",
+                    acf.counted(),
+                    s.observe.viscosity_every
+                ),
+                "upper limit t_max [DPD time]",
+                "viscosity up to t_max [m_s / (rc DPD time)]",
+                &series,
+                Scale::Linear,
+            ),
+            "stress_acf.png",
+            &mut files,
+            warnings,
+        );
     }
     if s.observe.trajectory_every > 0 {
         files.push("trajectory.gsd".into());

@@ -9,7 +9,7 @@
 //! eta = V / kT  int_0^t_max  C(t) dt,    C(t) = < P_xy(0) P_xy(t) >          (Green–Kubo)
 //! ```
 //!
-//! and, using every component of an isotropic fluid (Daivis & Evans 1994, eq. 10),
+//! and, using every component of an isotropic fluid (Daivis & Evans 1994),
 //! `C(t) = (1/10) sum_ab < Q_ab(0) Q_ab(t) >` with `Q = P - (tr P / 3) 1` the traceless symmetric
 //! part: the three off-diagonal components count twice, the three traceless diagonal ones once
 //! (`< Q_xx Q_xx > = (4/3) < P_xy P_xy >` by isotropy). Both the off-diagonal-only and the
@@ -17,9 +17,11 @@
 //!
 //! **Why the random stress needs block averages.** The random DPD force makes the stress a sum
 //! of a smooth part and a white noise of variance `~ 1 / dt` whose correlation is a delta at lag
-//! 0. Its share of the viscosity is exactly the dissipative contribution of kinetic theory
-//! (Marsh, Backx & Ernst 1997), and the discrete Green–Kubo sum counts it right only if the
-//! lag-0 term has weight `Delta / 2` with `Delta` the time the sample stands for. This follows
+//! 0. Its share of the viscosity is the instantaneous dissipative viscosity
+//! `gamma / V < sum_pairs w(r)^2 (x y / r)^2 >` (with g(r) = 1 the `eta_D = 2 pi gamma rho^2
+//! rc^5 / 1575` of Marsh, Backx & Ernst 1997), and the discrete Green–Kubo sum counts it right
+//! only if the lag-0 term has weight `Delta / 2` with `Delta` the time the sample stands for.
+//! This follows
 //! from the Einstein–Helfand form: the Helfand moment `H(t) = sum_i x_i p_iy` changes by
 //! `V int P_xy dt` (pairwise forces, momentum conserved), and
 //! `eta = lim V / (2 kT t) < [int_0^t P_xy dt']^2 >`; with samples `S_n` that are the averages of
