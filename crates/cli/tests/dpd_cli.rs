@@ -172,7 +172,11 @@ fn a_heating_time_step_stops_the_run_and_says_so() {
 fn restart_scenario(d: &Path) -> String {
     std::fs::write(
         d.join("r.toml"),
-        SMALL.replace("trajectory_every = 200", "trajectory_every = 30"),
+        // The Green–Kubo correlator is part of the checkpoint: 200 samples of 2 steps, 3 lags.
+        SMALL.replace(
+            "trajectory_every = 200",
+            "trajectory_every = 30\nviscosity_every = 2\nviscosity_time = 0.004",
+        ),
     )
     .unwrap();
     "r.toml".into()
@@ -453,4 +457,138 @@ fn quiet_keeps_errors_and_drops_information() {
         "{}",
         text(&o)
     );
+}
+
+/// DPD water (kT = 1) in a small box with the Green–Kubo viscosity observed.
+fn water_viscosity(steps: u64, extra: &str) -> String {
+    format!(
+        "method = \"dpd\"\nseed = 5\n[system]\nbox_length = 6.0\nkT = 1.0\n[run]\ndt = 0.02\nsteps = {steps}\n[observe]\nthermo_every = 100\ntrajectory_every = 0\nstructure_every = 0\nmsd_every = 0\nviscosity_every = 2\nviscosity_time = 1.0\n{extra}"
+    )
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn the_green_kubo_viscosity_is_written_with_its_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::fs::write(d.join("w.toml"), water_viscosity(3000, "")).unwrap();
+    let mut eta = Vec::new();
+    for threads in ["1", "2"] {
+        let out = format!("w{threads}");
+        let o = run(
+            d,
+            &[
+                "run",
+                "w.toml",
+                "--out",
+                &out,
+                "--quiet",
+                "--threads",
+                threads,
+            ],
+        );
+        assert!(o.status.success(), "{}", text(&o));
+        let s = summary(&d.join(&out));
+        let (v, e) = (
+            s["viscosity"].as_f64().unwrap(),
+            s["viscosity_error"].as_f64().unwrap(),
+        );
+        // 120 DPD times of 648 beads: a rough number (the tests of crates/md measure it).
+        assert!(v > 0.5 && v < 1.3 && e > 0.0 && e < 0.3 * v, "{v} +- {e}");
+        assert!(s["viscosity_off_diagonal"].as_f64().is_some());
+        assert!(
+            s["viscosity_note"].as_str().unwrap().contains("Green-Kubo"),
+            "{s}"
+        );
+        let theory = s["parameters"]["solvent_viscosity_kinetic_theory"]
+            .as_f64()
+            .unwrap();
+        assert!((theory - 0.957_35).abs() < 1e-4, "{theory}");
+        let (head, cols) =
+            colloidsim_core::output::read_table(&d.join(&out).join("stress_acf.csv")).unwrap();
+        assert_eq!(
+            head,
+            [
+                "lag_steps",
+                "time",
+                "acf",
+                "viscosity_integral",
+                "acf_off_diagonal",
+                "viscosity_integral_off_diagonal"
+            ]
+        );
+        // 1.0 / (2 x 0.02) + 1 lags; the integral ends at the summary's viscosity.
+        assert_eq!(cols[0].len(), 26);
+        assert_eq!(cols[0][25], 50.0);
+        let last = cols[3][25];
+        assert!((last - v).abs() < 1e-6 * v, "{last} vs {v}");
+        eta.push(std::fs::read(d.join(&out).join("stress_acf.csv")).unwrap());
+    }
+    assert!(d.join("w1/stress_acf.png").is_file());
+    // The correlator is serial and the engine bitwise: the same for 1 and 2 threads.
+    assert!(
+        eta[0] == eta[1],
+        "stress_acf.csv differs between 1 and 2 threads"
+    );
+    // Too short a run: the correlation function, but no viscosity, and the reason.
+    std::fs::write(d.join("short.toml"), water_viscosity(600, "")).unwrap();
+    let o = run(d, &["run", "short.toml", "--out", "short", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(&d.join("short"));
+    assert!(s["viscosity"].is_null() && s["viscosity_error"].is_null());
+    let note = s["viscosity_note"].as_str().unwrap();
+    assert!(
+        note.contains("not measured") && note.contains("1090 steps"),
+        "{note}"
+    );
+    assert!(d.join("short/stress_acf.csv").is_file());
+    // Off by default: no file, a null viscosity and a note.
+    let plain = water_viscosity(200, "").replace("viscosity_every = 2\n", "");
+    std::fs::write(d.join("off.toml"), plain).unwrap();
+    let o = run(d, &["run", "off.toml", "--out", "off", "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let s = summary(&d.join("off"));
+    assert!(s["viscosity"].is_null());
+    assert!(
+        s["viscosity_note"]
+            .as_str()
+            .unwrap()
+            .contains("not observed"),
+        "{s}"
+    );
+    assert!(!d.join("off/stress_acf.csv").exists());
+}
+
+#[test]
+fn bad_viscosity_keys_are_refused_with_the_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    for (sc, want) in [
+        // Shorter than one sample interval (2 x 0.02).
+        (
+            water_viscosity(100, "").replace("viscosity_time = 1.0", "viscosity_time = 0.01"),
+            "observe.viscosity_time",
+        ),
+        (
+            water_viscosity(100, "").replace("viscosity_time = 1.0", "viscosity_time = -1.0"),
+            "observe.viscosity_time",
+        ),
+        // More than 100,000 lags.
+        (
+            water_viscosity(100, "").replace("viscosity_time = 1.0", "viscosity_time = 5000.0"),
+            "observe.viscosity_time",
+        ),
+        (
+            water_viscosity(100, "").replace("viscosity_every = 2", "viscosity_every = -2"),
+            "observe.viscosity_every",
+        ),
+    ] {
+        std::fs::write(d.join("bad.toml"), &sc).unwrap();
+        let o = run(d, &["check", "bad.toml"]);
+        assert!(!o.status.success(), "accepted: {sc}");
+        assert!(text(&o).contains(want), "{want}: {}", text(&o));
+    }
 }

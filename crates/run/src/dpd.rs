@@ -16,7 +16,7 @@ use colloidsim_analysis::{
 };
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
-use colloidsim_md::dpd::{Dpd, Thermo};
+use colloidsim_md::dpd::{Dpd, StressAcf, Thermo};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
@@ -168,6 +168,16 @@ impl DpdSession {
             .iter()
             .map(|&t| 0.5 * p.diameter[t as usize])
             .collect();
+        let mut obs = obs;
+        if s.viscosity_lags > 0 && obs.stress_acf.is_none() {
+            obs.stress_acf = Some(StressAcf::new(
+                s.observe.viscosity_every,
+                s.viscosity_lags,
+                s.params.dt,
+                sim.sbox.volume(),
+                s.params.kt,
+            ));
+        }
         let mut monitor =
             TemperatureMonitor::new(s.params.kt, s.max_temperature_drift, s.temperature_window);
         for &(step, t) in &obs.monitor {
@@ -288,8 +298,12 @@ impl DpdSession {
         let next = self.sim.step + 1;
         let thermo_due = o.thermo_every > 0 && next.is_multiple_of(o.thermo_every);
         let frame_due = o.trajectory_every > 0 && next.is_multiple_of(o.trajectory_every);
+        let acf = self.obs.stress_acf.as_mut();
         let result = if thermo_due || frame_due {
             self.sim.advance_with_thermo().map(|th| {
+                if let Some(acf) = acf {
+                    acf.push(&th.pressure);
+                }
                 if thermo_due {
                     self.obs.thermo.push((next as f64 * dt, th.clone()));
                 }
@@ -297,6 +311,9 @@ impl DpdSession {
                     self.frame_thermo = Some(th);
                 }
             })
+        } else if let Some(acf) = acf {
+            // The Green–Kubo samples average the pressure tensor over every step.
+            self.sim.advance_with_pressure().map(|p| acf.push(&p))
         } else {
             self.sim.advance()
         };
@@ -376,6 +393,8 @@ impl Session for DpdSession {
             "sq.csv",
             "coordination.csv",
             "clusters.csv",
+            "stress_acf.csv",
+            "stress_acf.png",
             "trajectory.gsd",
         ]
         .contains(&name)
@@ -570,6 +589,7 @@ fn describe(s: &DpdSetup) -> serde_json::Value {
         "diffusion_time_tau": s.tau,
         "steps_per_tau": s.tau / p.dt,
         "contact_gap": s.contact_gap,
+        "solvent_viscosity_kinetic_theory": solvent_viscosity_kinetic_theory(s),
     })
 }
 
@@ -595,6 +615,8 @@ struct Observed {
     frames: u64,
     /// CRC-32 of those frames, checked before a restart appends to the file.
     digest: FrameDigest,
+    /// The running stress autocorrelation (`observe.viscosity_every > 0`).
+    stress_acf: Option<StressAcf>,
 }
 
 /// `(time, Thermo)` rows through a serialisable mirror of [`Thermo`].
@@ -991,6 +1013,55 @@ fn write_outputs(
         )?;
         files.push("clusters.csv".into());
     }
+    // stress_acf.csv: the Green–Kubo correlation function and its running integral.
+    if let Some(acf) = &obs.stress_acf
+        && acf.counted() > 0
+    {
+        let t = acf.table();
+        out.write_table(
+            "stress_acf.csv",
+            &[
+                ("lag_steps", &t.lag_steps),
+                ("time", &t.time),
+                ("acf", &t.acf),
+                ("viscosity_integral", &t.integral),
+                ("acf_off_diagonal", &t.acf_off_diagonal),
+                ("viscosity_integral_off_diagonal", &t.integral_off_diagonal),
+            ],
+        )?;
+        files.push("stress_acf.csv".into());
+        let series = [
+            Series {
+                label: "all components (traceless stress)",
+                x: &t.time,
+                y: &t.integral,
+                points: false,
+            },
+            Series {
+                label: "off-diagonal components",
+                x: &t.time,
+                y: &t.integral_off_diagonal,
+                points: false,
+            },
+        ];
+        picture(
+            line_plot(
+                &out.join("stress_acf.png"),
+                &format!(
+                    "Green-Kubo viscosity, {} samples of {} steps",
+                    acf.counted(),
+                    s.observe.viscosity_every
+                ),
+                "upper limit t_max [DPD time]",
+                "viscosity up to t_max [m_s / (rc DPD time)]",
+                &series,
+                Scale::Linear,
+            ),
+            "stress_acf.png",
+            &mut files,
+            warnings,
+        );
+    }
     if s.observe.trajectory_every > 0 {
         files.push("trajectory.gsd".into());
     }
@@ -1010,6 +1081,15 @@ fn summary(
     let (dt, tau) = (s.params.dt, s.tau);
     let last = obs.thermo.last().map(|(_, t)| t.clone());
     let n = (s.colloids + s.solvent) as f64;
+    let eta = obs.stress_acf.as_ref().map(|a| a.viscosity());
+    let value = |e: Option<colloidsim_md::dpd::viscosity::Estimate>| e.map(|e| e.value);
+    let error = |e: Option<colloidsim_md::dpd::viscosity::Estimate>| e.map(|e| e.error);
+    let all = eta.as_ref().and_then(|e| e.all);
+    let off = eta.as_ref().and_then(|e| e.off_diagonal);
+    let eta_note = eta.as_ref().map_or_else(
+        || "not observed (observe.viscosity_every = 0)".to_string(),
+        |e| e.note.clone(),
+    );
     json!({
         "software": crate::software(),
         "method": "dpd",
@@ -1030,6 +1110,11 @@ fn summary(
         "colloid_diffusion_long_time": diffusion,
         "colloid_diffusion_over_stokes_einstein": diffusion.map(|d| d / s.d0),
         "colloid_diffusion_note": diffusion_note(s, obs, diffusion),
+        "viscosity": value(all),
+        "viscosity_error": error(all),
+        "viscosity_off_diagonal": value(off),
+        "viscosity_off_diagonal_error": error(off),
+        "viscosity_note": eta_note,
         "warnings": warnings,
     })
 }
@@ -1062,4 +1147,17 @@ fn mean_second_half(rows: &[(f64, Thermo)], f: impl Fn(&Thermo) -> f64) -> Optio
     } else {
         Some(h.iter().map(|(_, t)| f(t)).sum::<f64>() / h.len() as f64)
     }
+}
+
+/// The viscosity of the pure solvent from the kinetic theory of Marsh, Backx & Ernst (1997),
+/// which neglects the conservative force (docs/dpd.md, *Viscosity*): with the weight
+/// `w_D(r) = (1 - r/rc)^2`, `eta_K = d m kT / (2 gamma int w_D d^3r) = 45 m kT / (4 pi gamma
+/// rc^3)` (velocities relax at `2 zeta / m`, `zeta = gamma rho int w_D d^3r / d`) and `eta_D =
+/// gamma rho^2 / (2 d (d + 2)) int r^2 w_D d^3r = 2 pi gamma rho^2 rc^5 / 1575`.
+fn solvent_viscosity_kinetic_theory(s: &DpdSetup) -> f64 {
+    let p = &s.params;
+    let (m, rho) = (s.solvent_mass, s.density);
+    let pi = std::f64::consts::PI;
+    45.0 * m * p.kt / (4.0 * pi * p.gamma * p.rc.powi(3))
+        + 2.0 * pi * p.gamma * rho * rho * p.rc.powi(5) / 1575.0
 }

@@ -1270,6 +1270,21 @@ pub static DPD: &[Spec] = &[
         Positive,
         "a contact is a surface gap below this",
     ),
+    key(
+        "observe.viscosity_every",
+        "steps",
+        "0",
+        Integer(0, COUNT),
+        "steps averaged into one pressure-tensor sample of the Green-Kubo viscosity, stress_acf.csv (0: off)",
+    ),
+    key(
+        "observe.viscosity_time",
+        "DPD time",
+        "5",
+        Positive,
+        "longest lag of the stress autocorrelation, the upper limit of the Green-Kubo integral",
+    )
+    .also("at least one sample interval viscosity_every x dt, at most 100000 of them"),
 ];
 
 /// The keys of `hs-mc` scenarios.

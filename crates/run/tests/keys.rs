@@ -152,6 +152,8 @@ msd_every = 100
 msd_solvent_beads = 1000
 structure_every = 1000
 gr_bins = 200
+viscosity_every = 0
+viscosity_time = 5.0
 "#;
 
 const MC: &str = r#"

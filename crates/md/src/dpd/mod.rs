@@ -24,12 +24,14 @@
 
 pub mod forces;
 pub mod scenario;
+pub mod viscosity;
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
+pub use viscosity::StressAcf;
 
 /// Parameters of a DPD colloid simulation (DPD units: lengths in `rc`, energies in `kT`
 /// multiples as noted, masses in solvent-bead masses).
@@ -664,6 +666,38 @@ impl Dpd {
     pub fn advance_with_thermo(&mut self) -> Result<Thermo, DpdError> {
         self.step_inner::<true>()?;
         Ok(self.thermo())
+    }
+
+    /// One step that also accumulates the virial and returns the pressure tensor at its end,
+    /// `(sum m v (x) v + sum_pairs r_ij (x) F_ij) / V` (xx, yy, zz, xy, xz, yz; all pair forces,
+    /// random and dissipative included), without allocating: the input of [`StressAcf`].
+    /// The trajectory is the same as with [`Self::advance`].
+    pub fn advance_with_pressure(&mut self) -> Result<[f64; 6], DpdError> {
+        self.step_inner::<true>()?;
+        Ok(self.pressure_tensor())
+    }
+
+    /// The pressure tensor from the current velocities and the virial of the last step taken
+    /// with it ([`Self::thermo`]'s `pressure`, without the rest).
+    pub fn pressure_tensor(&self) -> [f64; 6] {
+        let mut t = [0.0; 6];
+        for (v, &k) in self.vel.iter().zip(&self.key) {
+            let m = self.props[(k & !COLLOID_BIT) as usize].mass;
+            t[0] += m * v[0] * v[0];
+            t[1] += m * v[1] * v[1];
+            t[2] += m * v[2] * v[2];
+            t[3] += m * v[0] * v[1];
+            t[4] += m * v[0] * v[2];
+            t[5] += m * v[1] * v[2];
+        }
+        for s in &self.slabs {
+            let w = s.virial.total();
+            for k in 0..6 {
+                t[k] += w[k];
+            }
+        }
+        let vol = self.sbox.volume();
+        t.map(|x| x / vol)
     }
 
     fn step_inner<const THERMO: bool>(&mut self) -> Result<(), DpdError> {

@@ -285,6 +285,21 @@ pub struct ObserveSection {
     /// Contact gap of the coordination number and clusters, in `rc` (default `3 / kappa`).
     #[serde(default)]
     pub contact_gap: Option<f64>,
+    /// Steps averaged into one stress sample of the Green–Kubo viscosity (0: off).
+    #[serde(default)]
+    pub viscosity_every: u64,
+    /// Longest lag of the stress autocorrelation, the upper limit of the Green–Kubo integral
+    /// (DPD time).
+    #[serde(default = "d_viscosity_time")]
+    pub viscosity_time: f64,
+}
+
+/// Most sample intervals in the stress autocorrelation (`observe.viscosity_time`): each sample
+/// costs that many products of six components.
+pub const MAX_VISCOSITY_LAGS: usize = 100_000;
+
+fn d_viscosity_time() -> f64 {
+    5.0
 }
 
 fn d_thermo() -> u64 {
@@ -311,6 +326,8 @@ impl Default for ObserveSection {
             gr_bins: d_bins(),
             gr_max: None,
             contact_gap: None,
+            viscosity_every: 0,
+            viscosity_time: d_viscosity_time(),
         }
     }
 }
@@ -363,6 +380,9 @@ pub struct DpdSetup {
     pub contact_gap: f64,
     /// g(r) range.
     pub gr_max: f64,
+    /// Lags of the stress autocorrelation (`observe.viscosity_time / (viscosity_every dt)`
+    /// + 1; 0 when the viscosity is not observed).
+    pub viscosity_lags: usize,
     /// Warnings to show the user (valid but questionable settings).
     pub warnings: Vec<String>,
 }
@@ -514,6 +534,30 @@ impl DpdScenario {
             Some(g) => positive("observe.contact_gap", g)?,
             None => 3.0 / kappa,
         };
+        let viscosity_time = positive("observe.viscosity_time", o.viscosity_time)?;
+        let viscosity_lags = if o.viscosity_every > 0 {
+            let delta = o.viscosity_every as f64 * dt;
+            let intervals = (viscosity_time / delta).round();
+            if intervals < 1.0 {
+                return Err(ParamError::new(
+                    "observe.viscosity_time",
+                    format!(
+                        "must be at least one sample interval, viscosity_every x dt = {delta}, got {viscosity_time}"
+                    ),
+                ));
+            }
+            if intervals > MAX_VISCOSITY_LAGS as f64 {
+                return Err(ParamError::new(
+                    "observe.viscosity_time",
+                    format!(
+                        "spans {intervals} sample intervals of {delta}; at most {MAX_VISCOSITY_LAGS} (raise observe.viscosity_every)"
+                    ),
+                ));
+            }
+            intervals as usize + 1
+        } else {
+            0
+        };
         let sbox = SimBox::new(l);
         let vc = 4.0 / 3.0 * PI * radius.powi(3);
         // Memory before the counts become integers (a cast saturates) and anything is
@@ -598,6 +642,7 @@ impl DpdScenario {
             observe: o.clone(),
             contact_gap,
             gr_max,
+            viscosity_lags,
             warnings,
         })
     }
