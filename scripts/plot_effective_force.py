@@ -3,7 +3,7 @@
 Fig. S10): beta F_eff(r) = -d/dr [ln rho + beta mu_ex + beta V] of Eq. 16, zero at the
 equilibrium start and growing as the drying drives the suspension out of equilibrium.
 
-Usage: plot_effective_force.py OUT PICTURE.png [--bin BINARY] [--scenario TOML] [--dx DX]
+Usage: plot_effective_force.py OUT PICTURE.png [--bin BINARY] [--scenario TOML] [--dx DX] [--reuse]
 
 Runs `colloidsim theory` on the scenario (default examples/droplet/drying-bd-paper.toml, the
 paper's droplet: N = 6250, R0 = 25 d, phi0 = 0.05, Pe = 10, dried to phi 0.5) with output every
@@ -11,14 +11,14 @@ paper's droplet: N = 6250, R0 = 25 d, phi0 = 0.05, Pe = 10, dried to phi 0.5) wi
 are ejected) and RPY with Trokhymchuk's g, into OUT/<model>/ (force_<f>.csv: r, force in kT/d,
 phi; summary.json: effective_force). Draws the force profiles at 0, 25, 50, 75 and 100 % for
 free draining and RPY with Trokhymchuk's g, and the particle-weighted mean force and the largest
-|F| against the fraction of the drying time for all three; writes OUT/table.md.
+|F| against the fraction of the drying time for all three; writes OUT/table.md. --reuse keeps
+the runs already in OUT (their summary.json) and only draws.
 """
 import csv
 import json
 import os
 import subprocess
 import sys
-import time
 
 import matplotlib
 
@@ -56,6 +56,9 @@ def main():
         args, "--scenario", os.path.join(HERE, "..", "examples", "droplet", "drying-bd-paper.toml")
     )
     dx = option(args, "--dx", "0.02")
+    reuse = "--reuse" in args
+    if reuse:
+        args.remove("--reuse")
     if len(args) != 2:
         sys.exit(__doc__)
     out, picture = args
@@ -64,14 +67,15 @@ def main():
     results = {}
     for name, label, flags in MODELS:
         folder = os.path.join(out, name)
-        start = time.time()
-        cmd = [binary, "theory", scenario, "--dx", dx, "--out", folder, "--force"]
-        cmd += ["--set", f"observe.profile.fractions={fractions}"] + flags
-        # The dilute RPY run stops (non-zero exit) once particles are ejected; its summary says so.
-        subprocess.run(cmd, check=False, stdout=subprocess.DEVNULL)
-        seconds = time.time() - start
+        if not (reuse and os.path.exists(os.path.join(folder, "summary.json"))):
+            cmd = [binary, "theory", scenario, "--dx", dx, "--out", folder, "--force"]
+            cmd += ["--set", f"observe.profile.fractions={fractions}"] + flags
+            # The dilute RPY run stops (non-zero exit) once particles are ejected; its summary
+            # says so.
+            subprocess.run(cmd, check=False, stdout=subprocess.DEVNULL)
         with open(os.path.join(folder, "summary.json")) as f:
             summary = json.load(f)
+        seconds = summary["wall_seconds"]
         results[name] = (label, summary, seconds)
         print(f"{name}: {summary['status']} in {seconds:.1f} s {summary['message']}")
 
@@ -90,7 +94,7 @@ def main():
     a.set_xlabel("r / d")
     a.set_ylabel("beta F_eff d  (kT / d)")
     a.set_title("Effective force -d/dr [ln rho + beta mu_ex + beta V]")
-    a.legend(fontsize=7, ncol=2)
+    a.legend(fontsize=7, loc="lower right")
     rows = []
     for k, (name, label, _) in enumerate(MODELS):
         _, summary, _ = results[name]

@@ -1,5 +1,5 @@
 //! DDFT of the droplet: conservation, relaxation to equilibrium, time convergence, bad input,
-//! and the unphysical-solution stop of the pairwise-RPY flux.
+//! the unphysical-solution stop of the pairwise-RPY flux, and the effective force of Eq. 16.
 
 use colloidsim_dft::radial::{
     Ddft, DdftOptions, DropletSetup, DryingSchedule, EquilibriumOptions, HarmonicInterface,
