@@ -4,7 +4,10 @@
 1. free draining (FD) against RPY in an unbounded fluid (direct sums): the paper's Fig. 3a;
 2. RPY by positively split Ewald in the paper's periodic box (box_factor 2, optionally 3 or 4)
    against the direct free-space sums on the same droplet;
-3. the centres beyond R at the end of drying: the same droplets in a stiffer interface.
+3. the centres beyond R at the end of drying: the same droplets in a stiffer interface;
+4. free draining against RPY at the paper's other initial volume fractions, phi0 = 0.1 and 0.2
+   (fd-phi0.1, rpy-phi0.1, fd-phi0.2, rpy-phi0.2; the same N in a smaller droplet, dried to the
+   same phi = 0.5): the paper's Fig. S2.
 
 Each (variant, seed) is one droplet, `colloidsim run SCENARIO --out RUNS/N<n>/<variant>/seed<s>
 --seed s --threads T --quiet`; the droplet is examples/droplet/drying-rpy.toml scaled to N
@@ -81,7 +84,7 @@ particles = {n}
 diameter = 1.0
 kT = 1.0
 viscosity = 1.0
-phi0 = 0.05
+phi0 = {phi0}
 
 [drying]
 peclet = 10
@@ -119,6 +122,13 @@ def variants(splitting):
     for bf in (2, 3, 4):
         v[f"pse{bf}"] = dict(label=f"RPY PSE, box {bf} droplet diameters", hydro=pse(bf),
                              k=50.0, dt=DT)
+    # The paper's Fig. S2: Fig. 3 (free draining against RPY) at its other initial volume
+    # fractions, the same N (a smaller droplet dried to the same phi = 0.5).
+    for phi0 in (0.1, 0.2):
+        v[f"fd-phi{phi0}"] = dict(label=f"free draining, phi0 = {phi0}", hydro=fd, k=50.0,
+                                  dt=DT, phi0=phi0)
+        v[f"rpy-phi{phi0}"] = dict(label=f"RPY direct, phi0 = {phi0}", hydro=rpy, k=50.0,
+                                   dt=DT, phi0=phi0)
     for k in (200, 500):
         v[f"fd-k{k}"] = dict(label=f"free draining, k = {k}", hydro=fd, k=float(k), dt=DT)
         v[f"rpy-k{k}"] = dict(label=f"RPY direct, k = {k}", hydro=rpy, k=float(k), dt=DT)
@@ -143,6 +153,8 @@ COMPARISONS = [
     ("RPY k = 500 - RPY k = 50", "rpy-k500", "rpy"),
     ("FD k = 500: dt/2 - dt", "fd-k500-dt2", "fd-k500"),
     ("RPY k = 500: dt/2 - dt", "rpy-k500-dt2", "rpy-k500"),
+    ("RPY - FD, phi0 = 0.1", "rpy-phi0.1", "fd-phi0.1"),
+    ("RPY - FD, phi0 = 0.2", "rpy-phi0.2", "fd-phi0.2"),
 ]
 
 
@@ -153,7 +165,8 @@ def radii(n):
 
 
 def scenario_text(name, v, n, steps):
-    return SCENARIO.format(variant=name, n=n, k=v["k"], range=RANGE, offset=OFFSET,
+    return SCENARIO.format(variant=name, n=n, phi0=v.get("phi0", 0.05), k=v["k"],
+                           range=RANGE, offset=OFFSET,
                            dt=repr(v["dt"]), bins=BINS, every=steps, hydro=v["hydro"])
 
 
@@ -559,6 +572,10 @@ def figures(res, prow, vdefs, img_dir, n):
            f"brackets), bands ± 1 standard error; {BINS // MERGE} shells")
     panel("droplet-hydro-fd-vs-rpy.png", [("fd", "--"), ("rpy", "-")],
           "Free draining vs RPY in free space\n" + sub)
+    for phi0 in (0.1, 0.2):
+        panel(f"droplet-hydro-fd-vs-rpy-phi{phi0}.png",
+              [(f"fd-phi{phi0}", "--"), (f"rpy-phi{phi0}", "-")],
+              f"Free draining vs RPY in free space, phi0 = {phi0} (Fig. S2)\n" + sub)
     panel("droplet-hydro-direct-vs-pse.png", [("rpy", "-"), ("pse2", "--"), ("pse3", "-."),
                                               ("pse4", ":")],
           "RPY: direct (free space) vs PSE (periodic box)\n" + sub)

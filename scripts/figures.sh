@@ -23,6 +23,15 @@ fig() {
     printf '%s\tcolloidsim %s\t%d\n' "$name" "$*" $((SECONDS - start)) >> "$out/times.tsv"
 }
 
+# A DDFT of a droplet scenario (`colloidsim theory`, which has no --quiet).
+theory() {
+    local name=$1; shift
+    local start=$SECONDS
+    echo "== $name: colloidsim theory $*" >&2
+    "$bin" theory "$@" --out "$out/$name" >/dev/null
+    printf '%s\tcolloidsim theory %s\t%d\n' "$name" "$*" $((SECONDS - start)) >> "$out/times.tsv"
+}
+
 # A droplet run and its DDFT, which draws the run's profiles beside its own when the run's
 # folder (the scenario's stem) is in the working directory: both go into OUT/<name>/.
 run_and_theory() {
@@ -45,6 +54,7 @@ fig hard-rods-fig7-gamma1 run "$ex/bcd/sticky-single-file.toml"
 fig droplet-fig2a-phi0.2 run "$ex/droplet/static-equilibrium.toml"
 run_and_theory droplet-fig2b "$ex/droplet/drying-bd.toml"
 fig droplet-figS4 run "$ex/droplet/drying-mpcd-solvent.toml"
+theory droplet-figS10 "$ex/droplet/drying-bd-paper.toml" --dx 0.02
 fig droplet-fig7 run "$ex/mc/droplet-static.toml"
 
 echo "== done; wall times in $out/times.tsv" >&2

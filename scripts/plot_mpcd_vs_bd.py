@@ -10,6 +10,11 @@ boundary none / slip / no-slip, and its BD+RPY twin); its profile_F.csv files (c
 are drawn against r / R(t) with R(t) from summary.json, one panel per fraction. ``--merge K``
 joins K neighbouring shells (volume-weighted) first: a single droplet of tens of colloids is
 noisy at the bins of its run.
+
+It also prints, per run and fraction, the fraction of the colloids beyond the bin edge nearest
+0.8 R(t) (one minus the centres counted inside it, so that centres beyond R count as outer), with
+its binomial standard error over N x replicas colloids, and each run's difference from the first
+(a single droplet's colloids are correlated; the binomial error is a guide, not a bound).
 """
 import csv
 import json
@@ -48,6 +53,23 @@ def merged(r, phi, k):
     return out_r, out_phi
 
 
+def outer_fraction(c, summary, fr, cut=0.8):
+    """(edge / R, fraction of the colloids beyond the edge, binomial standard error)."""
+    p = summary["parameters"]
+    n, reps, d = p["particles"], p.get("replicas", 1), p["diameter"]
+    vp = math.pi * d**3 / 6
+    r = c["r"]
+    dr = r[1] - r[0] if len(r) > 1 else 2 * r[0]
+    big_r = radius(summary, fr)
+    k = round(cut * len(r))
+    inside = sum(
+        c["phi"][j] * 4 * math.pi / 3 * ((r[j] + dr / 2) ** 3 - (r[j] - dr / 2) ** 3) / vp
+        for j in range(k)
+    )
+    q = 1 - inside / n
+    return (r[k - 1] + dr / 2) / big_r, q, math.sqrt(max(q * (1 - q), 0) / (n * reps))
+
+
 def main():
     args = sys.argv[2:]
     merge = 1
@@ -75,6 +97,34 @@ def main():
     axes[0].legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(picture, dpi=110)
+    rows = {}
+    for label, folder in runs:
+        with open(os.path.join(folder, "summary.json")) as f:
+            summary = json.load(f)
+        for fr in fractions:
+            path = os.path.join(folder, f"profile_{fr:.2f}.csv")
+            if os.path.exists(path):
+                rows.setdefault(label, {})[fr] = outer_fraction(columns(path), summary, fr)
+    first = runs[0][0]
+    print("| run | " + " | ".join(f"{fr:.0%}" for fr in fractions) + " |")
+    print("|---" * (len(fractions) + 1) + "|")
+    for label, _ in runs:
+        cells = []
+        for fr in fractions:
+            if fr not in rows.get(label, {}):
+                cells.append("")
+                continue
+            edge, q, e = rows[label][fr]
+            cell = f"{q:.3f} ± {e:.3f}"
+            if label != first and fr in rows.get(first, {}):
+                _, q0, e0 = rows[first][fr]
+                z = (q - q0) / math.hypot(e, e0) if e or e0 else 0.0
+                cell += f" ({z:+.1f})"
+            cells.append(cell)
+        print(f"| {label} | " + " | ".join(cells) + " |")
+    edges = sorted({round(v[0], 3) for r in rows.values() for v in r.values()})
+    print(f"(fraction of the colloids beyond {edges} R(t); in brackets the difference from "
+          f"{first} in combined binomial errors)")
 
 
 if __name__ == "__main__":

@@ -51,7 +51,7 @@ pub mod interface;
 pub mod pair;
 pub mod rpy;
 
-pub use ddft::{Ddft, DdftOptions, Hydrodynamics, StepReport};
+pub use ddft::{Ddft, DdftOptions, EffectiveForce, Hydrodynamics, StepReport};
 pub use droplet::{
     DropletOutcome, DropletSetup, Snapshot, bin_average, equilibrium_at, run_droplet,
 };

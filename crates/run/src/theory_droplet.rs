@@ -7,8 +7,10 @@
 //! `[0, R(t)]`, at `t = round(fraction * steps) * dt` like the BD run), the fine-grid profiles
 //! `theory_profile_<fraction>.csv` (`r,rho,phi,n3`), the equilibrium of the same N in a static
 //! droplet of radius R(t) on the same bins (`equilibrium_<fraction>.csv`, `r,phi`; the paper's
-//! Fig. 2a references), `summary.json` and `profiles.png` (with the
-//! BD profiles of the run folder overlaid when they exist). See `docs/theory-droplet.md`.
+//! Fig. 2a references), the effective force of the paper's Eq. 16 on the theory grid's faces
+//! (`force_<fraction>.csv`, `r,force,phi`: `beta F_eff d = -d d/dr [ln rho + beta mu_ex + beta V]`
+//! in kT/d; the paper's Fig. S10), `summary.json`, `profiles.png` (with the BD profiles of the
+//! run folder overlaid when they exist) and `forces.png`. See `docs/theory-droplet.md`.
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -73,6 +75,11 @@ struct Written {
     fraction: f64,
     r: Vec<f64>,
     phi: Vec<f64>,
+    /// Face radii and `beta F_eff d` (kT/d) of the effective force.
+    force_r: Vec<f64>,
+    force: Vec<f64>,
+    /// Particle-weighted mean of the force (kT/d).
+    mean_force: f64,
 }
 
 /// `--hydrodynamics`: `free-draining` or `rpy`; by default the scenario's
@@ -193,6 +200,17 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         Err(e) => ("failed".to_string(), e.to_string()),
     };
     let outcome = result.as_ref().ok();
+    let forces: Vec<serde_json::Value> = written
+        .iter()
+        .map(|w| {
+            serde_json::json!({
+                "file": force_name(w.fraction),
+                "fraction": w.fraction,
+                "mean_kT_per_d": w.mean_force,
+                "max_abs_kT_per_d": w.force.iter().fold(0.0f64, |m, f| m.max(f.abs())),
+            })
+        })
+        .collect();
     let mut summary = serde_json::json!({
         "method": "droplet-bd",
         "engine": "theory: radial Rosenfeld FMT DDFT, implicit Euler",
@@ -228,6 +246,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         "profile_times": times,
         "equilibria": equilibria,
         "profiles_written": written.iter().map(|w| profile_name(w.fraction)).collect::<Vec<_>>(),
+        "effective_force": forces,
         "wall_seconds": wall,
     });
     if hydro == Hydrodynamics::Rpy {
@@ -235,6 +254,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     }
     dir.write_json("summary.json", &summary)?;
     let mut files: Vec<String> = written.iter().map(|w| profile_name(w.fraction)).collect();
+    files.extend(written.iter().map(|w| force_name(w.fraction)));
     let mut warnings = Vec::new();
     if !written.is_empty() {
         let tag = match hydro {
@@ -248,6 +268,12 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         plot::picture(
             draw(Path::new(src.name()), &dir, &written, tag, p.diameter),
             "profiles.png",
+            &mut files,
+            &mut warnings,
+        );
+        plot::picture(
+            draw_forces(&dir, &written, tag),
+            "forces.png",
             &mut files,
             &mut warnings,
         );
@@ -272,7 +298,13 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     }
 }
 
-/// Write `profile_<f>.csv` on the BD bins and `theory_profile_<f>.csv` on the theory grid.
+/// File name of the effective force at `fraction` of the drying time: `force_0.25.csv`.
+pub fn force_name(fraction: f64) -> String {
+    profile_name(fraction).replacen("profile", "force", 1)
+}
+
+/// Write `profile_<f>.csv` on the BD bins, `theory_profile_<f>.csv` on the theory grid and the
+/// effective force `force_<f>.csv` on its faces.
 #[allow(clippy::too_many_arguments)]
 fn write_snapshot(
     dir: &OutputDir,
@@ -303,8 +335,53 @@ fn write_snapshot(
         &name,
         &[("r", rf), ("rho", rho), ("phi", &phif), ("n3", &s.n3[..m])],
     )?;
-    written.push(Written { fraction, r, phi });
+    // The effective force of Eq. 16 in kT/d, with the volume fraction at the same faces.
+    let force: Vec<f64> = s.force.force.iter().map(|f| f * p.diameter).collect();
+    let phi_face: Vec<f64> = s.force.rho.iter().map(|x| x * vp).collect();
+    dir.write_table(
+        &force_name(fraction),
+        &[("r", &s.force.r), ("force", &force), ("phi", &phi_face)],
+    )?;
+    written.push(Written {
+        fraction,
+        r,
+        phi,
+        force_r: s.force.r.clone(),
+        force,
+        mean_force: s.force.mean() * p.diameter,
+    });
     Ok(())
+}
+
+/// `forces.png`: the effective force `beta F_eff d` against `r` at the output times (the paper's
+/// Fig. S10).
+fn draw_forces(dir: &OutputDir, written: &[Written], tag: &str) -> Result<()> {
+    let labels: Vec<String> = written
+        .iter()
+        .map(|w| format!("{:.0}% (mean {:.3})", 100.0 * w.fraction, w.mean_force))
+        .collect();
+    let series: Vec<Series> = written
+        .iter()
+        .zip(&labels)
+        .map(|(w, l)| Series {
+            label: l,
+            x: &w.force_r,
+            y: &w.force,
+            points: false,
+        })
+        .collect();
+    plot::line_plot_styled(
+        &dir.join("forces.png"),
+        &format!("Effective force of Eq. 16 in the drying droplet ({tag})"),
+        "r (length)",
+        "beta F_eff d = -d d/dr [ln rho + beta mu_ex + beta V] (kT/d)",
+        &series,
+        &[],
+        Scale::Linear,
+        plot::Style {
+            legend_outside: true,
+        },
+    )
 }
 
 /// `profiles.png`: theory lines, BD points from the run folder (`<scenario stem>/`) when present.

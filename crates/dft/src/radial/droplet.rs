@@ -6,9 +6,9 @@ use std::f64::consts::PI;
 use colloidsim_core::{ParamError, param};
 
 use super::{
-    Ddft, DdftOptions, DryingSchedule, Equilibrium, EquilibriumOptions, HarmonicInterface,
-    Hydrodynamics, PairCorrelation, RadialError, RadialGrid, Rosenfeld, StepReport,
-    solve_equilibrium,
+    Ddft, DdftOptions, DryingSchedule, EffectiveForce, Equilibrium, EquilibriumOptions,
+    HarmonicInterface, Hydrodynamics, PairCorrelation, RadialError, RadialGrid, Rosenfeld,
+    StepReport, solve_equilibrium,
 };
 
 /// Random close packing: the largest mean volume fraction accepted.
@@ -126,6 +126,8 @@ pub struct Snapshot {
     pub rho: Vec<f64>,
     /// Local packing fraction `n3` at the cell centres.
     pub n3: Vec<f64>,
+    /// The effective force `beta F_eff(r)` of the paper's Eq. 16 at the grid's faces.
+    pub force: EffectiveForce,
 }
 
 /// Summary of a run.
@@ -194,6 +196,7 @@ pub fn run_droplet(
     for &t in times {
         ddft.advance_to(t.min(setup.t_end), &mut on_step)?;
         let n3 = ddft.packing_fraction()?;
+        let force = ddft.effective_force()?;
         drift = drift.max((grid.integrate(ddft.rho()) / n0 - 1.0).abs());
         on_snapshot(
             &grid,
@@ -202,6 +205,7 @@ pub fn run_droplet(
                 radius: schedule.radius(ddft.time())?,
                 rho: ddft.rho().to_vec(),
                 n3,
+                force,
             },
         );
     }
