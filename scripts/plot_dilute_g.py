@@ -15,7 +15,6 @@ and the bulk sedimentation coefficient of the radial RPY flux that each g gives,
 K = 1 - 5 phi + 12 phi int_1^5 x h(x) dx (h = g - 1, x = r/d; the dilute step: 1 - 5 phi; the MC
 and Trokhymchuk both cut at 5 d, the MC's error from its bins' errors as if independent).
 """
-import csv
 import json
 import os
 import subprocess
@@ -26,25 +25,11 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from tables import columns, option  # noqa: E402  (scripts/tables.py)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..")
 CUT = 5.0  # diameters: the MC's g(r) range (output.gr_max of examples/mc/bulk.toml)
-
-
-def columns(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
-
-
-def option(args, name, default):
-    if name in args:
-        i = args.index(name)
-        value = args[i + 1]
-        del args[i : i + 2]
-        return value
-    return default
 
 
 def k_integral(x, g, err=None):

@@ -14,7 +14,6 @@ free draining and RPY with Trokhymchuk's g, and the particle-weighted mean force
 |F| against the fraction of the drying time for all three; writes OUT/table.md. --reuse keeps
 the runs already in OUT (their summary.json) and only draws.
 """
-import csv
 import json
 import os
 import subprocess
@@ -24,6 +23,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from tables import columns, option  # noqa: E402  (scripts/tables.py)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MODELS = [
@@ -32,21 +32,6 @@ MODELS = [
     ("rpy-trokhymchuk", "RPY, Trokhymchuk g", ["--hydrodynamics", "rpy", "--pair", "trokhymchuk"]),
 ]
 FRACTIONS = [round(0.05 * k, 2) for k in range(21)]
-
-
-def columns(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
-
-
-def option(args, name, default):
-    if name in args:
-        i = args.index(name)
-        value = args[i + 1]
-        del args[i : i + 2]
-        return value
-    return default
 
 
 def main():

@@ -16,7 +16,6 @@ It also prints, per run and fraction, the fraction of the colloids beyond the bi
 its binomial standard error over N x replicas colloids, and each run's difference from the first
 (a single droplet's colloids are correlated; the binomial error is a guide, not a bound).
 """
-import csv
 import json
 import math
 import os
@@ -26,12 +25,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def columns(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+from tables import columns  # noqa: E402  (scripts/tables.py)
 
 
 def radius(summary, fraction):

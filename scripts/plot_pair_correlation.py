@@ -9,7 +9,6 @@ Left: Trokhymchuk et al.'s g(r) at several packing fractions (the fits cover eta
 0.55 is extrapolated). Right: K(phi) of the radial RPY flux with the dilute g (1 - 5 phi) and
 with Trokhymchuk's g (1 - 5 phi + 12 phi int_1^8 x h dx).
 """
-import csv
 import os
 import sys
 
@@ -17,12 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-
-def columns(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+from tables import columns  # noqa: E402  (scripts/tables.py)
 
 
 def main():
