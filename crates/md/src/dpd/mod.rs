@@ -680,16 +680,7 @@ impl Dpd {
     /// The pressure tensor from the current velocities and the virial of the last step taken
     /// with it ([`Self::thermo`]'s `pressure`, without the rest).
     pub fn pressure_tensor(&self) -> [f64; 6] {
-        let mut t = [0.0; 6];
-        for (v, &k) in self.vel.iter().zip(&self.key) {
-            let m = self.props[(k & !COLLOID_BIT) as usize].mass;
-            t[0] += m * v[0] * v[0];
-            t[1] += m * v[1] * v[1];
-            t[2] += m * v[2] * v[2];
-            t[3] += m * v[0] * v[1];
-            t[4] += m * v[0] * v[2];
-            t[5] += m * v[1] * v[2];
-        }
+        let mut t = self.kinetic_tensor();
         for s in &self.slabs {
             let w = s.virial.total();
             for k in 0..6 {
@@ -822,25 +813,34 @@ impl Dpd {
         Ok(())
     }
 
+    /// `sum m v (x) v` over all particles (xx, yy, zz, xy, xz, yz).
+    fn kinetic_tensor(&self) -> [f64; 6] {
+        let mut t = [0.0; 6];
+        for (v, &k) in self.vel.iter().zip(&self.key) {
+            let m = self.props[(k & !COLLOID_BIT) as usize].mass;
+            t[0] += m * v[0] * v[0];
+            t[1] += m * v[1] * v[1];
+            t[2] += m * v[2] * v[2];
+            t[3] += m * v[0] * v[1];
+            t[4] += m * v[0] * v[2];
+            t[5] += m * v[1] * v[2];
+        }
+        t
+    }
+
     /// Thermodynamic state from the current velocities and the virial of the last
     /// [`Self::advance_with_thermo`] (zero virial after a plain [`Self::advance`]).
     pub fn thermo(&self) -> Thermo {
         let nt = self.type_names.len().max(1);
         let mut ke = vec![0.0; nt];
         let mut count = vec![0usize; nt];
-        let mut kin = [0.0; 6];
+        let kin = self.kinetic_tensor();
         let mut mom = [0.0; 3];
         for (v, &k) in self.vel.iter().zip(&self.key) {
             let q = &self.props[(k & !COLLOID_BIT) as usize];
             let m = q.mass;
             ke[q.typeid as usize] += m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
             count[q.typeid as usize] += 1;
-            kin[0] += m * v[0] * v[0];
-            kin[1] += m * v[1] * v[1];
-            kin[2] += m * v[2] * v[2];
-            kin[3] += m * v[0] * v[1];
-            kin[4] += m * v[0] * v[2];
-            kin[5] += m * v[1] * v[2];
             for k in 0..3 {
                 mom[k] += m * v[k];
             }
