@@ -35,6 +35,15 @@ impl CellSort {
         nc
     }
 
+    /// The cell (`0 ..< n`) of a wrapped coordinate `x` along an axis of length `l` cut into
+    /// `n` cells; the one formula of every sort, so that domains of a decomposed run agree on
+    /// which layer a particle is in.
+    #[inline(always)]
+    pub fn cell_coordinate(x: f64, l: f64, n: usize) -> usize {
+        let scale = n as f64 / l;
+        (((x + 0.5 * l) * scale).max(0.0) as usize).min(n - 1)
+    }
+
     /// Sort wrapped positions `pos` into cells at least `range` wide (z-major; inside a cell by
     /// increasing `tie`, so that the order is a function of the positions and ties alone, not of
     /// the threads). Fills [`Self::perm`] and [`Self::cell_start`] (in the new order).
@@ -45,16 +54,15 @@ impl CellSort {
         self.n_cells = nc;
         let [nx, ny, nz] = nc;
         let total = nx * ny * nz;
-        let scale = [nx as f64 / l[0], ny as f64 / l[1], nz as f64 / l[2]];
         self.cell_key.resize(n, 0);
         self.cell_key
             .par_iter_mut()
             .zip(pos.par_iter())
             .with_min_len(4096)
             .for_each(|(c, x)| {
-                let cx = (((x[0] + 0.5 * l[0]) * scale[0]).max(0.0) as usize).min(nx - 1);
-                let cy = (((x[1] + 0.5 * l[1]) * scale[1]).max(0.0) as usize).min(ny - 1);
-                let cz = (((x[2] + 0.5 * l[2]) * scale[2]).max(0.0) as usize).min(nz - 1);
+                let cx = Self::cell_coordinate(x[0], l[0], nx);
+                let cy = Self::cell_coordinate(x[1], l[1], ny);
+                let cz = Self::cell_coordinate(x[2], l[2], nz);
                 *c = ((cz * ny + cy) * nx + cx) as u32;
             });
         // Parallel counting sort: counts and scatter with atomics (the order inside a cell is

@@ -22,6 +22,7 @@
 //! number is a hash of (seed, step, pair of tags). Results are therefore bitwise independent of
 //! the number of threads.
 
+mod domain;
 pub mod forces;
 pub mod scenario;
 pub mod viscosity;
@@ -29,6 +30,8 @@ pub mod viscosity;
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
+use colloidsim_core::exchange::Exchange;
+use domain::Domain;
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
 pub use viscosity::StressAcf;
@@ -154,23 +157,44 @@ pub struct PairVirial {
     pub energy_morse: f64,
 }
 
+/// Numbers in [`PairVirial::write`].
+const VIRIAL_NUMBERS: usize = 39;
+
 impl PairVirial {
-    fn add(&mut self, o: &Self) {
-        for (a, b) in [
-            (&mut self.conservative, &o.conservative),
-            (&mut self.dissipative, &o.dissipative),
-            (&mut self.random, &o.random),
-            (&mut self.contact, &o.contact),
-            (&mut self.morse, &o.morse),
-            (&mut self.lubrication, &o.lubrication),
-        ] {
-            for k in 0..6 {
-                a[k] += b[k];
-            }
+    /// The parts in a flat row of [`VIRIAL_NUMBERS`] numbers (six tensors, three energies).
+    fn write(&self, r: &mut [f64]) {
+        for (p, part) in [
+            &self.conservative,
+            &self.dissipative,
+            &self.random,
+            &self.contact,
+            &self.morse,
+            &self.lubrication,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            r[6 * p..6 * p + 6].copy_from_slice(part);
         }
-        self.energy_conservative += o.energy_conservative;
-        self.energy_contact += o.energy_contact;
-        self.energy_morse += o.energy_morse;
+        r[36] = self.energy_conservative;
+        r[37] = self.energy_contact;
+        r[38] = self.energy_morse;
+    }
+
+    /// The inverse of [`Self::write`].
+    fn read(r: &[f64]) -> Self {
+        let t = |p: usize| -> [f64; 6] { std::array::from_fn(|k| r[6 * p + k]) };
+        Self {
+            conservative: t(0),
+            dissipative: t(1),
+            random: t(2),
+            contact: t(3),
+            morse: t(4),
+            lubrication: t(5),
+            energy_conservative: r[36],
+            energy_contact: r[37],
+            energy_morse: r[38],
+        }
     }
 
     /// Sum of all parts.
@@ -309,10 +333,17 @@ pub struct Dpd {
     cc_list: NeighborList,
     cc_pos: Vec<[f64; 3]>,
     cc_tag: Vec<u32>,
-    /// Storage index of each colloid slot.
-    cc_index: Vec<u32>,
     /// Colloid slot of each tag (`u32::MAX` for solvent).
     cc_slot: Vec<u32>,
+    /// Velocities of the colloid slots (with `cc_pos`, refreshed every step: on every rank of
+    /// a decomposed run).
+    cc_vel: Vec<[f64; 3]>,
+    /// Number of particles (on all ranks).
+    n_total: usize,
+    /// Storage range of the particles this rank integrates (all but the ghosts).
+    own: (usize, usize),
+    /// This rank's layers when the run is decomposed over ranks.
+    domain: Option<Domain>,
     /// Range of the cells: interaction range, plus the skin in Verlet mode.
     cell_range: f64,
     builds: u64,
@@ -329,7 +360,9 @@ struct Ctx<'a> {
     key: &'a [u32],
     props: &'a [Props],
     cc_list: &'a NeighborList,
-    cc_index: &'a [u32],
+    cc_pos: &'a [[f64; 3]],
+    cc_vel: &'a [[f64; 3]],
+    cc_tag: &'a [u32],
     cc_slot: &'a [u32],
     cell_start: &'a [u32],
     n_cells: [usize; 3],
@@ -361,6 +394,32 @@ impl Dpd {
         params: DpdParams,
         is_colloid_type: Vec<bool>,
         step: u64,
+    ) -> Result<Self, DpdError> {
+        Self::build(particles, sbox, params, is_colloid_type, step, None)
+    }
+
+    /// The share of rank `comm.rank()` of a run decomposed over `comm.size()` ranks (module
+    /// `domain`): every rank passes all `particles` (the same on every rank) and keeps those in
+    /// its layers. Every method is then collective: all ranks call them in the same order. The
+    /// run is bitwise the one of [`Self::new`] on one rank. One rank is the plain run.
+    pub fn decomposed(
+        particles: Particles,
+        sbox: SimBox,
+        params: DpdParams,
+        is_colloid_type: Vec<bool>,
+        step: u64,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Self, DpdError> {
+        Self::build(particles, sbox, params, is_colloid_type, step, Some(comm))
+    }
+
+    fn build(
+        particles: Particles,
+        sbox: SimBox,
+        params: DpdParams,
+        is_colloid_type: Vec<bool>,
+        step: u64,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Self, DpdError> {
         particles.check().map_err(DpdError::Invalid)?;
         let p = &params;
@@ -496,8 +555,11 @@ impl Dpd {
             cc_list: NeighborList::new(cc_range, p.skin),
             cc_pos: Vec::new(),
             cc_tag,
-            cc_index: Vec::new(),
             cc_slot,
+            cc_vel: Vec::new(),
+            n_total: n,
+            own: (0, n),
+            domain: None,
             cell_range,
             builds: 0,
             scratch3: Vec::new(),
@@ -505,12 +567,19 @@ impl Dpd {
             scratch_u32: Vec::new(),
             scratch_f64: Vec::new(),
         };
+        if let Some(comm) = comm.filter(|c| c.size() > 1) {
+            let nz = CellSort::cells_for(&sbox, cell_range)[2];
+            s.domain = Some(Domain::new(comm, nz, cell_range)?);
+            s.keep_own();
+            s.migrate_and_fetch_ghosts()?;
+        }
         s.sort_into_cells();
         if !s.cells_mode {
             s.build_lists();
         }
         s.update_colloid_list(true)?;
         s.compute_forces::<false>(s.step);
+        s.exchange_halo();
         Ok(s)
     }
 
@@ -528,6 +597,49 @@ impl Dpd {
         step: u64,
         sync_every: u64,
     ) -> Result<Self, DpdError> {
+        let types = is_colloid_type;
+        Self::restart_in(
+            particles, forces, sbox, params, types, step, sync_every, None,
+        )
+    }
+
+    /// [`Self::restart`] decomposed over ranks as in [`Self::decomposed`]: a checkpoint of a
+    /// run on any number of ranks continues on any other, bitwise.
+    #[allow(clippy::too_many_arguments)]
+    pub fn restart_decomposed(
+        particles: Particles,
+        forces: &[[f64; 3]],
+        sbox: SimBox,
+        params: DpdParams,
+        is_colloid_type: Vec<bool>,
+        step: u64,
+        sync_every: u64,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Self, DpdError> {
+        let types = is_colloid_type;
+        Self::restart_in(
+            particles,
+            forces,
+            sbox,
+            params,
+            types,
+            step,
+            sync_every,
+            Some(comm),
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn restart_in(
+        particles: Particles,
+        forces: &[[f64; 3]],
+        sbox: SimBox,
+        params: DpdParams,
+        is_colloid_type: Vec<bool>,
+        step: u64,
+        sync_every: u64,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Self, DpdError> {
         if forces.len() != particles.len() {
             return Err(DpdError::Invalid(format!(
                 "{} forces for {} particles",
@@ -535,9 +647,10 @@ impl Dpd {
                 particles.len()
             )));
         }
-        let mut s = Self::new(particles, sbox, params, is_colloid_type, step)?;
+        let mut s = Self::build(particles, sbox, params, is_colloid_type, step, comm)?;
         s.sync_every = sync_every;
-        for (i, &k) in s.key.iter().enumerate() {
+        for i in s.own.0..s.own.1 {
+            let k = s.key[i];
             let z = s.slab_of[i] as usize;
             let start = s.slabs[z].start;
             s.slabs[z].force[i - start] = forces[(k & !COLLOID_BIT) as usize];
@@ -560,14 +673,27 @@ impl Dpd {
         &self.params
     }
 
-    /// Number of particles.
+    /// Number of particles (on all ranks).
     pub fn len(&self) -> usize {
-        self.pos.len()
+        self.n_total
     }
 
     /// No particles (never true for a constructed simulation).
     pub fn is_empty(&self) -> bool {
-        self.pos.is_empty()
+        self.n_total == 0
+    }
+
+    /// Number of particles this rank integrates (all without a decomposition).
+    pub fn owned(&self) -> usize {
+        self.own.1 - self.own.0
+    }
+
+    /// This rank and the number of ranks the run is decomposed over (`(0, 1)`: not
+    /// decomposed).
+    pub fn rank(&self) -> (usize, usize) {
+        self.domain
+            .as_ref()
+            .map_or((0, 1), |d| (d.comm.rank(), d.comm.size()))
     }
 
     /// Time `step * dt`.
@@ -603,11 +729,26 @@ impl Dpd {
             mass: self.props.iter().map(|q| q.mass).collect(),
             type_names: self.type_names.clone(),
         };
-        for (i, &k) in self.key.iter().enumerate() {
-            let t = (k & !COLLOID_BIT) as usize;
-            p.pos[t] = self.pos[i];
-            p.image[t] = self.image[i];
-            p.vel[t] = self.vel[i];
+        if self.domain.is_none() {
+            for (i, &k) in self.key.iter().enumerate() {
+                let t = (k & !COLLOID_BIT) as usize;
+                p.pos[t] = self.pos[i];
+                p.image[t] = self.image[i];
+                p.vel[t] = self.vel[i];
+            }
+            return p;
+        }
+        let rows = self.gather_own(10, |i, r| {
+            r.push((self.key[i] & !COLLOID_BIT) as f64);
+            r.extend_from_slice(&self.pos[i]);
+            r.extend_from_slice(&self.vel[i]);
+            r.extend(self.image[i].iter().map(|&k| k as f64));
+        });
+        for m in rows.chunks_exact(10) {
+            let t = m[0] as usize;
+            p.pos[t] = [m[1], m[2], m[3]];
+            p.vel[t] = [m[4], m[5], m[6]];
+            p.image[t] = [m[7] as i32, m[8] as i32, m[9] as i32];
         }
         p
     }
@@ -615,19 +756,35 @@ impl Dpd {
     /// Unwrapped positions of the particles with tags `tags`, in that order, into `out`.
     pub fn unwrapped(&self, tags: &[u32], out: &mut Vec<[f64; 3]>) {
         out.clear();
-        out.extend(tags.iter().map(|&t| {
-            let i = self.by_tag[t as usize] as usize;
-            self.sbox.unwrap(self.pos[i], self.image[i])
-        }));
+        if self.domain.is_none() {
+            out.extend(tags.iter().map(|&t| {
+                let i = self.by_tag[t as usize] as usize;
+                self.sbox.unwrap(self.pos[i], self.image[i])
+            }));
+            return;
+        }
+        let rows = self.gather_own(4, |i, r| {
+            r.push((self.key[i] & !COLLOID_BIT) as f64);
+            r.extend_from_slice(&self.sbox.unwrap(self.pos[i], self.image[i]));
+        });
+        let mut by_tag = vec![[0.0; 3]; self.n_total];
+        for m in rows.chunks_exact(4) {
+            by_tag[m[0] as usize] = [m[1], m[2], m[3]];
+        }
+        out.extend(tags.iter().map(|&t| by_tag[t as usize]));
     }
 
     /// The forces of the last evaluation (positions and half-step velocities of the current
     /// step, noise of the current step), in tag order.
     pub fn forces(&self) -> Vec<[f64; 3]> {
+        let n_slabs = self.slabs.len();
+        let rows = self.gather_own(4, |i, r| {
+            r.push((self.key[i] & !COLLOID_BIT) as f64);
+            r.extend_from_slice(&total_force(&self.slabs, &self.slab_of, n_slabs, i));
+        });
         let mut f = vec![[0.0; 3]; self.len()];
-        for (i, &k) in self.key.iter().enumerate() {
-            f[(k & !COLLOID_BIT) as usize] =
-                total_force(&self.slabs, &self.slab_of, self.slabs.len(), i);
+        for m in rows.chunks_exact(4) {
+            f[m[0] as usize] = [m[1], m[2], m[3]];
         }
         f
     }
@@ -637,14 +794,24 @@ impl Dpd {
         &self.is_colloid_type
     }
 
-    /// Total momentum.
+    /// Total momentum (summed layer by layer, in layer order).
     pub fn momentum(&self) -> [f64; 3] {
         let mut m = [0.0; 3];
-        for (v, w) in self.vel.iter().zip(&self.inv_mass) {
-            for k in 0..3 {
-                m[k] += v[k] / w;
-            }
-        }
+        self.sum_layers(
+            3,
+            |z, r| {
+                let s = &self.slabs[z];
+                for (v, w) in self.vel[s.start..s.end]
+                    .iter()
+                    .zip(&self.inv_mass[s.start..s.end])
+                {
+                    for k in 0..3 {
+                        r[k] += v[k] / w;
+                    }
+                }
+            },
+            &mut m,
+        );
         m
     }
 
@@ -680,15 +847,18 @@ impl Dpd {
     /// The pressure tensor from the current velocities and the virial of the last step taken
     /// with it ([`Self::thermo`]'s `pressure`, without the rest).
     pub fn pressure_tensor(&self) -> [f64; 6] {
-        let mut t = self.kinetic_tensor();
-        for s in &self.slabs {
-            let w = s.virial.total();
-            for k in 0..6 {
-                t[k] += w[k];
-            }
-        }
+        let mut t = [0.0; 12];
+        self.sum_layers(
+            12,
+            |z, r| {
+                let s = &self.slabs[z];
+                self.kinetic_tensor(s.start, s.end, &mut r[..6]);
+                r[6..].copy_from_slice(&s.virial.total());
+            },
+            &mut t,
+        );
         let vol = self.sbox.volume();
-        t.map(|x| x / vol)
+        std::array::from_fn(|k| (t[k] + t[6 + k]) / vol)
     }
 
     fn step_inner<const THERMO: bool>(&mut self) -> Result<(), DpdError> {
@@ -696,21 +866,23 @@ impl Dpd {
         let half = 0.5 * dt;
         let sbox = self.sbox;
         let verlet = !self.cells_mode;
-        // First half kick and drift; largest step and largest displacement from the list's
-        // reference (Verlet mode).
+        let (o0, o1) = self.own;
+        // First half kick and drift of this rank's particles; largest step and largest
+        // displacement from the list's reference (Verlet mode).
         let (max_step2, fast, max_disp2) = {
             let slabs = &self.slabs;
             let slab_of = &self.slab_of;
             let inv_mass = &self.inv_mass;
             let ref_pos = &self.ref_pos;
             let n_slabs = slabs.len();
-            self.pos
+            self.pos[o0..o1]
                 .par_iter_mut()
-                .zip(self.vel.par_iter_mut())
-                .zip(self.image.par_iter_mut())
+                .zip(self.vel[o0..o1].par_iter_mut())
+                .zip(self.image[o0..o1].par_iter_mut())
                 .enumerate()
                 .with_min_len(1024)
-                .map(|(i, ((x, v), img))| {
+                .map(|(k, ((x, v), img))| {
+                    let i = o0 + k;
                     let f = total_force(slabs, slab_of, n_slabs, i);
                     let im = inv_mass[i] * half;
                     let mut step2 = 0.0;
@@ -743,16 +915,37 @@ impl Dpd {
                 )
         };
         self.step += 1;
+        let tag_of = |i: usize| {
+            if i == usize::MAX {
+                -1.0
+            } else {
+                (self.key[i] & !COLLOID_BIT) as f64
+            }
+        };
+        // The first particle gone non-finite, in storage order (-1: none).
+        let bad = if !max_step2.is_finite() || !max_disp2.is_finite() {
+            (o0..o1)
+                .find(|&i| {
+                    let (x, v) = (self.pos[i], self.vel[i]);
+                    x.iter().chain(&v).any(|a| !a.is_finite())
+                })
+                .map_or(-1.0, tag_of)
+        } else {
+            -1.0
+        };
+        let fast_tag = tag_of(fast);
+        // Every rank must agree on errors and on rebuilding the lists.
+        let (max_step2, fast_tag, max_disp2, bad) = match self.domain.as_mut() {
+            None => (max_step2, fast_tag, max_disp2, bad),
+            Some(d) => {
+                let [s, t, m, b] = d.agree_max(max_step2, fast_tag, max_disp2, bad);
+                (s, t, m, b)
+            }
+        };
         if !max_step2.is_finite() || !max_disp2.is_finite() {
-            let i = self
-                .pos
-                .iter()
-                .zip(&self.vel)
-                .position(|(x, v)| x.iter().chain(v).any(|a| !a.is_finite()))
-                .unwrap_or(0);
             return Err(DpdError::NonFinite {
                 step: self.step,
-                tag: self.key[i] & !COLLOID_BIT,
+                tag: bad.max(0.0) as u32,
                 what: "position",
             });
         }
@@ -760,35 +953,44 @@ impl Dpd {
         if max_step2 > limit * limit {
             return Err(DpdError::Unstable {
                 step: self.step,
-                tag: self.key[fast] & !COLLOID_BIT,
+                tag: fast_tag as u32,
                 distance: max_step2.sqrt(),
                 limit,
             });
         }
         let sync = self.sync_every > 0 && self.step.is_multiple_of(self.sync_every);
         if self.cells_mode {
+            self.migrate_and_fetch_ghosts()?;
             self.sort_into_cells();
             self.update_colloid_list(sync)?;
         } else if sync || max_disp2 > 0.25 * self.params.skin * self.params.skin {
+            self.migrate_and_fetch_ghosts()?;
             self.sort_into_cells();
             self.build_lists();
             self.update_colloid_list(true)?;
         } else {
-            // Colloid slots keep their storage indices between sorts.
+            // The same slots as at the last sort: refresh the ghosts and the colloid copies.
+            self.refresh_ghosts();
+            if self.cc_tag.len() >= 2 {
+                self.gather_colloids();
+            }
         }
         self.compute_forces::<THERMO>(self.step);
+        self.exchange_halo();
         // Second half kick.
+        let (o0, o1) = self.own;
         let bad = {
             let slabs = &self.slabs;
             let slab_of = &self.slab_of;
             let inv_mass = &self.inv_mass;
             let key = &self.key;
             let n_slabs = slabs.len();
-            self.vel
+            self.vel[o0..o1]
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(1024)
-                .map(|(i, v)| {
+                .map(|(k, v)| {
+                    let i = o0 + k;
                     let f = total_force(slabs, slab_of, n_slabs, i);
                     let im = inv_mass[i] * half;
                     for k in 0..3 {
@@ -803,6 +1005,10 @@ impl Dpd {
                 .min()
                 .unwrap_or(u32::MAX)
         };
+        let bad = match self.domain.as_mut() {
+            None => bad,
+            Some(d) => d.agree_min(bad),
+        };
         if bad != u32::MAX {
             return Err(DpdError::NonFinite {
                 step: self.step,
@@ -813,10 +1019,9 @@ impl Dpd {
         Ok(())
     }
 
-    /// `sum m v (x) v` over all particles (xx, yy, zz, xy, xz, yz).
-    fn kinetic_tensor(&self) -> [f64; 6] {
-        let mut t = [0.0; 6];
-        for (v, &k) in self.vel.iter().zip(&self.key) {
+    /// `sum m v (x) v` over the storage slots `a..b` (xx, yy, zz, xy, xz, yz), added to `t`.
+    fn kinetic_tensor(&self, a: usize, b: usize, t: &mut [f64]) {
+        for (v, &k) in self.vel[a..b].iter().zip(&self.key[a..b]) {
             let m = self.props[(k & !COLLOID_BIT) as usize].mass;
             t[0] += m * v[0] * v[0];
             t[1] += m * v[1] * v[1];
@@ -825,43 +1030,49 @@ impl Dpd {
             t[4] += m * v[0] * v[2];
             t[5] += m * v[1] * v[2];
         }
-        t
     }
 
     /// Thermodynamic state from the current velocities and the virial of the last
     /// [`Self::advance_with_thermo`] (zero virial after a plain [`Self::advance`]).
     pub fn thermo(&self) -> Thermo {
+        // Per layer: kinetic tensor (6), momentum (3), kinetic energy and count by type
+        // (2 nt), the virial (6 x 6 + 3).
         let nt = self.type_names.len().max(1);
-        let mut ke = vec![0.0; nt];
-        let mut count = vec![0usize; nt];
-        let kin = self.kinetic_tensor();
-        let mut mom = [0.0; 3];
-        for (v, &k) in self.vel.iter().zip(&self.key) {
-            let q = &self.props[(k & !COLLOID_BIT) as usize];
-            let m = q.mass;
-            ke[q.typeid as usize] += m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-            count[q.typeid as usize] += 1;
-            for k in 0..3 {
-                mom[k] += m * v[k];
-            }
-        }
+        let width = 9 + 2 * nt + VIRIAL_NUMBERS;
+        let mut sums = vec![0.0; width];
+        self.sum_layers(
+            width,
+            |z, r| {
+                let s = &self.slabs[z];
+                self.kinetic_tensor(s.start, s.end, &mut r[..6]);
+                for (v, &k) in self.vel[s.start..s.end]
+                    .iter()
+                    .zip(&self.key[s.start..s.end])
+                {
+                    let q = &self.props[(k & !COLLOID_BIT) as usize];
+                    let m = q.mass;
+                    r[9 + q.typeid as usize] += m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                    r[9 + nt + q.typeid as usize] += 1.0;
+                    for k in 0..3 {
+                        r[6 + k] += m * v[k];
+                    }
+                }
+                s.virial.write(&mut r[9 + 2 * nt..]);
+            },
+            &mut sums,
+        );
+        let kin: [f64; 6] = std::array::from_fn(|k| sums[k]);
+        let mom = [sums[6], sums[7], sums[8]];
+        let ke = &sums[9..9 + nt];
+        let count = &sums[9 + nt..9 + 2 * nt];
+        let virial = PairVirial::read(&sums[9 + 2 * nt..]);
         let n = self.len();
         let temperature = ke.iter().sum::<f64>() / (3.0 * n as f64 - 3.0);
         let temperature_by_type = ke
             .iter()
-            .zip(&count)
-            .map(|(e, &c)| {
-                if c > 0 {
-                    e / (3.0 * c as f64)
-                } else {
-                    f64::NAN
-                }
-            })
+            .zip(count)
+            .map(|(e, &c)| if c > 0.0 { e / (3.0 * c) } else { f64::NAN })
             .collect();
-        let mut virial = PairVirial::default();
-        for s in &self.slabs {
-            virial.add(&s.virial);
-        }
         let vol = self.sbox.volume();
         let w = virial.total();
         let mut pressure = [0.0; 6];
@@ -912,6 +1123,7 @@ impl Dpd {
             s.force.resize(own, [0.0; 3]);
             s.halo.resize(m, [0.0; 3]);
         }
+        self.set_own_range();
     }
 
     /// Verlet mode: half lists of solvent and colloid–solvent pairs within range + skin, slab
@@ -987,13 +1199,7 @@ impl Dpd {
         if self.cc_tag.len() < 2 {
             return Ok(());
         }
-        self.cc_index.clear();
-        self.cc_pos.clear();
-        for &t in &self.cc_tag {
-            let i = self.by_tag[t as usize];
-            self.cc_index.push(i);
-            self.cc_pos.push(self.pos[i as usize]);
-        }
+        self.gather_colloids();
         if force || self.cc_list.needs_rebuild(&self.sbox, &self.cc_pos) {
             self.cc_list.build(&self.sbox, &self.cc_pos, &self.cc_tag)?;
             if self.cells_mode {
@@ -1011,7 +1217,9 @@ impl Dpd {
             key: &self.key,
             props: &self.props,
             cc_list: &self.cc_list,
-            cc_index: &self.cc_index,
+            cc_pos: &self.cc_pos,
+            cc_vel: &self.cc_vel,
+            cc_tag: &self.cc_tag,
             cc_slot: &self.cc_slot,
             cell_start: &self.grid.cell_start,
             n_cells: self.grid.n_cells,
@@ -1034,10 +1242,16 @@ impl Dpd {
         let has_cc = self.cc_tag.len() >= 2;
         let nz = self.slabs.len();
         let starts = &self.slab_start;
-        self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
-            let next_start = starts[(z + 1) % nz];
-            slab_forces::<THERMO>(&ctx, z, slab, next_start, has_cc);
-        });
+        // This rank's layers (all without a decomposition).
+        let (z0, z1) = self.domain.as_ref().map_or((0, nz), |d| (d.z0, d.z1));
+        self.slabs[z0..z1]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, slab)| {
+                let z = z0 + k;
+                let next_start = starts[(z + 1) % nz];
+                slab_forces::<THERMO>(&ctx, z, slab, next_start, has_cc);
+            });
     }
 }
 
@@ -1209,10 +1423,10 @@ fn particle_forces<const THERMO: bool>(
         let slot = c.cc_slot[ti] as usize;
         let cf = &c.colloid;
         for &k in c.cc_list.neighbors(slot) {
-            let j = c.cc_index[k as usize] as usize;
-            let kj = c.key[j];
-            let pj = &c.props[(kj & !COLLOID_BIT) as usize];
-            let xj = c.pos[j];
+            let k = k as usize;
+            let tj = c.cc_tag[k];
+            let pj = &c.props[tj as usize];
+            let xj = c.cc_pos[k];
             let d = c
                 .sbox
                 .min_image([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
@@ -1224,7 +1438,7 @@ fn particle_forces<const THERMO: bool>(
             let abar = 0.5 * (pi.radius + pj.radius);
             let inv_r = 1.0 / r;
             let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
-            let vj = c.vel[j];
+            let vj = c.cc_vel[k];
             let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
             let w = 1.0 - h * c.inv_cc_cut;
             let f_con = cf.contact_force(h, abar);
@@ -1238,7 +1452,7 @@ fn particle_forces<const THERMO: bool>(
             } else {
                 0.0
             };
-            let theta = pair_noise(c.noise_key, ki & !COLLOID_BIT, kj & !COLLOID_BIT);
+            let theta = pair_noise(c.noise_key, ki & !COLLOID_BIT, tj);
             let noise = if c.authors_noise {
                 (c.two_kt_over_dt * (c.gamma + a_sq)).sqrt() * w
             } else {

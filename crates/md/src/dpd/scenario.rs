@@ -10,6 +10,7 @@ use super::{
 };
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::param::{in_range, non_negative, positive};
 use colloidsim_core::rng::{Purpose, stream};
 use rand::RngExt;
@@ -925,6 +926,30 @@ impl DpdSetup {
             self.params.colloid.contact_range,
         )?;
         Dpd::new(p, self.sbox, self.params, Self::colloid_types(), step)
+    }
+
+    /// [`Self::build`] decomposed over the ranks of `comm` ([`Dpd::decomposed`]): every rank
+    /// generates the same start and keeps its layers.
+    pub fn build_decomposed(&self, comm: Box<dyn Exchange>) -> Result<Dpd, DpdError> {
+        let p = self.initial_particles()?;
+        self.build_decomposed_from(p, 0, comm)
+    }
+
+    /// [`Self::build_from`] decomposed over the ranks of `comm`.
+    pub fn build_decomposed_from(
+        &self,
+        p: Particles,
+        step: u64,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Dpd, DpdError> {
+        check_overlaps(
+            &p,
+            &self.sbox,
+            &Self::colloid_types(),
+            self.params.colloid.contact_range,
+        )?;
+        let types = Self::colloid_types();
+        Dpd::decomposed(p, self.sbox, self.params, types, step, comm)
     }
 }
 

@@ -1,0 +1,413 @@
+//! Spatial domain decomposition of a DPD run over ranks ([`Exchange`]).
+//!
+//! The box is cut into slabs of whole z-layers of the force cells: rank `r` of `P` owns layers
+//! `z0 = r nz / P .. z1 = (r + 1) nz / P` and the particles in them. The half stencil of cells
+//! reaches only the own and the next layer ([`crate::cells`]), so a rank needs one ghost layer,
+//! `z1 mod nz` (the first layer of the rank on its right), and the forces its last layer's pairs
+//! exert on that ghost layer (the last slab's *halo*) go back to that rank, which adds them
+//! exactly where a single process adds the previous slab's halo. Every rank sorts its particles
+//! and ghosts into the same global cells (ties by tag), so each pair is met in the same order
+//! and summed in the same place as on one rank: **a decomposed run is bitwise the single-rank
+//! run**, for any number of ranks. Colloids are few: their positions and velocities are
+//! gathered on every rank each step, and the colloid–colloid list is built from that copy.
+//!
+//! Per step: the drift's largest displacement is agreed on (one all-gather), particles that
+//! left their rank's layers migrate to the neighbour (at every sort: every step with cells,
+//! at list rebuilds with Verlet lists), the ghost layer is sent left (whole at a sort, positions
+//! and velocities in between), the halo forces are sent right, and thermodynamic sums are
+//! gathered layer by layer and added in layer order.
+
+use super::{COLLOID_BIT, Dpd, DpdError};
+use crate::cells::CellSort;
+use colloidsim_core::exchange::Exchange;
+
+/// Numbers per migrating particle: key, position, velocity, image.
+const MIGRANT: usize = 10;
+/// Numbers per ghost at a sort: key, position, velocity.
+const GHOST: usize = 7;
+
+/// This rank's share of a decomposed run.
+pub(super) struct Domain {
+    pub comm: Box<dyn Exchange>,
+    /// Layers of cells along z.
+    pub nz: usize,
+    /// Owned layers `z0..z1`.
+    pub z0: usize,
+    pub z1: usize,
+    send_left: Vec<f64>,
+    send_right: Vec<f64>,
+    recv: Vec<f64>,
+    /// All-gather results.
+    pub gathered: Vec<f64>,
+    /// This rank's part of an all-gather.
+    pub mine: Vec<f64>,
+}
+
+impl Domain {
+    /// The domain of `comm`'s rank for `nz` layers; an error when there are more ranks than
+    /// layers.
+    pub fn new(comm: Box<dyn Exchange>, nz: usize, cell_range: f64) -> Result<Self, DpdError> {
+        let p = comm.size();
+        if nz < p {
+            return Err(DpdError::Invalid(format!(
+                "{p} ranks for {nz} layers of cells along z (cells at least {cell_range:.3} \
+                 wide): each rank needs a layer; use at most {nz} ranks or a longer box"
+            )));
+        }
+        let r = comm.rank();
+        Ok(Self {
+            z0: r * nz / p,
+            z1: (r + 1) * nz / p,
+            nz,
+            comm,
+            send_left: Vec::new(),
+            send_right: Vec::new(),
+            recv: Vec::new(),
+            gathered: Vec::new(),
+            mine: Vec::new(),
+        })
+    }
+
+    fn left(&self) -> usize {
+        let p = self.comm.size();
+        (self.comm.rank() + p - 1) % p
+    }
+
+    fn right(&self) -> usize {
+        (self.comm.rank() + 1) % self.comm.size()
+    }
+
+    fn owner(&self, z: usize) -> usize {
+        let p = self.comm.size();
+        (0..p).find(|&r| z < (r + 1) * self.nz / p).unwrap_or(p - 1)
+    }
+
+    /// Whether layer `z` is this rank's.
+    pub fn owns(&self, z: usize) -> bool {
+        (self.z0..self.z1).contains(&z)
+    }
+
+    /// The ghost layer.
+    pub fn ghost_layer(&self) -> usize {
+        self.z1 % self.nz
+    }
+
+    /// The layer before the first owned one (whose halo holds forces on the first owned layer).
+    pub fn before_layer(&self) -> usize {
+        (self.z0 + self.nz - 1) % self.nz
+    }
+
+    /// The largest of every rank's `value` (ties: the lowest rank) with its `tag`, and the
+    /// largest `other`, as `(value, tag, other)`; and the first tag of `bad` (negative: none)
+    /// in rank order.
+    pub fn agree_max(&mut self, value: f64, tag: f64, other: f64, bad: f64) -> [f64; 4] {
+        self.mine.clear();
+        self.mine.extend_from_slice(&[value, tag, other, bad]);
+        self.comm.all_gather(&self.mine, &mut self.gathered);
+        let mut out = [f64::NEG_INFINITY, -1.0, f64::NEG_INFINITY, -1.0];
+        for g in self.gathered.chunks_exact(4) {
+            // NaN never wins, as in the single-rank reduction; an infinity does.
+            if g[0] > out[0] {
+                out[0] = g[0];
+                out[1] = g[1];
+            }
+            out[2] = out[2].max(g[2]);
+            if out[3] < 0.0 && g[3] >= 0.0 {
+                out[3] = g[3];
+            }
+        }
+        if out[0] == f64::NEG_INFINITY {
+            out[0] = 0.0;
+        }
+        if out[2] == f64::NEG_INFINITY {
+            out[2] = 0.0;
+        }
+        out
+    }
+
+    /// The smallest of every rank's `x`.
+    pub fn agree_min(&mut self, x: u32) -> u32 {
+        self.mine.clear();
+        self.mine.push(x as f64);
+        self.comm.all_gather(&self.mine, &mut self.gathered);
+        self.gathered.iter().fold(u32::MAX, |m, &g| m.min(g as u32))
+    }
+}
+
+impl Dpd {
+    /// The z-layer of cells of a wrapped position, as [`CellSort::sort`] finds it.
+    fn layer_of(&self, x: &[f64; 3], nz: usize) -> usize {
+        CellSort::cell_coordinate(x[2], self.sbox.l[2], nz)
+    }
+
+    /// Keep the particles of this rank's layers (at construction, from the full set).
+    pub(super) fn keep_own(&mut self) {
+        let Some(d) = self.domain.as_ref() else {
+            return;
+        };
+        let (z0, z1, nz) = (d.z0, d.z1, d.nz);
+        let mut w = 0;
+        for i in 0..self.pos.len() {
+            let z = self.layer_of(&self.pos[i], nz);
+            if (z0..z1).contains(&z) {
+                self.move_slot(i, w);
+                w += 1;
+            }
+        }
+        self.truncate_slots(w);
+        self.own = (0, w);
+    }
+
+    fn move_slot(&mut self, from: usize, to: usize) {
+        self.pos[to] = self.pos[from];
+        self.vel[to] = self.vel[from];
+        self.image[to] = self.image[from];
+        self.key[to] = self.key[from];
+        self.inv_mass[to] = self.inv_mass[from];
+    }
+
+    fn truncate_slots(&mut self, n: usize) {
+        self.pos.truncate(n);
+        self.vel.truncate(n);
+        self.image.truncate(n);
+        self.key.truncate(n);
+        self.inv_mass.truncate(n);
+    }
+
+    fn push_slot(&mut self, key: u32, x: [f64; 3], v: [f64; 3], image: [i32; 3], inv_mass: f64) {
+        self.pos.push(x);
+        self.vel.push(v);
+        self.image.push(image);
+        self.key.push(key);
+        self.inv_mass.push(inv_mass);
+    }
+
+    /// Send the owned particles that left this rank's layers to the neighbours, take theirs,
+    /// drop the old ghosts and fetch the new ghost layer from the right. The caller sorts.
+    pub(super) fn migrate_and_fetch_ghosts(&mut self) -> Result<(), DpdError> {
+        let Some(mut d) = self.domain.take() else {
+            return Ok(());
+        };
+        let out = self.migrate(&mut d);
+        self.domain = Some(d);
+        out
+    }
+
+    fn migrate(&mut self, d: &mut Domain) -> Result<(), DpdError> {
+        let (left, right) = (d.left(), d.right());
+        d.send_left.clear();
+        d.send_right.clear();
+        let mut w = 0;
+        let (o0, o1) = self.own;
+        let mut lost = None;
+        for i in o0..o1 {
+            let z = self.layer_of(&self.pos[i], d.nz);
+            if d.owns(z) {
+                self.move_slot(i, w);
+                w += 1;
+                continue;
+            }
+            let to = d.owner(z);
+            let buf = if to == right {
+                &mut d.send_right
+            } else if to == left {
+                &mut d.send_left
+            } else {
+                lost.get_or_insert((self.key[i] & !COLLOID_BIT, z));
+                continue;
+            };
+            let (x, v, im) = (self.pos[i], self.vel[i], self.image[i]);
+            buf.push(self.key[i] as f64);
+            buf.extend_from_slice(&x);
+            buf.extend_from_slice(&v);
+            buf.extend(im.iter().map(|&k| k as f64));
+        }
+        self.truncate_slots(w);
+        // With two ranks left and right are one rank, and everything went right.
+        d.comm.shift(right, &d.send_right, left, &mut d.recv);
+        self.take_migrants(&d.recv);
+        if left != right {
+            d.comm.shift(left, &d.send_left, right, &mut d.recv);
+            self.take_migrants(&d.recv);
+        }
+        let n_own = self.pos.len();
+        self.own = (0, n_own);
+        // Ghosts: this rank's first layer goes left (it is the left rank's ghost layer).
+        d.send_left.clear();
+        for i in 0..n_own {
+            if self.layer_of(&self.pos[i], d.nz) == d.z0 {
+                d.send_left.push(self.key[i] as f64);
+                d.send_left.extend_from_slice(&self.pos[i]);
+                d.send_left.extend_from_slice(&self.vel[i]);
+            }
+        }
+        d.comm.shift(left, &d.send_left, right, &mut d.recv);
+        for g in d.recv.chunks_exact(GHOST) {
+            self.push_slot(
+                g[0] as u32,
+                [g[1], g[2], g[3]],
+                [g[4], g[5], g[6]],
+                [0; 3],
+                0.0,
+            );
+        }
+        // Every rank went through the same exchanges; now they agree on whether one failed.
+        let bad = d.agree_min(lost.map_or(u32::MAX, |(t, _)| t));
+        if bad != u32::MAX {
+            return Err(DpdError::Invalid(format!(
+                "particle {bad} crossed more than one domain in a step at step {}; reduce run.dt",
+                self.step
+            )));
+        }
+        Ok(())
+    }
+
+    fn take_migrants(&mut self, recv: &[f64]) {
+        for m in recv.chunks_exact(MIGRANT) {
+            let key = m[0] as u32;
+            let inv_mass = 1.0 / self.props[(key & !COLLOID_BIT) as usize].mass;
+            self.push_slot(
+                key,
+                [m[1], m[2], m[3]],
+                [m[4], m[5], m[6]],
+                [m[7] as i32, m[8] as i32, m[9] as i32],
+                inv_mass,
+            );
+        }
+    }
+
+    /// After a sort: the owned slots are the owned layers' (contiguous, as layers are stored in
+    /// z order and the ghost layer is before or after them).
+    pub(super) fn set_own_range(&mut self) {
+        self.own = match &self.domain {
+            None => (0, self.pos.len()),
+            Some(d) => (self.grid.layer(d.z0).0, self.grid.layer(d.z1 - 1).1),
+        };
+    }
+
+    /// Between sorts (Verlet lists): the ghosts' positions and velocities, in the same slots.
+    pub(super) fn refresh_ghosts(&mut self) {
+        let Some(d) = self.domain.as_mut() else {
+            return;
+        };
+        let (a, b) = (self.slabs[d.z0].start, self.slabs[d.z0].end);
+        d.send_left.clear();
+        for i in a..b {
+            d.send_left.extend_from_slice(&self.pos[i]);
+            d.send_left.extend_from_slice(&self.vel[i]);
+        }
+        let (left, right) = (d.left(), d.right());
+        d.comm.shift(left, &d.send_left, right, &mut d.recv);
+        let g = &self.slabs[d.ghost_layer()];
+        assert_eq!(
+            d.recv.len(),
+            6 * (g.end - g.start),
+            "ghost layer changed between sorts"
+        );
+        for (k, m) in d.recv.chunks_exact(6).enumerate() {
+            self.pos[g.start + k] = [m[0], m[1], m[2]];
+            self.vel[g.start + k] = [m[3], m[4], m[5]];
+        }
+    }
+
+    /// After the forces: the last owned slab's forces on the ghost layer go right; the left
+    /// rank's on the first owned layer arrive into the slab before it.
+    pub(super) fn exchange_halo(&mut self) {
+        let Some(d) = self.domain.as_mut() else {
+            return;
+        };
+        d.send_right.clear();
+        for f in &self.slabs[d.z1 - 1].halo {
+            d.send_right.extend_from_slice(f);
+        }
+        let (left, right) = (d.left(), d.right());
+        d.comm.shift(right, &d.send_right, left, &mut d.recv);
+        let h = &mut self.slabs[d.before_layer()].halo;
+        assert_eq!(d.recv.len(), 3 * h.len(), "halo of the first layer");
+        for (f, m) in h.iter_mut().zip(d.recv.chunks_exact(3)) {
+            *f = [m[0], m[1], m[2]];
+        }
+    }
+
+    /// Positions and velocities of every colloid, by slot, on every rank.
+    pub(super) fn gather_colloids(&mut self) {
+        let nc = self.cc_tag.len();
+        self.cc_pos.resize(nc, [0.0; 3]);
+        self.cc_vel.resize(nc, [0.0; 3]);
+        match self.domain.as_mut() {
+            None => {
+                for (s, &t) in self.cc_tag.iter().enumerate() {
+                    let i = self.by_tag[t as usize] as usize;
+                    self.cc_pos[s] = self.pos[i];
+                    self.cc_vel[s] = self.vel[i];
+                }
+            }
+            Some(d) => {
+                d.mine.clear();
+                for i in self.own.0..self.own.1 {
+                    let k = self.key[i];
+                    if k & COLLOID_BIT != 0 {
+                        d.mine.push((k & !COLLOID_BIT) as f64);
+                        d.mine.extend_from_slice(&self.pos[i]);
+                        d.mine.extend_from_slice(&self.vel[i]);
+                    }
+                }
+                d.comm.all_gather(&d.mine, &mut d.gathered);
+                for m in d.gathered.chunks_exact(7) {
+                    let s = self.cc_slot[m[0] as usize] as usize;
+                    self.cc_pos[s] = [m[1], m[2], m[3]];
+                    self.cc_vel[s] = [m[4], m[5], m[6]];
+                }
+            }
+        }
+    }
+
+    /// Every rank's `record(layer)` for its owned layers, in layer order, summed element-wise
+    /// in layer order into `total` (`width` numbers a layer): the same additions on any
+    /// number of ranks.
+    pub(super) fn sum_layers(
+        &self,
+        width: usize,
+        record: impl Fn(usize, &mut [f64]),
+        total: &mut [f64],
+    ) {
+        let nz = self.slabs.len();
+        let (z0, z1) = self.domain.as_ref().map_or((0, nz), |d| (d.z0, d.z1));
+        let mut mine = vec![0.0; width * (z1 - z0)];
+        for (z, r) in (z0..z1).zip(mine.chunks_exact_mut(width)) {
+            record(z, r);
+        }
+        let all = match &self.domain {
+            None => mine,
+            Some(d) => {
+                let mut all = Vec::new();
+                d.comm.all_gather(&mine, &mut all);
+                all
+            }
+        };
+        total.iter_mut().for_each(|t| *t = 0.0);
+        for r in all.chunks_exact(width) {
+            for (t, x) in total.iter_mut().zip(r) {
+                *t += x;
+            }
+        }
+    }
+
+    /// Every rank's owned particles as `(tag, numbers)` rows of `width` numbers from `row`,
+    /// on every rank (in rank order).
+    pub(super) fn gather_own(&self, width: usize, row: impl Fn(usize, &mut Vec<f64>)) -> Vec<f64> {
+        let mut mine = Vec::with_capacity((self.own.1 - self.own.0) * width);
+        for i in self.own.0..self.own.1 {
+            row(i, &mut mine);
+        }
+        debug_assert_eq!(mine.len(), (self.own.1 - self.own.0) * width);
+        match &self.domain {
+            None => mine,
+            Some(d) => {
+                let mut all = Vec::new();
+                d.comm.all_gather(&mine, &mut all);
+                all
+            }
+        }
+    }
+}

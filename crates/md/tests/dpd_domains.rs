@@ -1,0 +1,179 @@
+//! DPD decomposed over ranks (issue 20): the ranks are threads talking over channels
+//! ([`LocalRanks`]); the MPI ranks of the CLI run the same code. A decomposed run must be
+//! bitwise the single-rank run, for any number of ranks, with lists or cells, with colloids.
+
+use colloidsim_core::exchange::{Exchange, LocalRanks};
+use colloidsim_md::Particles;
+use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
+use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};
+
+fn scenario(text: &str) -> DpdSetup {
+    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+}
+
+/// A small polydisperse suspension with Morse attraction (as the thread test).
+fn suspension(mode: NeighborMode) -> DpdSetup {
+    let mut s = scenario(
+        "method = \"dpd\"\nseed = 9\n[system]\nbox_length = 8.0\nphi = 0.15\nradius_distribution = \"uniform\"\nradius_spread = 0.2\n[colloids]\nmorse_depth = 12.0\n",
+    );
+    s.params.neighbors = mode;
+    s
+}
+
+/// What a run ends with: particles, forces, the thermo of its last step, and the smallest and
+/// largest number of particles a rank held along the way.
+struct End {
+    snap: Particles,
+    forces: Vec<[f64; 3]>,
+    thermo: Thermo,
+    owned: (usize, usize),
+}
+
+/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
+fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
+    let f = &f;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = LocalRanks::new(ranks)
+            .into_iter()
+            .map(|c| s.spawn(move || f(Box::new(c))))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+/// DPD water (density 3, a = 25, gamma = 4.5) at dt = 0.04 in a cube of side `l`.
+fn water(l: f64) -> DpdSetup {
+    scenario(&format!(
+        "method = \"dpd\"\nseed = 4\n[system]\nbox_length = {l}\n[run]\ndt = 0.04\n"
+    ))
+}
+
+fn finish(sim: &mut Dpd, steps: u64) -> End {
+    let mut owned = (usize::MAX, 0);
+    for _ in 0..steps {
+        sim.advance().unwrap();
+        owned = (owned.0.min(sim.owned()), owned.1.max(sim.owned()));
+    }
+    let thermo = sim.advance_with_thermo().unwrap();
+    End {
+        snap: sim.snapshot(),
+        forces: sim.forces(),
+        thermo,
+        owned,
+    }
+}
+
+fn serial(setup: &DpdSetup, steps: u64) -> End {
+    finish(&mut setup.build().unwrap(), steps)
+}
+
+fn decomposed(setup: &DpdSetup, ranks: usize, steps: u64) -> Vec<End> {
+    on_ranks(ranks, |c| {
+        finish(&mut setup.build_decomposed(c).unwrap(), steps)
+    })
+}
+
+fn assert_same(a: &End, b: &End, what: &str) {
+    assert!(a.snap == b.snap, "{what}: particles differ");
+    assert!(a.forces == b.forces, "{what}: forces differ");
+    // Bitwise, NaN (the temperature of a type with no particles) included.
+    let (ta, tb) = (format!("{:?}", a.thermo), format!("{:?}", b.thermo));
+    assert_eq!(ta, tb, "{what}: thermo differs");
+}
+
+#[test]
+fn a_decomposed_suspension_is_bitwise_the_single_rank_run() {
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let setup = suspension(mode);
+        // 200 steps at dt 0.005: the lists are rebuilt (and particles migrate) a few times.
+        let one = serial(&setup, 200);
+        assert!(one.snap.typeid.iter().filter(|&&t| t == 1).count() > 5);
+        for ranks in [2, 3, 4] {
+            let ends = decomposed(&setup, ranks, 200);
+            let n = one.snap.len();
+            for (r, e) in ends.iter().enumerate() {
+                assert_same(&one, e, &format!("{mode:?}, rank {r} of {ranks}"));
+                assert!(e.owned.1 < n, "{mode:?}: {:?}", e.owned);
+            }
+        }
+    }
+}
+
+#[test]
+fn water_is_bitwise_the_single_rank_run_with_lists_and_with_cells() {
+    // At dt 0.04 the lists are rebuilt every few steps (each rebuild migrates particles and
+    // fetches new ghosts), and with cells every step sorts. The box has 5 layers of cells
+    // with lists (1.4 wide) and 7 with cells: on 3 ranks some own one layer, others two.
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let mut setup = water(7.0);
+        setup.params.neighbors = mode;
+        let one = serial(&setup, 100);
+        for ranks in [2, 3] {
+            for (r, e) in decomposed(&setup, ranks, 100).iter().enumerate() {
+                assert_same(&one, e, &format!("water, {mode:?}, rank {r} of {ranks}"));
+                assert!(e.owned.0 < e.owned.1, "{mode:?}: {:?}", e.owned);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_checkpoint_continues_bitwise_on_another_number_of_ranks() {
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let setup = suspension(mode);
+        // Checkpoint at step 100 of a run on 2 ranks, synchronised every 50 steps.
+        let (snap, forces) = on_ranks(2, |c| {
+            let mut sim = setup.build_decomposed(c).unwrap();
+            sim.set_sync_every(50);
+            sim.run(100).unwrap();
+            (sim.snapshot(), sim.forces())
+        })
+        .remove(0);
+        // The uninterrupted run, on one rank.
+        let mut a = setup.build().unwrap();
+        a.set_sync_every(50);
+        a.run(250).unwrap();
+        for ranks in [1, 3] {
+            let ends = on_ranks(ranks, |c| {
+                let mut b = Dpd::restart_decomposed(
+                    snap.clone(),
+                    &forces,
+                    setup.sbox,
+                    setup.params,
+                    DpdSetup::colloid_types(),
+                    100,
+                    50,
+                    c,
+                )
+                .unwrap();
+                b.run(150).unwrap();
+                b.snapshot()
+            });
+            for b in ends {
+                assert!(
+                    a.snapshot() == b,
+                    "{mode:?}: restart on {ranks} ranks differs"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_rank_stops_with_the_same_error() {
+    // A time step far too large: the first step moves a particle more than half the cut-off.
+    let setup = water(7.0);
+    let mut fast = setup.clone();
+    fast.params.dt = 2.0;
+    let one = fast.build().unwrap().run(5).unwrap_err();
+    let errs = on_ranks(3, |c| fast.build_decomposed(c).unwrap().run(5).unwrap_err());
+    assert!(matches!(one, DpdError::Unstable { .. }), "{one}");
+    for e in errs {
+        assert_eq!(e, one);
+    }
+    // More ranks than layers of cells: refused on every rank, naming the limit.
+    let errs = on_ranks(6, |c| setup.build_decomposed(c).err().unwrap().to_string());
+    for e in errs {
+        assert!(e.contains("6 ranks for 5 layers"), "{e}");
+    }
+}
