@@ -400,10 +400,10 @@ fn quiet_on_closed_pipe() {
 }
 
 /// The error of an interrupted run, with the command that continues it.
-fn continue_hint(e: anyhow::Error) -> anyhow::Error {
+fn continue_hint(e: anyhow::Error, launcher: &str) -> anyhow::Error {
     match e.downcast_ref::<colloidsim_run::Interrupted>() {
         Some(i) => anyhow::anyhow!(
-            "{i}. Continue with: colloidsim run --restart {}",
+            "{i}. Continue with: {launcher}colloidsim run --restart {}",
             shell_word(&i.out.display().to_string())
         ),
         None => e,
@@ -436,7 +436,11 @@ fn run_cli() -> Result<()> {
             overrides,
         } => {
             let ranks = parallel::Ranks::init()?;
-            parallel::single_rank(&ranks, "run")?;
+            if ranks.size() > 1 {
+                let opts = RunOptions { out, seed, force };
+                let sc = path.as_deref().map(|p| (p, &overrides));
+                return run_on_ranks(&ranks, sc, opts, restart, threads, quiet);
+            }
             thread_pool(threads)?;
             let sc = path
                 .as_deref()
@@ -453,7 +457,7 @@ fn run_cli() -> Result<()> {
                 (None, Some(sc)) => colloidsim_run::run(sc, &RunOptions { out, seed, force }, &ctl),
                 (None, None) => unreachable!("clap requires a scenario without --restart"),
             }
-            .map_err(continue_hint)?;
+            .map_err(|e| continue_hint(e, ""))?;
             if !quiet {
                 println!("{}", report.message);
             }
@@ -569,6 +573,43 @@ fn run_cli() -> Result<()> {
             BenchKind::Mpcd(args) => bench_mpcd::bench(&args),
         },
     }
+}
+
+/// `colloidsim run` under `mpirun -n N`: one run decomposed in space over the ranks (only
+/// DPD so far; docs/parallel.md). Every rank reads the scenario and builds its share; rank 0
+/// writes the folder a single-rank run writes.
+fn run_on_ranks(
+    ranks: &parallel::Ranks,
+    scenario_path: Option<(&Path, &Overrides)>,
+    opts: RunOptions,
+    restart: Option<PathBuf>,
+    threads: Option<usize>,
+    quiet: bool,
+) -> Result<()> {
+    let (rank, size) = (ranks.rank(), ranks.size());
+    ranks.agree(thread_pool(threads.or(ranks.default_threads())))?;
+    let sc = ranks.agree(scenario_path.map(|(p, o)| scenario(p, o)).transpose())?;
+    ranks.agree(match (&sc, scenario_path) {
+        (None, Some((_, o))) if !o.set.is_empty() => Err(anyhow::anyhow!(
+            "--set needs the scenario file: colloidsim run SCENARIO --set ... --restart DIR"
+        )),
+        _ => Ok(()),
+    })?;
+    let ctl = control(quiet || rank != 0);
+    let comm = ranks.agree(ranks.exchange())?;
+    let report = match (&restart, &sc) {
+        (Some(dir), _) => {
+            colloidsim_run::resume_decomposed(dir, sc.as_ref(), opts.seed, &ctl, comm)
+        }
+        (None, Some(sc)) => colloidsim_run::run_decomposed(sc, &opts, &ctl, comm),
+        (None, None) => unreachable!("clap requires a scenario without --restart"),
+    }
+    .map_err(|e| continue_hint(e, "mpirun -n N "));
+    let report = ranks.agree(report)?;
+    if rank == 0 && !quiet {
+        println!("{} ({size} MPI ranks)", report.message);
+    }
+    Ok(())
 }
 
 /// `colloidsim ensemble`: every rank plans the same ensemble (and stops alike on bad input),

@@ -7,6 +7,7 @@
 //! non-zero exit. A panic on any rank aborts all of them.
 
 use anyhow::{Result, bail};
+use colloidsim_core::exchange::Exchange;
 
 /// A rank failed and has printed why on stderr; every rank stops without another message.
 #[derive(Debug, thiserror::Error)]
@@ -42,7 +43,8 @@ impl Ranks {
     #[cfg(feature = "mpi")]
     pub fn init() -> Result<Self> {
         use mpi::traits::Communicator;
-        let Some(universe) = mpi::initialize() else {
+        // A decomposed run calls MPI from the thread that steps it, one call at a time.
+        let Some((universe, _)) = mpi::initialize_with_threading(mpi::Threading::Serialized) else {
             bail!("MPI was initialised twice");
         };
         let world = universe.world();
@@ -147,32 +149,36 @@ impl Ranks {
         x
     }
 
+    /// The ranks as a run decomposed in space talks over them.
+    #[cfg(feature = "mpi")]
+    pub fn exchange(&self) -> Result<Box<dyn Exchange>> {
+        let level = mpi::environment::threading_support();
+        if level < mpi::Threading::Serialized {
+            bail!(
+                "this MPI library gives threading level {level:?}; a decomposed run needs at least \
+                 Serialized (MPI_THREAD_SERIALIZED)"
+            );
+        }
+        Ok(Box::new(MpiExchange))
+    }
+
+    #[cfg(not(feature = "mpi"))]
+    pub fn exchange(&self) -> Result<Box<dyn Exchange>> {
+        bail!("this colloidsim was built without MPI")
+    }
+
     /// Every rank's `text`, in rank order, on every rank.
     #[cfg(feature = "mpi")]
     pub fn all_gather(&self, text: &str) -> Vec<String> {
-        use mpi::collective::CommunicatorCollectives;
-        use mpi::datatype::PartitionMut;
-        let bytes = text.as_bytes();
-        let mut counts = vec![0i32; self.size];
-        self.world
-            .all_gather_into(&(bytes.len() as i32), &mut counts[..]);
-        let displs: Vec<i32> = counts
+        let mut buf = Vec::new();
+        let counts = all_gather_varcount(text.as_bytes(), &mut buf);
+        let mut start = 0;
+        counts
             .iter()
-            .scan(0, |acc, &c| {
-                let d = *acc;
-                *acc += c;
-                Some(d)
-            })
-            .collect();
-        let mut buf = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
-        {
-            let mut part = PartitionMut::new(&mut buf[..], &counts[..], &displs[..]);
-            self.world.all_gather_varcount_into(bytes, &mut part);
-        }
-        (0..self.size)
-            .map(|r| {
-                let (d, c) = (displs[r] as usize, counts[r] as usize);
-                String::from_utf8_lossy(&buf[d..d + c]).into_owned()
+            .map(|&c| {
+                let part = &buf[start..start + c];
+                start += c;
+                String::from_utf8_lossy(part).into_owned()
             })
             .collect()
     }
@@ -183,15 +189,84 @@ impl Ranks {
     }
 }
 
-/// Refuse a command that does not spread over ranks when launched on several.
-pub fn single_rank(ranks: &Ranks, command: &str) -> Result<()> {
-    if ranks.size() > 1 {
-        bail!(
-            "`colloidsim {command}` runs on one rank: the engines are not decomposed over MPI ranks \
-             yet (issue #20); spread replicas and sweeps over ranks with `colloidsim ensemble`"
-        );
+/// Every rank's `mine`, concatenated in rank order, into `all` on every rank; the lengths.
+#[cfg(feature = "mpi")]
+fn all_gather_varcount<T: mpi::datatype::Equivalence + Copy + Default>(
+    mine: &[T],
+    all: &mut Vec<T>,
+) -> Vec<usize> {
+    use mpi::collective::CommunicatorCollectives;
+    use mpi::datatype::PartitionMut;
+    use mpi::traits::Communicator;
+    let world = mpi::topology::SimpleCommunicator::world();
+    let mut counts = vec![0i32; world.size() as usize];
+    world.all_gather_into(&(mine.len() as i32), &mut counts[..]);
+    let displs: Vec<i32> = counts
+        .iter()
+        .scan(0, |acc, &c| {
+            let d = *acc;
+            *acc += c;
+            Some(d)
+        })
+        .collect();
+    all.clear();
+    all.resize(counts.iter().map(|&c| c as usize).sum(), T::default());
+    let mut part = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
+    world.all_gather_varcount_into(mine, &mut part);
+    counts.iter().map(|&c| c as usize).collect()
+}
+
+/// The engines' [`Exchange`] over MPI's world communicator (MPI at level Serialized, checked
+/// in [`Ranks::exchange`]: a run makes its calls one at a time, from whichever thread steps
+/// it). Collectives meet in call order, which every rank shares, so the run's messages never
+/// mix with [`Ranks`]'s.
+#[cfg(feature = "mpi")]
+struct MpiExchange;
+
+#[cfg(feature = "mpi")]
+impl MpiExchange {
+    fn world() -> mpi::topology::SimpleCommunicator {
+        mpi::topology::SimpleCommunicator::world()
     }
-    Ok(())
+}
+
+#[cfg(feature = "mpi")]
+impl Exchange for MpiExchange {
+    fn rank(&self) -> usize {
+        use mpi::traits::Communicator;
+        Self::world().rank() as usize
+    }
+
+    fn size(&self) -> usize {
+        use mpi::traits::Communicator;
+        Self::world().size() as usize
+    }
+
+    fn shift(&self, to: usize, send: &[f64], from: usize, recv: &mut Vec<f64>) {
+        use mpi::point_to_point::send_receive_into;
+        use mpi::traits::Communicator;
+        let world = Self::world();
+        let (dest, source) = (
+            world.process_at_rank(to as i32),
+            world.process_at_rank(from as i32),
+        );
+        // The length first, then the numbers.
+        let mut n = 0u64;
+        send_receive_into(&(send.len() as u64), &dest, &mut n, &source);
+        recv.clear();
+        recv.resize(n as usize, 0.0);
+        send_receive_into(send, &dest, &mut recv[..], &source);
+    }
+
+    fn all_gather(&self, mine: &[f64], all: &mut Vec<f64>) {
+        all_gather_varcount(mine, all);
+    }
+
+    fn abort(&self, message: &str) -> ! {
+        use mpi::traits::Communicator;
+        eprintln!("error: {message}");
+        Self::world().abort(1)
+    }
 }
 
 #[cfg(all(test, not(feature = "mpi")))]
@@ -209,6 +284,5 @@ mod tests {
         let e = r.agree::<()>(Err(anyhow::anyhow!("bad key"))).unwrap_err();
         assert_eq!(e.to_string(), "bad key");
         assert_eq!(r.all_gather("x"), ["x"]);
-        assert!(single_rank(&r, "run").is_ok());
     }
 }

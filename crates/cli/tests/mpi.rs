@@ -1,6 +1,7 @@
 //! `colloidsim` under `mpirun -n 1, 2, 4` (built with `--features mpi`; `.ci/run` runs these
-//! with Open MPI): an ensemble's folder is byte for byte the single-process one on any number
-//! of ranks, and a failure on one rank stops every rank with its message instead of a hang.
+//! with Open MPI): an ensemble's folder, and a DPD run decomposed in space, are byte for byte
+//! the single-process ones on any number of ranks, also when continued on another number of
+//! ranks, and a failure on one rank stops every rank with its message instead of a hang.
 #![cfg(feature = "mpi")]
 
 use std::path::{Path, PathBuf};
@@ -147,7 +148,7 @@ fn a_member_failing_on_one_rank_stops_all_ranks_without_averages() {
 }
 
 #[test]
-fn run_refuses_several_ranks_until_the_engines_are_decomposed() {
+fn run_refuses_several_ranks_for_a_method_not_decomposed() {
     let tmp = tempfile::tempdir().unwrap();
     let sc = tiny(tmp.path());
     let out = tmp.path().join("run");
@@ -156,7 +157,12 @@ fn run_refuses_several_ranks_until_the_engines_are_decomposed() {
         &["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()],
     );
     assert!(!o.status.success());
-    assert!(text(&o).contains("colloidsim ensemble"), "{}", text(&o));
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(
+        t.contains("runs on one rank") && t.contains("colloidsim ensemble"),
+        "{t}"
+    );
     assert!(!out.exists());
     let one = mpirun(
         1,
@@ -169,6 +175,129 @@ fn run_refuses_several_ranks_until_the_engines_are_decomposed() {
         ],
     );
     assert!(one.status.success());
+}
+
+/// DPD colloids (12 colloids in 1382 solvent beads, Verlet lists) for 400 steps, observing
+/// everything: the decomposed runs.
+const TINY_DPD: &str = r#"
+method = "dpd"
+seed = 5
+[system]
+box_length = 8.0
+phi = 0.1
+[run]
+steps = 400
+[observe]
+thermo_every = 20
+trajectory_every = 100
+msd_every = 50
+"#;
+
+/// The DPD scenario in `dir` and its run in one process on one thread into `dir/serial`.
+fn dpd_reference(dir: &Path) -> (String, PathBuf) {
+    let sc = dir.join("dpd.toml");
+    std::fs::write(&sc, TINY_DPD).unwrap();
+    let reference = dir.join("serial");
+    let (s, r) = (sc.to_str().unwrap(), reference.to_str().unwrap());
+    let o = common::cli(&["run", s, "--out", r, "--threads", "1", "--quiet"], &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    (s.to_string(), reference)
+}
+
+#[test]
+fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
+    // The box has 4 layers of cells: on 3 ranks one rank owns two layers.
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = dpd_reference(tmp.path());
+    for ranks in [1, 2, 3, 4] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let o = mpirun(
+            ranks,
+            &["run", &s, "--out", out.to_str().unwrap(), "--threads", "1"],
+        );
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        // One report, from rank 0.
+        assert_eq!(text(&o).matches("wrote ").count(), 1, "{}", text(&o));
+        assert_same_tree(&reference, &out);
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(summary["ranks"], ranks);
+    }
+}
+
+#[test]
+fn a_dpd_run_interrupted_on_2_ranks_continues_on_1_and_4() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = dpd_reference(tmp.path());
+    for ranks in [1, 4] {
+        let out = tmp.path().join(format!("continued-on-{ranks}"));
+        let o = mpirun_env(
+            2,
+            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
+            &[("COLLOIDSIM_INTERRUPT_AT_STEP", "150")],
+        );
+        assert!(!o.status.success());
+        let t = text(&o);
+        assert!(t.contains("mpirun -n N colloidsim run --restart"), "{t}");
+        assert_eq!(t.matches("error:").count(), 1, "{t}");
+        assert!(out.join("checkpoint.bin").exists());
+        let args = ["run", "--restart", out.to_str().unwrap(), "--quiet"];
+        let r = if ranks == 1 {
+            common::cli(&args, &[])
+        } else {
+            mpirun(ranks, &args)
+        };
+        assert!(r.status.success(), "restart on {ranks} ranks: {}", text(&r));
+        assert_same_tree(&reference, &out);
+    }
+}
+
+#[test]
+fn a_failing_decomposed_run_stops_every_rank_with_one_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join("dpd.toml");
+    std::fs::write(&sc, TINY_DPD).unwrap();
+    let s = sc.to_str().unwrap();
+    // Rank 0 alone cannot create the folder (it holds a file): the job ends with its message.
+    let taken = tmp.path().join("taken");
+    std::fs::create_dir_all(&taken).unwrap();
+    std::fs::write(taken.join("notes.txt"), b"mine").unwrap();
+    let o = mpirun(3, &["run", s, "--out", taken.to_str().unwrap(), "--quiet"]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains("already exists"), "{t}");
+    assert_eq!(std::fs::read_dir(&taken).unwrap().count(), 1);
+    // More ranks than layers of cells: refused on every rank, said once.
+    let out = tmp.path().join("many");
+    let o = mpirun(5, &["run", s, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains("5 ranks for 4 layers of cells"), "{t}");
+    assert!(!out.exists());
+    // A time step far too large: every rank stops at the same step, rank 0 writes the outputs
+    // so far and a summary saying so, and the message comes once.
+    let out = tmp.path().join("unstable");
+    let o = mpirun(
+        2,
+        &[
+            "run",
+            s,
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "run.dt=0.3",
+        ],
+    );
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains("reduce run.dt"), "{t}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["completed"], false);
 }
 
 #[test]

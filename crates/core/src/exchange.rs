@@ -19,6 +19,10 @@ pub trait Exchange: Send {
     fn shift(&self, to: usize, send: &[f64], from: usize, recv: &mut Vec<f64>);
     /// Every rank's `mine`, concatenated in rank order, into `all` (on every rank).
     fn all_gather(&self, mine: &[f64], all: &mut Vec<f64>);
+    /// Stop every rank after a failure on this one alone (a file rank 0 could not write),
+    /// which the others cannot learn of at their next message: print `error: message` and
+    /// end the job (`MPI_Abort`; a panic for threads).
+    fn abort(&self, message: &str) -> !;
 }
 
 /// Ranks that are threads of one process, talking over channels: [`LocalRanks::new`] gives one
@@ -66,6 +70,10 @@ impl LocalRanks {
 }
 
 impl Exchange for LocalRanks {
+    fn abort(&self, message: &str) -> ! {
+        panic!("rank {}: {message}", self.rank)
+    }
+
     fn rank(&self) -> usize {
         self.rank
     }

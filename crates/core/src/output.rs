@@ -83,6 +83,12 @@ impl OutputDir {
         Ok(Self { root })
     }
 
+    /// The folder another process writes (rank 0 of a run decomposed over MPI ranks): only its
+    /// path, which nothing here touches.
+    pub fn unwritten(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
     /// Open an existing folder to continue writing into it (restarts).
     pub fn reopen(root: impl Into<PathBuf>) -> Result<Self, OutputError> {
         let root = root.into();

@@ -14,6 +14,7 @@ use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
     pair_distribution, percus_yevick_g, structure_factor_windowed,
 };
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
 use colloidsim_md::dpd::{Dpd, StressAcf, Thermo};
@@ -61,11 +62,16 @@ impl Method for DpdMethod {
     }
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        let (_, s) = resolve(src, seed)?;
-        let (sync_every, _) = periods(s.steps);
-        let mut sim = s.build()?;
-        sim.set_sync_every(sync_every);
-        DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
+        start(src, seed, None)
+    }
+
+    fn start_decomposed(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        start(src, seed, Some(comm))
     }
 
     fn restore(
@@ -75,32 +81,18 @@ impl Method for DpdMethod {
         out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
-        let (_, s) = resolve(src, Some(seed))?;
-        let ck: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
-        if ck.sync_every != periods(s.steps).0 {
-            bail!(
-                "checkpoint: synchronisation period {} does not fit the scenario's {}",
-                ck.sync_every,
-                periods(s.steps).0
-            );
-        }
-        let sim = Dpd::restart(
-            ck.particles,
-            &ck.forces,
-            SimBox::new(ck.box_l),
-            s.params,
-            DpdSetup::colloid_types(),
-            ck.step,
-            ck.sync_every,
-        )?;
-        ck.obs
-            .digest
-            .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &FRAME_LOGS, true)
-            })?;
-        // Restoring builds the lists the interrupted run built at this step: count them once.
-        let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
-        DpdSession::new(s, sim, ck.obs, builds0).map(|d| Box::new(d) as Box<dyn Session>)
+        restore(src, seed, out, envelope, None)
+    }
+
+    fn restore_decomposed(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        restore(src, seed, out, envelope, Some(comm))
     }
 
     fn keys(&self) -> Vec<Key> {
@@ -110,6 +102,67 @@ impl Method for DpdMethod {
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let (_, s) = resolve(src, seed)?;
         Ok(Box::new(DpdEngine { sim: s.build()? }))
+    }
+}
+
+/// A fresh session, decomposed over the ranks of `comm` when given.
+fn start(
+    src: &Source,
+    seed: Option<u64>,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let (_, s) = resolve(src, seed)?;
+    let (sync_every, _) = periods(s.steps);
+    let mut sim = match comm {
+        None => s.build()?,
+        Some(c) => s.build_decomposed(c)?,
+    };
+    sim.set_sync_every(sync_every);
+    DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
+}
+
+/// The session a checkpoint continues (on any number of ranks).
+fn restore(
+    src: &Source,
+    seed: u64,
+    out: &OutputDir,
+    envelope: &Envelope,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let (_, s) = resolve(src, Some(seed))?;
+    let ck: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+    if ck.sync_every != periods(s.steps).0 {
+        bail!(
+            "checkpoint: synchronisation period {} does not fit the scenario's {}",
+            ck.sync_every,
+            periods(s.steps).0
+        );
+    }
+    let (sbox, types) = (SimBox::new(ck.box_l), DpdSetup::colloid_types());
+    let (p, f, step, sync) = (ck.particles, &ck.forces, ck.step, ck.sync_every);
+    let sim = match comm {
+        None => Dpd::restart(p, f, sbox, s.params, types, step, sync)?,
+        Some(c) => Dpd::restart_decomposed(p, f, sbox, s.params, types, step, sync, c)?,
+    };
+    // Only the writer touches the folder.
+    if sim.rank().0 == 0 {
+        ck.obs
+            .digest
+            .restore(&out.join("trajectory.gsd"), |path, frames| {
+                trim_trajectory(path, frames, &FRAME_LOGS, true)
+            })
+            .map_err(|e| fail_alone(&sim, e))?;
+    }
+    // Restoring builds the lists the interrupted run built at this step: count them once.
+    let builds0 = ck.neighbor_builds.saturating_sub(sim.neighbor_builds());
+    DpdSession::new(s, sim, ck.obs, builds0).map(|d| Box::new(d) as Box<dyn Session>)
+}
+
+/// An error on this rank alone: see [`Session::fail_alone`].
+fn fail_alone(sim: &Dpd, e: anyhow::Error) -> anyhow::Error {
+    match sim.exchange() {
+        Some(c) => c.abort(&format!("{e:#}")),
+        None => e,
     }
 }
 
@@ -253,9 +306,8 @@ impl DpdSession {
                 cs.mean_degree,
             ]);
         }
-        if let Some(w) = self.gsd.as_mut()
-            && step.is_multiple_of(o.trajectory_every)
-        {
+        // Every rank of a decomposed run gathers the frame; the writer writes it.
+        if o.trajectory_every > 0 && step.is_multiple_of(o.trajectory_every) {
             let snap = sim.snapshot();
             // What HOOMD-blue's ThermodynamicQuantities compute logs, under its names
             // (FRAME_LOGS). The virial parts exist only for a step taken with them: at step 0
@@ -284,7 +336,10 @@ impl DpdSession {
                 &[potential],
             ];
             let log: Vec<(&str, &[f64])> = FRAME_LOGS.iter().copied().zip(values).collect();
-            w.write_frame_log(step, &sim.sbox, &snap, &log)?;
+            if let Some(w) = self.gsd.as_mut() {
+                w.write_frame_log(step, &sim.sbox, &snap, &log)
+                    .map_err(|e| fail_alone(sim, e.into()))?;
+            }
             obs.frames += 1;
         }
         Ok(())
@@ -323,7 +378,8 @@ impl DpdSession {
         if let Some(log) = self.thermo_log.as_mut()
             && let Some((time, th)) = self.obs.thermo.last().filter(|(_, th)| th.step == next)
         {
-            log.append(&thermo_row(*time, th, self.sim.sbox.volume(), self.s.tau))?;
+            log.append(&thermo_row(*time, th, self.sim.sbox.volume(), self.s.tau))
+                .map_err(|e| fail_alone(&self.sim, e.into()))?;
         }
         let check_every = if o.thermo_every > 0 {
             o.thermo_every
@@ -401,6 +457,12 @@ impl Session for DpdSession {
     }
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
+        if !self.is_writer() {
+            if fresh {
+                self.record()?;
+            }
+            return Ok(());
+        }
         if self.s.observe.thermo_every > 0 {
             let (vol, tau) = (self.sim.sbox.volume(), self.s.tau);
             self.thermo_log = Some(CsvLog::start(
@@ -429,6 +491,23 @@ impl Session for DpdSession {
         Some((self.sim.step / self.checkpoint_every + 1) * self.checkpoint_every)
     }
 
+    fn is_writer(&self) -> bool {
+        self.sim.rank().0 == 0
+    }
+
+    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
+        let Some(c) = self.sim.exchange() else {
+            return (chunk, interrupted);
+        };
+        let mut all = Vec::new();
+        c.all_gather(&[chunk as f64, interrupted as u8 as f64], &mut all);
+        (all[0] as u64, all.chunks_exact(2).any(|r| r[1] != 0.0))
+    }
+
+    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        fail_alone(&self.sim, e)
+    }
+
     /// The engine restarts bitwise only where it rebuilds every list.
     fn stop_point(&self) -> u64 {
         self.sim
@@ -454,10 +533,11 @@ impl Session for DpdSession {
     }
 
     fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
-        if self.s.observe.trajectory_every > 0 {
+        if self.s.observe.trajectory_every > 0 && self.is_writer() {
             self.obs
                 .digest
-                .extend(&out.join("trajectory.gsd"), self.obs.frames)?;
+                .extend(&out.join("trajectory.gsd"), self.obs.frames)
+                .map_err(|e| fail_alone(&self.sim, e))?;
         }
         let ck = Checkpoint {
             sync_every: self.sync_every,
@@ -472,6 +552,9 @@ impl Session for DpdSession {
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        if !self.is_writer() {
+            return Ok(Vec::new());
+        }
         let mut warnings = Vec::new();
         Ok(write_outputs(out, &self.s, &self.sim, &self.obs, &mut warnings)?.0)
     }
@@ -482,6 +565,14 @@ impl Session for DpdSession {
         wall: f64,
         _failure: Option<&str>,
     ) -> Result<Finished> {
+        if !self.is_writer() {
+            return Ok(Finished {
+                summary: json!({}),
+                files: Vec::new(),
+                message: String::new(),
+                warnings: Vec::new(),
+            });
+        }
         let mut warnings = Vec::new();
         let (files, diffusion) = write_outputs(out, &self.s, &self.sim, &self.obs, &mut warnings)?;
         let builds = self.builds0 + self.sim.neighbor_builds();
@@ -1101,6 +1192,7 @@ fn summary(
         "wall_seconds": wall,
         "particle_steps_per_second": n * sim.step as f64 / wall,
         "threads": rayon::current_num_threads(),
+        "ranks": sim.rank().1,
         "neighbor_builds": neighbor_builds,
         "final_temperature": last.as_ref().map(|t| t.temperature),
         "final_temperature_by_type": last.as_ref().map(|t| t.temperature_by_type.clone()),

@@ -6,6 +6,7 @@ use crate::control::Control;
 use crate::method::{self, Session};
 use crate::{Failed, Interrupted, Report, RunOptions, Scenario};
 use anyhow::{Context, Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -62,24 +63,55 @@ fn absolute(p: &Path) -> PathBuf {
 /// Run a scenario from the start. Everything is validated and the engine built before the
 /// output folder is touched, so bad input leaves nothing behind.
 pub fn run(sc: &Scenario, opts: &RunOptions, ctl: &Control) -> Result<Report> {
+    run_with(sc, opts, ctl, None)
+}
+
+/// [`run`] decomposed in space over the ranks of `comm` (docs/parallel.md): every rank calls
+/// it; rank 0 writes the folder, which is the one [`run`] writes.
+pub fn run_decomposed(
+    sc: &Scenario,
+    opts: &RunOptions,
+    ctl: &Control,
+    comm: Box<dyn Exchange>,
+) -> Result<Report> {
+    run_with(sc, opts, ctl, Some(comm))
+}
+
+fn run_with(
+    sc: &Scenario,
+    opts: &RunOptions,
+    ctl: &Control,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Report> {
     let m = method::of(sc)?;
     if let Some(s) = opts.seed {
         crate::seed32(s)?;
     }
-    let mut session = m.start(sc, opts.seed)?;
+    let mut session = match comm {
+        None => m.start(sc, opts.seed)?,
+        Some(c) => m.start_decomposed(sc, opts.seed, c)?,
+    };
     let mut warnings = session.warnings();
     for w in &warnings {
         ctl.progress().warning(w);
     }
     let out_path = opts.out.clone().unwrap_or_else(|| PathBuf::from(sc.name()));
-    let out = OutputDir::create(&out_path, opts.force)?;
-    if opts.force {
-        for w in clear_earlier_outputs(&out, &*session)? {
-            ctl.progress().warning(&w);
-            warnings.push(w);
-        }
-    }
-    out.write_bytes("scenario.toml", sc.text().as_bytes())?;
+    let out = if session.is_writer() {
+        let created = (|| -> Result<OutputDir> {
+            let out = OutputDir::create(&out_path, opts.force)?;
+            if opts.force {
+                for w in clear_earlier_outputs(&out, &*session)? {
+                    ctl.progress().warning(&w);
+                    warnings.push(w);
+                }
+            }
+            out.write_bytes("scenario.toml", sc.text().as_bytes())?;
+            Ok(out)
+        })();
+        created.map_err(|e| session.fail_alone(e))?
+    } else {
+        OutputDir::unwritten(&out_path)
+    };
     let envelope = Envelope {
         method: sc.method()?,
         scenario: sc.text().to_string(),
@@ -90,7 +122,9 @@ pub fn run(sc: &Scenario, opts: &RunOptions, ctl: &Control) -> Result<Report> {
         wall_seconds: 0.0,
         payload: Vec::new(),
     };
-    session.begin(&out, true)?;
+    if let Err(e) = session.begin(&out, true) {
+        return Err(session.fail_alone(e));
+    }
     drive(session, out, envelope, ctl, warnings)
 }
 
@@ -148,6 +182,27 @@ pub fn resume(
     seed: Option<u64>,
     ctl: &Control,
 ) -> Result<Report> {
+    resume_with(dir, sc, seed, ctl, None)
+}
+
+/// [`resume`] decomposed over the ranks of `comm`, however many ranks the interrupted run had.
+pub fn resume_decomposed(
+    dir: &Path,
+    sc: Option<&Scenario>,
+    seed: Option<u64>,
+    ctl: &Control,
+    comm: Box<dyn Exchange>,
+) -> Result<Report> {
+    resume_with(dir, sc, seed, ctl, Some(comm))
+}
+
+fn resume_with(
+    dir: &Path,
+    sc: Option<&Scenario>,
+    seed: Option<u64>,
+    ctl: &Control,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Report> {
     if !dir.is_dir() {
         bail!("--restart {}: no such folder", dir.display());
     }
@@ -197,9 +252,11 @@ pub fn resume(
     }
     let m = method::of(&sc)?;
     let seed = seed.unwrap_or(envelope.seed);
-    let mut session = m
-        .restore(&sc, seed, &out, &envelope)
-        .with_context(|| format!("--restart {}", dir.display()))?;
+    let mut session = match comm {
+        None => m.restore(&sc, seed, &out, &envelope),
+        Some(c) => m.restore_decomposed(&sc, seed, &out, &envelope, c),
+    }
+    .with_context(|| format!("--restart {}", dir.display()))?;
     let now = resolved(&*session)?;
     if now != envelope.resolved {
         bail!(
@@ -220,17 +277,23 @@ pub fn resume(
     for w in &warnings {
         ctl.progress().warning(w);
     }
-    session.begin(&out, false)?;
+    if let Err(e) = session.begin(&out, false) {
+        return Err(session.fail_alone(e));
+    }
     drive(session, out, envelope, ctl, warnings)
 }
 
-/// Write a checkpoint at the session's position.
+/// Write a checkpoint at the session's position (every rank of a decomposed run takes part;
+/// the writer writes).
 fn save(s: &mut dyn Session, out: &OutputDir, env: &mut Envelope, wall: f64) -> Result<()> {
     s.flush()?;
     env.payload = s.save(out)?;
     env.position = s.position();
     env.wall_seconds = wall;
-    out.write_bytes(CHECKPOINT, &checkpoint::encode(env)?)?;
+    if s.is_writer() {
+        let written = checkpoint::encode(env).and_then(|b| Ok(out.write_bytes(CHECKPOINT, &b)?));
+        written.map_err(|e| s.fail_alone(e))?;
+    }
     env.payload = Vec::new();
     s.after_save(out);
     Ok(())
@@ -299,7 +362,13 @@ fn drive(
             if hooks.interrupt == Some(pos) {
                 ctl.interrupt();
             }
-            if !draining && ctl.interrupted() {
+            // The ranks of a decomposed run go on alike: the same chunk, the same interrupt.
+            let interrupted;
+            (chunk, interrupted) = s.agree(chunk, ctl.interrupted());
+            if interrupted && !ctl.interrupted() {
+                ctl.interrupt();
+            }
+            if !draining && interrupted {
                 let stop = s.stop_point();
                 if stop >= total {
                     draining = true;
@@ -357,6 +426,9 @@ fn drive(
     s.flush()?;
     let wall_seconds = wall();
     let position = s.position();
+    // No rank exchanges anything from here on: an error on the writer alone reaches the
+    // command's last agreement like any other.
+    let s_is_writer = s.is_writer();
     let fin = s.finish(&out, wall_seconds, failure.as_deref())?;
     for w in &fin.warnings {
         ctl.progress().warning(w);
@@ -370,9 +442,11 @@ fn drive(
         m.insert("error".into(), json!(failure));
         m.insert("files".into(), json!(files));
     }
-    out.write_json("summary.json", &summary)?;
-    // The run is over: its checkpoint is no longer needed (a restart now refuses).
-    let _ = std::fs::remove_file(out.join(CHECKPOINT));
+    if s_is_writer {
+        out.write_json("summary.json", &summary)?;
+        // The run is over: its checkpoint is no longer needed (a restart now refuses).
+        let _ = std::fs::remove_file(out.join(CHECKPOINT));
+    }
     if let Some(message) = failure {
         return Err(Failed {
             message,

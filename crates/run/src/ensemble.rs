@@ -592,7 +592,7 @@ pub(crate) fn write_pooled(dir: &OutputDir, name: &str, p: &Pooled) -> Result<()
 
 /// Whether a summary key is about the run rather than the physics: timings and thread counts.
 pub fn is_timing(key: &str) -> bool {
-    key == "threads" || key.ends_with("seconds") || key.ends_with("_per_second")
+    key == "threads" || key == "ranks" || key.ends_with("seconds") || key.ends_with("_per_second")
 }
 
 /// Every number in a summary outside its bookkeeping (`parameters`, `seed`, timings

@@ -29,7 +29,7 @@ mod theory_droplet;
 pub mod two_body;
 
 pub use control::{Control, Progress, Silent};
-pub use driver::{resume, run};
+pub use driver::{resume, resume_decomposed, run, run_decomposed};
 pub use engine::Engine;
 pub use ensemble::{EnsembleOptions, ensemble, resume_ensemble};
 pub use extrapolate::{ExtrapolateOptions, extrapolate};

@@ -10,6 +10,7 @@ use crate::control::Control;
 use crate::keys::Key;
 use crate::{Report, TheoryOptions};
 use anyhow::{Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 
 /// The outcome of `check`: the resolved parameters and any warnings.
@@ -56,6 +57,28 @@ pub trait Method: Sync {
         out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>>;
+    /// A fresh session decomposed in space over the ranks of `comm` (docs/parallel.md): every
+    /// rank calls this and then drives its session in step; rank 0 writes.
+    fn start_decomposed(
+        &self,
+        sc: &Scenario,
+        _seed: Option<u64>,
+        _comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        bail!(not_decomposed(sc, self.names()[0]))
+    }
+    /// [`Self::restore`] decomposed over the ranks of `comm`, which need not be as many as
+    /// the interrupted run's.
+    fn restore_decomposed(
+        &self,
+        sc: &Scenario,
+        _seed: u64,
+        _out: &OutputDir,
+        _envelope: &Envelope,
+        _comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        bail!(not_decomposed(sc, self.names()[0]))
+    }
     /// Does `colloidsim theory` apply?
     fn has_theory(&self) -> bool {
         false
@@ -124,6 +147,21 @@ pub trait Session: Send {
     fn interim_outputs(&mut self, _out: &OutputDir) -> Result<Vec<String>> {
         Ok(Vec::new())
     }
+    /// Whether this rank writes the outputs (rank 0 of a decomposed run; always otherwise).
+    fn is_writer(&self) -> bool {
+        true
+    }
+    /// Decomposed runs: every rank's chunk of positions and whether it saw an interrupt,
+    /// combined so that all ranks go on alike (rank 0's chunk; interrupted if any rank was).
+    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
+        (chunk, interrupted)
+    }
+    /// An error on this rank alone (a file the writer could not write): returned as it is on
+    /// one rank; in a decomposed run, where the other ranks cannot learn of it, printed and the
+    /// job ended on every rank.
+    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        e
+    }
     /// Write every output; `failure` says why the run stopped early.
     fn finish(
         self: Box<Self>,
@@ -134,6 +172,15 @@ pub trait Session: Send {
 }
 
 pub use crate::scenario::Scenario;
+
+/// Why `colloidsim run` under `mpirun -n N` refuses a method.
+fn not_decomposed(sc: &Scenario, method: &str) -> String {
+    format!(
+        "{}: method '{method}' runs on one rank: only 'dpd' is decomposed over MPI ranks so far \
+         (docs/parallel.md); spread replicas and sweeps over ranks with `colloidsim ensemble`",
+        sc.label()
+    )
+}
 
 /// Every method, in the order `--help` lists them. New methods register here.
 static METHODS: &[&dyn Method] = &[

@@ -683,6 +683,12 @@ impl Dpd {
         self.n_total == 0
     }
 
+    /// The ranks of a decomposed run (`None`: not decomposed), for the collective steps of a
+    /// run path around the engine.
+    pub fn exchange(&self) -> Option<&dyn Exchange> {
+        self.domain.as_ref().map(|d| &*d.comm)
+    }
+
     /// Number of particles this rank integrates (all without a decomposition).
     pub fn owned(&self) -> usize {
         self.own.1 - self.own.0
