@@ -59,6 +59,21 @@ pub struct BenchArgs {
     /// folder, removed at the end).
     #[arg(long)]
     pub keep: Option<PathBuf>,
+    /// MPI rank counts to measure DPD water on (strong and weak scaling, LAMMPS beside it on
+    /// the same ranks; docs/parallel.md): launches `mpirun -n R` of this executable, which must
+    /// be built with `--features mpi`. The first `--threads` value is the threads per rank.
+    #[arg(long, value_delimiter = ',')]
+    pub ranks: Vec<usize>,
+    /// Open MPI's `mpirun` for `--ranks`.
+    #[arg(long, default_value = "mpirun")]
+    pub mpirun: PathBuf,
+    /// The `mpirun` of LAMMPS's MPI (default: the one beside the LAMMPS executable, else
+    /// `mpirun`).
+    #[arg(long)]
+    pub lammps_mpirun: Option<PathBuf>,
+    /// Internal: run as one of the `mpirun` workers of `--ranks` on this saved state.
+    #[arg(long, hide = true)]
+    pub worker_state: Option<PathBuf>,
 }
 
 /// One row of the table: the medians of `repeats` runs of one code at one skin.
@@ -166,6 +181,12 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
 
 /// `colloidsim bench dpd`.
 pub fn bench(a: &BenchArgs) -> Result<()> {
+    if let Some(state) = &a.worker_state {
+        return crate::bench_dpd_ranks::worker(a, state);
+    }
+    if !a.ranks.is_empty() {
+        return crate::bench_dpd_ranks::bench(a);
+    }
     if a.colloids {
         return bench_colloids(a);
     }
@@ -262,7 +283,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
         }
         if lammps_ok {
-            match measure_lammps(a, &dir, skin, n, repeats)? {
+            match measure_lammps(a, &dir, "relaxed.data", skin, n, repeats, None)? {
                 Some(row) => {
                     row.print(a.steps);
                     rows.push(row);
@@ -387,16 +408,34 @@ fn measure_ours(
     })
 }
 
-/// `repeats` LAMMPS runs (one MPI rank) from the relaxed state; `None` if LAMMPS cannot be run.
+/// The median, min and max rate of LAMMPS on `ranks` MPI ranks (launched by
+/// [`crate::bench_dpd_ranks::lammps_mpirun`]) from the state in `dir/data` of `n` beads;
+/// `None` if LAMMPS cannot be run.
+pub fn lammps_rates(
+    a: &BenchArgs,
+    dir: &Path,
+    data: &str,
+    skin: f64,
+    n: usize,
+    ranks: usize,
+) -> Result<Option<(f64, f64, f64)>> {
+    let row = measure_lammps(a, dir, data, skin, n, a.repeats.max(1), Some(ranks))?;
+    Ok(row.map(|r| r.rate))
+}
+
+/// `repeats` LAMMPS runs from the relaxed state in `dir/data`: the executable itself (one
+/// rank), or under `mpirun -n R`; `None` if LAMMPS cannot be run.
 fn measure_lammps(
     a: &BenchArgs,
     dir: &Path,
+    data: &str,
     skin: f64,
     n: usize,
     repeats: usize,
+    ranks: Option<usize>,
 ) -> Result<Option<Row>> {
     let input = format!(
-        "units lj\natom_style atomic\nboundary p p p\ncomm_modify vel yes\nread_data relaxed.data\n\
+        "units lj\natom_style atomic\nboundary p p p\ncomm_modify vel yes\nread_data {data}\n\
          pair_style dpd 1.0 1.0 {seed}\npair_coeff * * 25.0 4.5 1.0\n\
          neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
          fix 1 all nve\ntimestep {dt}\nthermo_style custom step temp press\nthermo {steps}\n\
@@ -405,13 +444,21 @@ fn measure_lammps(
         dt = a.dt,
         steps = a.steps
     );
-    let name = format!("in.dpd-skin{skin}");
+    let name = format!("in.dpd-{data}-skin{skin}");
     std::fs::write(dir.join(&name), input)?;
-    let screen = format!("lammps-skin{skin}.out");
+    let screen = format!("lammps-{data}-skin{skin}.out");
     let (mut rates, mut cpu_rates, mut builds) = (Vec::new(), Vec::new(), Vec::new());
     let mut t_end = f64::NAN;
     for _ in 0..repeats {
-        let out = std::process::Command::new(&a.lammps)
+        let mut cmd = match ranks {
+            None => std::process::Command::new(&a.lammps),
+            Some(r) => {
+                let mut c = std::process::Command::new(crate::bench_dpd_ranks::lammps_mpirun(a));
+                c.args(["-n", &r.to_string()]).arg(&a.lammps);
+                c
+            }
+        };
+        let out = cmd
             .args(["-in", &name, "-log", "none", "-screen", &screen])
             .env("OMP_NUM_THREADS", "1")
             .current_dir(dir)

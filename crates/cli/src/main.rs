@@ -3,6 +3,7 @@
 
 mod bench_bcd;
 mod bench_bd;
+mod bench_dpd_ranks;
 mod bench_mc;
 mod bench_mpcd;
 mod common;

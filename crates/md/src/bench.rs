@@ -86,19 +86,30 @@ pub fn wca_periodic_rpy(
 /// `stream(seed, 0, Purpose::Initial, _)`; `seed` also seeds the pair noise. The system of
 /// `colloidsim bench dpd`.
 pub fn dpd_water(l: f64, density: f64, dt: f64, seed: u32, skin: f64) -> Result<Dpd, DpdError> {
-    if !(l.is_finite() && l > 0.0 && density.is_finite() && density > 0.0) {
+    dpd_water_box([l; 3], density, dt, seed, skin)
+}
+
+/// [`dpd_water`] in a box of edges `l` (the same start as the cube when the edges are equal).
+pub fn dpd_water_box(
+    l: [f64; 3],
+    density: f64,
+    dt: f64,
+    seed: u32,
+    skin: f64,
+) -> Result<Dpd, DpdError> {
+    if !(l.iter().all(|x| x.is_finite() && *x > 0.0) && density.is_finite() && density > 0.0) {
         return Err(DpdError::Invalid(format!(
-            "box edge {l} and density {density} must be > 0"
+            "box edges {l:?} and density {density} must be > 0"
         )));
     }
-    let n = (density * l.powi(3)).round() as usize;
+    let n = (density * l[0] * l[1] * l[2]).round() as usize;
     let mut rng = stream(seed, 0, Purpose::Initial, 0);
     let pos: Vec<[f64; 3]> = (0..n)
         .map(|_| {
             [
-                (rng.random::<f64>() - 0.5) * l,
-                (rng.random::<f64>() - 0.5) * l,
-                (rng.random::<f64>() - 0.5) * l,
+                (rng.random::<f64>() - 0.5) * l[0],
+                (rng.random::<f64>() - 0.5) * l[1],
+                (rng.random::<f64>() - 0.5) * l[2],
             ]
         })
         .collect();
@@ -134,7 +145,7 @@ pub fn dpd_water(l: f64, density: f64, dt: f64, seed: u32, skin: f64) -> Result<
     let mut params = DpdParams::water(dt, seed);
     params.kt = kt;
     params.skin = skin;
-    Dpd::new(particles, SimBox::cube(l), params, vec![false], 0)
+    Dpd::new(particles, SimBox::new(l), params, vec![false], 0)
 }
 
 #[cfg(test)]

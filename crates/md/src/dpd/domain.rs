@@ -37,6 +37,10 @@ pub(super) struct Domain {
     send_left: Vec<f64>,
     send_right: Vec<f64>,
     recv: Vec<f64>,
+    /// Particles that would have to skip a rank (an error, reported after the exchange).
+    lost: Vec<f64>,
+    /// The layer of each owned slot during a migration.
+    layer: Vec<u32>,
     /// All-gather results.
     pub gathered: Vec<f64>,
     /// This rank's part of an all-gather.
@@ -63,6 +67,8 @@ impl Domain {
             send_left: Vec::new(),
             send_right: Vec::new(),
             recv: Vec::new(),
+            lost: Vec::new(),
+            layer: Vec::new(),
             gathered: Vec::new(),
             mine: Vec::new(),
         })
@@ -197,14 +203,24 @@ impl Dpd {
         let (left, right) = (d.left(), d.right());
         d.send_left.clear();
         d.send_right.clear();
-        let mut w = 0;
+        // Drop the ghosts, which lie before or after the owned slots: move the owned slots at
+        // the end into the ghosts' place (the order does not matter: a sort follows).
         let (o0, o1) = self.own;
+        let n_own = o1 - o0;
+        for k in 0..o0.min(n_own) {
+            self.move_slot(o1 - 1 - k, k);
+        }
+        self.truncate_slots(n_own);
+        // Leavers go to the neighbours; the last slot fills the hole.
         let mut lost = None;
-        for i in o0..o1 {
+        let mut n = n_own;
+        let mut i = 0;
+        d.layer.clear();
+        while i < n {
             let z = self.layer_of(&self.pos[i], d.nz);
             if d.owns(z) {
-                self.move_slot(i, w);
-                w += 1;
+                d.layer.push(z as u32);
+                i += 1;
                 continue;
             }
             let to = d.owner(z);
@@ -213,16 +229,21 @@ impl Dpd {
             } else if to == left {
                 &mut d.send_left
             } else {
-                lost.get_or_insert((self.key[i] & !COLLOID_BIT, z));
-                continue;
+                &mut d.lost
             };
+            if to != right && to != left {
+                lost.get_or_insert(self.key[i] & !COLLOID_BIT);
+            }
             let (x, v, im) = (self.pos[i], self.vel[i], self.image[i]);
             buf.push(self.key[i] as f64);
             buf.extend_from_slice(&x);
             buf.extend_from_slice(&v);
             buf.extend(im.iter().map(|&k| k as f64));
+            n -= 1;
+            self.move_slot(n, i);
         }
-        self.truncate_slots(w);
+        self.truncate_slots(n);
+        d.lost.clear();
         // With two ranks left and right are one rank, and everything went right.
         d.comm.shift(right, &d.send_right, left, &mut d.recv);
         self.take_migrants(&d.recv);
@@ -232,10 +253,14 @@ impl Dpd {
         }
         let n_own = self.pos.len();
         self.own = (0, n_own);
+        for i in d.layer.len()..n_own {
+            let z = self.layer_of(&self.pos[i], d.nz);
+            d.layer.push(z as u32);
+        }
         // Ghosts: this rank's first layer goes left (it is the left rank's ghost layer).
         d.send_left.clear();
-        for i in 0..n_own {
-            if self.layer_of(&self.pos[i], d.nz) == d.z0 {
+        for (i, &z) in d.layer.iter().enumerate() {
+            if z as usize == d.z0 {
                 d.send_left.push(self.key[i] as f64);
                 d.send_left.extend_from_slice(&self.pos[i]);
                 d.send_left.extend_from_slice(&self.vel[i]);
@@ -252,7 +277,7 @@ impl Dpd {
             );
         }
         // Every rank went through the same exchanges; now they agree on whether one failed.
-        let bad = d.agree_min(lost.map_or(u32::MAX, |(t, _)| t));
+        let bad = d.agree_min(lost.unwrap_or(u32::MAX));
         if bad != u32::MAX {
             return Err(DpdError::Invalid(format!(
                 "particle {bad} crossed more than one domain in a step at step {}; reduce run.dt",

