@@ -262,6 +262,25 @@ impl Exchange for MpiExchange {
         all_gather_varcount(mine, all);
     }
 
+    fn all_gather_same(&self, mine: &[f64], all: &mut Vec<f64>) {
+        use mpi::collective::CommunicatorCollectives;
+        let world = Self::world();
+        all.clear();
+        all.resize(mine.len() * self.size(), 0.0);
+        world.all_gather_into(mine, &mut all[..]);
+    }
+
+    fn shift_exact(&self, to: usize, send: &[f64], from: usize, recv: &mut [f64]) {
+        use mpi::point_to_point::send_receive_into;
+        use mpi::traits::Communicator;
+        let world = Self::world();
+        let (dest, source) = (
+            world.process_at_rank(to as i32),
+            world.process_at_rank(from as i32),
+        );
+        send_receive_into(send, &dest, recv, &source);
+    }
+
     fn abort(&self, message: &str) -> ! {
         use mpi::traits::Communicator;
         eprintln!("error: {message}");

@@ -19,6 +19,22 @@ pub trait Exchange: Send {
     fn shift(&self, to: usize, send: &[f64], from: usize, recv: &mut Vec<f64>);
     /// Every rank's `mine`, concatenated in rank order, into `all` (on every rank).
     fn all_gather(&self, mine: &[f64], all: &mut Vec<f64>);
+    /// [`Self::all_gather`] when every rank sends as many numbers (one message fewer).
+    fn all_gather_same(&self, mine: &[f64], all: &mut Vec<f64>) {
+        self.all_gather(mine, all);
+    }
+    /// [`Self::shift`] when the receiver knows the length: into `recv`, which must be as long
+    /// as the message (one message fewer).
+    fn shift_exact(&self, to: usize, send: &[f64], from: usize, recv: &mut [f64]) {
+        let mut m = Vec::with_capacity(recv.len());
+        self.shift(to, send, from, &mut m);
+        assert_eq!(
+            m.len(),
+            recv.len(),
+            "shift_exact: message of another length"
+        );
+        recv.copy_from_slice(&m);
+    }
     /// Stop every rank after a failure on this one alone (a file rank 0 could not write),
     /// which the others cannot learn of at their next message: print `error: message` and
     /// end the job (`MPI_Abort`; a panic for threads).

@@ -109,7 +109,7 @@ impl Domain {
     pub fn agree_max(&mut self, value: f64, tag: f64, other: f64, bad: f64) -> [f64; 4] {
         self.mine.clear();
         self.mine.extend_from_slice(&[value, tag, other, bad]);
-        self.comm.all_gather(&self.mine, &mut self.gathered);
+        self.comm.all_gather_same(&self.mine, &mut self.gathered);
         let mut out = [f64::NEG_INFINITY, -1.0, f64::NEG_INFINITY, -1.0];
         for g in self.gathered.chunks_exact(4) {
             // NaN never wins, as in the single-rank reduction; an infinity does.
@@ -135,7 +135,7 @@ impl Domain {
     pub fn agree_min(&mut self, x: u32) -> u32 {
         self.mine.clear();
         self.mine.push(x as f64);
-        self.comm.all_gather(&self.mine, &mut self.gathered);
+        self.comm.all_gather_same(&self.mine, &mut self.gathered);
         self.gathered.iter().fold(u32::MAX, |m, &g| m.min(g as u32))
     }
 }
@@ -322,13 +322,9 @@ impl Dpd {
             d.send_left.extend_from_slice(&self.vel[i]);
         }
         let (left, right) = (d.left(), d.right());
-        d.comm.shift(left, &d.send_left, right, &mut d.recv);
         let g = &self.slabs[d.ghost_layer()];
-        assert_eq!(
-            d.recv.len(),
-            6 * (g.end - g.start),
-            "ghost layer changed between sorts"
-        );
+        d.recv.resize(6 * (g.end - g.start), 0.0);
+        d.comm.shift_exact(left, &d.send_left, right, &mut d.recv);
         for (k, m) in d.recv.chunks_exact(6).enumerate() {
             self.pos[g.start + k] = [m[0], m[1], m[2]];
             self.vel[g.start + k] = [m[3], m[4], m[5]];
@@ -346,9 +342,9 @@ impl Dpd {
             d.send_right.extend_from_slice(f);
         }
         let (left, right) = (d.left(), d.right());
-        d.comm.shift(right, &d.send_right, left, &mut d.recv);
         let h = &mut self.slabs[d.before_layer()].halo;
-        assert_eq!(d.recv.len(), 3 * h.len(), "halo of the first layer");
+        d.recv.resize(3 * h.len(), 0.0);
+        d.comm.shift_exact(right, &d.send_right, left, &mut d.recv);
         for (f, m) in h.iter_mut().zip(d.recv.chunks_exact(3)) {
             *f = [m[0], m[1], m[2]];
         }
