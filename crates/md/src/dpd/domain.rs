@@ -394,20 +394,23 @@ impl Dpd {
     ) {
         let nz = self.slabs.len();
         let (z0, z1) = self.domain.as_ref().map_or((0, nz), |d| (d.z0, d.z1));
-        let mut mine = vec![0.0; width * (z1 - z0)];
+        // Buffers kept between calls: the pressure is summed every step of a viscosity run.
+        let mut guard = self.layer_sums.borrow_mut();
+        let (mine, all) = &mut *guard;
+        mine.clear();
+        mine.resize(width * (z1 - z0), 0.0);
         for (z, r) in (z0..z1).zip(mine.chunks_exact_mut(width)) {
             record(z, r);
         }
-        let all = match &self.domain {
-            None => mine,
+        let rows = match &self.domain {
+            None => &*mine,
             Some(d) => {
-                let mut all = Vec::new();
-                d.comm.all_gather(&mine, &mut all);
-                all
+                d.comm.all_gather(mine, all);
+                &*all
             }
         };
         total.iter_mut().for_each(|t| *t = 0.0);
-        for r in all.chunks_exact(width) {
+        for r in rows.chunks_exact(width) {
             for (t, x) in total.iter_mut().zip(r) {
                 *t += x;
             }

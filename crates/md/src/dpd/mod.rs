@@ -344,6 +344,8 @@ pub struct Dpd {
     own: (usize, usize),
     /// This rank's layers when the run is decomposed over ranks.
     domain: Option<Domain>,
+    /// Per-layer sums of this rank and of all ranks (buffers of [`Self::sum_layers`]).
+    layer_sums: std::cell::RefCell<(Vec<f64>, Vec<f64>)>,
     /// Range of the cells: interaction range, plus the skin in Verlet mode.
     cell_range: f64,
     builds: u64,
@@ -560,6 +562,7 @@ impl Dpd {
             n_total: n,
             own: (0, n),
             domain: None,
+            layer_sums: Default::default(),
             cell_range,
             builds: 0,
             scratch3: Vec::new(),
