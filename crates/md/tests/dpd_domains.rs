@@ -135,7 +135,7 @@ fn a_checkpoint_continues_bitwise_on_another_number_of_ranks() {
         a.run(250).unwrap();
         for ranks in [1, 3] {
             let ends = on_ranks(ranks, |c| {
-                let mut b = Dpd::restart_decomposed(
+                let mut b = Dpd::restart_on(
                     snap.clone(),
                     &forces,
                     setup.sbox,
@@ -143,7 +143,7 @@ fn a_checkpoint_continues_bitwise_on_another_number_of_ranks() {
                     DpdSetup::colloid_types(),
                     100,
                     50,
-                    c,
+                    Some(c),
                 )
                 .unwrap();
                 b.run(150).unwrap();

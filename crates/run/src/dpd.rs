@@ -140,10 +140,7 @@ fn restore(
     }
     let (sbox, types) = (SimBox::new(ck.box_l), DpdSetup::colloid_types());
     let (p, f, step, sync) = (ck.particles, &ck.forces, ck.step, ck.sync_every);
-    let sim = match comm {
-        None => Dpd::restart(p, f, sbox, s.params, types, step, sync)?,
-        Some(c) => Dpd::restart_decomposed(p, f, sbox, s.params, types, step, sync, c)?,
-    };
+    let sim = Dpd::restart_on(p, f, sbox, s.params, types, step, sync, comm)?;
     // Only the writer touches the folder.
     if sim.rank().0 == 0 {
         ck.obs

@@ -601,39 +601,16 @@ impl Dpd {
         sync_every: u64,
     ) -> Result<Self, DpdError> {
         let types = is_colloid_type;
-        Self::restart_in(
+        Self::restart_on(
             particles, forces, sbox, params, types, step, sync_every, None,
         )
     }
 
-    /// [`Self::restart`] decomposed over ranks as in [`Self::decomposed`]: a checkpoint of a
-    /// run on any number of ranks continues on any other, bitwise.
+    /// [`Self::restart`], decomposed over the ranks of `comm` when given (as in
+    /// [`Self::decomposed`]): a checkpoint of a run on any number of ranks continues on any
+    /// other, bitwise.
     #[allow(clippy::too_many_arguments)]
-    pub fn restart_decomposed(
-        particles: Particles,
-        forces: &[[f64; 3]],
-        sbox: SimBox,
-        params: DpdParams,
-        is_colloid_type: Vec<bool>,
-        step: u64,
-        sync_every: u64,
-        comm: Box<dyn Exchange>,
-    ) -> Result<Self, DpdError> {
-        let types = is_colloid_type;
-        Self::restart_in(
-            particles,
-            forces,
-            sbox,
-            params,
-            types,
-            step,
-            sync_every,
-            Some(comm),
-        )
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn restart_in(
+    pub fn restart_on(
         particles: Particles,
         forces: &[[f64; 3]],
         sbox: SimBox,

@@ -919,28 +919,21 @@ impl DpdSetup {
     /// The engine on given particles (types `"S"`, `"C"`) at `step`, after checking colloid
     /// overlaps.
     pub fn build_from(&self, p: Particles, step: u64) -> Result<Dpd, DpdError> {
-        check_overlaps(
-            &p,
-            &self.sbox,
-            &Self::colloid_types(),
-            self.params.colloid.contact_range,
-        )?;
-        Dpd::new(p, self.sbox, self.params, Self::colloid_types(), step)
+        self.build_on(p, step, None)
     }
 
     /// [`Self::build`] decomposed over the ranks of `comm` ([`Dpd::decomposed`]): every rank
     /// generates the same start and keeps its layers.
     pub fn build_decomposed(&self, comm: Box<dyn Exchange>) -> Result<Dpd, DpdError> {
         let p = self.initial_particles()?;
-        self.build_decomposed_from(p, 0, comm)
+        self.build_on(p, 0, Some(comm))
     }
 
-    /// [`Self::build_from`] decomposed over the ranks of `comm`.
-    pub fn build_decomposed_from(
+    fn build_on(
         &self,
         p: Particles,
         step: u64,
-        comm: Box<dyn Exchange>,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Dpd, DpdError> {
         check_overlaps(
             &p,
@@ -948,8 +941,11 @@ impl DpdSetup {
             &Self::colloid_types(),
             self.params.colloid.contact_range,
         )?;
-        let types = Self::colloid_types();
-        Dpd::decomposed(p, self.sbox, self.params, types, step, comm)
+        let (sbox, params, types) = (self.sbox, self.params, Self::colloid_types());
+        match comm {
+            None => Dpd::new(p, sbox, params, types, step),
+            Some(c) => Dpd::decomposed(p, sbox, params, types, step, c),
+        }
     }
 }
 
