@@ -206,14 +206,24 @@ fn dpd_reference(dir: &Path) -> (String, PathBuf) {
 
 #[test]
 fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
-    // The box has 4 layers of cells: on 3 ranks one rank owns two layers.
+    // The box has 4 layers of cells: on 3 ranks one rank owns two layers. The reference ran
+    // on one thread.
     let tmp = tempfile::tempdir().unwrap();
     let (s, reference) = dpd_reference(tmp.path());
     for ranks in [1, 2, 3, 4] {
         let out = tmp.path().join(format!("ranks-{ranks}"));
+        // Ranks times threads: two ranks of two threads each.
+        let threads = if ranks == 2 { "2" } else { "1" };
         let o = mpirun(
             ranks,
-            &["run", &s, "--out", out.to_str().unwrap(), "--threads", "1"],
+            &[
+                "run",
+                &s,
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                threads,
+            ],
         );
         assert!(o.status.success(), "mpirun -n {ranks}");
         // One report, from rank 0.
