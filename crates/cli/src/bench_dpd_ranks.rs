@@ -11,6 +11,7 @@
 use crate::common::{load_average, median, write_lammps_data};
 use crate::dpd_bench::BenchArgs;
 use anyhow::{Context, Result, bail};
+use colloidsim_md::dpd::scenario::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdParams};
 use colloidsim_md::{Particles, SimBox};
 use std::path::{Path, PathBuf};
@@ -45,11 +46,17 @@ pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
     let bytes = std::fs::read(state).with_context(|| state.display().to_string())?;
     let (p, l, step): State = bincode::deserialize(&bytes)?;
     let n = p.len();
+    let (params, types) = if a.colloids {
+        let s = crate::dpd_bench::colloid_setup(a)?;
+        (s.params, DpdSetup::colloid_types())
+    } else {
+        (water(a), vec![false])
+    };
     let mut rates = Vec::new();
     for _ in 0..a.repeats.max(1) {
         let comm = ranks.exchange()?;
-        let mut sim =
-            Dpd::decomposed(p.clone(), SimBox::new(l), water(a), vec![false], step, comm)?;
+        let types = types.clone();
+        let mut sim = Dpd::decomposed(p.clone(), SimBox::new(l), params, types, step, comm)?;
         let start = Instant::now();
         sim.run(a.steps)?;
         let wall = start.elapsed().as_secs_f64();
@@ -78,6 +85,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     }
     let threads = a.threads.first().copied().unwrap_or(1);
     let exe = std::env::current_exe()?;
+    if a.colloids {
+        return colloids(a, &exe, threads);
+    }
     let dir = match &a.keep {
         Some(d) => d.clone(),
         None => std::env::temp_dir().join(format!("colloidsim-bench-ranks-{}", std::process::id())),
@@ -209,6 +219,47 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// `--colloids --ranks ...`: strong scaling of the notes' standard colloid system (Verlet
+/// lists, colloids gathered every step; LAMMPS has no such model).
+fn colloids(a: &BenchArgs, exe: &Path, threads: usize) -> Result<()> {
+    let setup = crate::dpd_bench::colloid_setup(a)?;
+    let mut sim = setup.build()?;
+    sim.run(a.warmup).context("warm-up")?;
+    let state: State = (sim.snapshot(), sim.sbox.l, sim.step);
+    let file = std::env::temp_dir().join(format!(
+        "colloidsim-bench-colloids-{}.bin",
+        std::process::id()
+    ));
+    std::fs::write(&file, bincode::serialize(&state)?)?;
+    println!(
+        "# colloidsim bench dpd --colloids --ranks: {} colloids + {} solvent beads (L = {}, phi = 0.2, kT = 0.1, dt = 0.001, Verlet lists), {threads} thread(s) per rank; {} warm-up steps, then {} timed steps per run, median (min-max) of {}",
+        setup.colloids,
+        setup.solvent,
+        a.l,
+        a.warmup,
+        a.steps,
+        a.repeats.max(1)
+    );
+    println!("ranks\tparticle_steps_per_s\tmin\tmax");
+    let mut first = None;
+    for &r in &a.ranks {
+        let rate = match run_worker(a, exe, &file, r, threads) {
+            Ok((x, _)) => x,
+            Err(e) => {
+                let _ = std::fs::remove_file(&file);
+                return Err(e);
+            }
+        };
+        println!("{r}\t{:.4e}\t{:.4e}\t{:.4e}", rate.0, rate.1, rate.2);
+        match first {
+            None => first = Some((r, rate.0)),
+            Some((r0, x0)) => println!("# {r} ranks / {r0}: {:.2}", rate.0 / x0),
+        }
+    }
+    let _ = std::fs::remove_file(&file);
+    Ok(())
+}
+
 /// Environment that lets Open MPI's mpirun run as root (containers) and oversubscribe.
 const OMPI_ENV: [(&str, &str); 3] = [
     ("OMPI_ALLOW_RUN_AS_ROOT", "1"),
@@ -233,6 +284,8 @@ fn run_worker(
         .args(["--steps", &a.steps.to_string()])
         .args(["--repeats", &a.repeats.max(1).to_string()])
         .args(["--dt", &a.dt.to_string(), "--seed", &a.seed.to_string()])
+        .args(["--l", &a.l.to_string()])
+        .args(a.colloids.then_some("--colloids"))
         .envs(OMPI_ENV)
         .output()
         .with_context(|| format!("{} (Open MPI's mpirun; --mpirun)", a.mpirun.display()))?;

@@ -120,14 +120,19 @@ fn load() -> String {
     load_average().map_or("unknown".into(), |[a, b, c]| format!("{a} {b} {c}"))
 }
 
-/// `colloidsim bench dpd --colloids`: the standard colloid system on each thread count, timed
-/// in `repeats` consecutive segments of `steps` after the warm-up.
-fn bench_colloids(a: &BenchArgs) -> Result<()> {
+/// The notes' standard colloid system in a cube of edge `--l` (seed `--seed`).
+pub fn colloid_setup(a: &BenchArgs) -> Result<colloidsim_md::dpd::scenario::DpdSetup> {
     let text = format!(
         "method = \"dpd\"\nseed = {}\n[system]\nbox_length = {}\nphi = 0.2\n[run]\ndt = 0.001\n",
         a.seed, a.l
     );
-    let setup = colloidsim_md::dpd::scenario::DpdScenario::from_toml(&text)?.validate()?;
+    Ok(colloidsim_md::dpd::scenario::DpdScenario::from_toml(&text)?.validate()?)
+}
+
+/// `colloidsim bench dpd --colloids`: the standard colloid system on each thread count, timed
+/// in `repeats` consecutive segments of `steps` after the warm-up.
+fn bench_colloids(a: &BenchArgs) -> Result<()> {
+    let setup = colloid_setup(a)?;
     let n = setup.colloids + setup.solvent;
     println!(
         "# colloidsim bench dpd --colloids: standard system, {} colloids + {} solvent beads (L = {}, phi = 0.2, kT = 0.1, gamma = 4.5, eta0 = 0.3, dt = 0.001, skin {}); {} warm-up steps, then {} segments of {} steps, median (min-max)",
