@@ -298,7 +298,9 @@ const COLLOID_BIT: u32 = 1 << 31;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum NeighborMode {
     /// Cells when the lists would be rebuilt within about three steps (DPD water at dt ~ 0.04),
-    /// Verlet lists otherwise (colloids at dt ~ 0.001).
+    /// Verlet lists otherwise (colloids at dt ~ 0.001). Under shear the lifetime also counts the
+    /// Lees–Edwards offset's drift `gamma_dot L_y dt` a step (eq. LE-4): cells when
+    /// `skin < 3 (2 x fastest step + drift)`.
     #[default]
     Auto,
     /// Verlet lists with a skin, rebuilt when a particle has moved half the skin.
@@ -535,6 +537,12 @@ impl Dpd {
         let cells_mode = match p.neighbors {
             NeighborMode::Cells => true,
             NeighborMode::Verlet => false,
+            // Under shear pairs across the y boundary also move by gamma_dot L_y dt a step
+            // (eq. LE-4: rebuild when 2 max|disp| + offset change > skin).
+            NeighborMode::Auto if p.shear_rate != 0.0 => {
+                let drift = p.shear_rate.abs() * sbox.l[1] * p.dt;
+                p.skin < 3.0 * (2.0 * fast_step + drift)
+            }
             NeighborMode::Auto => 0.5 * p.skin < 3.0 * fast_step,
         };
         let interaction = p.rc.max(max_cs_centre);
