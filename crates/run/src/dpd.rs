@@ -357,13 +357,13 @@ impl DpdSession {
         let thermo_due = o.thermo_every > 0 && next.is_multiple_of(o.thermo_every);
         let frame_due = o.trajectory_every > 0 && next.is_multiple_of(o.trajectory_every);
         let acf = self.obs.stress_acf.as_mut();
-        let mut shear = self.obs.shear.as_mut();
+        let shear = self.obs.shear.as_mut();
         let result = if thermo_due || frame_due {
             self.sim.advance_with_thermo().map(|th| {
                 if let Some(acf) = acf {
                     acf.push(&th.pressure);
                 }
-                if let Some(sh) = shear.as_deref_mut() {
+                if let Some(sh) = shear {
                     sh.push(next, &th.pressure);
                 }
                 if thermo_due {
@@ -380,7 +380,7 @@ impl DpdSession {
                 if let Some(acf) = acf {
                     acf.push(&p);
                 }
-                if let Some(sh) = shear.as_deref_mut() {
+                if let Some(sh) = shear {
                     sh.push(next, &p);
                 }
             })
