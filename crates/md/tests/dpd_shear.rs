@@ -475,14 +475,22 @@ fn check_against_fresh(sim: &Dpd, setup: &DpdSetup) {
 
 #[test]
 fn aged_verlet_lists_under_shear_miss_no_pair() {
-    // DPD water at rate 1 (the offset moves 0.08 a step, the lists are rebuilt every few steps)
-    // and the colloid suspension at rate 1.5, both with Verlet lists.
-    for (mut setup, steps, every) in [
-        (water(8.0, 0.01, 1.0, 3), 200, 7),
-        (suspension(NeighborMode::Verlet, 1.5), 600, 37),
+    // DPD water at rate 3 started at rest (no streaming profile: the fastest particles move
+    // about 0.05 a step while the offset moves 0.24, so only the offset's drift calls for the
+    // first rebuilds), and the colloid suspension at rate 1.5 from its profile, both with Verlet
+    // lists.
+    for (mut setup, at_rest, steps, every) in [
+        (water(8.0, 0.01, 3.0, 3), true, 40, 1),
+        (suspension(NeighborMode::Verlet, 1.5), false, 600, 37),
     ] {
         setup.params.neighbors = NeighborMode::Verlet;
-        let mut sim = setup.build().unwrap();
+        let mut p = setup.initial_particles().unwrap();
+        if at_rest {
+            for (v, x) in p.vel.iter_mut().zip(&p.pos) {
+                v[0] -= setup.params.shear_rate * x[1];
+            }
+        }
+        let mut sim = setup.build_from(p, 0).unwrap();
         assert!(!sim.uses_cells());
         let b0 = sim.neighbor_builds();
         for s in 1..=steps {
