@@ -414,30 +414,6 @@ fn bad_shear_rates_are_refused_with_the_key() {
     setup.params.shear_rate = f64::NAN;
     let e = setup.build().err().expect("refused").to_string();
     assert!(e.contains("shear rate"), "{e}");
-    // A decomposed run refuses shear with a clear message (on every rank).
-    let setup = water(8.0, 0.04, 0.5, 1);
-    let errs: Vec<String> = std::thread::scope(|s| {
-        let handles: Vec<_> = LocalRanks::new(2)
-            .into_iter()
-            .map(|c| {
-                let setup = &setup;
-                s.spawn(move || {
-                    let c: Box<dyn Exchange> = Box::new(c);
-                    setup.build_decomposed(c).err().map(|e| e.to_string())
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap().unwrap())
-            .collect()
-    });
-    for e in errs {
-        assert!(e.contains("not decomposed over ranks"), "{e}");
-    }
-    // One rank is the plain run.
-    let one: Box<dyn Exchange> = Box::new(LocalRanks::new(1).pop().unwrap());
-    assert!(setup.build_decomposed(one).is_ok());
 }
 
 /// The forces a running engine used at its last step against those of a fresh engine (new
@@ -500,5 +476,55 @@ fn aged_verlet_lists_under_shear_miss_no_pair() {
             }
         }
         assert!(sim.neighbor_builds() > b0 + 5);
+    }
+}
+
+/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
+fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
+    let f = &f;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = LocalRanks::new(ranks)
+            .into_iter()
+            .map(|c| s.spawn(move || f(Box::new(c) as Box<dyn Exchange>)))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+/// Particles, forces, the thermo of the last step and the velocity profile after `steps`
+/// steps plus one thermo step.
+fn end_of(sim: &mut Dpd, steps: u64) -> (Particles, Vec<[f64; 3]>, String, Vec<f64>) {
+    sim.run(steps).unwrap();
+    let th = sim.advance_with_thermo().unwrap();
+    let (mut sum, mut count) = (vec![0.0; 8], vec![0.0; 8]);
+    sim.add_velocity_profile(&mut sum, &mut count);
+    sum.extend(count);
+    (sim.snapshot(), sim.forces(), format!("{th:?}"), sum)
+}
+
+#[test]
+fn a_decomposed_shear_run_is_bitwise_the_single_rank_run() {
+    // The suspension (lists and cells) at rate 1.5 and water at dt 0.04 (cells) at rate 0.5:
+    // particles cross the y boundary inside every slab and migrate between ranks along z.
+    let mut cases: Vec<(DpdSetup, u64)> = [NeighborMode::Verlet, NeighborMode::Cells]
+        .into_iter()
+        .map(|m| (suspension(m, 1.5), 800))
+        .collect();
+    cases.push((water(7.0, 0.04, 0.5, 4), 150));
+    for (setup, steps) in &cases {
+        let one = end_of(&mut setup.build().unwrap(), *steps);
+        assert!(one.0.image.iter().any(|i| i[1] != 0));
+        for ranks in [2, 3] {
+            let ends = on_ranks(ranks, |c| {
+                end_of(&mut setup.build_decomposed(c).unwrap(), *steps)
+            });
+            for (r, e) in ends.iter().enumerate() {
+                let what = format!("{:?}, rank {r} of {ranks}", setup.params.neighbors);
+                assert!(one.0 == e.0, "{what}: particles differ");
+                assert!(one.1 == e.1, "{what}: forces differ");
+                assert_eq!(one.2, e.2, "{what}: thermo differs");
+                assert!(one.3 == e.3, "{what}: profile differs");
+            }
+        }
     }
 }

@@ -39,9 +39,10 @@
 //! plus the change of `delta`; the displacement is measured with the Lees–Edwards minimum
 //! image, which follows a particle through the boundary). The DPD thermostat is pair-based and
 //! Galilean invariant, so no profile is imposed on it; the kinetic temperature and the kinetic
-//! stress use the peculiar velocities `v - gamma_dot y e_x` (eq. LE-5). Shear runs are not
-//! decomposed over ranks ([`Dpd::decomposed`] refuses them). With `gamma_dot = 0` every step
-//! takes the code path of the plain box.
+//! stress use the peculiar velocities `v - gamma_dot y e_x` (eq. LE-5). A decomposition over
+//! ranks (z-slabs) is untouched: every owner applies eq. LE-3 to its particles before they
+//! migrate or are copied as ghosts. With `gamma_dot = 0` every step takes the code path of the
+//! plain box.
 
 mod domain;
 pub mod forces;
@@ -479,11 +480,6 @@ impl Dpd {
                 p.shear_rate
             )));
         }
-        if p.shear_rate != 0.0 && comm.as_ref().is_some_and(|c| c.size() > 1) {
-            return Err(DpdError::Invalid(
-                "Lees-Edwards shear (run.shear_rate > 0) is not decomposed over ranks yet: run it on one rank".into(),
-            ));
-        }
         if is_colloid_type.len() != particles.n_types() {
             return Err(DpdError::Invalid(format!(
                 "{} colloid flags for {} types",
@@ -784,21 +780,36 @@ impl Dpd {
         self.params.shear_rate != 0.0
     }
 
-    /// Add the x velocities of this rank's particles into `sum[b]` and their number into
-    /// `count[b]`, `b` the bin of `y` among `sum.len()` equal bins over `[-L_y/2, L_y/2)` (in
-    /// storage order: bitwise independent of the threads). Under shear the mean is the
-    /// streaming profile `gamma_dot y`.
+    /// Add the x velocities of all particles into `sum[b]` and their number into `count[b]`,
+    /// `b` the bin of `y` among `sum.len()` equal bins over `[-L_y/2, L_y/2)` (summed layer by
+    /// layer in storage order, then over the layers in order: bitwise independent of the
+    /// threads and of the ranks; collective in a decomposed run). Under shear the mean is the
+    /// streaming profile `gamma_dot y`. Allocates (a sample, not a step).
     pub fn add_velocity_profile(&self, sum: &mut [f64], count: &mut [f64]) {
         let bins = sum.len().min(count.len());
         if bins == 0 {
             return;
         }
         let ly = self.sbox.l[1];
-        let (a, b) = self.own;
-        for (x, v) in self.pos[a..b].iter().zip(&self.vel[a..b]) {
-            let k = CellSort::cell_coordinate(x[1], ly, bins);
-            sum[k] += v[0];
-            count[k] += 1.0;
+        let mut total = vec![0.0; 2 * bins];
+        self.sum_layers(
+            2 * bins,
+            |z, r| {
+                let s = &self.slabs[z];
+                for (x, v) in self.pos[s.start..s.end]
+                    .iter()
+                    .zip(&self.vel[s.start..s.end])
+                {
+                    let k = CellSort::cell_coordinate(x[1], ly, bins);
+                    r[k] += v[0];
+                    r[bins + k] += 1.0;
+                }
+            },
+            &mut total,
+        );
+        for k in 0..bins {
+            sum[k] += total[k];
+            count[k] += total[bins + k];
         }
     }
 
