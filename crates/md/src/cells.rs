@@ -222,15 +222,45 @@ pub(crate) fn scan_layer(
     sbox: &SimBox,
     range: f64,
     buf: &mut Vec<(u32, [f64; 3])>,
+    f: impl FnMut(usize, &[(u32, [f64; 3])]),
+) {
+    scan_layer_sheared(cz, pos, cell_start, n_cells, sbox, range, None, buf, f)
+}
+
+/// [`scan_layer`] in a Lees–Edwards box when `shear_offset` is `Some(offset)`: the image of the
+/// box above (`y + L_y`) is displaced by `offset` along x. A stencil row that crosses the y
+/// boundary (the `+y` row of the top cell row, the `-y` and `+y` rows of the next z-layer at the
+/// bottom and top) is replaced by the whole x row of cells across the boundary, its members
+/// seen at `x_j +- offset` and `y_j +- L_y`, and their x separation reduced to the nearest image
+/// (as [`SimBox::min_image_sheared`]). The stencil still reaches only the own and the next
+/// z-layer, and every pair is met once (a crossing row is a whole row, not three cells, so the
+/// shifted images of its members are all seen; each member once, as `L_x > 2 range`). With
+/// `None` this is exactly [`scan_layer`]. Needs at least 3 cells along y (the callers' boxes
+/// hold three cells along every axis).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn scan_layer_sheared(
+    cz: usize,
+    pos: &[[f64; 3]],
+    cell_start: &[u32],
+    n_cells: [usize; 3],
+    sbox: &SimBox,
+    range: f64,
+    shear_offset: Option<f64>,
+    buf: &mut Vec<(u32, [f64; 3])>,
     mut f: impl FnMut(usize, &[(u32, [f64; 3])]),
 ) {
     let range2 = range * range;
+    let lx = sbox.l[0];
+    let inv_lx = 1.0 / lx;
     let [nx, ny, nz] = n_cells;
     let l = sbox.l;
     let n = [nx, ny, nz];
     let mut lo = [0usize; 14];
     let mut hi = [0usize; 14];
     let mut shift = [[0.0f64; 3]; 14];
+    // Runs across the sheared y boundary: their x separations are reduced to the nearest image.
+    let mut wrap_x = [false; 14];
     for cy in 0..ny {
         for cx in 0..nx {
             let own = (cz * ny + cy) * nx + cx;
@@ -256,15 +286,35 @@ pub(crate) fn scan_layer(
                         (raw - 1, 0.0)
                     };
                 }
-                let cell = (c[2] * ny + c[1]) * nx + c[0];
-                let (a, b) = (cell_start[cell] as usize, cell_start[cell + 1] as usize);
+                let mut wrap = false;
+                let (a, b) = match shear_offset {
+                    Some(offset) if sh[1] != 0.0 => {
+                        // A row across the y boundary: the whole row once, at its first entry.
+                        if off[0] != 0 {
+                            continue;
+                        }
+                        wrap = true;
+                        sh[0] = if sh[1] > 0.0 { offset } else { -offset };
+                        let row = (c[2] * ny + c[1]) * nx;
+                        (cell_start[row] as usize, cell_start[row + nx] as usize)
+                    }
+                    _ => {
+                        let cell = (c[2] * ny + c[1]) * nx + c[0];
+                        (cell_start[cell] as usize, cell_start[cell + 1] as usize)
+                    }
+                };
                 total += b - a;
-                if runs > 0 && hi[runs - 1] == a && shift[runs - 1] == sh {
+                if runs > 0
+                    && hi[runs - 1] == a
+                    && shift[runs - 1] == sh
+                    && wrap_x[runs - 1] == wrap
+                {
                     hi[runs - 1] = b;
                 } else {
                     lo[runs] = a;
                     hi[runs] = b;
                     shift[runs] = sh;
+                    wrap_x[runs] = wrap;
                     runs += 1;
                 }
             }
@@ -282,10 +332,19 @@ pub(crate) fn scan_layer(
                         xi[1] - shift[s][1],
                         xi[2] - shift[s][2],
                     ];
-                    for (j, q) in pos[first..hi[s]].iter().enumerate() {
-                        let d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
-                        buf[m] = ((first + j) as u32, d);
-                        m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
+                    if wrap_x[s] {
+                        for (j, q) in pos[first..hi[s]].iter().enumerate() {
+                            let mut d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
+                            d[0] -= lx * (d[0] * inv_lx + 0.5).floor();
+                            buf[m] = ((first + j) as u32, d);
+                            m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
+                        }
+                    } else {
+                        for (j, q) in pos[first..hi[s]].iter().enumerate() {
+                            let d = [y[0] - q[0], y[1] - q[1], y[2] - q[2]];
+                            buf[m] = ((first + j) as u32, d);
+                            m += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < range2) as usize;
+                        }
                     }
                 }
                 f(i, &buf[..m]);

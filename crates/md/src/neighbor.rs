@@ -105,6 +105,34 @@ impl NeighborList {
         })
     }
 
+    /// [`Self::needs_rebuild`] in a Lees–Edwards box whose offset is now `offset` and has moved
+    /// by `moved` (unwrapped) since the last build: true when `2 max|displacement| + moved`
+    /// exceeds the skin (the separation of a pair across the y boundary changes by the two
+    /// displacements plus the change of the offset), the displacements measured with
+    /// [`SimBox::min_image_sheared`].
+    pub fn needs_rebuild_sheared(
+        &self,
+        sbox: &SimBox,
+        pos: &[[f64; 3]],
+        offset: f64,
+        moved: f64,
+    ) -> bool {
+        if self.ref_pos.len() != pos.len() {
+            return true;
+        }
+        let half = 0.5 * (self.skin - moved);
+        if half <= 0.0 {
+            return true;
+        }
+        let lim = half * half;
+        pos.par_iter().zip(self.ref_pos.par_iter()).any(|(p, q)| {
+            let d = sbox
+                .min_image_sheared([p[0] - q[0], p[1] - q[1], p[2] - q[2]], offset)
+                .0;
+            d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim
+        })
+    }
+
     /// Squared displacement of `p` from particle `i`'s reference position.
     #[inline(always)]
     pub fn displacement2(&self, sbox: &SimBox, i: usize, p: [f64; 3]) -> f64 {
@@ -121,6 +149,29 @@ impl NeighborList {
         sbox: &SimBox,
         pos: &[[f64; 3]],
         key: &[u32],
+    ) -> Result<(), BoxTooSmall> {
+        self.build_with(sbox, pos, key, None)
+    }
+
+    /// [`Self::build`] in a Lees–Edwards box: the image of the box above (`y + L_y`) displaced
+    /// by `offset` along x. Separations are [`SimBox::min_image_sheared`]; a row of cells
+    /// across the y boundary is scanned whole (its members' images are shifted along x).
+    pub fn build_sheared(
+        &mut self,
+        sbox: &SimBox,
+        pos: &[[f64; 3]],
+        key: &[u32],
+        offset: f64,
+    ) -> Result<(), BoxTooSmall> {
+        self.build_with(sbox, pos, key, Some(offset))
+    }
+
+    fn build_with(
+        &mut self,
+        sbox: &SimBox,
+        pos: &[[f64; 3]],
+        key: &[u32],
+        shear: Option<f64>,
     ) -> Result<(), BoxTooSmall> {
         let n = pos.len();
         let range = self.range();
@@ -162,7 +213,7 @@ impl NeighborList {
                     let p = pos[i];
                     let [cx, cy, cz] = cell_xyz[i];
                     let mut m = 0usize;
-                    if nx >= 3 && ny >= 3 && nz >= 3 {
+                    if nx >= 3 && ny >= 3 && nz >= 3 && shear.is_none() {
                         // Every neighbour cell is a distinct cell next to particle i's, so the
                         // periodic image of each run is known in advance: `d = (p - q) + s`
                         // with the run's shift `s` in {-L, 0, +L} per axis, the value
@@ -211,7 +262,11 @@ impl NeighborList {
                         let mut scan = |first: usize, last: usize| {
                             for k in cells[first] as usize..cells[last + 1] as usize {
                                 let q = cpos[k];
-                                let d = sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
+                                let d = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+                                let d = match shear {
+                                    None => sbox.min_image(d),
+                                    Some(offset) => sbox.min_image_sheared(d, offset).0,
+                                };
                                 let j = members[k];
                                 let hit = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2max)
                                     & (j as usize != i);
@@ -227,9 +282,12 @@ impl NeighborList {
                             for b in 0..y_n {
                                 let y = wrap_index(y_lo + b, ny);
                                 let row = (z * ny + y) * nx;
+                                // Under shear a row across the y boundary (or the only row)
+                                // holds images shifted along x: all of it.
+                                let across = y_n == 1 || cy + b == 0 || cy + b > ny;
                                 // The 3 (or 1) cells along x as runs of consecutive cells; a
                                 // run that would wrap around the boundary is split in two.
-                                if nx < 3 {
+                                if nx < 3 || (shear.is_some() && across) {
                                     scan(row, row + nx - 1);
                                 } else if cx == 0 {
                                     scan(row, row + 1);

@@ -66,6 +66,55 @@ impl SimBox {
         }
     }
 
+    /// Lees–Edwards minimum image (Lees & Edwards 1972; Allen & Tildesley, sec. 11.3.1) of a
+    /// separation `d = x_i - x_j` when the periodic image of the box above (`y + L_y`) is
+    /// displaced by `offset` along x: the y image index `n = floor(d_y / L_y + 1/2)` is taken
+    /// first, `d_y -= n L_y`, `d_x -= n offset` (eq. LE-1), then x and z as [`Self::min_image`].
+    /// Returns the separation and `n`: the image of `j` used moves with `v_j + n gamma_dot L_y`
+    /// along x (eq. LE-2). With `offset = 0` the separation is that of [`Self::min_image`].
+    #[inline(always)]
+    pub fn min_image_sheared(&self, mut d: [f64; 3], offset: f64) -> ([f64; 3], f64) {
+        let ly = self.l[1];
+        let n = if d[1] >= 0.5 * ly || d[1] < -0.5 * ly {
+            (d[1] / ly + 0.5).floor()
+        } else {
+            0.0
+        };
+        d[1] -= n * ly;
+        d[0] -= n * offset;
+        (self.min_image(d), n)
+    }
+
+    /// Wrap `p` into a Lees–Edwards box (box above displaced by `offset` along x and moving
+    /// with `shear_velocity = gamma_dot L_y` along x): a particle leaving through the top
+    /// (`y >= L_y/2`) re-enters at the bottom with `x -= offset` and `v_x -= gamma_dot L_y`, and
+    /// the reverse through the bottom (eq. LE-3); then x and z as [`Self::wrap`]. `image[1]`
+    /// counts the y crossings; `image[0]` counts the x wraps only, so under shear
+    /// [`Self::unwrap`] does not include the shifts of the y crossings.
+    #[inline(always)]
+    pub fn wrap_sheared(
+        &self,
+        p: &mut [f64; 3],
+        v: &mut [f64; 3],
+        image: &mut [i32; 3],
+        offset: f64,
+        shear_velocity: f64,
+    ) {
+        let ly = self.l[1];
+        if p[1] >= 0.5 * ly || p[1] < -0.5 * ly {
+            let mut n = (p[1] / ly + 0.5).floor();
+            p[1] -= n * ly;
+            if p[1] >= 0.5 * ly {
+                p[1] -= ly;
+                n += 1.0;
+            }
+            p[0] -= n * offset;
+            v[0] -= n * shear_velocity;
+            image[1] = image[1].saturating_add(n as i32);
+        }
+        self.wrap(p, image);
+    }
+
     /// Unwrapped position `p + image * L`.
     #[inline]
     pub fn unwrap(&self, p: [f64; 3], image: [i32; 3]) -> [f64; 3] {
@@ -183,5 +232,30 @@ mod tests {
         }
         let d = b.min_image([3.9, -4.9, 0.1]);
         assert!((d[0] + 0.1).abs() < 1e-12 && (d[1] - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lees_edwards_image_and_wrap() {
+        let b = SimBox::new([6.0, 5.0, 4.0]);
+        let off = 1.25;
+        // j near the top, i near the bottom: i sees j's image below (n = -1), at x_j - offset.
+        let (xi, xj) = ([0.3, -2.4, 0.0], [-0.1, 2.3, 0.1]);
+        let (d, n) = b.min_image_sheared([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]], off);
+        assert_eq!(n, -1.0);
+        assert!((d[1] - 0.3).abs() < 1e-12);
+        assert!((d[0] - (0.4 + off)).abs() < 1e-12, "{d:?}");
+        // No crossing: the plain minimum image.
+        let (d0, n0) = b.min_image_sheared([2.9, 1.0, -3.9], off);
+        assert_eq!((d0, n0), (b.min_image([2.9, 1.0, -3.9]), 0.0));
+        // Leaving through the top: x shifted by -offset, v_x by -gamma L_y.
+        let (mut p, mut v, mut img) = ([2.8, 2.6, 0.0], [0.5, 1.0, 0.0], [0, 0, 0]);
+        b.wrap_sheared(&mut p, &mut v, &mut img, off, 0.7);
+        assert!((p[1] + 2.4).abs() < 1e-12 && (p[0] - (2.8 - off)).abs() < 1e-12);
+        assert!((v[0] + 0.2).abs() < 1e-12 && img == [0, 1, 0]);
+        // And back through the bottom.
+        p[1] -= 0.2;
+        b.wrap_sheared(&mut p, &mut v, &mut img, off, 0.7);
+        assert!((p[1] - 2.4).abs() < 1e-12 && (p[0] - 2.8).abs() < 1e-12);
+        assert!((v[0] - 0.5).abs() < 1e-12 && img == [0, 0, 0]);
     }
 }

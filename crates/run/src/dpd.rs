@@ -219,6 +219,9 @@ impl DpdSession {
             .map(|&t| 0.5 * p.diameter[t as usize])
             .collect();
         let mut obs = obs;
+        if s.params.shear_rate != 0.0 && obs.shear.is_none() {
+            obs.shear = Some(ShearObserved::new(s.steps, s.observe.profile_bins));
+        }
         if s.viscosity_lags > 0 && obs.stress_acf.is_none() {
             obs.stress_acf = Some(StressAcf::new(
                 s.observe.viscosity_every,
@@ -351,10 +354,14 @@ impl DpdSession {
         let thermo_due = o.thermo_every > 0 && next.is_multiple_of(o.thermo_every);
         let frame_due = o.trajectory_every > 0 && next.is_multiple_of(o.trajectory_every);
         let acf = self.obs.stress_acf.as_mut();
+        let shear = self.obs.shear.as_mut();
         let result = if thermo_due || frame_due {
             self.sim.advance_with_thermo().map(|th| {
                 if let Some(acf) = acf {
                     acf.push(&th.pressure);
+                }
+                if let Some(sh) = shear {
+                    sh.push(next, &th.pressure);
                 }
                 if thermo_due {
                     self.obs.thermo.push((next as f64 * dt, th.clone()));
@@ -363,14 +370,36 @@ impl DpdSession {
                     self.frame_thermo = Some(th);
                 }
             })
-        } else if let Some(acf) = acf {
-            // The Green–Kubo samples average the pressure tensor over every step.
-            self.sim.advance_with_pressure().map(|p| acf.push(&p))
+        } else if acf.is_some() || shear.is_some() {
+            // The Green–Kubo samples average the pressure tensor over every step, and so does
+            // the mean shear stress.
+            self.sim.advance_with_pressure().map(|p| {
+                if let Some(acf) = acf {
+                    acf.push(&p);
+                }
+                if let Some(sh) = shear {
+                    sh.push(next, &p);
+                }
+            })
         } else {
             self.sim.advance()
         };
         if let Err(e) = result {
             return Ok(Some(e.to_string()));
+        }
+        // The velocity profile over the second half, every thermo_every (or 100) steps.
+        let profile_every = if o.thermo_every > 0 {
+            o.thermo_every
+        } else {
+            100
+        };
+        if let Some(sh) = self.obs.shear.as_mut()
+            && next > self.s.steps / 2
+            && next.is_multiple_of(profile_every)
+        {
+            self.sim
+                .add_velocity_profile(&mut sh.profile_sum, &mut sh.profile_count);
+            sh.profile_samples += 1;
         }
         if let Some(log) = self.thermo_log.as_mut()
             && let Some((time, th)) = self.obs.thermo.last().filter(|(_, th)| th.step == next)
@@ -448,6 +477,7 @@ impl Session for DpdSession {
             "clusters.csv",
             "stress_acf.csv",
             "stress_acf.png",
+            "velocity_profile.csv",
             "trajectory.gsd",
         ]
         .contains(&name)
@@ -678,6 +708,7 @@ fn describe(s: &DpdSetup) -> serde_json::Value {
         "steps_per_tau": s.tau / p.dt,
         "contact_gap": s.contact_gap,
         "solvent_viscosity_kinetic_theory": solvent_viscosity_kinetic_theory(s),
+        "shear_rate": p.shear_rate,
     })
 }
 
@@ -705,6 +736,98 @@ struct Observed {
     digest: FrameDigest,
     /// The running stress autocorrelation (`observe.viscosity_every > 0`).
     stress_acf: Option<StressAcf>,
+    /// Shear stress and velocity profile of a Lees–Edwards run (`run.shear_rate > 0`).
+    shear: Option<ShearObserved>,
+}
+
+/// What a shear run accumulates (in the checkpoint): the shear stress `-P_xy` of every step
+/// summed over chunks of steps, and the velocity profile over the second half.
+#[derive(Default, Serialize, Deserialize)]
+struct ShearObserved {
+    /// Steps per chunk: `max(1, steps / 1000)`.
+    chunk: u64,
+    /// `sum -P_xy` over the steps `k chunk + 1 ..= (k + 1) chunk` (entry `k`).
+    stress: Vec<f64>,
+    /// `sum v_x` and the number of particles per y bin, over the profile samples.
+    profile_sum: Vec<f64>,
+    profile_count: Vec<f64>,
+    /// Profile samples taken.
+    profile_samples: u64,
+}
+
+impl ShearObserved {
+    fn new(steps: u64, bins: usize) -> Self {
+        Self {
+            chunk: (steps / 1000).max(1),
+            stress: Vec::new(),
+            profile_sum: vec![0.0; bins],
+            profile_count: vec![0.0; bins],
+            profile_samples: 0,
+        }
+    }
+
+    /// Add the shear stress `-P_xy` of step `step` (1-based).
+    fn push(&mut self, step: u64, pressure: &[f64; 6]) {
+        let k = ((step - 1) / self.chunk) as usize;
+        if self.stress.len() <= k {
+            self.stress.resize(k + 1, 0.0);
+        }
+        self.stress[k] -= pressure[3];
+    }
+
+    /// Mean shear stress `<-P_xy>` over the complete chunks of the second half of `steps`
+    /// steps and the standard error of 10 block means (at least 10 chunks), or why not.
+    fn mean_stress(&self, steps: u64) -> std::result::Result<(f64, f64, u64), String> {
+        let complete = (steps / self.chunk) as usize;
+        let first = complete / 2;
+        let chunks = &self.stress[first.min(self.stress.len())..complete.min(self.stress.len())];
+        if chunks.len() < 10 {
+            return Err(format!(
+                "the second half holds {} chunks of {} steps; need 10 (a run of at least 20 steps)",
+                chunks.len(),
+                self.chunk
+            ));
+        }
+        let per = chunks.len() / 10;
+        let means: Vec<f64> = (0..10)
+            .map(|b| {
+                chunks[b * per..(b + 1) * per].iter().sum::<f64>()
+                    / (per as u64 * self.chunk) as f64
+            })
+            .collect();
+        let mean = means.iter().sum::<f64>() / 10.0;
+        let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / 9.0;
+        Ok((mean, (var / 10.0).sqrt(), 10 * per as u64 * self.chunk))
+    }
+
+    /// Bin centres, mean `v_x` per bin (NaN in an empty bin) and the least-squares slope.
+    fn profile(&self, ly: f64) -> (Vec<f64>, Vec<f64>, Option<f64>) {
+        let bins = self.profile_sum.len();
+        let y: Vec<f64> = (0..bins)
+            .map(|b| -0.5 * ly + (b as f64 + 0.5) * ly / bins as f64)
+            .collect();
+        let v: Vec<f64> = self
+            .profile_sum
+            .iter()
+            .zip(&self.profile_count)
+            .map(|(s, &c)| if c > 0.0 { s / c } else { f64::NAN })
+            .collect();
+        let pts: Vec<(f64, f64)> = y
+            .iter()
+            .zip(&v)
+            .filter(|(_, v)| v.is_finite())
+            .map(|(&a, &b)| (a, b))
+            .collect();
+        let slope = (pts.len() >= 2).then(|| {
+            let n = pts.len() as f64;
+            let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+            let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+            let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+            let sxx: f64 = pts.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+            sxy / sxx
+        });
+        (y, v, slope)
+    }
 }
 
 /// `(time, Thermo)` rows through a serialisable mirror of [`Thermo`].
@@ -1150,6 +1273,25 @@ fn write_outputs(
             warnings,
         );
     }
+    // velocity_profile.csv: v_x(y) of a shear run, beside the imposed gamma_dot y.
+    if let Some(sh) = &obs.shear
+        && sh.profile_samples > 0
+    {
+        let (y, v, _) = sh.profile(sim.sbox.l[1]);
+        let imposed: Vec<f64> = y.iter().map(|y| s.params.shear_rate * y).collect();
+        let samples = vec![sh.profile_samples as f64; y.len()];
+        out.write_table(
+            "velocity_profile.csv",
+            &[
+                ("y", &y),
+                ("v_x", &v),
+                ("v_x_imposed", &imposed),
+                ("particle_samples", &sh.profile_count),
+                ("profile_samples", &samples),
+            ],
+        )?;
+        files.push("velocity_profile.csv".into());
+    }
     if s.observe.trajectory_every > 0 {
         files.push("trajectory.gsd".into());
     }
@@ -1178,6 +1320,25 @@ fn summary(
         || "not observed (observe.viscosity_every = 0)".to_string(),
         |e| e.note.clone(),
     );
+    // Lees–Edwards: <-P_xy> over the second half, eta = <-P_xy> / gamma_dot.
+    let rate = s.params.shear_rate;
+    let (stress, shear_note) = match &obs.shear {
+        None => (None, "no shear (run.shear_rate = 0)".to_string()),
+        Some(sh) => match sh.mean_stress(s.steps) {
+            Ok((m, e, n)) => (
+                Some((m, e)),
+                format!(
+                    "<-P_xy> over the last {n} steps of the second half (every step), error: standard error of 10 block means; eta = <-P_xy> / shear_rate"
+                ),
+            ),
+            Err(why) => (None, why),
+        },
+    };
+    let slope = obs
+        .shear
+        .as_ref()
+        .filter(|sh| sh.profile_samples > 0)
+        .and_then(|sh| sh.profile(sim.sbox.l[1]).2);
     json!({
         "software": crate::software(),
         "method": "dpd",
@@ -1204,6 +1365,13 @@ fn summary(
         "viscosity_off_diagonal": value(off),
         "viscosity_off_diagonal_error": error(off),
         "viscosity_note": eta_note,
+        "shear_rate": rate,
+        "shear_stress": stress.map(|x| x.0),
+        "shear_stress_error": stress.map(|x| x.1),
+        "shear_viscosity": stress.map(|x| x.0 / rate),
+        "shear_viscosity_error": stress.map(|x| x.1 / rate),
+        "shear_viscosity_note": shear_note,
+        "velocity_profile_slope": slope,
         "warnings": warnings,
     })
 }

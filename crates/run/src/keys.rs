@@ -1217,6 +1217,13 @@ pub static DPD: &[Spec] = &[
         OneOf(&["auto", "verlet", "cells"]),
         "how solvent pairs are found: Verlet lists, cells every step, or chosen by the list lifetime",
     ),
+    key(
+        "run.shear_rate",
+        "1 / DPD time",
+        "0",
+        Closed(0.0, 10.0),
+        "Lees-Edwards shear rate gamma_dot: flow along x, gradient along y (0: no shear); the run reports the shear stress, the viscosity and velocity_profile.csv",
+    ),
     key("observe", "-", "defaults", Table, "what to measure"),
     key(
         "observe.thermo_every",
@@ -1285,6 +1292,13 @@ pub static DPD: &[Spec] = &[
         "longest lag of the stress autocorrelation, the upper limit of the Green-Kubo integral",
     )
     .also("at least one sample interval viscosity_every x dt, at most 100000 of them"),
+    key(
+        "observe.profile_bins",
+        "-",
+        "16",
+        Integer(1, 1000),
+        "bins along y of velocity_profile.csv (shear runs)",
+    ),
 ];
 
 /// The keys of `hs-mc` scenarios.

@@ -21,13 +21,35 @@
 //! Colloid–colloid pairs use a full list ([`NeighborList`]) summed per colloid. The pair random
 //! number is a hash of (seed, step, pair of tags). Results are therefore bitwise independent of
 //! the number of threads.
+//!
+//! **Lees–Edwards shear** ([`DpdParams::shear_rate`] `gamma_dot > 0`; Lees & Edwards 1972,
+//! Allen & Tildesley sec. 11.3). Flow along x, gradient along y. The image of the box above
+//! (`y + L_y`) is displaced along x by `delta(t) = gamma_dot L_y t mod L_x` (eq. LE-0) and moves
+//! with `+gamma_dot L_y` along x. `delta` is a function of the step alone
+//! ([`Dpd::shear_offset`]), so a restart at a step restores it bitwise. Pair separations use
+//! [`SimBox::min_image_sheared`] (eq. LE-1: `d_y -= n L_y, d_x -= n delta`); the dissipative
+//! force of a pair across the boundary sees `v_i - v_j - n gamma_dot L_y e_x` (eq. LE-2); a
+//! particle crossing it is moved by [`SimBox::wrap_sheared`] (eq. LE-3: `x -+= delta`,
+//! `v_x -+= gamma_dot L_y`). The cells sit inside the z-slabs, and the y boundary inside every
+//! slab, so the slab/halo structure is unchanged; the half stencil of a cell next to the y
+//! boundary scans the whole x row across it (`cells::scan_layer_sheared`). Verlet lists: a pair
+//! across the y boundary moves by the change of `delta`, so the lists (solvent and colloid) are
+//! rebuilt when `2 max|displacement| + |gamma_dot| L_y (t - t_build) > skin` (eq. LE-4: every
+//! pair within range has `|n| <= 1`, its separation changes by at most the two displacements
+//! plus the change of `delta`; the displacement is measured with the Lees–Edwards minimum
+//! image, which follows a particle through the boundary). The DPD thermostat is pair-based and
+//! Galilean invariant, so no profile is imposed on it; the kinetic temperature and the kinetic
+//! stress use the peculiar velocities `v - gamma_dot y e_x` (eq. LE-5). A decomposition over
+//! ranks (z-slabs) is untouched: every owner applies eq. LE-3 to its particles before they
+//! migrate or are copied as ghosts. With `gamma_dot = 0` every step takes the code path of the
+//! plain box.
 
 mod domain;
 pub mod forces;
 pub mod scenario;
 pub mod viscosity;
 
-use crate::cells::{CellSort, permute, scan_layer};
+use crate::cells::{CellSort, permute, scan_layer_sheared};
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::exchange::Exchange;
@@ -64,6 +86,10 @@ pub struct DpdParams {
     pub neighbors: NeighborMode,
     /// Seed of the pair random numbers.
     pub seed: u32,
+    /// Lees–Edwards shear rate `gamma_dot` (1 / DPD time; 0: no shear, the plain periodic box):
+    /// flow along x, gradient along y, streaming profile `u_x(y) = gamma_dot y` (see
+    /// [`Dpd`]'s module docs).
+    pub shear_rate: f64,
 }
 
 impl DpdParams {
@@ -90,6 +116,7 @@ impl DpdParams {
             skin: 0.4,
             neighbors: NeighborMode::Auto,
             seed,
+            shear_rate: 0.0,
         }
     }
 }
@@ -272,7 +299,9 @@ const COLLOID_BIT: u32 = 1 << 31;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum NeighborMode {
     /// Cells when the lists would be rebuilt within about three steps (DPD water at dt ~ 0.04),
-    /// Verlet lists otherwise (colloids at dt ~ 0.001).
+    /// Verlet lists otherwise (colloids at dt ~ 0.001). Under shear the lifetime also counts the
+    /// Lees–Edwards offset's drift `gamma_dot L_y dt` a step (eq. LE-4): cells when
+    /// `skin < 3 (2 x fastest step + drift)`.
     #[default]
     Auto,
     /// Verlet lists with a skin, rebuilt when a particle has moved half the skin.
@@ -349,6 +378,10 @@ pub struct Dpd {
     /// Range of the cells: interaction range, plus the skin in Verlet mode.
     cell_range: f64,
     builds: u64,
+    /// Step of the last build of the solvent lists (Verlet mode) and of the colloid list: the
+    /// change of the Lees–Edwards offset since then enters the rebuild criterion (eq. LE-4).
+    list_step: u64,
+    cc_list_step: u64,
     scratch3: Vec<[f64; 3]>,
     scratch_img: Vec<[i32; 3]>,
     scratch_u32: Vec<u32>,
@@ -384,6 +417,12 @@ struct Ctx<'a> {
     inv_cc_cut: f64,
     colloid: ColloidForces,
     authors_noise: bool,
+    /// Lees–Edwards offset `delta` of this step (0 without shear).
+    shear_offset: f64,
+    /// `gamma_dot L_y`: the x velocity of the image above.
+    shear_velocity: f64,
+    /// `1 / L_y`.
+    inv_ly: f64,
 }
 
 impl Dpd {
@@ -436,6 +475,12 @@ impl Dpd {
             if !(v.is_finite() && v > 0.0) {
                 return Err(DpdError::Invalid(format!("{name} = {v} must be > 0")));
             }
+        }
+        if !p.shear_rate.is_finite() {
+            return Err(DpdError::Invalid(format!(
+                "shear rate = {} must be finite",
+                p.shear_rate
+            )));
         }
         if is_colloid_type.len() != particles.n_types() {
             return Err(DpdError::Invalid(format!(
@@ -490,6 +535,12 @@ impl Dpd {
         let cells_mode = match p.neighbors {
             NeighborMode::Cells => true,
             NeighborMode::Verlet => false,
+            // Under shear pairs across the y boundary also move by gamma_dot L_y dt a step
+            // (eq. LE-4: rebuild when 2 max|disp| + offset change > skin).
+            NeighborMode::Auto if p.shear_rate != 0.0 => {
+                let drift = p.shear_rate.abs() * sbox.l[1] * p.dt;
+                p.skin < 3.0 * (2.0 * fast_step + drift)
+            }
             NeighborMode::Auto => 0.5 * p.skin < 3.0 * fast_step,
         };
         let interaction = p.rc.max(max_cs_centre);
@@ -505,8 +556,17 @@ impl Dpd {
         };
         let mut pos = particles.pos;
         let mut image = particles.image;
-        for (x, img) in pos.iter_mut().zip(image.iter_mut()) {
-            sbox.wrap(x, img);
+        let mut vel = particles.vel;
+        if p.shear_rate != 0.0 {
+            let offset = shear_offset_at(p, &sbox, step);
+            let sv = p.shear_rate * sbox.l[1];
+            for ((x, v), img) in pos.iter_mut().zip(vel.iter_mut()).zip(image.iter_mut()) {
+                sbox.wrap_sheared(x, v, img, offset, sv);
+            }
+        } else {
+            for (x, img) in pos.iter_mut().zip(image.iter_mut()) {
+                sbox.wrap(x, img);
+            }
         }
         let key = (0..n as u32)
             .map(|t| {
@@ -541,7 +601,7 @@ impl Dpd {
             type_names: particles.type_names,
             is_colloid_type,
             pos,
-            vel: particles.vel,
+            vel,
             image,
             key,
             inv_mass,
@@ -565,6 +625,8 @@ impl Dpd {
             layer_sums: Default::default(),
             cell_range,
             builds: 0,
+            list_step: step,
+            cc_list_step: step,
             scratch3: Vec::new(),
             scratch_img: Vec::new(),
             scratch_u32: Vec::new(),
@@ -685,6 +747,50 @@ impl Dpd {
     /// Time `step * dt`.
     pub fn time(&self) -> f64 {
         self.step as f64 * self.params.dt
+    }
+
+    /// The Lees–Edwards offset `delta = gamma_dot L_y t mod L_x` of the current step (eq. LE-0;
+    /// 0 without shear).
+    pub fn shear_offset(&self) -> f64 {
+        shear_offset_at(&self.params, &self.sbox, self.step)
+    }
+
+    /// Whether the box is sheared (`shear_rate != 0`).
+    pub fn sheared(&self) -> bool {
+        self.params.shear_rate != 0.0
+    }
+
+    /// Add the x velocities of all particles into `sum[b]` and their number into `count[b]`,
+    /// `b` the bin of `y` among `sum.len()` equal bins over `[-L_y/2, L_y/2)` (summed layer by
+    /// layer in storage order, then over the layers in order: bitwise independent of the
+    /// threads and of the ranks; collective in a decomposed run). Under shear the mean is the
+    /// streaming profile `gamma_dot y`. Allocates (a sample, not a step).
+    pub fn add_velocity_profile(&self, sum: &mut [f64], count: &mut [f64]) {
+        let bins = sum.len().min(count.len());
+        if bins == 0 {
+            return;
+        }
+        let ly = self.sbox.l[1];
+        let mut total = vec![0.0; 2 * bins];
+        self.sum_layers(
+            2 * bins,
+            |z, r| {
+                let s = &self.slabs[z];
+                for (x, v) in self.pos[s.start..s.end]
+                    .iter()
+                    .zip(&self.vel[s.start..s.end])
+                {
+                    let k = CellSort::cell_coordinate(x[1], ly, bins);
+                    r[k] += v[0];
+                    r[bins + k] += 1.0;
+                }
+            },
+            &mut total,
+        );
+        for k in 0..bins {
+            sum[k] += total[k];
+            count[k] += total[bins + k];
+        }
     }
 
     /// Number of Verlet-list builds so far (solvent lists in Verlet mode, colloid lists in
@@ -853,6 +959,10 @@ impl Dpd {
         let sbox = self.sbox;
         let verlet = !self.cells_mode;
         let (o0, o1) = self.own;
+        let shear = self.params.shear_rate != 0.0;
+        // The Lees–Edwards offset of the step being taken (0 without shear).
+        let offset = shear_offset_at(&self.params, &sbox, self.step + 1);
+        let shear_velocity = self.params.shear_rate * sbox.l[1];
         // First half kick and drift of this rank's particles; largest step and largest
         // displacement from the list's reference (Verlet mode).
         let (max_step2, fast, max_disp2) = {
@@ -878,10 +988,21 @@ impl Dpd {
                         x[k] += dx;
                         step2 += dx * dx;
                     }
-                    sbox.wrap(x, img);
+                    if shear {
+                        sbox.wrap_sheared(x, v, img, offset, shear_velocity);
+                    } else {
+                        sbox.wrap(x, img);
+                    }
                     let disp2 = if verlet {
                         let q = ref_pos[i];
-                        let d = sbox.min_image([x[0] - q[0], x[1] - q[1], x[2] - q[2]]);
+                        let d = [x[0] - q[0], x[1] - q[1], x[2] - q[2]];
+                        // Under shear the Lees–Edwards image follows a particle through the y
+                        // boundary: the displacement of its continuous trajectory.
+                        let d = if shear {
+                            sbox.min_image_sheared(d, offset).0
+                        } else {
+                            sbox.min_image(d)
+                        };
                         d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
                     } else {
                         0.0
@@ -945,11 +1066,19 @@ impl Dpd {
             });
         }
         let sync = self.sync_every > 0 && self.step.is_multiple_of(self.sync_every);
+        let stale = if shear {
+            // Eq. LE-4: the lists hold while 2 max|disp| + |gamma_dot| L_y (t - t_build) <= skin.
+            let moved = self.shear_moved(self.list_step);
+            let lim = 0.5 * (self.params.skin - moved);
+            lim <= 0.0 || max_disp2 > lim * lim
+        } else {
+            max_disp2 > 0.25 * self.params.skin * self.params.skin
+        };
         if self.cells_mode {
             self.migrate_and_fetch_ghosts()?;
             self.sort_into_cells();
             self.update_colloid_list(sync)?;
-        } else if sync || max_disp2 > 0.25 * self.params.skin * self.params.skin {
+        } else if sync || stale {
             self.migrate_and_fetch_ghosts()?;
             self.sort_into_cells();
             self.build_lists();
@@ -1005,9 +1134,31 @@ impl Dpd {
         Ok(())
     }
 
-    /// `sum m v (x) v` over the storage slots `a..b` (xx, yy, zz, xy, xz, yz), added to `t`.
+    /// How far the Lees–Edwards offset has moved (unwrapped) since `step`:
+    /// `|gamma_dot| L_y (t - t_step)`.
+    fn shear_moved(&self, step: u64) -> f64 {
+        self.params.shear_rate.abs()
+            * self.sbox.l[1]
+            * (self.step.saturating_sub(step) as f64 * self.params.dt)
+    }
+
+    /// The velocity of storage slot `i`, minus the streaming profile `gamma_dot y e_x` under
+    /// shear (the peculiar velocity, eq. LE-5).
+    #[inline(always)]
+    fn peculiar(&self, i: usize) -> [f64; 3] {
+        let v = self.vel[i];
+        if self.params.shear_rate != 0.0 {
+            [v[0] - self.params.shear_rate * self.pos[i][1], v[1], v[2]]
+        } else {
+            v
+        }
+    }
+
+    /// `sum m v (x) v` over the storage slots `a..b` (xx, yy, zz, xy, xz, yz), added to `t`;
+    /// peculiar velocities under shear (eq. LE-5).
     fn kinetic_tensor(&self, a: usize, b: usize, t: &mut [f64]) {
-        for (v, &k) in self.vel[a..b].iter().zip(&self.key[a..b]) {
+        for (i, &k) in (a..b).zip(&self.key[a..b]) {
+            let v = self.peculiar(i);
             let m = self.props[(k & !COLLOID_BIT) as usize].mass;
             t[0] += m * v[0] * v[0];
             t[1] += m * v[1] * v[1];
@@ -1031,13 +1182,11 @@ impl Dpd {
             |z, r| {
                 let s = &self.slabs[z];
                 self.kinetic_tensor(s.start, s.end, &mut r[..6]);
-                for (v, &k) in self.vel[s.start..s.end]
-                    .iter()
-                    .zip(&self.key[s.start..s.end])
-                {
+                for (i, &k) in (s.start..s.end).zip(&self.key[s.start..s.end]) {
                     let q = &self.props[(k & !COLLOID_BIT) as usize];
                     let m = q.mass;
-                    r[9 + q.typeid as usize] += m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                    let (v, u) = (self.vel[i], self.peculiar(i));
+                    r[9 + q.typeid as usize] += m * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
                     r[9 + nt + q.typeid as usize] += 1.0;
                     for k in 0..3 {
                         r[6 + k] += m * v[k];
@@ -1116,6 +1265,8 @@ impl Dpd {
     /// by slab in parallel, over the half stencil of cells.
     fn build_lists(&mut self) {
         self.builds += 1;
+        self.list_step = self.step;
+        let shear = (self.params.shear_rate != 0.0).then(|| self.shear_offset());
         self.ref_pos.clear();
         self.ref_pos.extend_from_slice(&self.pos);
         let pos = &self.pos;
@@ -1137,13 +1288,14 @@ impl Dpd {
                 cand,
                 ..
             } = slab;
-            scan_layer(
+            scan_layer_sheared(
                 z,
                 pos,
                 cell_start,
                 n_cells,
                 &sbox,
                 cell_range,
+                shear,
                 cand,
                 |i, cands| {
                     let ki = key[i];
@@ -1186,6 +1338,24 @@ impl Dpd {
             return Ok(());
         }
         self.gather_colloids();
+        if self.params.shear_rate != 0.0 {
+            // Eq. LE-4 for the colloid list.
+            let offset = self.shear_offset();
+            let moved = self.shear_moved(self.cc_list_step);
+            if force
+                || self
+                    .cc_list
+                    .needs_rebuild_sheared(&self.sbox, &self.cc_pos, offset, moved)
+            {
+                self.cc_list
+                    .build_sheared(&self.sbox, &self.cc_pos, &self.cc_tag, offset)?;
+                self.cc_list_step = self.step;
+                if self.cells_mode {
+                    self.builds += 1;
+                }
+            }
+            return Ok(());
+        }
         if force || self.cc_list.needs_rebuild(&self.sbox, &self.cc_pos) {
             self.cc_list.build(&self.sbox, &self.cc_pos, &self.cc_tag)?;
             if self.cells_mode {
@@ -1224,7 +1394,11 @@ impl Dpd {
             inv_cc_cut: 1.0 / p.colloid_cutoff,
             colloid: p.colloid,
             authors_noise: p.lubrication_noise == LubricationNoise::Authors,
+            shear_offset: shear_offset_at(p, &self.sbox, step),
+            shear_velocity: p.shear_rate * self.sbox.l[1],
+            inv_ly: 1.0 / self.sbox.l[1],
         };
+        let shear = p.shear_rate != 0.0;
         let has_cc = self.cc_tag.len() >= 2;
         let nz = self.slabs.len();
         let starts = &self.slab_start;
@@ -1236,9 +1410,24 @@ impl Dpd {
             .for_each(|(k, slab)| {
                 let z = z0 + k;
                 let next_start = starts[(z + 1) % nz];
-                slab_forces::<THERMO>(&ctx, z, slab, next_start, has_cc);
+                if shear {
+                    slab_forces::<THERMO, true>(&ctx, z, slab, next_start, has_cc);
+                } else {
+                    slab_forces::<THERMO, false>(&ctx, z, slab, next_start, has_cc);
+                }
             });
     }
+}
+
+/// The Lees–Edwards offset `delta = gamma_dot L_y t mod L_x` at `step` (`t = step dt`; eq. LE-0),
+/// in `[0, L_x)`.
+fn shear_offset_at(p: &DpdParams, sbox: &SimBox, step: u64) -> f64 {
+    if p.shear_rate == 0.0 {
+        return 0.0;
+    }
+    let d = (p.shear_rate * sbox.l[1] * (step as f64 * p.dt)).rem_euclid(sbox.l[0]);
+    // rem_euclid can round up to L_x itself.
+    if d >= sbox.l[0] { 0.0 } else { d }
 }
 
 /// Force on particle `i`: its slab's own sum plus the previous slab's halo.
@@ -1260,7 +1449,8 @@ fn total_force(slabs: &[Slab], slab_of: &[u32], n_slabs: usize, i: usize) -> [f6
 /// Forces of one slab's pairs: solvent and colloid–solvent pairs from the half list or the
 /// half stencil of cells (into the slab's buffer and the next slab's halo), colloid–colloid
 /// pairs from the full list (each colloid sums its own).
-fn slab_forces<const THERMO: bool>(
+/// `SHEAR`: Lees–Edwards separations and velocities (eqs. LE-1, LE-2).
+fn slab_forces<const THERMO: bool, const SHEAR: bool>(
     c: &Ctx,
     z: usize,
     slab: &mut Slab,
@@ -1290,16 +1480,17 @@ fn slab_forces<const THERMO: bool>(
         vir: &mut vir,
     };
     if c.cells_mode {
-        scan_layer(
+        scan_layer_sheared(
             z,
             c.pos,
             c.cell_start,
             c.n_cells,
             &c.sbox,
             c.cell_range,
+            SHEAR.then_some(c.shear_offset),
             cand,
             |i, cands| {
-                particle_forces::<THERMO>(
+                particle_forces::<THERMO, SHEAR>(
                     c,
                     i,
                     cands.iter().map(|&(j, d)| (j as usize, d)),
@@ -1315,12 +1506,15 @@ fn slab_forces<const THERMO: bool>(
             let k1 = nbr_start[i - start + 1] as usize;
             let pairs = nbr[k0..k1].iter().map(|&j| {
                 let q = c.pos[j as usize];
-                (
-                    j as usize,
-                    c.sbox.min_image([xi[0] - q[0], xi[1] - q[1], xi[2] - q[2]]),
-                )
+                let d = [xi[0] - q[0], xi[1] - q[1], xi[2] - q[2]];
+                let d = if SHEAR {
+                    c.sbox.min_image_sheared(d, c.shear_offset).0
+                } else {
+                    c.sbox.min_image(d)
+                };
+                (j as usize, d)
             });
-            particle_forces::<THERMO>(c, i, pairs, &mut out, has_cc);
+            particle_forces::<THERMO, SHEAR>(c, i, pairs, &mut out, has_cc);
         }
     }
     *virial = if THERMO { vir } else { PairVirial::default() };
@@ -1338,8 +1532,12 @@ struct Out<'a> {
 
 /// All forces of particle `i`'s pairs: solvent and colloid–solvent pairs `(j, x_i - x_j)` from
 /// `pairs` (each pair once: the reaction goes to `j`), colloid–colloid pairs from the full list.
+///
+/// `SHEAR`: `pairs` carry Lees–Edwards separations; the image index of a pair is recovered as
+/// `n = round((y_i - y_j - d_y) / L_y)` and its dissipative force sees
+/// `v_i - v_j - n gamma_dot L_y e_x` (eq. LE-2).
 #[inline(always)]
-fn particle_forces<const THERMO: bool>(
+fn particle_forces<const THERMO: bool, const SHEAR: bool>(
     c: &Ctx,
     i: usize,
     pairs: impl Iterator<Item = (usize, [f64; 3])>,
@@ -1376,7 +1574,11 @@ fn particle_forces<const THERMO: bool>(
         };
         let inv_r = 1.0 / r;
         let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
-        let vj = c.vel[j];
+        let mut vj = c.vel[j];
+        if SHEAR {
+            let n = ((xi[1] - c.pos[j][1] - d[1]) * c.inv_ly).round();
+            vj[0] += n * c.shear_velocity;
+        }
         let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
         let w = 1.0 - h * inv_cut;
         let theta = pair_noise(c.noise_key, ki & !COLLOID_BIT, kj & !COLLOID_BIT);
@@ -1413,9 +1615,12 @@ fn particle_forces<const THERMO: bool>(
             let tj = c.cc_tag[k];
             let pj = &c.props[tj as usize];
             let xj = c.cc_pos[k];
-            let d = c
-                .sbox
-                .min_image([xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]]);
+            let dx = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+            let (d, n_img) = if SHEAR {
+                c.sbox.min_image_sheared(dx, c.shear_offset)
+            } else {
+                (c.sbox.min_image(dx), 0.0)
+            };
             let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             let h = r - (pi.radius + pj.radius);
             if h >= c.cc_cut {
@@ -1424,7 +1629,10 @@ fn particle_forces<const THERMO: bool>(
             let abar = 0.5 * (pi.radius + pj.radius);
             let inv_r = 1.0 / r;
             let e = [d[0] * inv_r, d[1] * inv_r, d[2] * inv_r];
-            let vj = c.cc_vel[k];
+            let mut vj = c.cc_vel[k];
+            if SHEAR {
+                vj[0] += n_img * c.shear_velocity;
+            }
             let ev = e[0] * (vi[0] - vj[0]) + e[1] * (vi[1] - vj[1]) + e[2] * (vi[2] - vj[2]);
             let w = 1.0 - h * c.inv_cc_cut;
             let f_con = cf.contact_force(h, abar);

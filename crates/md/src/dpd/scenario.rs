@@ -223,6 +223,10 @@ pub struct RunSection {
     /// (re-sorted every step, no lists).
     #[serde(default = "d_auto")]
     pub neighbors: String,
+    /// Lees–Edwards shear rate `gamma_dot` (1 / DPD time; 0: no shear): flow along x,
+    /// gradient along y.
+    #[serde(default)]
+    pub shear_rate: f64,
 }
 
 fn d_auto() -> String {
@@ -254,6 +258,7 @@ impl Default for RunSection {
             max_temperature_drift: d_drift(),
             temperature_window: d_window(),
             neighbors: d_auto(),
+            shear_rate: 0.0,
         }
     }
 }
@@ -293,6 +298,13 @@ pub struct ObserveSection {
     /// (DPD time).
     #[serde(default = "d_viscosity_time")]
     pub viscosity_time: f64,
+    /// Bins along y of the velocity profile `v_x(y)` of a shear run (`run.shear_rate > 0`).
+    #[serde(default = "d_profile_bins")]
+    pub profile_bins: usize,
+}
+
+fn d_profile_bins() -> usize {
+    16
 }
 
 /// Most sample intervals in the stress autocorrelation (`observe.viscosity_time`): each sample
@@ -329,6 +341,7 @@ impl Default for ObserveSection {
             contact_gap: None,
             viscosity_every: 0,
             viscosity_time: d_viscosity_time(),
+            profile_bins: d_profile_bins(),
         }
     }
 }
@@ -501,6 +514,7 @@ impl DpdScenario {
         let r = &self.run;
         let dt = positive("run.dt", r.dt)?;
         let skin = in_range("run.skin", r.skin, 0.05, 2.0)?;
+        let shear_rate = in_range("run.shear_rate", r.shear_rate, 0.0, 10.0)?;
         let max_drift = in_range(
             "run.max_temperature_drift",
             r.max_temperature_drift,
@@ -530,6 +544,12 @@ impl DpdScenario {
         };
         if o.gr_bins == 0 {
             return Err(ParamError::new("observe.gr_bins", "must be >= 1"));
+        }
+        if !(1..=1000).contains(&o.profile_bins) {
+            return Err(ParamError::new(
+                "observe.profile_bins",
+                format!("must lie in [1, 1000], got {}", o.profile_bins),
+            ));
         }
         let contact_gap = match o.contact_gap {
             Some(g) => positive("observe.contact_gap", g)?,
@@ -625,6 +645,7 @@ impl DpdScenario {
             skin,
             neighbors,
             seed,
+            shear_rate,
         };
         Ok(DpdSetup {
             params,
@@ -892,6 +913,15 @@ impl DpdSetup {
         for v in vel.iter_mut() {
             for k in 0..3 {
                 v[k] -= p[k] / mtot;
+            }
+        }
+        // Under shear the start has the streaming profile u_x = gamma_dot y (y wrapped).
+        let shear = self.params.shear_rate;
+        if shear != 0.0 {
+            let ly = self.sbox.l[1];
+            for (v, x) in vel.iter_mut().zip(&pos) {
+                let y = x[1] - ly * (x[1] / ly + 0.5).floor();
+                v[0] += shear * y;
             }
         }
         Ok(Particles {

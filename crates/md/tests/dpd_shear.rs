@@ -1,0 +1,530 @@
+//! Lees–Edwards shear flow in the DPD engine (issue 19): zero shear is the engine of before
+//! bitwise; the pair forces under shear equal a brute-force sum with the shifted images; x
+//! momentum changes only by the boundary flux and the flow profile is linear with the imposed
+//! slope; the shear viscosity of DPD water agrees with the Green–Kubo value; results do not
+//! depend on the threads; restarts continue bitwise; bad input is refused with the key.
+
+use colloidsim_core::exchange::{Exchange, LocalRanks};
+use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
+use colloidsim_md::dpd::{Dpd, DpdParams, NeighborMode};
+use colloidsim_md::{Particles, SimBox};
+
+/// FNV-1a over the bits of `x`.
+fn fnv(h: &mut u64, x: f64) {
+    for b in x.to_bits().to_le_bytes() {
+        *h ^= b as u64;
+        *h = h.wrapping_mul(0x100_0000_01b3);
+    }
+}
+
+/// Fingerprints (positions, velocities, images, forces, thermo of the last step) of 150 steps
+/// of the colloid suspension with lists and with cells, and of DPD water at dt = 0.04 (cells),
+/// all without shear.
+fn fingerprints() -> Vec<u64> {
+    let sus = |mode: NeighborMode| {
+        let mut s = DpdScenario::from_toml(
+            "method = \"dpd\"\nseed = 9\n[system]\nbox_length = 8.0\nphi = 0.15\nradius_distribution = \"uniform\"\nradius_spread = 0.2\n[colloids]\nmorse_depth = 12.0\n",
+        )
+        .unwrap()
+        .validate()
+        .unwrap();
+        s.params.neighbors = mode;
+        s
+    };
+    let water = DpdScenario::from_toml(
+        "method = \"dpd\"\nseed = 4\n[system]\nbox_length = 8.0\nkT = 1.0\n[run]\ndt = 0.04\n",
+    )
+    .unwrap()
+    .validate()
+    .unwrap();
+    [sus(NeighborMode::Verlet), sus(NeighborMode::Cells), water]
+        .iter()
+        .map(|setup| {
+            let mut sim = setup.build().unwrap();
+            sim.run(150).unwrap();
+            let th = sim.advance_with_thermo().unwrap();
+            let p = sim.snapshot();
+            let mut h = 0xcbf2_9ce4_8422_2325u64;
+            for i in 0..p.len() {
+                for k in 0..3 {
+                    fnv(&mut h, p.pos[i][k]);
+                    fnv(&mut h, p.vel[i][k]);
+                    fnv(&mut h, p.image[i][k] as f64);
+                }
+            }
+            for f in sim.forces() {
+                for x in f {
+                    fnv(&mut h, x);
+                }
+            }
+            for x in th.pressure.iter().chain(&th.kinetic) {
+                fnv(&mut h, *x);
+            }
+            fnv(&mut h, th.temperature);
+            fnv(&mut h, sim.neighbor_builds() as f64);
+            h
+        })
+        .collect()
+}
+
+/// The fingerprints of [`fingerprints`] computed by the engine before Lees–Edwards was added
+/// (commit fc1f1d7, the same test code, x86_64).
+const BEFORE: [u64; 3] = [
+    14898732051159294842,
+    8454528982586352973,
+    2265221180990248690,
+];
+
+#[test]
+fn zero_shear_is_the_engine_of_before_bitwise() {
+    assert_eq!(fingerprints(), BEFORE);
+}
+
+fn scenario(text: &str) -> DpdSetup {
+    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+}
+
+/// The colloid suspension of the thread tests (Morse attraction, polydisperse) under shear.
+fn suspension(mode: NeighborMode, shear: f64) -> DpdSetup {
+    let mut s = scenario(&format!(
+        "method = \"dpd\"\nseed = 9\n[system]\nbox_length = 8.0\nphi = 0.15\nradius_distribution = \"uniform\"\nradius_spread = 0.2\n[colloids]\nmorse_depth = 12.0\n[run]\nshear_rate = {shear}\n"
+    ));
+    s.params.neighbors = mode;
+    s
+}
+
+/// DPD water (density 3, a = 25, gamma = 4.5, kT = 1) in a cube of side `l` under shear.
+fn water(l: f64, dt: f64, shear: f64, seed: u64) -> DpdSetup {
+    scenario(&format!(
+        "method = \"dpd\"\nseed = {seed}\n[system]\nbox_length = {l}\nkT = 1.0\n[run]\ndt = {dt}\nshear_rate = {shear}\n"
+    ))
+}
+
+/// Every pair force by brute force over all pairs and over the Lees–Edwards images
+/// (`SimBox::min_image_sheared`, image velocity `v_j + n gamma_dot L_y e_x`).
+fn brute_force(
+    p: &Particles,
+    sbox: &SimBox,
+    prm: &DpdParams,
+    step: u64,
+    offset: f64,
+) -> Vec<[f64; 3]> {
+    use colloidsim_md::dpd::{colloid_solvent_cutoff, pair_noise, step_key};
+    let n = p.len();
+    let key = step_key(prm.seed, step);
+    let sv = prm.shear_rate * sbox.l[1];
+    let a: Vec<f64> = (0..n)
+        .map(|i| {
+            if p.typeid[i] == 1 {
+                0.5 * p.diameter[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut f = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for j in 0..n {
+            if i == j {
+                continue;
+            }
+            let (x, y) = (p.pos[i], p.pos[j]);
+            let (d, img) = sbox.min_image_sheared([x[0] - y[0], x[1] - y[1], x[2] - y[2]], offset);
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let e = [d[0] / r, d[1] / r, d[2] / r];
+            let vj = [p.vel[j][0] + img * sv, p.vel[j][1], p.vel[j][2]];
+            let dv: Vec<f64> = (0..3).map(|k| p.vel[i][k] - vj[k]).collect();
+            let ev = e[0] * dv[0] + e[1] * dv[1] + e[2] * dv[2];
+            let h = r - a[i] - a[j];
+            let theta = pair_noise(key, i as u32, j as u32);
+            let mag = if a[i] > 0.0 && a[j] > 0.0 {
+                if h >= prm.colloid_cutoff {
+                    continue;
+                }
+                let w = 1.0 - h / prm.colloid_cutoff;
+                let c = &prm.colloid;
+                let abar = 0.5 * (a[i] + a[j]);
+                let asq = if c.eta0 > 0.0 {
+                    c.squeeze_coefficient(h, abar)
+                } else {
+                    0.0
+                };
+                c.contact_force(h, abar) + c.morse_force(h) - (prm.gamma * w * w + asq) * ev
+                    + (2.0 * prm.kt * (prm.gamma * w * w + asq) / prm.dt).sqrt() * theta
+            } else {
+                let big = a[i].max(a[j]);
+                let (cut, amp) = if big > 0.0 {
+                    let c = colloid_solvent_cutoff(prm.rc, big);
+                    (c, prm.repulsion_cs * prm.kt / c)
+                } else {
+                    (prm.rc, prm.repulsion * prm.kt / prm.rc)
+                };
+                if h >= cut {
+                    continue;
+                }
+                let w = 1.0 - h / cut;
+                amp * w - prm.gamma * w * w * ev
+                    + (2.0 * prm.gamma * prm.kt / prm.dt).sqrt() * w * theta
+            };
+            for k in 0..3 {
+                f[i][k] += mag * e[k];
+            }
+        }
+    }
+    f
+}
+
+#[test]
+fn sheared_forces_equal_a_brute_force_sum_over_the_shifted_images() {
+    // 250 steps at gamma_dot = 2 move the offset by 2 * 8 * 0.25 = 4 (continuously from a start
+    // without overlaps); a fresh engine on that state at that step sums its forces.
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let setup = suspension(mode, 2.0);
+        let mut run = setup.build().unwrap();
+        run.run(250).unwrap();
+        let p = run.snapshot();
+        let sim = Dpd::new(
+            p.clone(),
+            setup.sbox,
+            setup.params,
+            DpdSetup::colloid_types(),
+            250,
+        )
+        .unwrap();
+        assert_eq!(sim.snapshot(), p);
+        let offset = sim.shear_offset();
+        assert!((3.9..4.1).contains(&offset), "offset {offset}");
+        let got = sim.forces();
+        let want = brute_force(&p, &setup.sbox, &setup.params, 250, offset);
+        let scale = want
+            .iter()
+            .map(|f| f.iter().map(|x| x.abs()).fold(0.0, f64::max))
+            .fold(0.0, f64::max);
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            for k in 0..3 {
+                assert!(
+                    (g[k] - w[k]).abs() <= 1e-9 * scale,
+                    "{mode:?}: particle {i} (type {}): engine {g:?}, brute force {w:?}",
+                    p.typeid[i]
+                );
+            }
+        }
+        // Without the image velocity in the dissipative force the sum differs (resolved).
+        let mut wrong = setup.params;
+        wrong.shear_rate = 0.0;
+        let bad = brute_force(&p, &setup.sbox, &wrong, 250, offset);
+        let dmax = got
+            .iter()
+            .zip(&bad)
+            .map(|(g, b)| (0..3).map(|k| (g[k] - b[k]).abs()).fold(0.0, f64::max))
+            .fold(0.0, f64::max);
+        assert!(dmax > 1e-3 * scale, "{mode:?}: {dmax} vs scale {scale}");
+    }
+}
+
+/// Build `setup` and run 800 steps plus one thermo step on a pool of `threads` threads.
+fn run_on_threads(setup: &DpdSetup, threads: usize) -> (Particles, String, Vec<[f64; 3]>) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut sim = setup.build().unwrap();
+        sim.run(800).unwrap();
+        let th = sim.advance_with_thermo().unwrap();
+        (sim.snapshot(), format!("{th:?}"), sim.forces())
+    })
+}
+
+#[test]
+fn sheared_results_do_not_depend_on_the_number_of_threads() {
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        // gamma_dot L_y t = 1.5 * 8 * 0.8: the offset moves 9.6 (more than L_x), many list
+        // rebuilds.
+        let setup = suspension(mode, 1.5);
+        let (a, ta, fa) = run_on_threads(&setup, 1);
+        let (b, tb, fb) = run_on_threads(&setup, 2);
+        assert!(a == b, "{mode:?}: 2 threads differ from 1");
+        assert_eq!(ta, tb);
+        assert!(fa == fb);
+        // Particles did cross the y boundary.
+        assert!(a.image.iter().any(|i| i[1] != 0));
+    }
+}
+
+#[test]
+fn a_sheared_restart_continues_bitwise() {
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let setup = suspension(mode, 1.5);
+        let mut a = setup.build().unwrap();
+        a.set_sync_every(50);
+        a.run(100).unwrap();
+        let (snap, forces) = (a.snapshot(), a.forces());
+        a.run(150).unwrap();
+        let mut b = Dpd::restart(
+            snap,
+            &forces,
+            setup.sbox,
+            setup.params,
+            DpdSetup::colloid_types(),
+            100,
+            50,
+        )
+        .unwrap();
+        assert_eq!(b.shear_offset().to_bits(), {
+            let mut c = setup.build().unwrap();
+            c.run(100).unwrap();
+            c.shear_offset().to_bits()
+        });
+        b.run(150).unwrap();
+        assert!(a.snapshot() == b.snapshot(), "{mode:?}: restart differs");
+    }
+}
+
+/// Slope and its standard error of a least-squares line through `(x, y)`.
+fn slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+/// Mean and standard error of `x` from `blocks` block means.
+fn mean_and_error(x: &[f64], blocks: usize) -> (f64, f64) {
+    let m = x.len() / blocks;
+    let means: Vec<f64> = (0..blocks)
+        .map(|b| x[b * m..(b + 1) * m].iter().sum::<f64>() / m as f64)
+        .collect();
+    let mean = means.iter().sum::<f64>() / blocks as f64;
+    let var = means.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / (blocks - 1) as f64;
+    (mean, (var / blocks as f64).sqrt())
+}
+
+/// What a shear run of DPD water measures.
+#[derive(Debug)]
+struct ShearRun {
+    /// `<-P_xy> / gamma_dot` over the second half, and its block standard error.
+    eta: (f64, f64),
+    /// Slope of the mean `v_x(y)` profile (8 bins) over the second half, and its block error.
+    slope: (f64, f64),
+    /// Kinetic temperature (peculiar velocities) over the second half.
+    temperature: f64,
+    /// Largest change of `P_x + gamma_dot L_y sum m image_y` (x momentum corrected by the
+    /// boundary flux of the crossings), relative to `sum m |v_x|`.
+    momentum_drift: f64,
+}
+
+/// DPD water (L = 8, 1536 beads, kT = 1, dt = 0.01) at shear rate `rate` for `steps` steps
+/// from the linear profile; the stress every step, the profile every 10 steps.
+fn shear_run(rate: f64, steps: u64, seed: u64) -> ShearRun {
+    let setup = water(8.0, 0.01, rate, seed);
+    let mut sim = setup.build().unwrap();
+    let ly = setup.sbox.l[1];
+    let corrected = |sim: &Dpd| {
+        let p = sim.snapshot();
+        let mut px = 0.0;
+        let mut scale = 0.0;
+        for i in 0..p.len() {
+            px += p.mass[i] * (p.vel[i][0] + rate * ly * p.image[i][1] as f64);
+            scale += p.mass[i] * p.vel[i][0].abs();
+        }
+        (px, scale)
+    };
+    let (px0, scale) = corrected(&sim);
+    let mut drift: f64 = 0.0;
+    let bins = 8;
+    let y: Vec<f64> = (0..bins)
+        .map(|b| -0.5 * ly + (b as f64 + 0.5) * ly / bins as f64)
+        .collect();
+    let (mut stress, mut slopes, mut temps) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut sum, mut count) = (vec![0.0; bins], vec![0.0; bins]);
+    for s in 0..steps {
+        let p = sim.advance_with_pressure().unwrap();
+        if s >= steps / 2 {
+            stress.push(-p[3]);
+            if s % 10 == 0 {
+                sum.iter_mut().for_each(|x| *x = 0.0);
+                count.iter_mut().for_each(|x| *x = 0.0);
+                sim.add_velocity_profile(&mut sum, &mut count);
+                let v: Vec<f64> = sum.iter().zip(&count).map(|(a, c)| a / c).collect();
+                slopes.push(slope(&y, &v));
+                temps.push(sim.thermo().temperature);
+            }
+        }
+        if s % 500 == 0 {
+            drift = drift.max((corrected(&sim).0 - px0).abs() / scale);
+        }
+    }
+    let (m, e) = mean_and_error(&stress, 10);
+    ShearRun {
+        eta: (m / rate, e / rate),
+        slope: mean_and_error(&slopes, 10),
+        temperature: temps.iter().sum::<f64>() / temps.len() as f64,
+        momentum_drift: drift,
+    }
+}
+
+/// Shear rate of the CI test: DPD water heats under shear (the thermostat removes the viscous
+/// heat `eta gamma_dot^2` only at a finite rate): measured T = 1.03 kT at 0.5, 1.12 kT at 1.
+const RATE: f64 = 0.5;
+
+#[test]
+fn dpd_water_under_shear_has_the_linear_profile_and_the_green_kubo_viscosity() {
+    let r = shear_run(RATE, 12_000, 7);
+    println!("{r:?}");
+    // x momentum changes only by the boundary flux: pair forces conserve it exactly.
+    assert!(r.momentum_drift < 1e-12, "{r:?}");
+    // The measured profile v_x(y) is linear with the imposed slope (4 block errors).
+    assert!(r.slope.1 < 0.02 * RATE, "{r:?}");
+    assert!((r.slope.0 - RATE).abs() < 4.0 * r.slope.1, "{r:?}");
+    // The temperature of the peculiar velocities: kT plus the viscous heating (3 %).
+    assert!((r.temperature - 1.0).abs() < 0.06, "{r:?}");
+    // The viscosity agrees with Green-Kubo (0.832 +- 0.012 at t_max = 2, docs/dpd.md) within
+    // 4 combined standard errors.
+    let (gk, gk_err) = (0.832, 0.012);
+    let tol = 4.0 * (r.eta.1.powi(2) + gk_err * gk_err).sqrt();
+    assert!(r.eta.1 < 0.03, "{r:?}");
+    assert!((r.eta.0 - gk).abs() < tol, "{r:?}: tolerance {tol}");
+}
+
+/// The table of docs/dpd.md: longer runs at three rates (`-- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn shear_viscosity_table() {
+    for rate in [0.25, 0.5, 1.0] {
+        let r = shear_run(rate, 40_000, 11);
+        println!("rate {rate}: {r:?}");
+    }
+}
+
+#[test]
+fn bad_shear_rates_are_refused_with_the_key() {
+    let base = "method = \"dpd\"\n[system]\nbox_length = 8.0\n[run]\n";
+    for bad in ["-0.1", "nan", "inf", "11.0"] {
+        let e = DpdScenario::from_toml(&format!("{base}shear_rate = {bad}\n"))
+            .unwrap()
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("run.shear_rate"), "{bad}: {e}");
+    }
+    // The engine refuses a non-finite rate too.
+    let mut setup = water(8.0, 0.04, 0.0, 1);
+    setup.params.shear_rate = f64::NAN;
+    let e = setup.build().err().expect("refused").to_string();
+    assert!(e.contains("shear rate"), "{e}");
+}
+
+/// The forces a running engine used at its last step against those of a fresh engine (new
+/// lists or cells) on the same positions and the same half-step velocities
+/// (`v(n) - F dt / 2m`): a pair missing from an aged Verlet list shows as a difference.
+fn check_against_fresh(sim: &Dpd, setup: &DpdSetup) {
+    let mut p = sim.snapshot();
+    let f = sim.forces();
+    let dt = setup.params.dt;
+    for i in 0..p.len() {
+        for k in 0..3 {
+            p.vel[i][k] -= 0.5 * dt * f[i][k] / p.mass[i];
+        }
+    }
+    let mut prm = setup.params;
+    prm.neighbors = NeighborMode::Cells;
+    let fresh = Dpd::new(p, setup.sbox, prm, DpdSetup::colloid_types(), sim.step).unwrap();
+    let g = fresh.forces();
+    let scale = g
+        .iter()
+        .map(|f| f.iter().map(|x| x.abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    for i in 0..g.len() {
+        for k in 0..3 {
+            assert!(
+                (f[i][k] - g[i][k]).abs() < 1e-8 * scale,
+                "step {}: particle {i}: running {:?}, fresh {:?}",
+                sim.step,
+                f[i],
+                g[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn aged_verlet_lists_under_shear_miss_no_pair() {
+    // DPD water at rate 3 started at rest (no streaming profile: the fastest particles move
+    // about 0.05 a step while the offset moves 0.24, so only the offset's drift calls for the
+    // first rebuilds), and the colloid suspension at rate 1.5 from its profile, both with Verlet
+    // lists.
+    for (mut setup, at_rest, steps, every) in [
+        (water(8.0, 0.01, 3.0, 3), true, 40, 1),
+        (suspension(NeighborMode::Verlet, 1.5), false, 600, 37),
+    ] {
+        setup.params.neighbors = NeighborMode::Verlet;
+        let mut p = setup.initial_particles().unwrap();
+        if at_rest {
+            for (v, x) in p.vel.iter_mut().zip(&p.pos) {
+                v[0] -= setup.params.shear_rate * x[1];
+            }
+        }
+        let mut sim = setup.build_from(p, 0).unwrap();
+        assert!(!sim.uses_cells());
+        let b0 = sim.neighbor_builds();
+        for s in 1..=steps {
+            sim.advance().unwrap();
+            if s % every == 0 {
+                check_against_fresh(&sim, &setup);
+            }
+        }
+        assert!(sim.neighbor_builds() > b0 + 5);
+    }
+}
+
+/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
+fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
+    let f = &f;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = LocalRanks::new(ranks)
+            .into_iter()
+            .map(|c| s.spawn(move || f(Box::new(c) as Box<dyn Exchange>)))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+/// Particles, forces, the thermo of the last step and the velocity profile after `steps`
+/// steps plus one thermo step.
+fn end_of(sim: &mut Dpd, steps: u64) -> (Particles, Vec<[f64; 3]>, String, Vec<f64>) {
+    sim.run(steps).unwrap();
+    let th = sim.advance_with_thermo().unwrap();
+    let (mut sum, mut count) = (vec![0.0; 8], vec![0.0; 8]);
+    sim.add_velocity_profile(&mut sum, &mut count);
+    sum.extend(count);
+    (sim.snapshot(), sim.forces(), format!("{th:?}"), sum)
+}
+
+#[test]
+fn a_decomposed_shear_run_is_bitwise_the_single_rank_run() {
+    // The suspension (lists and cells) at rate 1.5 and water at dt 0.04 (cells) at rate 0.5:
+    // particles cross the y boundary inside every slab and migrate between ranks along z.
+    let mut cases: Vec<(DpdSetup, u64)> = [NeighborMode::Verlet, NeighborMode::Cells]
+        .into_iter()
+        .map(|m| (suspension(m, 1.5), 800))
+        .collect();
+    cases.push((water(7.0, 0.04, 0.5, 4), 150));
+    for (setup, steps) in &cases {
+        let one = end_of(&mut setup.build().unwrap(), *steps);
+        assert!(one.0.image.iter().any(|i| i[1] != 0));
+        for ranks in [2, 3] {
+            let ends = on_ranks(ranks, |c| {
+                end_of(&mut setup.build_decomposed(c).unwrap(), *steps)
+            });
+            for (r, e) in ends.iter().enumerate() {
+                let what = format!("{:?}, rank {r} of {ranks}", setup.params.neighbors);
+                assert!(one.0 == e.0, "{what}: particles differ");
+                assert!(one.1 == e.1, "{what}: forces differ");
+                assert_eq!(one.2, e.2, "{what}: thermo differs");
+                assert!(one.3 == e.3, "{what}: profile differs");
+            }
+        }
+    }
+}
