@@ -5,6 +5,8 @@ use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
 use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
 
+mod common;
+
 /// Mean and standard error from `blocks` block averages of `x`.
 fn mean_and_error(x: &[f64], blocks: usize) -> (f64, f64) {
     let m = x.len() / blocks;
@@ -353,73 +355,6 @@ fn colloid_diffusion_at_phi_0_05_against_stokes_einstein() {
     assert!((d1 - d2).abs() < 0.5 * d, "slopes {d1} and {d2}");
 }
 
-/// Every pair force by brute force over all pairs, from the model's definitions (METHODS.md
-/// section 4), for the same positions, velocities and pair noise as the engine.
-fn brute_force(p: &Particles, sbox: &SimBox, prm: &DpdParams, step: u64) -> Vec<[f64; 3]> {
-    use colloidsim_md::dpd::{colloid_solvent_cutoff, pair_noise, step_key};
-    let n = p.len();
-    let key = step_key(prm.seed, step);
-    let a: Vec<f64> = (0..n)
-        .map(|i| {
-            if p.typeid[i] == 1 {
-                0.5 * p.diameter[i]
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let mut f = vec![[0.0; 3]; n];
-    for i in 0..n {
-        for j in 0..n {
-            if i == j {
-                continue;
-            }
-            let (x, y) = (p.pos[i], p.pos[j]);
-            let d = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
-            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            let e = [d[0] / r, d[1] / r, d[2] / r];
-            let dv: Vec<f64> = (0..3).map(|k| p.vel[i][k] - p.vel[j][k]).collect();
-            let ev = e[0] * dv[0] + e[1] * dv[1] + e[2] * dv[2];
-            let h = r - a[i] - a[j];
-            let theta = pair_noise(key, i as u32, j as u32);
-            let both = a[i] > 0.0 && a[j] > 0.0;
-            let mag = if both {
-                if h >= prm.colloid_cutoff {
-                    continue;
-                }
-                let w = 1.0 - h / prm.colloid_cutoff;
-                let c = &prm.colloid;
-                let abar = 0.5 * (a[i] + a[j]);
-                let asq = if c.eta0 > 0.0 {
-                    c.squeeze_coefficient(h, abar)
-                } else {
-                    0.0
-                };
-                c.contact_force(h, abar) + c.morse_force(h) - (prm.gamma * w * w + asq) * ev
-                    + (2.0 * prm.kt * (prm.gamma * w * w + asq) / prm.dt).sqrt() * theta
-            } else {
-                let big = a[i].max(a[j]);
-                let (cut, amp) = if big > 0.0 {
-                    let c = colloid_solvent_cutoff(prm.rc, big);
-                    (c, prm.repulsion_cs * prm.kt / c)
-                } else {
-                    (prm.rc, prm.repulsion * prm.kt / prm.rc)
-                };
-                if h >= cut {
-                    continue;
-                }
-                let w = 1.0 - h / cut;
-                amp * w - prm.gamma * w * w * ev
-                    + (2.0 * prm.gamma * prm.kt / prm.dt).sqrt() * w * theta
-            };
-            for k in 0..3 {
-                f[i][k] += mag * e[k];
-            }
-        }
-    }
-    f
-}
-
 #[test]
 fn engine_forces_equal_a_brute_force_sum_over_all_pairs() {
     for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
@@ -433,7 +368,7 @@ fn check_forces_against_brute_force(setup: &DpdSetup) {
     let p = setup.initial_particles().unwrap();
     let sim = setup.build().unwrap();
     let got = sim.forces();
-    let want = brute_force(&p, &setup.sbox, &setup.params, 0);
+    let want = common::brute_force(&p, &setup.sbox, &setup.params, 0, 0.0);
     let scale = want
         .iter()
         .map(|f| f.iter().map(|x| x.abs()).fold(0.0, f64::max))
@@ -450,7 +385,7 @@ fn check_forces_against_brute_force(setup: &DpdSetup) {
     // A 1 % error in the colloid-solvent repulsion is resolved by the comparison.
     let mut wrong = setup.params;
     wrong.repulsion_cs *= 1.01;
-    let bad = brute_force(&p, &setup.sbox, &wrong, 0);
+    let bad = common::brute_force(&p, &setup.sbox, &wrong, 0, 0.0);
     assert!(
         got.iter()
             .zip(&bad)
