@@ -5,9 +5,9 @@
 //! depend on the threads; restarts continue bitwise; bad input is refused with the key.
 
 use colloidsim_core::exchange::{Exchange, LocalRanks};
+use colloidsim_md::Particles;
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
 use colloidsim_md::dpd::{Dpd, NeighborMode};
-use colloidsim_md::Particles;
 
 mod common;
 use common::brute_force;
