@@ -33,7 +33,10 @@
 //! the buffers are then swapped). Leimkuhler–Matthews draws its deviates `xi_{n+1}` in a third
 //! pass, by input index, before the positions.
 
+mod ranks;
+
 use crate::cells::{CellSort, permute, scan_layer};
+use crate::domain::Domain;
 use crate::neighbor::BoxTooSmall;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
@@ -198,6 +201,8 @@ struct Slab {
     /// Pair forces on this slab's particles (`end - start` entries), then on the next slab's
     /// particles (the halo).
     acc: Vec<[f64; 3]>,
+    /// First slot of the next slab (slab 0 after the last; a ghost layer in a domain).
+    next_start: usize,
 }
 
 /// A Brownian dynamics simulation with pair potential `P` and external field `E`.
@@ -238,6 +243,15 @@ pub struct Brownian<P: Pair, E: External> {
     lm_now: Vec<[f64; 3]>,
     lm_next: Vec<[f64; 3]>,
     lm_step: Option<u64>,
+    /// A run decomposed over ranks ([`Self::decomposed`]): this rank's layers and messages.
+    domain: Option<Domain>,
+    /// The owned slots (all, on one rank; the ghosts lie before or after them).
+    own: (usize, usize),
+    /// Slot of the first owned particle in the storage order of the whole system (the noise
+    /// streams are keyed by that order).
+    first_slot: usize,
+    /// Decomposed: every particle's constants (type, diameter, mass, velocity) in input order.
+    whole: Option<Box<Particles>>,
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
@@ -284,6 +298,17 @@ fn fill_deviates(seed: u32, step: u64, key0: u64, out: &mut [[f64; 3]]) {
                 ];
             }
         });
+}
+
+/// `dt / gamma`, `sqrt(2 kT dt / gamma)` and `(max_drift d)^2` of a particle of diameter `d`
+/// (`gamma = 3 pi eta d`).
+fn kinetics_of(p: &BdParams, d: f64) -> [f64; 3] {
+    let mobility = 1.0 / (3.0 * PI * p.viscosity * d);
+    [
+        mobility * p.dt,
+        (2.0 * p.kt * p.dt * mobility).sqrt(),
+        (p.max_drift * d).powi(2),
+    ]
 }
 
 /// Pairs per batch of the pair-force pass.
@@ -359,18 +384,15 @@ fn slab_pair_forces<P: Pair>(
     }
 }
 
-/// Pair forces of every slab into its buffer, slabs in parallel.
+/// Pair forces of every slab (of the owned ones, `slabs` being those) into its buffer, slabs
+/// in parallel.
 fn all_pair_forces<P: Pair>(slabs: &mut [Slab], p: &Particles, pair: &P) {
-    let nz = slabs.len();
     let r_cut = pair.r_cut_max();
-    // The first slab's start, read before the slabs are borrowed mutably.
-    let first = slabs.first().map_or(0, |s| s.start);
-    slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
-        let next_start = if z + 1 == nz { first } else { slab.end };
+    slabs.par_iter_mut().for_each(|slab| {
         let mut acc = std::mem::take(&mut slab.acc);
         slab_pair_forces(
             slab,
-            next_start,
+            slab.next_start,
             r_cut,
             &p.pos,
             &p.typeid,
@@ -536,6 +558,10 @@ impl<P: Pair, E: External> Brownian<P, E> {
             lm_now: Vec::new(),
             lm_next: Vec::new(),
             lm_step: None,
+            domain: None,
+            own: (0, n),
+            first_slot: 0,
+            whole: None,
         };
         if params.integrator == Integrator::Lm {
             s.lm_now = vec![[0.0; 3]; n];
@@ -543,7 +569,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         }
         s.set_dt(params.dt);
         match list {
-            None => s.sort_and_rebuild(),
+            None => s.sort_and_rebuild()?,
             Some(ls) => s.resume_lists(ls)?,
         }
         Ok(s)
@@ -612,8 +638,11 @@ impl<P: Pair, E: External> Brownian<P, E> {
     }
 
     /// The storage order and the positions of the last list build: what a checkpoint needs to
-    /// continue bitwise ([`Self::restart`]).
+    /// continue bitwise ([`Self::restart`]). Collective when decomposed.
     pub fn list_state(&self) -> ListState {
+        if self.domain.is_some() {
+            return self.list_state_decomposed();
+        }
         ListState {
             order: self.tag.clone(),
             reference: self.ref_pos.clone(),
@@ -628,7 +657,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
     pub fn with_integrator(mut self, integrator: Integrator) -> Self {
         self.params.integrator = integrator;
         let n = if integrator == Integrator::Lm {
-            self.particles.len()
+            self.n_particles()
         } else {
             0
         };
@@ -646,14 +675,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
             .particles
             .diameter
             .iter()
-            .map(|d| {
-                let mobility = 1.0 / (3.0 * PI * p.viscosity * d);
-                [
-                    mobility * dt,
-                    (2.0 * p.kt * dt * mobility).sqrt(),
-                    (p.max_drift * d).powi(2),
-                ]
-            })
+            .map(|&d| kinetics_of(&p, d))
             .collect();
     }
 
@@ -664,18 +686,24 @@ impl<P: Pair, E: External> Brownian<P, E> {
 
     /// Particles in the engine's internal (cell) order ([`Self::order`]), positions as stored:
     /// wrapped at the last list build, up to half the skin outside the box since (the image
-    /// counts match; [`Self::snapshot`] wraps).
+    /// counts match; [`Self::snapshot`] wraps). Decomposed ([`Self::decomposed`]): this rank's
+    /// owned and ghost slots only; [`Self::snapshot`] gathers the whole system.
     pub fn particles(&self) -> &Particles {
         &self.particles
     }
 
-    /// Input index of each internally stored particle (the storage order).
+    /// Input index of each internally stored particle (the storage order; this rank's slots
+    /// when decomposed).
     pub fn order(&self) -> &[u32] {
         &self.tag
     }
 
     /// The particles in input order, wrapped into the box (allocates; for output and analysis).
+    /// Collective when decomposed: every rank gets the whole system.
     pub fn snapshot(&self) -> Particles {
+        if self.domain.is_some() {
+            return self.snapshot_decomposed();
+        }
         let n = self.particles.len();
         let mut inv = vec![0u32; n];
         for (k, &t) in self.tag.iter().enumerate() {
@@ -709,13 +737,19 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.builds
     }
 
-    /// Forces on the particles in input order at the current positions and time (allocates).
+    /// Forces on the particles in input order at the current positions and time (allocates;
+    /// collective when decomposed).
     pub fn forces(&self) -> Vec<[f64; 3]> {
+        if self.domain.is_some() {
+            return self.forces_decomposed();
+        }
         let t = self.time();
         let n = self.particles.len();
         let mut slabs = self.slabs.clone();
         let p = &self.particles;
-        all_pair_forces(&mut slabs, p, &self.pair);
+        if !slabs.is_empty() {
+            all_pair_forces(&mut slabs, p, &self.pair);
+        }
         let mut out = vec![[0.0; 3]; n];
         let mut pair_force = PairForceCursor::new(&slabs, &self.slab_of, 0);
         for (k, &tag) in self.tag.iter().enumerate() {
@@ -730,8 +764,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
     }
 
     /// Wrap the positions, sort the particles into cells and rebuild the lists (without pair
-    /// forces: only wrap).
-    fn sort_and_rebuild(&mut self) {
+    /// forces: only wrap). Decomposed: with the migration and the new ghosts (an error when a
+    /// particle crossed more than one domain).
+    fn sort_and_rebuild(&mut self) -> Result<(), BdError> {
+        if self.domain.is_some() {
+            return self.rebuild_decomposed();
+        }
         let sbox = self.sbox;
         self.particles
             .pos
@@ -749,9 +787,18 @@ impl<P: Pair, E: External> Brownian<P, E> {
         if self.range > 0.0 {
             self.build_lists();
         }
+        Ok(())
     }
 
-    /// Slabs and half lists from the reference positions (which are in cell order).
+    /// The layers of cells whose pairs this engine sums: all, or a domain's own.
+    fn owned_layers(&self) -> (usize, usize) {
+        self.domain
+            .as_ref()
+            .map_or((0, self.slabs.len()), |d| (d.z0, d.z1))
+    }
+
+    /// Slabs and half lists (of the owned layers) from the reference positions (which are in
+    /// cell order).
     fn build_lists(&mut self) {
         self.builds += 1;
         let n = self.particles.len();
@@ -761,9 +808,11 @@ impl<P: Pair, E: External> Brownian<P, E> {
             (self.slabs[z].start, self.slabs[z].end) = self.grid.layer(z);
         }
         for z in 0..nz {
-            let next = self.slabs[(z + 1) % nz].end - self.slabs[(z + 1) % nz].start;
+            let next = &self.slabs[(z + 1) % nz];
+            let (next_start, next_len) = (next.start, next.end - next.start);
             let s = &mut self.slabs[z];
-            s.acc.resize(s.end - s.start + next, [0.0; 3]);
+            s.next_start = next_start;
+            s.acc.resize(s.end - s.start + next_len, [0.0; 3]);
         }
         debug_assert_eq!(self.slabs.last().map_or(n, |s| s.end), n);
         self.grid.layer_of_slots(&mut self.slab_of);
@@ -771,49 +820,54 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let cell_start = &self.grid.cell_start;
         let n_cells = self.grid.n_cells;
         let (sbox, range) = (self.sbox, self.range);
-        self.slabs.par_iter_mut().enumerate().for_each(|(z, slab)| {
-            let Slab {
-                pairs,
-                shifted,
-                cand,
-                ..
-            } = slab;
-            pairs.clear();
-            shifted.clear();
-            let (l, h) = (sbox.l, sbox.l.map(|x| 0.5 * x));
-            scan_layer(
-                z,
-                pos,
-                cell_start,
-                n_cells,
-                &sbox,
-                range,
-                cand,
-                |i, cands| {
-                    let xi = pos[i];
-                    for &(j, d) in cands {
-                        // The periodic shift the scan applied to x_i: 0 or +-L per axis.
-                        let xj = pos[j as usize];
-                        let mut sh = [0.0; 3];
-                        for k in 0..3 {
-                            let gap = (xi[k] - xj[k]) - d[k];
-                            sh[k] = if gap > h[k] {
-                                l[k]
-                            } else if gap < -h[k] {
-                                -l[k]
+        let (z0, z1) = self.owned_layers();
+        self.slabs[z0..z1]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, slab)| {
+                let z = z0 + k;
+                let Slab {
+                    pairs,
+                    shifted,
+                    cand,
+                    ..
+                } = slab;
+                pairs.clear();
+                shifted.clear();
+                let (l, h) = (sbox.l, sbox.l.map(|x| 0.5 * x));
+                scan_layer(
+                    z,
+                    pos,
+                    cell_start,
+                    n_cells,
+                    &sbox,
+                    range,
+                    cand,
+                    |i, cands| {
+                        let xi = pos[i];
+                        for &(j, d) in cands {
+                            // The periodic shift the scan applied to x_i: 0 or +-L per axis.
+                            let xj = pos[j as usize];
+                            let mut sh = [0.0; 3];
+                            for k in 0..3 {
+                                let gap = (xi[k] - xj[k]) - d[k];
+                                sh[k] = if gap > h[k] {
+                                    l[k]
+                                } else if gap < -h[k] {
+                                    -l[k]
+                                } else {
+                                    0.0
+                                };
+                            }
+                            if sh == [0.0; 3] {
+                                pairs.push([i as u32, j]);
                             } else {
-                                0.0
-                            };
+                                shifted.push(([i as u32, j], sh));
+                            }
                         }
-                        if sh == [0.0; 3] {
-                            pairs.push([i as u32, j]);
-                        } else {
-                            shifted.push(([i as u32, j], sh));
-                        }
-                    }
-                },
-            );
-        });
+                    },
+                );
+            });
     }
 
     /// Apply `self.grid.perm` (new slot k takes old slot perm[k]) to every per-particle array.
@@ -847,7 +901,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let key0 = (self.params.replica as u64) << 32;
         let n = self.particles.len();
         if self.range > 0.0 {
-            all_pair_forces(&mut self.slabs, &self.particles, &self.pair);
+            let (z0, z1) = self.owned_layers();
+            all_pair_forces(&mut self.slabs[z0..z1], &self.particles, &self.pair);
+            self.exchange_halo();
         }
         // Leimkuhler–Matthews: xi_n (drawn by the previous step, or afresh after a restart)
         // and xi_{n+1}, by input index.
@@ -859,104 +915,42 @@ impl<P: Pair, E: External> Brownian<P, E> {
             fill_deviates(seed, step + 1, key0, &mut self.lm_next);
             self.lm_step = Some(step);
         }
-        let (lm_now, lm_next) = (&self.lm_now, &self.lm_next);
         let mut new_pos = std::mem::take(&mut self.new_pos);
         new_pos.resize(n, [0.0; 3]);
-        let p = &self.particles;
-        let pos = &p.pos;
-        let (slabs, slab_of, ref_pos) = (&self.slabs, &self.slab_of, &self.ref_pos);
-        let external = &self.external;
-        let (kinetics, tag) = (&self.kinetics, &self.tag);
-        let zig = Ziggurat::get();
-        let report = new_pos
+        let pass = StepPass {
+            pos: &self.particles.pos,
+            kinetics: &self.kinetics,
+            ref_pos: &self.ref_pos,
+            tag: &self.tag,
+            slabs: &self.slabs,
+            slab_of: &self.slab_of,
+            external: &self.external,
+            t,
+            seed,
+            step,
+            key0,
+            lm: lm.then_some((&self.lm_now[..], &self.lm_next[..])),
+        };
+        // The owned slots, whose noise comes from the blocks of the whole system's storage
+        // order: a first, partial block when this domain starts inside one, then whole chunks.
+        let (a, b) = self.own;
+        let g0 = self.first_slot;
+        let head = ((BLOCK - g0 % BLOCK) % BLOCK).min(b - a);
+        let (head_out, rest) = new_pos[a..b].split_at_mut(head);
+        let first = pass.integrate(a, head_out, (g0 / BLOCK) as u64, g0 % BLOCK);
+        let g1 = (g0 + head) / BLOCK;
+        let report = rest
             .par_chunks_mut(CHUNK)
             .enumerate()
-            .map(|(b, out)| {
-                let mut rep = ChunkReport::EMPTY;
-                let lo = b * CHUNK;
-                let mut pair_force = PairForceCursor::new(slabs, slab_of, lo);
-                for (kb, out) in out.chunks_mut(BLOCK).enumerate() {
-                    let lo = lo + kb * BLOCK;
-                    let m = out.len();
-                    let (x, c, r) = (
-                        &pos[lo..lo + m],
-                        &kinetics[lo..lo + m],
-                        &ref_pos[lo..lo + m],
-                    );
-                    let mut rng = stream(seed, step, Purpose::Noise, key0 | (lo / BLOCK) as u64);
-                    let tags = &tag[lo..lo + m];
-                    for k in 0..m {
-                        let [drift_per_force, amp, limit2] = c[k];
-                        let fp = pair_force.force(lo + k);
-                        let fe = external.force(x[k], t);
-                        let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
-                        let drift = [
-                            f[0] * drift_per_force,
-                            f[1] * drift_per_force,
-                            f[2] * drift_per_force,
-                        ];
-                        let drift2 =
-                            drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
-                        // NaN forces fail the comparison and count as a blow-up too.
-                        let ok = drift2 <= limit2;
-                        if !ok {
-                            let i = lo + k;
-                            if rep.blow_up.is_none_or(|b| tag[i] < b.3) {
-                                rep.blow_up = Some((
-                                    i,
-                                    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt(),
-                                    drift2.sqrt(),
-                                    tag[i],
-                                ));
-                            }
-                        }
-                        let xi = if lm {
-                            // (xi_n + xi_{n+1}) / 2 of this particle.
-                            let i = tags[k] as usize;
-                            let (a, b) = (lm_now[i], lm_next[i]);
-                            [
-                                0.5 * (a[0] + b[0]),
-                                0.5 * (a[1] + b[1]),
-                                0.5 * (a[2] + b[2]),
-                            ]
-                        } else {
-                            [
-                                zig.sample(&mut rng),
-                                zig.sample(&mut rng),
-                                zig.sample(&mut rng),
-                            ]
-                        };
-                        let q = [
-                            x[k][0] + drift[0] + amp * xi[0],
-                            x[k][1] + drift[1] + amp * xi[1],
-                            x[k][2] + drift[2] + amp * xi[2],
-                        ];
-                        let rk = r[k];
-                        let d = [q[0] - rk[0], q[1] - rk[1], q[2] - rk[2]];
-                        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        // NaN compares false and is ignored here; the blow-up check reports it.
-                        rep.max_disp2 = if d2 > rep.max_disp2 {
-                            d2
-                        } else {
-                            rep.max_disp2
-                        };
-                        out[k] = q;
-                    }
-                }
-                rep
+            .map(|(c, out)| {
+                let lo = a + head + c * CHUNK;
+                pass.integrate(lo, out, (g1 + c * CHUNK / BLOCK) as u64, 0)
             })
-            .reduce(|| ChunkReport::EMPTY, ChunkReport::merge);
-        if let Some((i, force, drift, _)) = report.blow_up {
+            .reduce(|| first, ChunkReport::merge);
+        let (max_disp2, blow_up) = self.agree_on_step(report);
+        if let Some(e) = blow_up {
             self.new_pos = new_pos;
-            return Err(BdError::BlowUp {
-                step,
-                time: t,
-                particle: self.tag[i] as usize,
-                position: self.particles.pos[i],
-                force,
-                drift,
-                diameter: self.particles.diameter[i],
-            });
+            return Err(e);
         }
         std::mem::swap(&mut self.particles.pos, &mut new_pos);
         self.new_pos = new_pos;
@@ -969,9 +963,130 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let every = self.params.sort_every;
         // NaN displacements (a run gone non-finite without a blow-up) fail every comparison:
         // the rebuild is skipped and the next step reports the blow-up.
-        if report.max_disp2 > self.rebuild_disp2 || (every > 0 && self.step.is_multiple_of(every)) {
-            self.sort_and_rebuild();
+        if max_disp2 > self.rebuild_disp2 || (every > 0 && self.step.is_multiple_of(every)) {
+            self.sort_and_rebuild()?;
+        } else {
+            self.refresh_ghosts();
         }
         Ok(())
+    }
+
+    /// The blow-up of a step's report as an error (one process).
+    fn blow_up_error(&self, report: &ChunkReport) -> Option<BdError> {
+        report
+            .blow_up
+            .map(|(i, force, drift, tag)| BdError::BlowUp {
+                step: self.step,
+                time: self.time(),
+                particle: tag as usize,
+                position: self.particles.pos[i],
+                force,
+                drift,
+                diameter: self.particles.diameter[i],
+            })
+    }
+}
+
+/// Leimkuhler–Matthews deviates `xi_n` and `xi_{n+1}`, by input index.
+type LmDeviates<'a> = (&'a [[f64; 3]], &'a [[f64; 3]]);
+
+/// What the integration pass of a step reads.
+struct StepPass<'a, E> {
+    pos: &'a [[f64; 3]],
+    kinetics: &'a [[f64; 3]],
+    ref_pos: &'a [[f64; 3]],
+    tag: &'a [u32],
+    slabs: &'a [Slab],
+    slab_of: &'a [u32],
+    external: &'a E,
+    t: f64,
+    seed: u32,
+    step: u64,
+    key0: u64,
+    /// Leimkuhler–Matthews: `xi_n` and `xi_{n+1}` by input index.
+    lm: Option<LmDeviates<'a>>,
+}
+
+impl<E: External> StepPass<'_, E> {
+    /// New positions of slots `lo ..< lo + out.len()` into `out`. Their Euler noise comes from
+    /// the streams of blocks `block, block + 1, ...` of the whole system's storage order, the
+    /// first of which begins `skip` particles before slot `lo` (their deviates are drawn and
+    /// dropped).
+    fn integrate(&self, lo: usize, out: &mut [[f64; 3]], block: u64, skip: usize) -> ChunkReport {
+        let zig = Ziggurat::get();
+        let mut rep = ChunkReport::EMPTY;
+        let mut pair_force = PairForceCursor::new(self.slabs, self.slab_of, lo);
+        let (mut k0, mut block, mut skip) = (0, block, skip);
+        while k0 < out.len() {
+            let m = (BLOCK - skip).min(out.len() - k0);
+            let mut rng = stream(self.seed, self.step, Purpose::Noise, self.key0 | block);
+            if self.lm.is_none() {
+                for _ in 0..3 * skip {
+                    zig.sample(&mut rng);
+                }
+            }
+            for k in k0..k0 + m {
+                let i = lo + k;
+                let [drift_per_force, amp, limit2] = self.kinetics[i];
+                let x = self.pos[i];
+                let fp = pair_force.force(i);
+                let fe = self.external.force(x, self.t);
+                let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
+                let drift = [
+                    f[0] * drift_per_force,
+                    f[1] * drift_per_force,
+                    f[2] * drift_per_force,
+                ];
+                let drift2 = drift[0] * drift[0] + drift[1] * drift[1] + drift[2] * drift[2];
+                // NaN forces fail the comparison and count as a blow-up too.
+                let ok = drift2 <= limit2;
+                if !ok {
+                    let tag = self.tag[i];
+                    if rep.blow_up.is_none_or(|b| tag < b.3) {
+                        rep.blow_up = Some((
+                            i,
+                            (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt(),
+                            drift2.sqrt(),
+                            tag,
+                        ));
+                    }
+                }
+                let xi = match self.lm {
+                    // (xi_n + xi_{n+1}) / 2 of this particle.
+                    Some((now, next)) => {
+                        let (a, b) = (now[self.tag[i] as usize], next[self.tag[i] as usize]);
+                        [
+                            0.5 * (a[0] + b[0]),
+                            0.5 * (a[1] + b[1]),
+                            0.5 * (a[2] + b[2]),
+                        ]
+                    }
+                    None => [
+                        zig.sample(&mut rng),
+                        zig.sample(&mut rng),
+                        zig.sample(&mut rng),
+                    ],
+                };
+                let q = [
+                    x[0] + drift[0] + amp * xi[0],
+                    x[1] + drift[1] + amp * xi[1],
+                    x[2] + drift[2] + amp * xi[2],
+                ];
+                let r = self.ref_pos[i];
+                let d = [q[0] - r[0], q[1] - r[1], q[2] - r[2]];
+                let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                // NaN compares false and is ignored here; the blow-up check reports it.
+                rep.max_disp2 = if d2 > rep.max_disp2 {
+                    d2
+                } else {
+                    rep.max_disp2
+                };
+                out[k] = q;
+            }
+            k0 += m;
+            block += 1;
+            skip = 0;
+        }
+        rep
     }
 }

@@ -7,6 +7,7 @@ pub mod bench;
 pub mod brownian;
 pub mod bulk;
 mod cells;
+mod domain;
 pub mod dpd;
 pub mod droplet;
 pub mod gsd;

@@ -50,10 +50,10 @@ pub mod scenario;
 pub mod viscosity;
 
 use crate::cells::{CellSort, permute, scan_layer_sheared};
+use crate::domain::Domain;
 use crate::neighbor::{BoxTooSmall, NeighborList};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::exchange::Exchange;
-use domain::Domain;
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
 pub use viscosity::StressAcf;
@@ -634,7 +634,7 @@ impl Dpd {
         };
         if let Some(comm) = comm.filter(|c| c.size() > 1) {
             let nz = CellSort::cells_for(&sbox, cell_range)[2];
-            s.domain = Some(Domain::new(comm, nz, cell_range)?);
+            s.domain = Some(Domain::new(comm, nz, cell_range).map_err(DpdError::Invalid)?);
             s.keep_own();
             s.migrate_and_fetch_ghosts()?;
         }
