@@ -3,25 +3,15 @@
 //! be bitwise the single-rank run for any number of ranks: periodic (with a body force that
 //! drives particles across every domain face and the periodic seam) and in a drying droplet.
 
-use colloidsim_core::exchange::{Exchange, LocalRanks};
+mod common;
+
 use colloidsim_md::brownian::ListState;
 use colloidsim_md::potential::{ConstantForce, External};
 use colloidsim_md::{
     BdError, BdParams, Brownian, DropletScenario, Integrator, LennardJones, Particles, SimBox,
 };
+use common::on_ranks;
 use std::f64::consts::PI;
-
-/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
-fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
-    let f = &f;
-    std::thread::scope(|s| {
-        let handles: Vec<_> = LocalRanks::new(ranks)
-            .into_iter()
-            .map(|c| s.spawn(move || f(Box::new(c))))
-            .collect();
-        handles.into_iter().map(|h| h.join().unwrap()).collect()
-    })
-}
 
 /// `n` steps one at a time: [`Brownian::run`] runs them on a worker of the thread pool, where
 /// ranks that are threads of one process would wait for each other with too few workers.

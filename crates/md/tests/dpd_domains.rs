@@ -2,10 +2,12 @@
 //! ([`LocalRanks`]); the MPI ranks of the CLI run the same code. A decomposed run must be
 //! bitwise the single-rank run, for any number of ranks, with lists or cells, with colloids.
 
-use colloidsim_core::exchange::{Exchange, LocalRanks};
+mod common;
+
 use colloidsim_md::Particles;
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
 use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};
+use common::on_ranks;
 
 fn scenario(text: &str) -> DpdSetup {
     DpdScenario::from_toml(text).unwrap().validate().unwrap()
@@ -27,18 +29,6 @@ struct End {
     forces: Vec<[f64; 3]>,
     thermo: Thermo,
     owned: (usize, usize),
-}
-
-/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
-fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
-    let f = &f;
-    std::thread::scope(|s| {
-        let handles: Vec<_> = LocalRanks::new(ranks)
-            .into_iter()
-            .map(|c| s.spawn(move || f(Box::new(c))))
-            .collect();
-        handles.into_iter().map(|h| h.join().unwrap()).collect()
-    })
 }
 
 /// DPD water (density 3, a = 25, gamma = 4.5) at dt = 0.04 in a cube of side `l`.

@@ -1,6 +1,7 @@
-//! The DPD force model summed by brute force, for the engine tests.
+//! Shared by the engine tests: the DPD force model summed by brute force, ranks as threads.
 #![allow(dead_code)]
 
+use colloidsim_core::exchange::{Exchange, LocalRanks};
 use colloidsim_md::dpd::DpdParams;
 use colloidsim_md::{Particles, SimBox};
 
@@ -79,4 +80,16 @@ pub fn brute_force(
         }
     }
     f
+}
+
+/// `f(rank)` on `ranks` threads, each with its endpoint; the results in rank order.
+pub fn on_ranks<T: Send>(ranks: usize, f: impl Fn(Box<dyn Exchange>) -> T + Sync) -> Vec<T> {
+    let f = &f;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = LocalRanks::new(ranks)
+            .into_iter()
+            .map(|c| s.spawn(move || f(Box::new(c))))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
 }
