@@ -1,5 +1,6 @@
 //! `colloidsim` under `mpirun -n 1, 2, 4` (built with `--features mpi`; `.ci/run` runs these
-//! with Open MPI): an ensemble's folder, and a DPD run decomposed in space, are byte for byte
+//! with Open MPI): an ensemble's folder, and a DPD or free-draining Brownian-dynamics run
+//! decomposed in space, are byte for byte
 //! the single-process ones on any number of ranks, also when continued on another number of
 //! ranks, and a failure on one rank stops every rank with its message instead of a hang.
 #![cfg(feature = "mpi")]
@@ -193,23 +194,12 @@ trajectory_every = 100
 msd_every = 50
 "#;
 
-/// The DPD scenario in `dir` and its run in one process on one thread into `dir/serial`.
-fn dpd_reference(dir: &Path) -> (String, PathBuf) {
-    let sc = dir.join("dpd.toml");
-    std::fs::write(&sc, TINY_DPD).unwrap();
-    let reference = dir.join("serial");
-    let (s, r) = (sc.to_str().unwrap(), reference.to_str().unwrap());
-    let o = common::cli(&["run", s, "--out", r, "--threads", "1", "--quiet"], &[]);
-    assert!(o.status.success(), "{}", text(&o));
-    (s.to_string(), reference)
-}
-
 #[test]
 fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
     // The box has 4 layers of cells: on 3 ranks one rank owns two layers. The reference ran
     // on one thread.
     let tmp = tempfile::tempdir().unwrap();
-    let (s, reference) = dpd_reference(tmp.path());
+    let (s, reference) = reference(tmp.path(), "dpd", TINY_DPD);
     for ranks in [1, 2, 3, 4] {
         let out = tmp.path().join(format!("ranks-{ranks}"));
         // Ranks times threads: two ranks of two threads each.
@@ -238,28 +228,34 @@ fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
 #[test]
 fn a_dpd_run_interrupted_on_2_ranks_continues_on_1_and_4() {
     let tmp = tempfile::tempdir().unwrap();
-    let (s, reference) = dpd_reference(tmp.path());
+    let (s, reference) = reference(tmp.path(), "dpd", TINY_DPD);
     for ranks in [1, 4] {
         let out = tmp.path().join(format!("continued-on-{ranks}"));
-        let o = mpirun_env(
-            2,
-            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
-            &[("COLLOIDSIM_INTERRUPT_AT_STEP", "150")],
-        );
-        assert!(!o.status.success());
-        let t = text(&o);
-        assert!(t.contains("mpirun -n N colloidsim run --restart"), "{t}");
-        assert_eq!(t.matches("error:").count(), 1, "{t}");
-        assert!(out.join("checkpoint.bin").exists());
-        let args = ["run", "--restart", out.to_str().unwrap(), "--quiet"];
-        let r = if ranks == 1 {
-            common::cli(&args, &[])
-        } else {
-            mpirun(ranks, &args)
-        };
-        assert!(r.status.success(), "restart on {ranks} ranks: {}", text(&r));
+        interrupted_on_2_continued_on(ranks, &s, &out, "150");
         assert_same_tree(&reference, &out);
     }
+}
+
+/// Run scenario `s` into `out` on 2 ranks, interrupted at step `at`, and continue it on
+/// `ranks` ranks (in one process for 1).
+fn interrupted_on_2_continued_on(ranks: usize, s: &str, out: &Path, at: &str) {
+    let o = mpirun_env(
+        2,
+        &["run", s, "--out", out.to_str().unwrap(), "--quiet"],
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", at)],
+    );
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert!(t.contains("mpirun -n N colloidsim run --restart"), "{t}");
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(out.join("checkpoint.bin").exists());
+    let args = ["run", "--restart", out.to_str().unwrap(), "--quiet"];
+    let r = if ranks == 1 {
+        common::cli(&args, &[])
+    } else {
+        mpirun(ranks, &args)
+    };
+    assert!(r.status.success(), "restart on {ranks} ranks: {}", text(&r));
 }
 
 #[test]
@@ -331,4 +327,154 @@ fn an_ensemble_interrupted_on_2_ranks_continues_on_1_and_4() {
         assert!(r.status.success(), "restart on {ranks} ranks");
         assert_same_tree(&reference, &out);
     }
+}
+
+/// A drying droplet, free draining: 400 colloids, 2 replicas of 6166 steps, profiles, a
+/// trajectory of replica 0 and its cross-section; its box has 14 layers of cells, most of
+/// them empty at first.
+const TINY_DROPLET: &str = r#"
+method = "droplet-bd"
+seed = 5
+replicas = 2
+[system]
+particles = 400
+phi0 = 0.1
+[drying]
+peclet = 10
+final_volume_fraction = 0.3
+[run]
+dt = 0.0025
+[observe]
+profile = { bins = 12, fractions = [0, 0.5, 1.0] }
+trajectory = { every = 100 }
+cross_section = { width = 1.0 }
+"#;
+
+/// Bulk Brownian dynamics, free draining (Leimkuhler–Matthews) under a body force: 400
+/// spheres, 2 replicas of 1100 steps, MSD blocks and a trajectory of replica 0.
+const TINY_BULK_BD: &str = r#"
+method = "bd"
+seed = 4
+replicas = 2
+[system]
+particles = 400
+box_length = 10.0
+body_force = [1.0, 0.0, -2.0]
+[run]
+dt = 0.002
+time = 2.0
+equilibrate = 0.2
+integrator = "lm"
+[observe.trajectory]
+every = 100
+"#;
+
+/// `scenario` as `dir/NAME.toml` and its run in one process on one thread into
+/// `dir/NAME-serial`.
+fn reference(dir: &Path, name: &str, scenario: &str) -> (String, PathBuf) {
+    let sc = dir.join(format!("{name}.toml"));
+    std::fs::write(&sc, scenario).unwrap();
+    let reference = dir.join(format!("{name}-serial"));
+    let (s, r) = (sc.to_str().unwrap(), reference.to_str().unwrap());
+    let o = common::cli(&["run", s, "--out", r, "--threads", "1", "--quiet"], &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    (s.to_string(), reference)
+}
+
+#[test]
+fn a_droplet_bd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "droplet", TINY_DROPLET);
+    for ranks in [1, 2, 3, 4] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let threads = if ranks == 2 { "2" } else { "1" };
+        let o = mpirun(
+            ranks,
+            &[
+                "run",
+                &s,
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                threads,
+            ],
+        );
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        assert_eq!(text(&o).matches("outputs in").count(), 1, "{}", text(&o));
+        assert_same_tree(&reference, &out);
+        assert!(out.join("cross_section.csv").exists());
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(summary["ranks"], ranks);
+    }
+}
+
+#[test]
+fn bd_runs_interrupted_on_2_ranks_continue_on_1_and_3() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Interrupted in replica 1 (droplet) and in replica 1's sampling (bulk).
+    for (name, scenario, at) in [
+        ("droplet", TINY_DROPLET, "7000"),
+        ("bulk", TINY_BULK_BD, "1500"),
+    ] {
+        let (s, reference) = reference(tmp.path(), name, scenario);
+        if name == "bulk" {
+            let out = tmp.path().join("bulk-on-3");
+            let o = mpirun(3, &["run", &s, "--out", out.to_str().unwrap(), "--quiet"]);
+            assert!(o.status.success());
+            assert_same_tree(&reference, &out);
+        }
+        for ranks in [1, 3] {
+            let out = tmp.path().join(format!("{name}-continued-on-{ranks}"));
+            interrupted_on_2_continued_on(ranks, &s, &out, at);
+            assert_same_tree(&reference, &out);
+        }
+    }
+}
+
+#[test]
+fn a_failing_bd_run_on_ranks_stops_every_rank_with_one_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join("droplet.toml");
+    std::fs::write(&sc, TINY_DROPLET).unwrap();
+    let s = sc.to_str().unwrap();
+    // A time step too large: the single-process run's message and outputs, once.
+    let unstable = ["--quiet", "--set", "run.dt=0.005"];
+    let one = tmp.path().join("one");
+    let o = common::cli(
+        &[&["run", s, "--out", one.to_str().unwrap()][..], &unstable].concat(),
+        &[],
+    );
+    assert!(!o.status.success());
+    let want = text(&o);
+    let want = want.lines().find(|l| l.starts_with("error:")).unwrap();
+    let out = tmp.path().join("unstable");
+    let o = mpirun(
+        2,
+        &[&["run", s, "--out", out.to_str().unwrap()][..], &unstable].concat(),
+    );
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains(want), "{t}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["completed"], false);
+    // Hydrodynamics is not decomposed: refused on every rank before anything is written.
+    let rpy = tmp.path().join("rpy.toml");
+    std::fs::write(
+        &rpy,
+        "method = \"bd\"\n[system]\nparticles = 20\nbox_length = 8.0\n[run]\ndt = 0.01\ntime = 0.5\n[hydrodynamics]\nmodel = \"rpy\"\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("rpy");
+    let o = mpirun(
+        2,
+        &["run", rpy.to_str().unwrap(), "--out", out.to_str().unwrap()],
+    );
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains("runs on one rank"), "{t}");
+    assert!(!out.exists());
 }

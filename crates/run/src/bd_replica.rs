@@ -8,6 +8,7 @@ use crate::engine::flat;
 use crate::method::{Finished, Session};
 use crate::trajectory::FrameDigest;
 use anyhow::{Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::brownian::Integrator;
 use colloidsim_md::gsd::{self, GsdFrame, GsdWriter};
@@ -56,7 +57,7 @@ impl<E: External> Replica<E> {
         }
     }
 
-    /// The particles in the engine's order (for profiles, where the order does not matter).
+    /// The particles in the engine's order (this rank's slots when decomposed).
     pub(crate) fn particles(&self) -> &Particles {
         match self {
             Self::Free(s) => s.particles(),
@@ -64,7 +65,36 @@ impl<E: External> Replica<E> {
         }
     }
 
-    /// The particles in input order, positions wrapped into the box.
+    /// This replica decomposed in space over the ranks of `comm` (free draining only).
+    pub(crate) fn decomposed(self, comm: Box<dyn Exchange>) -> Result<Self> {
+        match self {
+            Self::Free(s) => Ok(Self::Free(Box::new(s.decomposed(comm)?))),
+            Self::Hydro(_) => bail!(
+                "Brownian dynamics with hydrodynamics runs on one rank: only free-draining \
+                 Brownian dynamics is decomposed over MPI ranks (docs/parallel.md); spread \
+                 replicas over ranks with `colloidsim ensemble`"
+            ),
+        }
+    }
+
+    /// The ranks of a decomposed replica.
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        match self {
+            Self::Free(s) => s.exchange(),
+            Self::Hydro(_) => None,
+        }
+    }
+
+    /// The replica is done with: the ranks it ran on, for the next one.
+    fn into_exchange(self) -> Option<Box<dyn Exchange>> {
+        match self {
+            Self::Free(s) => s.into_exchange(),
+            Self::Hydro(_) => None,
+        }
+    }
+
+    /// The particles in input order, positions wrapped into the box (collective when
+    /// decomposed).
     pub(crate) fn snapshot(&self) -> Particles {
         match self {
             Self::Free(s) => s.snapshot(),
@@ -73,18 +103,13 @@ impl<E: External> Replica<E> {
     }
 
     /// The unwrapped positions `x + image L` in input order, into `out` (no allocation once
-    /// `out` has its length).
+    /// `out` has its length on one process; collective when decomposed).
     pub(crate) fn unwrapped_into(&self, out: &mut Vec<[f64; 3]>) {
-        let p = self.particles();
-        out.resize(p.len(), [0.0; 3]);
-        let sbox = self.sbox();
         match self {
-            Self::Free(s) => {
-                for ((x, img), &tag) in p.pos.iter().zip(&p.image).zip(s.order()) {
-                    out[tag as usize] = sbox.unwrap(*x, *img);
-                }
-            }
-            Self::Hydro(_) => {
+            Self::Free(s) => s.unwrapped_into(out),
+            Self::Hydro(s) => {
+                let (p, sbox) = (s.particles(), &s.sbox);
+                out.resize(p.len(), [0.0; 3]);
                 for ((x, img), u) in p.pos.iter().zip(&p.image).zip(out.iter_mut()) {
                     *u = sbox.unwrap(*x, *img);
                 }
@@ -119,16 +144,26 @@ impl<E: External> Replica<E> {
     /// positions and images, and for the free-draining engine its list state
     /// (`GsdWriter::write_checkpoint`); the hydrodynamic engine's whole state is its exact
     /// positions and images (its noise is keyed by (seed, step, replica, particle) and its
-    /// pair forces do not depend on when the list was built).
-    pub(crate) fn write_checkpoint(&self, path: &Path) -> Result<()> {
-        let mut w = GsdWriter::create_new(path)?;
+    /// pair forces do not depend on when the list was built). Decomposed: every rank gathers
+    /// the state, the writer alone writes (`path` is `None` on the others).
+    pub(crate) fn write_checkpoint(&self, path: Option<&Path>) -> Result<()> {
         match self {
             Self::Free(s) => {
-                w.write_checkpoint(s.step, &s.sbox, &s.snapshot(), &s.list_state(), &[])?
+                let (snap, list) = (s.snapshot(), s.list_state());
+                if let Some(path) = path {
+                    let mut w = GsdWriter::create_new(path)?;
+                    w.write_checkpoint(s.step, &s.sbox, &snap, &list, &[])?;
+                    w.sync()?;
+                }
             }
-            Self::Hydro(s) => w.write_frame(s.step, &s.sbox, s.particles(), true, &[])?,
+            Self::Hydro(s) => {
+                if let Some(path) = path {
+                    let mut w = GsdWriter::create_new(path)?;
+                    w.write_frame(s.step, &s.sbox, s.particles(), true, &[])?;
+                    w.sync()?;
+                }
+            }
         }
-        w.sync()?;
         Ok(())
     }
 }
@@ -222,11 +257,13 @@ pub(crate) type ReplicaState = (String, u32, EngineState);
 /// into the GSD file (`checkpoint-0.gsd` / `checkpoint-1.gsd`, alternating with
 /// `checkpoints`, the count including this one) that the current `checkpoint.bin` does not
 /// name. Returns its state and the files to remove once `checkpoint.bin` names it, so that a
-/// run killed at any moment leaves a consistent checkpoint.
+/// run killed at any moment leaves a consistent checkpoint. Decomposed: every rank takes part,
+/// the writer writes (the others' CRC is 0; their state is not written).
 fn save_replica<E: External>(
     out: &OutputDir,
     checkpoints: u64,
     sim: Option<(&Replica<E>, u64)>,
+    writer: bool,
 ) -> Result<(Option<ReplicaState>, Vec<String>)> {
     let name = format!("checkpoint-{}.gsd", checkpoints % 2);
     let old = format!("checkpoint-{}.gsd", (checkpoints + 1) % 2);
@@ -234,9 +271,14 @@ fn save_replica<E: External>(
     let state = match sim {
         Some((s, builds)) => {
             let path = out.join(&name);
-            let _ = std::fs::remove_file(&path);
-            s.write_checkpoint(&path)?;
-            let crc = file_crc(&path)?;
+            let crc = if writer {
+                let _ = std::fs::remove_file(&path);
+                s.write_checkpoint(Some(&path))?;
+                file_crc(&path)?
+            } else {
+                s.write_checkpoint(None)?;
+                0
+            };
             Some((name, crc, EngineState::of(s, builds + s.neighbor_builds())))
         }
         None => {
@@ -300,7 +342,9 @@ pub(crate) trait Observe<E: External> {
 
 /// The replicas of a Brownian-dynamics run, one after the other: where the run stands (the
 /// driver's position counts steps over the replicas), the running replica, replica 0's
-/// trajectory writer and the GSD checkpoint files.
+/// trajectory writer and the GSD checkpoint files. Decomposed over MPI ranks
+/// (docs/parallel.md), each replica runs on all ranks, every rank takes part in what is
+/// gathered (frames, checkpoints) and rank 0 writes.
 pub(crate) struct Replicas<E: External> {
     /// Steps per replica.
     pub(crate) steps: u64,
@@ -319,19 +363,29 @@ pub(crate) struct Replicas<E: External> {
     traj: Option<PathBuf>,
     /// GSD file the previous checkpoint named, removed once the next one is in place.
     stale: Vec<String>,
+    /// The ranks of a decomposed run while no replica holds them (between replicas).
+    parked: Option<Box<dyn Exchange>>,
+    /// This process's rank and the number of ranks (0 and 1 on one process).
+    rank: (usize, usize),
 }
 
 impl<E: External> Replicas<E> {
     /// `replicas` replicas of `steps` steps each, standing at replica `rep` (running `sim`, or
-    /// not yet built).
+    /// not yet built), each decomposed over the ranks of `comm` when given.
     pub(crate) fn new(
         steps: u64,
         replicas: usize,
         trajectory_every: u64,
         rep: usize,
         sim: Option<(Replica<E>, u64)>,
-    ) -> Self {
-        Self {
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Self> {
+        let rank = comm.as_ref().map_or((0, 1), |c| (c.rank(), c.size()));
+        let (sim, parked) = match (sim, comm) {
+            (Some((s, b)), Some(c)) => (Some((s.decomposed(c)?, b)), None),
+            (sim, comm) => (sim, comm),
+        };
+        Ok(Self {
             steps,
             replicas,
             trajectory_every,
@@ -341,7 +395,73 @@ impl<E: External> Replicas<E> {
             gsd: None,
             traj: None,
             stale: Vec::new(),
+            parked,
+            rank,
+        })
+    }
+
+    /// Does this process write the outputs (rank 0; always on one process)?
+    pub(crate) fn is_writer(&self) -> bool {
+        self.rank.0 == 0
+    }
+
+    /// The number of ranks the run is decomposed over (1 on one process).
+    pub(crate) fn ranks(&self) -> usize {
+        self.rank.1
+    }
+
+    /// The ranks of a decomposed run (`None` on one process).
+    pub(crate) fn exchange(&self) -> Option<&dyn Exchange> {
+        match &self.sim {
+            Some((s, _)) => s.exchange(),
+            None => self.parked.as_deref(),
         }
+    }
+
+    /// An error on this rank alone: see [`Session::fail_alone`].
+    pub(crate) fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        crate::method::fail_alone_over(self.exchange(), e)
+    }
+
+    /// Is a trajectory frame due at step `s` of the running replica (replica 0, every
+    /// `trajectory_every` steps, once the folder is known)?
+    pub(crate) fn frame_due(&self, s: u64) -> bool {
+        self.rep == 0
+            && self.trajectory_every > 0
+            && self.traj.is_some()
+            && s.is_multiple_of(self.trajectory_every)
+    }
+
+    /// A trajectory frame of the running replica at step `s` with `logs`, when one is due
+    /// ([`Self::frame_due`]); `snap` is its snapshot when the caller has taken one. Every rank
+    /// of a decomposed run gathers the frame; the writer writes it. Returns whether a frame
+    /// was due.
+    pub(crate) fn write_frame(
+        &mut self,
+        s: u64,
+        snap: Option<&Particles>,
+        logs: &[(&str, f64)],
+    ) -> Result<bool> {
+        if !self.frame_due(s) {
+            return Ok(false);
+        }
+        let Some((sim, _)) = &self.sim else {
+            return Ok(false);
+        };
+        let taken;
+        let snap = match snap {
+            Some(p) => p,
+            None => {
+                taken = sim.snapshot();
+                &taken
+            }
+        };
+        let written = match self.gsd.as_mut() {
+            Some(w) => w.write_frame(s, sim.sbox(), snap, false, logs),
+            None => Ok(()),
+        };
+        written.map_err(|e| self.fail_alone(e.into()))?;
+        Ok(true)
     }
 
     /// Steps of the whole run.
@@ -374,9 +494,10 @@ impl<E: External> Replicas<E> {
         }
     }
 
-    /// Open (or reopen) the trajectory when replica 0 runs.
+    /// Open (or reopen) the trajectory when replica 0 runs (the writer).
     fn open_trajectory(&mut self) -> Result<()> {
         if self.rep == 0
+            && self.is_writer()
             && self.trajectory_every > 0
             && let Some(traj) = &self.traj
         {
@@ -418,7 +539,11 @@ impl<E: External> Replicas<E> {
         let steps = self.steps;
         while self.position() < until {
             if self.sim.is_none() {
-                self.sim = Some((obs.build(self.rep as u32)?, 0));
+                let mut sim = obs.build(self.rep as u32)?;
+                if let Some(c) = self.parked.take() {
+                    sim = sim.decomposed(c)?;
+                }
+                self.sim = Some((sim, 0));
                 self.open_trajectory()?;
                 obs.record(self, 0)?;
             }
@@ -448,7 +573,9 @@ impl<E: External> Replicas<E> {
                     .as_ref()
                     .map_or(0, |(s, b)| b + s.neighbor_builds());
                 obs.replica_done(self, builds)?;
-                self.sim = None;
+                if let Some((s, _)) = self.sim.take() {
+                    self.parked = s.into_exchange();
+                }
                 self.rep += 1;
             }
         }
@@ -470,16 +597,24 @@ impl<E: External> Replicas<E> {
         out: &OutputDir,
         checkpoints: u64,
     ) -> Result<(Option<ReplicaState>, u64)> {
-        let (state, stale) =
-            save_replica(out, checkpoints, self.sim.as_ref().map(|(s, b)| (s, *b)))?;
+        let writer = self.is_writer();
+        let (state, stale) = save_replica(
+            out,
+            checkpoints,
+            self.sim.as_ref().map(|(s, b)| (s, *b)),
+            writer,
+        )?;
         self.stale = stale;
         Ok((state, self.step()))
     }
 
-    /// `checkpoint.bin` names the new state: remove the previous GSD checkpoint.
+    /// `checkpoint.bin` names the new state: remove the previous GSD checkpoint (the writer).
     pub(crate) fn after_save(&mut self, out: &OutputDir) {
+        let writer = self.is_writer();
         for f in self.stale.drain(..) {
-            let _ = std::fs::remove_file(out.join(&f));
+            if writer {
+                let _ = std::fs::remove_file(out.join(&f));
+            }
         }
     }
 }
@@ -532,6 +667,25 @@ pub(crate) struct BdSession<E: External, O> {
 impl<E: External, O: BdMethod<E>> BdSession<E, O> {
     pub(crate) fn new(run: Replicas<E>, obs: O) -> Self {
         Self { run, obs }
+    }
+
+    /// [`Session::save`] of this rank.
+    fn save_state(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
+        let writer = self.run.is_writer();
+        let (frames, digest, checkpoints) = self.obs.bookkeeping();
+        if self.run.trajectory_every > 0 && writer {
+            digest.extend(&out.join("trajectory.gsd"), frames)?;
+        }
+        *checkpoints += 1;
+        let count = *checkpoints;
+        let (state, step) = self.run.save(out, count)?;
+        let saved = Saved {
+            replica: self.run.rep,
+            step,
+            state,
+            acc: self.obs.acc(),
+        };
+        Ok(bincode::serialize(&saved)?)
     }
 }
 
@@ -599,24 +753,24 @@ where
     /// driver) `checkpoint.bin` naming it, then [`Session::after_save`] removes the older one:
     /// a run killed at any point leaves a consistent checkpoint.
     fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
-        let (frames, digest, checkpoints) = self.obs.bookkeeping();
-        if self.run.trajectory_every > 0 {
-            digest.extend(&out.join("trajectory.gsd"), frames)?;
-        }
-        *checkpoints += 1;
-        let count = *checkpoints;
-        let (state, step) = self.run.save(out, count)?;
-        let saved = Saved {
-            replica: self.run.rep,
-            step,
-            state,
-            acc: self.obs.acc(),
-        };
-        Ok(bincode::serialize(&saved)?)
+        // Only the writer touches the folder; its errors end the job on every rank.
+        self.save_state(out).map_err(|e| self.run.fail_alone(e))
     }
 
     fn after_save(&mut self, out: &OutputDir) {
         self.run.after_save(out);
+    }
+
+    fn is_writer(&self) -> bool {
+        self.run.is_writer()
+    }
+
+    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
+        crate::method::agree_over(self.run.exchange(), chunk, interrupted)
+    }
+
+    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        self.run.fail_alone(e)
     }
 
     fn finish(
@@ -625,8 +779,20 @@ where
         wall_seconds: f64,
         failure: Option<&str>,
     ) -> Result<Finished> {
+        if !self.run.is_writer() {
+            return Ok(Finished {
+                summary: serde_json::json!({}),
+                files: Vec::new(),
+                message: String::new(),
+                warnings: Vec::new(),
+            });
+        }
+        let ranks = self.run.ranks();
         let Self { obs, .. } = *self;
-        let fin = obs.finish(out, wall_seconds, failure)?;
+        let mut fin = obs.finish(out, wall_seconds, failure)?;
+        if let Some(m) = fin.summary.as_object_mut() {
+            m.insert("ranks".into(), serde_json::json!(ranks));
+        }
         // The run is over: the replica checkpoints are no longer needed.
         for f in CHECKPOINT_FILES {
             let _ = std::fs::remove_file(out.join(f));

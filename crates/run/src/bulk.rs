@@ -30,10 +30,11 @@ use crate::bd_replica::{
 use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
 use crate::keys::Key;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::mean_and_error;
@@ -126,11 +127,16 @@ impl Method for BulkBd {
     }
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        let p = resolve(src, seed)?;
-        // Set up replica 0 before the output folder is created: bad input leaves nothing.
-        let sim = build_replica(&p, 0).with_context(|| src.label())?;
-        let acc = Accum::new(&p);
-        Ok(Box::new(BulkObs::session(p, acc, 0, Some((sim, 0)))))
+        start(src, seed, None)
+    }
+
+    fn start_decomposed(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        start(src, seed, Some(comm))
     }
 
     fn restore(
@@ -140,32 +146,18 @@ impl Method for BulkBd {
         out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
-        let p = resolve(src, Some(seed))?;
-        let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
-        let lags = p.msd_lags().len();
-        if saved.replica >= p.replicas
-            || saved.acc.velocities.len() > p.replicas * p.blocks
-            || saved.acc.msd.iter().any(|m| m.len() != lags)
-        {
-            bail!(
-                "checkpoint: replica {} with {} blocks does not fit the scenario",
-                saved.replica,
-                saved.acc.velocities.len()
-            );
-        }
-        let sim = match &saved.state {
-            None => None,
-            Some(state) => Some(restore_replica(out, &p, &saved, state)?),
-        };
-        if p.trajectory_every > 0 {
-            saved
-                .acc
-                .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &[TIME_LOG], false)
-                })?;
-        }
-        Ok(Box::new(BulkObs::session(p, saved.acc, saved.replica, sim)))
+        restore(src, seed, out, envelope, None)
+    }
+
+    fn restore_decomposed(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        restore(src, seed, out, envelope, Some(comm))
     }
 
     fn keys(&self) -> Vec<Key> {
@@ -177,6 +169,63 @@ impl Method for BulkBd {
         let sim = build_replica(&p, 0).with_context(|| src.label())?;
         Ok(Box::new(ReplicaEngine { method: "bd", sim }))
     }
+}
+
+/// A fresh session, decomposed over the ranks of `comm` when given.
+fn start(
+    src: &Source,
+    seed: Option<u64>,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let p = resolve(src, seed)?;
+    // Set up replica 0 before the output folder is created: bad input leaves nothing.
+    let sim = build_replica(&p, 0).with_context(|| src.label())?;
+    let acc = Accum::new(&p);
+    Ok(Box::new(BulkObs::session(p, acc, 0, Some((sim, 0)), comm)?))
+}
+
+/// The session a checkpoint continues (on any number of ranks when decomposed).
+fn restore(
+    src: &Source,
+    seed: u64,
+    out: &OutputDir,
+    envelope: &Envelope,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let p = resolve(src, Some(seed))?;
+    let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
+    let lags = p.msd_lags().len();
+    if saved.replica >= p.replicas
+        || saved.acc.velocities.len() > p.replicas * p.blocks
+        || saved.acc.msd.iter().any(|m| m.len() != lags)
+    {
+        bail!(
+            "checkpoint: replica {} with {} blocks does not fit the scenario",
+            saved.replica,
+            saved.acc.velocities.len()
+        );
+    }
+    let sim = match &saved.state {
+        None => None,
+        Some(state) => Some(restore_replica(out, &p, &saved, state)?),
+    };
+    // Only the writer touches the folder.
+    if p.trajectory_every > 0 && comm.as_ref().is_none_or(|c| c.rank() == 0) {
+        saved
+            .acc
+            .digest
+            .restore(&out.join("trajectory.gsd"), |path, frames| {
+                trim_trajectory(path, frames, &[TIME_LOG], false)
+            })
+            .map_err(|e| fail_alone_over(comm.as_deref(), e))?;
+    }
+    Ok(Box::new(BulkObs::session(
+        p,
+        saved.acc,
+        saved.replica,
+        sim,
+        comm,
+    )?))
 }
 
 /// The simulated time in every trajectory frame (`log/bd/time`).
@@ -282,11 +331,17 @@ struct BulkObs {
 
 impl BulkObs {
     /// The session of `p` at replica `rep` (running `sim`, or not yet built) with `acc`.
-    fn session(p: BulkParams, acc: Accum, rep: usize, sim: Option<(Replica, u64)>) -> BulkSession {
+    fn session(
+        p: BulkParams,
+        acc: Accum,
+        rep: usize,
+        sim: Option<(Replica, u64)>,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<BulkSession> {
         let lags = p.msd_lags();
         let msd_on = !(p.force > 0.0 && p.particles == 1);
-        BdSession::new(
-            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim),
+        Ok(BdSession::new(
+            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim, comm)?,
             BulkObs {
                 p,
                 acc,
@@ -295,7 +350,7 @@ impl BulkObs {
                 unwrapped: Vec::new(),
                 coords: Vec::new(),
             },
-        )
+        ))
     }
 
     /// Offer the block's MSD the configuration in `self.unwrapped` at step `s` (relative to
@@ -350,19 +405,14 @@ impl Observe<ConstantForce> for BulkObs {
         let Some((sim, _)) = &run.sim else {
             return Ok(());
         };
-        let p = &self.p;
-        if let Some(w) = run.gsd.as_mut()
-            && s.is_multiple_of(p.trajectory_every)
-        {
-            w.write_frame(
-                s,
-                sim.sbox(),
-                &sim.snapshot(),
-                false,
-                &[(TIME_LOG, sim.time())],
-            )?;
+        let time = sim.time();
+        if run.write_frame(s, None, &[(TIME_LOG, time)])? {
             self.acc.frames += 1;
         }
+        let Some((sim, _)) = &run.sim else {
+            return Ok(());
+        };
+        let p = &self.p;
         if s < p.equilibrate_steps {
             return Ok(());
         }

@@ -157,10 +157,7 @@ fn restore(
 
 /// An error on this rank alone: see [`Session::fail_alone`].
 fn fail_alone(sim: &Dpd, e: anyhow::Error) -> anyhow::Error {
-    match sim.exchange() {
-        Some(c) => c.abort(&format!("{e:#}")),
-        None => e,
-    }
+    crate::method::fail_alone_over(sim.exchange(), e)
 }
 
 /// The method's part of `checkpoint.bin`: everything a run needs to continue bitwise from
@@ -523,12 +520,7 @@ impl Session for DpdSession {
     }
 
     fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        let Some(c) = self.sim.exchange() else {
-            return (chunk, interrupted);
-        };
-        let mut all = Vec::new();
-        c.all_gather(&[chunk as f64, interrupted as u8 as f64], &mut all);
-        (all[0] as u64, all.chunks_exact(2).any(|r| r[1] != 0.0))
+        crate::method::agree_over(self.sim.exchange(), chunk, interrupted)
     }
 
     fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {

@@ -10,7 +10,7 @@ use crate::bd_replica::{
 use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Key;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{
     Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
     picture,
@@ -20,10 +20,11 @@ use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::droplet::DropletSim;
 use colloidsim_md::gsd::{self, GsdWriter};
-use colloidsim_md::{DropletParams, DropletScenario, HarmonicInterface, LennardJones};
+use colloidsim_md::{DropletParams, DropletScenario, HarmonicInterface, LennardJones, Particles};
 use hoomd_gsd::file_layer::Mode;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -73,11 +74,16 @@ impl Method for DropletBd {
     }
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        let (_, p) = resolve(src, seed)?;
-        // Set up replica 0 before the output folder is created: bad input leaves nothing.
-        let sim = build_replica(&p, 0)?;
-        let acc = Accum::new(&p);
-        Ok(Box::new(DropletObs::session(p, acc, 0, Some((sim, 0)))))
+        start(src, seed, None)
+    }
+
+    fn start_decomposed(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        start(src, seed, Some(comm))
     }
 
     fn restore(
@@ -87,31 +93,18 @@ impl Method for DropletBd {
         out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
-        let (_, p) = resolve(src, Some(seed))?;
-        let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
-        if saved.replica >= p.replicas || saved.acc.sums.len() != p.fractions.len() {
-            bail!(
-                "checkpoint: replica {} of {} with {} profiles does not fit the scenario",
-                saved.replica,
-                p.replicas,
-                saved.acc.sums.len()
-            );
-        }
-        let sim = restore_replica(out, &p, &saved)?;
-        if p.trajectory_every > 0 {
-            saved
-                .acc
-                .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &["droplet/radius", "droplet/time"], false)
-                })?;
-        }
-        Ok(Box::new(DropletObs::session(
-            p,
-            saved.acc,
-            saved.replica,
-            sim,
-        )))
+        restore(src, seed, out, envelope, None)
+    }
+
+    fn restore_decomposed(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        restore(src, seed, out, envelope, Some(comm))
     }
 
     fn has_theory(&self) -> bool {
@@ -134,6 +127,63 @@ impl Method for DropletBd {
             sim,
         }))
     }
+}
+
+/// A fresh session, decomposed over the ranks of `comm` when given.
+fn start(
+    src: &Source,
+    seed: Option<u64>,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let (_, p) = resolve(src, seed)?;
+    // Set up replica 0 before the output folder is created: bad input leaves nothing.
+    let sim = build_replica(&p, 0)?;
+    let acc = Accum::new(&p);
+    Ok(Box::new(DropletObs::session(
+        p,
+        acc,
+        0,
+        Some((sim, 0)),
+        comm,
+    )?))
+}
+
+/// The session a checkpoint continues (on any number of ranks when decomposed).
+fn restore(
+    src: &Source,
+    seed: u64,
+    out: &OutputDir,
+    envelope: &Envelope,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let (_, p) = resolve(src, Some(seed))?;
+    let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
+    if saved.replica >= p.replicas || saved.acc.sums.len() != p.fractions.len() {
+        bail!(
+            "checkpoint: replica {} of {} with {} profiles does not fit the scenario",
+            saved.replica,
+            p.replicas,
+            saved.acc.sums.len()
+        );
+    }
+    let sim = restore_replica(out, &p, &saved)?;
+    // Only the writer touches the folder.
+    if p.trajectory_every > 0 && comm.as_ref().is_none_or(|c| c.rank() == 0) {
+        saved
+            .acc
+            .digest
+            .restore(&out.join("trajectory.gsd"), |path, frames| {
+                trim_trajectory(path, frames, &["droplet/radius", "droplet/time"], false)
+            })
+            .map_err(|e| fail_alone_over(comm.as_deref(), e))?;
+    }
+    Ok(Box::new(DropletObs::session(
+        p,
+        saved.acc,
+        saved.replica,
+        sim,
+        comm,
+    )?))
 }
 
 /// Everything a droplet run accumulates across replicas, saved in every checkpoint.
@@ -251,13 +301,15 @@ struct DropletObs {
 }
 
 impl DropletObs {
-    /// The session of `p` at replica `rep` (running `sim`, or not yet built) with `acc`.
+    /// The session of `p` at replica `rep` (running `sim`, or not yet built) with `acc`,
+    /// decomposed over the ranks of `comm` when given.
     fn session(
         p: DropletParams,
         acc: Accum,
         rep: usize,
         sim: Option<(Replica, u64)>,
-    ) -> DropletSession {
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<DropletSession> {
         let mut stops: Vec<u64> = p.profile_steps.clone();
         if p.trajectory_every > 0 {
             stops.extend((0..=p.steps).step_by(p.trajectory_every as usize));
@@ -265,15 +317,15 @@ impl DropletObs {
         stops.push(p.steps);
         stops.sort_unstable();
         stops.dedup();
-        BdSession::new(
-            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim),
+        Ok(BdSession::new(
+            Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim, comm)?,
             DropletObs {
                 p,
                 acc,
                 stops,
                 folder: None,
             },
-        )
+        ))
     }
 }
 
@@ -301,7 +353,8 @@ impl Observe<HarmonicInterface> for DropletObs {
         let t = s.time();
         let radius = p.radius_at(t);
         let wall_r = radius + p.offset;
-        let part = s.particles();
+        // In input order and wrapped: the same on any number of ranks (collective).
+        let part = s.snapshot();
         for x in &part.pos {
             let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
             acc.max_excursion = acc.max_excursion.max(r - wall_r);
@@ -320,16 +373,8 @@ impl Observe<HarmonicInterface> for DropletObs {
                 }
             }
         }
-        if let Some(w) = run.gsd.as_mut()
-            && ev.is_multiple_of(p.trajectory_every)
-        {
-            w.write_frame(
-                ev,
-                s.sbox(),
-                &s.snapshot(),
-                false,
-                &[("droplet/radius", radius), ("droplet/time", t)],
-            )?;
+        let logs = [("droplet/radius", radius), ("droplet/time", t)];
+        if run.write_frame(ev, Some(&part), &logs)? {
             acc.frames += 1;
         }
         Ok(())
@@ -340,7 +385,11 @@ impl Observe<HarmonicInterface> for DropletObs {
             && let (Some(width), Some(out), Some((s, _))) =
                 (self.p.cross_section, &self.folder, &run.sim)
         {
-            write_cross_section(out, &self.p, s, width)?;
+            let snap = s.snapshot();
+            if run.is_writer() {
+                write_cross_section(out, &self.p, s.time(), &snap, width)
+                    .map_err(|e| run.fail_alone(e))?;
+            }
         }
         self.acc.builds += builds;
         Ok(())
@@ -569,11 +618,16 @@ fn mobility_label(p: &DropletParams) -> Option<String> {
 /// `width / 2` of the plane z = 0 through the droplet's centre, as `cross_section.csv`
 /// (columns `x,y,z,r`: centre and distance from the droplet's centre) and `cross_section.png`
 /// (the circles where the slab's mid-plane cuts the spheres, inside the circle of R(t)).
-fn write_cross_section(dir: &Path, p: &DropletParams, s: &Replica, width: f64) -> Result<()> {
+fn write_cross_section(
+    dir: &Path,
+    p: &DropletParams,
+    time: f64,
+    snap: &Particles,
+    width: f64,
+) -> Result<()> {
     let out = OutputDir::reopen(dir)?;
-    let radius = p.radius_at(s.time());
+    let radius = p.radius_at(time);
     let a = 0.5 * p.diameter;
-    let snap = s.snapshot();
     let mut cols: [Vec<f64>; 4] = Default::default();
     let mut discs = Vec::new();
     for x in &snap.pos {
@@ -606,7 +660,7 @@ fn write_cross_section(dir: &Path, p: &DropletParams, s: &Replica, width: f64) -
         "{}: slab |z| < {} at t = {:.1} (R = {:.2}), replica 0",
         mobility_label(p).unwrap_or_else(|| "free-draining BD".into()),
         0.5 * width,
-        s.time(),
+        time,
         radius
     );
     // A picture that cannot be drawn leaves the table; the run goes on.

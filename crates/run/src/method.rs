@@ -173,11 +173,35 @@ pub trait Session: Send {
 
 pub use crate::scenario::Scenario;
 
+/// [`Session::agree`] over the ranks of `comm` (unchanged on one process).
+pub(crate) fn agree_over(
+    comm: Option<&dyn Exchange>,
+    chunk: u64,
+    interrupted: bool,
+) -> (u64, bool) {
+    let Some(c) = comm else {
+        return (chunk, interrupted);
+    };
+    let mut all = Vec::new();
+    c.all_gather(&[chunk as f64, interrupted as u8 as f64], &mut all);
+    (all[0] as u64, all.chunks_exact(2).any(|r| r[1] != 0.0))
+}
+
+/// [`Session::fail_alone`] over the ranks of `comm`: the error as it is on one process; the
+/// message printed and the job ended on every rank otherwise.
+pub(crate) fn fail_alone_over(comm: Option<&dyn Exchange>, e: anyhow::Error) -> anyhow::Error {
+    match comm {
+        Some(c) => c.abort(&format!("{e:#}")),
+        None => e,
+    }
+}
+
 /// Why `colloidsim run` under `mpirun -n N` refuses a method.
 fn not_decomposed(sc: &Scenario, method: &str) -> String {
     format!(
-        "{}: method '{method}' runs on one rank: only 'dpd' is decomposed over MPI ranks so far \
-         (docs/parallel.md); spread replicas and sweeps over ranks with `colloidsim ensemble`",
+        "{}: method '{method}' runs on one rank: only 'dpd' and free-draining 'bd' and \
+         'droplet-bd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
+         and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )
 }

@@ -85,6 +85,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.domain.as_ref().map(|d| &*d.comm)
     }
 
+    /// The engine is done with: the ranks it ran on, for the next engine (`None` on one
+    /// process).
+    pub fn into_exchange(self) -> Option<Box<dyn Exchange>> {
+        self.domain.map(|d| d.comm)
+    }
+
     /// Particles this rank owns (all on one process).
     pub fn owned(&self) -> usize {
         self.own.1 - self.own.0
