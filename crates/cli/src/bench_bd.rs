@@ -1,7 +1,8 @@
-//! `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube, beside LAMMPS.
+//! `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube, beside LAMMPS; with
+//! `--ranks`, the engine decomposed over MPI ranks (strong and weak scaling).
 
-use crate::common::{cpu_seconds, lammps_loop_time, median, write_lammps_data};
-use anyhow::{Context, Result};
+use crate::common::{cpu_seconds, lammps_loop_time, load_average, median, write_lammps_data};
+use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -32,6 +33,116 @@ pub struct BenchArgs {
     /// Verlet skin, for both codes (LAMMPS's default in LJ units is 0.3).
     #[arg(long, default_value_t = 0.3)]
     pub skin: f64,
+    /// MPI rank counts: one run decomposed over the ranks (docs/parallel.md), strong scaling
+    /// (the cube on R ranks) and weak scaling (the cube stretched along z to R times its
+    /// length, R N particles), each under `mpirun -n R` of this executable, which must be
+    /// built with `--features mpi`. The first `--threads` value is the threads per rank.
+    #[arg(long, value_delimiter = ',')]
+    pub ranks: Vec<usize>,
+    /// Open MPI's `mpirun` for `--ranks`.
+    #[arg(long, default_value = "mpirun")]
+    pub mpirun: PathBuf,
+    /// Internal: run as one of the `mpirun` workers of `--ranks`, on the cube stretched this
+    /// many times along z.
+    #[arg(long, hide = true)]
+    pub worker_stretch: Option<usize>,
+}
+
+/// The time step of every `bench bd` run.
+const DT: f64 = 1e-4;
+
+/// `--worker-stretch k` under `mpirun`: `k N` particles at the volume fraction in the cube
+/// stretched `k` times along z, decomposed over the job's ranks, 100 warm-up steps, then
+/// `repeats` timed runs of `steps`; rank 0 prints the rate of the slowest rank.
+fn worker(a: &BenchArgs, k: usize) -> Result<()> {
+    let ranks = crate::parallel::Ranks::init()?;
+    let threads = a.threads.first().copied().unwrap_or(1);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .context("thread pool")?;
+    let l = (a.n as f64 * std::f64::consts::PI / 6.0 / a.phi).cbrt();
+    let sbox = colloidsim_md::SimBox::new([l, l, k as f64 * l]);
+    let n = k * a.n;
+    let sim = colloidsim_md::bench::wca_periodic_box(n, sbox, DT, 1, a.skin)?;
+    let mut sim = sim.decomposed(ranks.exchange()?)?;
+    sim.run(100)?;
+    let mut walls = Vec::new();
+    for _ in 0..a.repeats.max(1) {
+        let start = Instant::now();
+        sim.run(a.steps)?;
+        let wall = start.elapsed().as_secs_f64();
+        let mut all = Vec::new();
+        match sim.exchange() {
+            Some(c) => c.all_gather(&[wall], &mut all),
+            None => all.push(wall),
+        }
+        walls.push(all);
+    }
+    crate::bench_dpd_ranks::print_rate(ranks.rank(), n, a.steps, &walls);
+    Ok(())
+}
+
+/// `--ranks`: strong and weak scaling of the decomposed engine.
+fn over_ranks(a: &BenchArgs) -> Result<()> {
+    if a.ranks.contains(&0) || a.steps == 0 {
+        bail!("--ranks must be at least 1 and --steps > 0");
+    }
+    let threads = a.threads.first().copied().unwrap_or(1);
+    let exe = std::env::current_exe()?;
+    println!(
+        "# colloidsim bench bd --ranks: WCA Brownian dynamics, N = {} at phi = {} (periodic cube; weak scaling: R N in the cube stretched R times along z), dt = {DT}, skin {}, {threads} thread(s) per rank; 100 warm-up steps, then {} timed steps per run, median (min-max) of {}",
+        a.n,
+        a.phi,
+        a.skin,
+        a.steps,
+        a.repeats.max(1)
+    );
+    let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
+    println!("# load average (1, 5, 15 min) at start: {}", load());
+    println!("kind\tranks\tparticles\tparticle_steps_per_s\tmin\tmax");
+    let mut base = None;
+    for &r in &a.ranks {
+        for (kind, k) in [("strong", 1), ("weak", r)] {
+            if kind == "weak" && r == 1 {
+                continue;
+            }
+            let mut args: Vec<String> = vec!["bench".into(), "bd".into()];
+            for (key, v) in [
+                ("--worker-stretch", k.to_string()),
+                ("--n", a.n.to_string()),
+                ("--phi", a.phi.to_string()),
+                ("--skin", a.skin.to_string()),
+                ("--threads", threads.to_string()),
+                ("--steps", a.steps.to_string()),
+                ("--repeats", a.repeats.max(1).to_string()),
+            ] {
+                args.extend([key.to_string(), v]);
+            }
+            let (rate, n) = crate::bench_dpd_ranks::mpirun_worker(&a.mpirun, &exe, r, &args)?;
+            println!(
+                "{kind}\t{r}\t{n}\t{:.4e}\t{:.4e}\t{:.4e}",
+                rate.0, rate.1, rate.2
+            );
+            match (kind, base) {
+                ("strong", None) => base = Some((r, rate.0)),
+                ("strong", Some((r0, x0))) => {
+                    let speedup = rate.0 / x0;
+                    println!(
+                        "# strong: {r} ranks / {r0}: {speedup:.2} (efficiency {:.0} %)",
+                        100.0 * speedup * r0 as f64 / r as f64
+                    );
+                }
+                (_, Some((r0, x0))) => println!(
+                    "# weak: {r} ranks, {r} cubes: efficiency {:.0} %",
+                    100.0 * rate.0 / (x0 * r as f64 / r0 as f64)
+                ),
+                _ => {}
+            }
+        }
+    }
+    println!("# load average (1, 5, 15 min) at end: {}", load());
+    Ok(())
 }
 
 /// `colloidsim bench bd`: WCA Brownian dynamics in a periodic cube (friction 1, kT 1,
@@ -39,7 +150,13 @@ pub struct BenchArgs {
 /// configuration in the same run (LAMMPS on one MPI rank, with Gaussian and with its default
 /// uniform noise).
 pub fn bench(a: &BenchArgs) -> Result<()> {
-    let dt = 1e-4;
+    if let Some(k) = a.worker_stretch {
+        return worker(a, k);
+    }
+    if !a.ranks.is_empty() {
+        return over_ranks(a);
+    }
+    let dt = DT;
     println!(
         "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin {}; {} steps per run, median (min-max) of {}",
         a.n, a.phi, a.skin, a.steps, a.repeats

@@ -52,7 +52,7 @@ pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
     } else {
         (water(a), vec![false])
     };
-    let mut rates = Vec::new();
+    let mut walls = Vec::new();
     for _ in 0..a.repeats.max(1) {
         let comm = ranks.exchange()?;
         let types = types.clone();
@@ -65,18 +65,14 @@ pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
             Some(c) => c.all_gather(&[wall], &mut all),
             None => all.push(wall),
         }
-        let slowest = all.iter().cloned().fold(0.0, f64::max);
-        rates.push(n as f64 * a.steps as f64 / slowest);
+        walls.push(all);
     }
-    if ranks.rank() == 0 {
-        let (m, lo, hi) = median(rates);
-        println!("RATE\t{m:e}\t{lo:e}\t{hi:e}\t{n}");
-    }
+    print_rate(ranks.rank(), n, a.steps, &walls);
     Ok(())
 }
 
 /// One measured rate: median, min, max of the repeats.
-type Rate = (f64, f64, f64);
+pub type Rate = (f64, f64, f64);
 
 /// `colloidsim bench dpd --ranks ...`.
 pub fn bench(a: &BenchArgs) -> Result<()> {
@@ -275,25 +271,45 @@ fn run_worker(
     ranks: usize,
     threads: usize,
 ) -> Result<(Rate, usize)> {
-    let o = Command::new(&a.mpirun)
+    let mut args: Vec<String> = vec!["bench".into(), "dpd".into(), "--worker-state".into()];
+    args.push(state.display().to_string());
+    for (k, v) in [
+        ("--threads", threads.to_string()),
+        ("--steps", a.steps.to_string()),
+        ("--repeats", a.repeats.max(1).to_string()),
+        ("--dt", a.dt.to_string()),
+        ("--seed", a.seed.to_string()),
+        ("--l", a.l.to_string()),
+    ] {
+        args.extend([k.to_string(), v]);
+    }
+    if a.colloids {
+        args.push("--colloids".into());
+    }
+    mpirun_worker(&a.mpirun, exe, ranks, &args)
+}
+
+/// `mpirun -n ranks EXE ARGS`, a benchmark worker whose rank 0 prints
+/// `RATE <median> <min> <max> <particles>`: that rate and the particle count.
+pub fn mpirun_worker(
+    mpirun: &Path,
+    exe: &Path,
+    ranks: usize,
+    args: &[String],
+) -> Result<(Rate, usize)> {
+    let o = Command::new(mpirun)
         .args(["-n", &ranks.to_string()])
         .arg(exe)
-        .args(["bench", "dpd", "--worker-state"])
-        .arg(state)
-        .args(["--threads", &threads.to_string()])
-        .args(["--steps", &a.steps.to_string()])
-        .args(["--repeats", &a.repeats.max(1).to_string()])
-        .args(["--dt", &a.dt.to_string(), "--seed", &a.seed.to_string()])
-        .args(["--l", &a.l.to_string()])
-        .args(a.colloids.then_some("--colloids"))
+        .args(args)
         .envs(OMPI_ENV)
         .output()
-        .with_context(|| format!("{} (Open MPI's mpirun; --mpirun)", a.mpirun.display()))?;
+        .with_context(|| format!("{} (Open MPI's mpirun; --mpirun)", mpirun.display()))?;
     let text = String::from_utf8_lossy(&o.stdout);
     let line = text.lines().find(|l| l.starts_with("RATE\t"));
     let Some(line) = line.filter(|_| o.status.success()) else {
         bail!(
-            "mpirun -n {ranks} colloidsim bench dpd --worker-state failed (a build with --features mpi is needed):\n{text}{}",
+            "mpirun -n {ranks} colloidsim {} failed (a build with --features mpi is needed):\n{text}{}",
+            args[..2].join(" "),
             String::from_utf8_lossy(&o.stderr)
         );
     };
@@ -303,6 +319,19 @@ fn run_worker(
         .map(|x| x.parse())
         .collect::<Result<_, _>>()?;
     Ok(((f[0], f[1], f[2]), f[3] as usize))
+}
+
+/// Rank 0 prints the `RATE` line of [`mpirun_worker`]: the median (min, max) over the runs
+/// of `n` particles times `steps` over the wall times of the slowest rank, `walls[run][rank]`.
+pub fn print_rate(rank: usize, n: usize, steps: u64, walls: &[Vec<f64>]) {
+    let rates = walls
+        .iter()
+        .map(|w| n as f64 * steps as f64 / w.iter().cloned().fold(0.0, f64::max))
+        .collect();
+    if rank == 0 {
+        let (m, lo, hi) = median(rates);
+        println!("RATE\t{m:e}\t{lo:e}\t{hi:e}\t{n}");
+    }
 }
 
 /// The `mpirun` that launches LAMMPS: `--lammps-mpirun`, else the one beside the LAMMPS

@@ -34,7 +34,18 @@ pub fn wca_periodic_skin(
     skin: f64,
 ) -> Result<Brownian<LennardJones, NoExternal>, BdError> {
     let l = (n as f64 * PI / 6.0 / phi).cbrt();
-    let sbox = SimBox::cube(l);
+    wca_periodic_box(n, SimBox::cube(l), dt, seed, skin)
+}
+
+/// [`wca_periodic_skin`] of `n` particles in the periodic box `sbox` (the weak scaling of
+/// `colloidsim bench bd --ranks` stretches the cube along z).
+pub fn wca_periodic_box(
+    n: usize,
+    sbox: SimBox,
+    dt: f64,
+    seed: u32,
+    skin: f64,
+) -> Result<Brownian<LennardJones, NoExternal>, BdError> {
     let pos = random_in_box(n, 1.0, &sbox, seed, 0).map_err(|e| BdError::Invalid(e.to_string()))?;
     let mut params = BdParams::new(dt, seed);
     params.viscosity = 1.0 / (3.0 * PI);
