@@ -225,6 +225,44 @@ fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
     }
 }
 
+/// DPD water sheared by Lees–Edwards boundaries (`examples/dpd/shear.toml`, shortened): 1536
+/// beads in a box of 8 layers of cells, 600 steps.
+const SHEARED_DPD: &str = r#"
+method = "dpd"
+seed = 1
+[system]
+box_length = 8.0
+density = 3.0
+phi = 0.0
+kT = 1.0
+[run]
+dt = 0.01
+steps = 600
+shear_rate = 0.5
+[observe]
+thermo_every = 50
+trajectory_every = 200
+msd_every = 0
+structure_every = 0
+profile_bins = 16
+"#;
+
+#[test]
+fn a_sheared_dpd_run_on_2_and_3_ranks_writes_the_single_process_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "shear", SHEARED_DPD);
+    assert!(reference.join("velocity_profile.csv").exists());
+    for ranks in [2, 3] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let o = mpirun(
+            ranks,
+            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
+        );
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        assert_same_tree(&reference, &out);
+    }
+}
+
 #[test]
 fn a_dpd_run_interrupted_on_2_ranks_continues_on_1_and_4() {
     let tmp = tempfile::tempdir().unwrap();
