@@ -544,7 +544,9 @@ impl<E: External> Replicas<E> {
                     sim = sim.decomposed(c)?;
                 }
                 self.sim = Some((sim, 0));
-                self.open_trajectory()?;
+                // The writer's files: an error there ends the job on every rank.
+                let opened = self.open_trajectory();
+                opened.map_err(|e| self.fail_alone(e))?;
                 obs.record(self, 0)?;
             }
             let local_until = until.min((self.rep as u64 + 1) * steps) - self.rep as u64 * steps;
@@ -566,7 +568,8 @@ impl<E: External> Replicas<E> {
             if local_until == steps {
                 // The replica is complete.
                 if let Some(mut w) = self.gsd.take() {
-                    w.sync()?;
+                    let synced = w.sync();
+                    synced.map_err(|e| self.fail_alone(e.into()))?;
                 }
                 let builds = self
                     .sim
@@ -582,12 +585,13 @@ impl<E: External> Replicas<E> {
         Ok(None)
     }
 
-    /// Bring the trajectory to the disk.
+    /// Bring the trajectory to the disk (the writer; an error ends the job on every rank).
     pub(crate) fn flush(&mut self) -> Result<()> {
-        if let Some(w) = self.gsd.as_mut() {
-            w.sync()?;
-        }
-        Ok(())
+        let synced = match self.gsd.as_mut() {
+            Some(w) => w.sync(),
+            None => Ok(()),
+        };
+        synced.map_err(|e| self.fail_alone(e.into()))
     }
 
     /// Checkpoint the running replica ([`save_replica`], `checkpoints` counting this one);
