@@ -71,13 +71,10 @@ fn worker(a: &BenchArgs, k: usize) -> Result<()> {
     for _ in 0..a.repeats.max(1) {
         let start = Instant::now();
         sim.run(a.steps)?;
-        let wall = start.elapsed().as_secs_f64();
-        let mut all = Vec::new();
-        match sim.exchange() {
-            Some(c) => c.all_gather(&[wall], &mut all),
-            None => all.push(wall),
-        }
-        walls.push(all);
+        walls.push(crate::bench_dpd_ranks::walls_of_ranks(
+            sim.exchange(),
+            start.elapsed().as_secs_f64(),
+        ));
     }
     crate::bench_dpd_ranks::print_rate(ranks.rank(), n, a.steps, &walls);
     Ok(())
@@ -89,7 +86,6 @@ fn over_ranks(a: &BenchArgs) -> Result<()> {
         bail!("--ranks must be at least 1 and --steps > 0");
     }
     let threads = a.threads.first().copied().unwrap_or(1);
-    let exe = std::env::current_exe()?;
     println!(
         "# colloidsim bench bd --ranks: WCA Brownian dynamics, N = {} at phi = {} (periodic cube; weak scaling: R N in the cube stretched R times along z), dt = {DT}, skin {}, {threads} thread(s) per rank; 100 warm-up steps, then {} timed steps per run, median (min-max) of {}",
         a.n,
@@ -100,47 +96,21 @@ fn over_ranks(a: &BenchArgs) -> Result<()> {
     );
     let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
     println!("# load average (1, 5, 15 min) at start: {}", load());
-    println!("kind\tranks\tparticles\tparticle_steps_per_s\tmin\tmax");
-    let mut base = None;
-    for &r in &a.ranks {
-        for (kind, k) in [("strong", 1), ("weak", r)] {
-            if kind == "weak" && r == 1 {
-                continue;
-            }
-            let mut args: Vec<String> = vec!["bench".into(), "bd".into()];
-            for (key, v) in [
-                ("--worker-stretch", k.to_string()),
-                ("--n", a.n.to_string()),
-                ("--phi", a.phi.to_string()),
-                ("--skin", a.skin.to_string()),
-                ("--threads", threads.to_string()),
-                ("--steps", a.steps.to_string()),
-                ("--repeats", a.repeats.max(1).to_string()),
-            ] {
-                args.extend([key.to_string(), v]);
-            }
-            let (rate, n) = crate::bench_dpd_ranks::mpirun_worker(&a.mpirun, &exe, r, &args)?;
-            println!(
-                "{kind}\t{r}\t{n}\t{:.4e}\t{:.4e}\t{:.4e}",
-                rate.0, rate.1, rate.2
-            );
-            match (kind, base) {
-                ("strong", None) => base = Some((r, rate.0)),
-                ("strong", Some((r0, x0))) => {
-                    let speedup = rate.0 / x0;
-                    println!(
-                        "# strong: {r} ranks / {r0}: {speedup:.2} (efficiency {:.0} %)",
-                        100.0 * speedup * r0 as f64 / r as f64
-                    );
-                }
-                (_, Some((r0, x0))) => println!(
-                    "# weak: {r} ranks, {r} cubes: efficiency {:.0} %",
-                    100.0 * rate.0 / (x0 * r as f64 / r0 as f64)
-                ),
-                _ => {}
-            }
+    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.ranks, |k| {
+        let mut args: Vec<String> = vec!["bench".into(), "bd".into()];
+        for (key, v) in [
+            ("--worker-stretch", k.to_string()),
+            ("--n", a.n.to_string()),
+            ("--phi", a.phi.to_string()),
+            ("--skin", a.skin.to_string()),
+            ("--threads", threads.to_string()),
+            ("--steps", a.steps.to_string()),
+            ("--repeats", a.repeats.max(1).to_string()),
+        ] {
+            args.extend([key.to_string(), v]);
         }
-    }
+        args
+    })?;
     println!("# load average (1, 5, 15 min) at end: {}", load());
     Ok(())
 }

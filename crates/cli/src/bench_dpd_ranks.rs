@@ -59,13 +59,10 @@ pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
         let mut sim = Dpd::decomposed(p.clone(), SimBox::new(l), params, types, step, comm)?;
         let start = Instant::now();
         sim.run(a.steps)?;
-        let wall = start.elapsed().as_secs_f64();
-        let mut all = Vec::new();
-        match sim.exchange() {
-            Some(c) => c.all_gather(&[wall], &mut all),
-            None => all.push(wall),
-        }
-        walls.push(all);
+        walls.push(walls_of_ranks(
+            sim.exchange(),
+            start.elapsed().as_secs_f64(),
+        ));
     }
     print_rate(ranks.rank(), n, a.steps, &walls);
     Ok(())
@@ -319,6 +316,61 @@ pub fn mpirun_worker(
         .map(|x| x.parse())
         .collect::<Result<_, _>>()?;
     Ok(((f[0], f[1], f[2]), f[3] as usize))
+}
+
+/// The wall time of every rank of `comm` (this one's alone on one process), in rank order.
+pub fn walls_of_ranks(
+    comm: Option<&dyn colloidsim_core::exchange::Exchange>,
+    wall: f64,
+) -> Vec<f64> {
+    let mut all = Vec::new();
+    match comm {
+        Some(c) => c.all_gather(&[wall], &mut all),
+        None => all.push(wall),
+    }
+    all
+}
+
+/// Strong scaling (the system on R ranks) and weak scaling (the system stretched R times along
+/// z on R ranks) of a decomposed engine: `mpirun -n R` of this executable with
+/// `worker_args(stretch)` for each R of `ranks`, one table row each (`kind ranks particles
+/// rate min max`), then the speed-up and efficiency against the first rank count.
+pub fn strong_and_weak(
+    mpirun: &Path,
+    ranks: &[usize],
+    worker_args: impl Fn(usize) -> Vec<String>,
+) -> Result<()> {
+    let exe = std::env::current_exe()?;
+    println!("kind\tranks\tparticles\tparticle_steps_per_s\tmin\tmax");
+    let mut base = None;
+    for &r in ranks {
+        for (kind, k) in [("strong", 1), ("weak", r)] {
+            if kind == "weak" && r == 1 {
+                continue;
+            }
+            let (rate, n) = mpirun_worker(mpirun, &exe, r, &worker_args(k))?;
+            println!(
+                "{kind}\t{r}\t{n}\t{:.4e}\t{:.4e}\t{:.4e}",
+                rate.0, rate.1, rate.2
+            );
+            match (kind, base) {
+                ("strong", None) => base = Some((r, rate.0)),
+                ("strong", Some((r0, x0))) => {
+                    let speedup = rate.0 / x0;
+                    println!(
+                        "# strong: {r} ranks / {r0}: {speedup:.2} (efficiency {:.0} %)",
+                        100.0 * speedup * r0 as f64 / r as f64
+                    );
+                }
+                (_, Some((r0, x0))) => println!(
+                    "# weak: {r} ranks, {r} boxes: efficiency {:.0} %",
+                    100.0 * rate.0 / (x0 * r as f64 / r0 as f64)
+                ),
+                _ => {}
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Rank 0 prints the `RATE` line of [`mpirun_worker`]: the median (min, max) over the runs

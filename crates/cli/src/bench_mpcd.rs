@@ -36,6 +36,86 @@ pub struct BenchArgs {
     /// Skip LAMMPS.
     #[arg(long)]
     pub no_lammps: bool,
+    /// MPI rank counts of colloidsim instead: the solvent decomposed over the ranks
+    /// (docs/parallel.md), strong scaling (the cube on R ranks) and weak scaling (the cube
+    /// stretched along z to R times its length), each under `mpirun -n R` of this executable,
+    /// which must be built with `--features mpi`; the first `--threads` value is the threads
+    /// per rank. LAMMPS is not run.
+    #[arg(long, value_delimiter = ',')]
+    pub mpi_ranks: Vec<usize>,
+    /// Open MPI's `mpirun` for `--mpi-ranks`.
+    #[arg(long, default_value = "mpirun")]
+    pub mpirun: PathBuf,
+    /// Internal: run as one of the `mpirun` workers of `--mpi-ranks`, on the cube stretched
+    /// this many times along z.
+    #[arg(long, hide = true)]
+    pub worker_stretch: Option<usize>,
+}
+
+/// `--worker-stretch k` under `mpirun`: the standard solvent in the cube stretched `k` times
+/// along z, decomposed over the job's ranks, 5 warm-up steps, then `repeats` timed runs of
+/// `steps`; rank 0 prints the rate of the slowest rank.
+fn worker(a: &BenchArgs, k: usize) -> Result<()> {
+    let ranks = crate::parallel::Ranks::init()?;
+    let threads = a.threads.first().copied().unwrap_or(1);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .context("thread pool")?;
+    let l = a.l as f64;
+    let sbox = SimBox::new([l, l, k as f64 * l]);
+    let srd = Srd::new(SrdParams::standard(7), sbox, &Confinement::None, 0.0)?;
+    let n = srd.len();
+    let mut part = srd.decomposed(ranks.exchange()?)?;
+    let drive = Acceleration::None;
+    for _ in 0..5 {
+        part.advance(&drive)?;
+    }
+    let mut walls = Vec::new();
+    for _ in 0..a.repeats.max(1) {
+        let start = Instant::now();
+        for _ in 0..a.steps {
+            part.advance(&drive)?;
+        }
+        walls.push(crate::bench_dpd_ranks::walls_of_ranks(
+            Some(part.exchange()),
+            start.elapsed().as_secs_f64(),
+        ));
+    }
+    crate::bench_dpd_ranks::print_rate(ranks.rank(), n, a.steps, &walls);
+    Ok(())
+}
+
+/// `--mpi-ranks`: strong and weak scaling of the decomposed solvent.
+fn over_ranks(a: &BenchArgs) -> Result<()> {
+    if a.mpi_ranks.contains(&0) || a.steps == 0 {
+        anyhow::bail!("--mpi-ranks must be at least 1 and --steps > 0");
+    }
+    let threads = a.threads.first().copied().unwrap_or(1);
+    println!(
+        "# colloidsim bench mpcd --mpi-ranks: SRD solvent (density 5, 130 degrees, tau 0.1, cell thermostat), periodic cube of {l} cells, N = {}; weak scaling: R N in {l} x {l} x R {l}; {threads} thread(s) per rank; 5 warm-up steps, then {} timed steps per run, median (min-max) of {}",
+        5 * a.l.pow(3),
+        a.steps,
+        a.repeats.max(1),
+        l = a.l,
+    );
+    let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
+    println!("# load average (1, 5, 15 min) at start: {}", load());
+    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.mpi_ranks, |k| {
+        let mut args: Vec<String> = vec!["bench".into(), "mpcd".into()];
+        for (key, v) in [
+            ("--worker-stretch", k.to_string()),
+            ("--l", a.l.to_string()),
+            ("--threads", threads.to_string()),
+            ("--steps", a.steps.to_string()),
+            ("--repeats", a.repeats.max(1).to_string()),
+        ] {
+            args.extend([key.to_string(), v]);
+        }
+        args
+    })?;
+    println!("# load average (1, 5, 15 min) at end: {}", load());
+    Ok(())
 }
 
 /// The LAMMPS input of the same system (docs/data/mpcd/in.srd.bulk).
@@ -129,6 +209,12 @@ fn lammps_run(a: &BenchArgs, dir: &Path, ranks: usize) -> Option<(f64, f64, f64)
 
 /// `colloidsim bench mpcd`.
 pub fn bench(a: &BenchArgs) -> Result<()> {
+    if let Some(k) = a.worker_stretch {
+        return worker(a, k);
+    }
+    if !a.mpi_ranks.is_empty() {
+        return over_ranks(a);
+    }
     let p = SrdParams::standard(1);
     let conf = Confinement::None;
     let rss0 = resident_bytes();

@@ -12,6 +12,7 @@ pub mod boundary;
 pub mod colloid;
 pub mod drying;
 pub mod measure;
+pub mod ranks;
 pub mod scenario;
 pub mod srd;
 pub mod theory;
@@ -20,6 +21,7 @@ use colloidsim_core::rng::{Purpose, stream};
 
 pub use boundary::{Confinement, WallKind};
 pub use colloid::{ColloidParams, ColloidState, DiscreteColloids, MpcdSystem, Region};
+pub use ranks::SrdRanks;
 pub use srd::{Acceleration, Embedded, Srd, SrdParams};
 
 /// What a random stream of the MPCD engine is drawn for (the top byte of its index).

@@ -22,10 +22,13 @@
 //! (resolution `L / 2^32`, 1.4e-8 `a` in a box of 60 cells), so that periodic wrapping is exact
 //! integer arithmetic and a position takes 12 bytes; velocities are `f64`s (24 bytes). Each
 //! collision sorts the particles into the shifted cells by a counting sort (a rank within the
-//! cell, 2 bytes, then a list of slots cell by cell, 4 bytes); the members of a cell are taken in
-//! increasing slot order, and every random number of a collision is drawn from a counter-based
-//! stream keyed by (seed, step, block of [`CELLS_PER_STREAM`] cells), consumed cell by cell in
-//! order, so a step is a function of the state alone, bitwise the same on any number of threads.
+//! cell, 2 bytes, then a list of slots cell by cell, 4 bytes). A cell's sums (its momentum
+//! and, for the thermostat, its relative kinetic energy) are added exactly in fixed point
+//! ([`ExactSum`]), so a collision does not depend on the order of the cell's members, and
+//! every random number of a collision is drawn from a counter-based stream keyed by (seed,
+//! step, row of cells along x), consumed cell by cell along the row: a step is a function of
+//! the set of particles alone, bitwise the same on any number of threads, in any storage
+//! order, and on any number of ranks ([`super::ranks`], each owning whole layers of cells).
 //! The collision writes the velocities of each cell's members through the cell list, from many
 //! threads at once (rayon over chunks of cells): velocities are therefore stored as the bits of
 //! `f64`s in `AtomicU64`s ([`SharedVectors`]), whose relaxed loads and stores are plain moves;
@@ -46,12 +49,42 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
 /// Members of a cell handled on the stack; larger cells (rare) allocate.
 pub const CELL_CAPACITY: usize = 64;
-/// Cells that share one random stream (consumed in cell order).
-pub const CELLS_PER_STREAM: usize = 16;
 /// Particles per streaming chunk (fixed, so that the bounce lists do not depend on the threads).
 const STREAM_CHUNK: usize = 4096;
-/// Cells per collision task (a multiple of [`CELLS_PER_STREAM`]).
-const CELL_CHUNK: usize = 16 * CELLS_PER_STREAM;
+/// Cells per collision task, at least (whole rows of cells are taken).
+const CELL_CHUNK: usize = 256;
+
+/// A sum of `f64`s that does not depend on their order. Each term `x` (|x| < 2^19) is split
+/// into `x` rounded to a multiple of 2^-32 and the rest rounded to a multiple of 2^-64 (by
+/// adding and subtracting 1.5 2^20 and 1.5 2^-12), and the two parts are summed separately:
+/// while the sums stay below 2^20 every partial sum is a float exactly, so the result, the two
+/// parts added once at the end, is the same in any order (and within 2^-64 per term of the
+/// true sum).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ExactSum {
+    hi: f64,
+    lo: f64,
+}
+
+impl ExactSum {
+    const HI: f64 = 1572864.0; // 1.5 2^20: its ulp is 2^-32
+    const LO: f64 = 1.5 / 4096.0; // 1.5 2^-12: its ulp is 2^-64
+
+    /// Add `x`.
+    #[inline(always)]
+    pub fn add(&mut self, x: f64) {
+        let h = (x + Self::HI) - Self::HI;
+        let l = ((x - h) + Self::LO) - Self::LO;
+        self.hi += h;
+        self.lo += l;
+    }
+
+    /// The sum, rounded once to the nearest `f64`.
+    #[inline]
+    pub fn value(self) -> f64 {
+        self.hi + self.lo
+    }
+}
 
 /// Parameters of the SRD solvent (MPCD units: lengths in `a`, masses in `m`, energies in `kT`
 /// unless chosen otherwise).
@@ -463,6 +496,9 @@ pub struct Srd {
     step: u64,
     /// Permute the arrays into cell order every this many collisions (0: never).
     sort_every: u64,
+    /// The cells whose collisions this engine does (all, or the layers of a rank's domain):
+    /// the per-cell arrays below are indexed by `c - owned.start`.
+    owned: std::ops::Range<usize>,
     /// Per cell: members counted.
     count: Vec<AtomicU32>,
     /// Members of cell `c` are `order[start[c]..start[c + 1]]`.
@@ -592,6 +628,7 @@ impl Srd {
             vel: SharedVectors::from_slice(vel),
             step,
             sort_every: 10,
+            owned: 0..cells,
             count: (0..cells).map(|_| AtomicU32::new(0)).collect(),
             start: vec![0; cells + 1],
             rank: vec![0; n],
@@ -825,6 +862,38 @@ impl Srd {
         Ok(s)
     }
 
+    /// Collide only the cells of layers `z0..z1` along z (a rank's domain, [`super::ranks`]);
+    /// every particle must then lie in those layers of the shifted grid when it collides.
+    pub(crate) fn own_layers(&mut self, z0: usize, z1: usize) {
+        let layer = self.grid.n[0] * self.grid.n[1];
+        self.owned = z0 * layer..z1 * layer;
+        self.count = (0..self.owned.len()).map(|_| AtomicU32::new(0)).collect();
+        self.start = vec![0; self.owned.len() + 1];
+    }
+
+    /// The layer along z of slot `i` on the grid shifted by `s` (fixed point).
+    #[inline]
+    pub(crate) fn layer_of(&self, i: usize, s: [u32; 3]) -> usize {
+        ((self.pos[2][i].wrapping_sub(s[2]) as u64 * self.grid.n[2] as u64) >> 32) as usize
+    }
+
+    /// The grid shift of collision `step` in fixed point.
+    pub(crate) fn fixed_shift(&self, step: u64) -> [u32; 3] {
+        self.raw_shift(step)
+    }
+
+    /// Append a particle (fixed-point position, velocity).
+    pub(crate) fn push(&mut self, x: [u32; 3], v: [f64; 3]) {
+        for (k, c) in self.pos.iter_mut().enumerate() {
+            c.push(x[k]);
+        }
+        for (k, c) in self.vel.0.iter_mut().enumerate() {
+            c.push(AtomicU64::new(v[k].to_bits()));
+        }
+        self.order.push(AtomicU32::new(0));
+        self.rank.push(0);
+    }
+
     /// Slots of the particles reflected in the last streaming step, in increasing order.
     pub fn bounced(&self) -> impl Iterator<Item = u32> + '_ {
         self.bounced.iter().flatten().copied()
@@ -855,7 +924,8 @@ impl Srd {
     /// the slots cell by cell.
     fn bin(&mut self, s: [u32; 3], emb_pos: &[[f64; 3]]) {
         let grid = self.grid;
-        let cells = grid.cells();
+        let c0 = self.owned.start;
+        let cells = self.owned.len();
         let n = self.len();
         let [px, py, pz] = &self.pos;
         let count = &self.count;
@@ -869,7 +939,7 @@ impl Srd {
             .enumerate()
             .with_min_len(4096)
             .for_each(|(i, r)| {
-                let c = grid.cell([px[i], py[i], pz[i]], s);
+                let c = grid.cell([px[i], py[i], pz[i]], s) - c0;
                 let k = count[c].fetch_add(1, Relaxed);
                 *r = k as u16;
                 if k > u16::MAX as u32 {
@@ -883,7 +953,7 @@ impl Srd {
         let (start, rank, order) = (&self.start, &self.rank, &self.order);
         if crowded.load(Relaxed) == 0 {
             (0..n).into_par_iter().with_min_len(4096).for_each(|i| {
-                let c = grid.cell([px[i], py[i], pz[i]], s);
+                let c = grid.cell([px[i], py[i], pz[i]], s) - c0;
                 order[(start[c] + rank[i] as u32) as usize].store(i as u32, Relaxed);
             });
         } else {
@@ -893,18 +963,20 @@ impl Srd {
                 .enumerate()
                 .for_each(|(c, f)| f.store(start[c], Relaxed));
             (0..n).into_par_iter().with_min_len(4096).for_each(|i| {
-                let c = grid.cell([px[i], py[i], pz[i]], s);
+                let c = grid.cell([px[i], py[i], pz[i]], s) - c0;
                 let slot = count[c].fetch_add(1, Relaxed);
                 order[slot as usize].store(i as u32, Relaxed);
             });
         }
         let fixed = self.fixed;
         self.emb.clear();
+        let owned = self.owned.clone();
         self.emb.extend(
             emb_pos
                 .iter()
                 .enumerate()
-                .map(|(j, x)| (grid.cell(fixed.encode(*x), s) as u32, j as u32)),
+                .map(|(j, x)| (grid.cell(fixed.encode(*x), s) as u32, j as u32))
+                .filter(|&(c, _)| owned.contains(&(c as usize))),
         );
         self.emb.sort_unstable();
     }
@@ -916,7 +988,7 @@ impl Srd {
         let n = self.len();
         let (start, order) = (&self.start, &self.order);
         // The members of each cell in increasing slot order (the fill order is the threads').
-        (0..self.grid.cells())
+        (0..self.owned.len())
             .into_par_iter()
             .with_min_len(1024)
             .for_each(|c| {
@@ -1002,24 +1074,28 @@ impl Srd {
         };
         let (seed, step) = (p.seed, self.step);
         let grid = self.grid;
-        let cells = grid.cells();
+        // Whole rows of cells along x: one random stream each, several per task.
+        let row = grid.n[0];
+        let (first_row, rows) = (self.owned.start / row, self.owned.len() / row);
+        let rows_per_task = CELL_CHUNK.div_ceil(row);
         let (start, order, vel) = (&self.start, &self.order, &self.vel);
         let (emb_list, emb_vel, emb_mass) = (&self.emb, &self.emb_vel, &self.emb_mass);
         let conf = *conf;
         let walls = !matches!(conf, Confinement::None);
-        let totals: Vec<(u64, u64)> = (0..cells.div_ceil(CELL_CHUNK))
+        let totals: Vec<(u64, u64)> = (0..rows.div_ceil(rows_per_task))
             .into_par_iter()
-            .map(|chunk| {
-                let c0 = chunk * CELL_CHUNK;
-                let c1 = (c0 + CELL_CHUNK).min(cells);
-                let mut e = emb_list.partition_point(|&(c, _)| (c as usize) < c0);
+            .map(|task| {
+                let r0 = first_row + task * rows_per_task;
+                let r1 = (r0 + rows_per_task).min(first_row + rows);
+                let mut e = emb_list.partition_point(|&(c, _)| (c as usize) < r0 * row);
                 let (mut occupied, mut virt) = (0u64, 0u64);
                 let zig = Ziggurat::get();
                 let mut buf = Buffers::new();
-                for b0 in (c0..c1).step_by(CELLS_PER_STREAM) {
-                    let mut rng = draw(seed, step, Draw::Cell, (b0 / CELLS_PER_STREAM) as u64);
-                    for c in b0..(b0 + CELLS_PER_STREAM).min(c1) {
-                        let (a, b) = (start[c] as usize, start[c + 1] as usize);
+                for r in r0..r1 {
+                    let mut rng = draw(seed, step, Draw::Cell, r as u64);
+                    for c in r * row..(r + 1) * row {
+                        let l = c - first_row * row;
+                        let (a, b) = (start[l] as usize, start[l + 1] as usize);
                         let e0 = e;
                         while e < emb_list.len() && emb_list[e].0 as usize == c {
                             e += 1;
@@ -1260,32 +1336,23 @@ fn collide_in(
 ) -> usize {
     let ns = members.solvent.len();
     let ne = members.embedded.len();
-    // Solvent members in increasing slot order (the cell list is filled by many threads).
+    // The solvent members in the order the threads filled the cell list: their sums are exact,
+    // so the order does not matter.
     for (s, o) in slots.iter_mut().zip(members.solvent) {
         *s = o.load(Relaxed);
     }
-    let slots = &mut slots[..ns];
-    // Insertion sort: a handful of members, nearly sorted after a storage sort.
-    for i in 1..ns {
-        let x = slots[i];
-        let mut j = i;
-        while j > 0 && slots[j - 1] > x {
-            slots[j] = slots[j - 1];
-            j -= 1;
-        }
-        slots[j] = x;
-    }
-    let mut sum_v = [0.0f64; 3];
+    let slots = &slots[..ns];
+    let mut sum_v = [ExactSum::default(); 3];
     for (k, &s) in slots.iter().enumerate() {
         let x = vel.get(s as usize);
         v[k] = x;
         m[k] = rule.mass;
         for d in 0..3 {
-            sum_v[d] += x[d];
+            sum_v[d].add(x[d]);
         }
     }
     let mut mass = rule.mass * ns as f64;
-    let mut p = sum_v.map(|x| rule.mass * x);
+    let mut p = sum_v.map(|x| rule.mass * x.value());
     for (k, &(_, j)) in members.embedded.iter().enumerate() {
         let x = emb_vel.get(j as usize);
         let mj = emb_mass[j as usize];
@@ -1341,8 +1408,14 @@ fn collide_in(
     let rot = rotation(unit_vector(rng), rule.cos, rule.sin);
     let mut scale = 1.0;
     if rule.thermostat {
-        let mut twice_e = 0.0;
-        for k in 0..n {
+        // The solvent's part exactly (order-free), then the embedded and virtual members'.
+        let mut solvent = ExactSum::default();
+        for w in &v[..ns] {
+            let w = [w[0] - u[0], w[1] - u[1], w[2] - u[2]];
+            solvent.add(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        }
+        let mut twice_e = rule.mass * solvent.value();
+        for k in ns..n {
             let w = [v[k][0] - u[0], v[k][1] - u[1], v[k][2] - u[2]];
             twice_e += m[k] * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
         }

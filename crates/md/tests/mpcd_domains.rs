@@ -1,0 +1,127 @@
+//! The SRD solvent decomposed over ranks (issue 20), the ranks being threads talking over
+//! channels ([`common::on_ranks`]): a decomposed run must be bitwise the single-rank run, as a
+//! set of particles, for any number of ranks, including one layer of cells per rank (where a
+//! fast particle crosses a whole domain in a step and is passed on).
+
+mod common;
+
+use colloidsim_md::SimBox;
+use colloidsim_md::mpcd::ranks::canonical_state;
+use colloidsim_md::mpcd::{Acceleration, Confinement, MpcdError, Srd, SrdParams};
+use common::on_ranks;
+
+type State = (Vec<[u32; 3]>, Vec<[f64; 3]>);
+
+/// A periodic box of 12 x 10 x 12 cells at density 5 (7200 particles), sorted every 3
+/// collisions.
+fn solvent(seed: u32) -> Srd {
+    let mut srd = Srd::new(
+        SrdParams::standard(seed),
+        SimBox::new([12.0, 10.0, 12.0]),
+        &Confinement::None,
+        0.0,
+    )
+    .unwrap();
+    srd.set_sort_every(3);
+    srd
+}
+
+/// A body force along z and x: in 40 steps the mean flow reaches 4 cells per unit time along z
+/// (8 cells travelled), so particles cross every domain face and the periodic seam both ways
+/// (thermal motion and the random grid shift move them back and forth too).
+const DRIVE: Acceleration = Acceleration::Uniform([0.3, 0.0, 1.0]);
+
+fn single(seed: u32, steps: u64, accel: Acceleration) -> State {
+    let mut srd = solvent(seed);
+    for _ in 0..steps {
+        let t = (srd.step() + 1) as f64 * srd.params().tau;
+        srd.stream(t, &Confinement::None, &accel).unwrap();
+        srd.collide(t, &Confinement::None, None);
+    }
+    canonical_state(&srd)
+}
+
+fn decomposed(ranks: usize, seed: u32, steps: u64, accel: Acceleration) -> Vec<State> {
+    on_ranks(ranks, |comm| {
+        let mut part = solvent(seed).decomposed(comm).unwrap();
+        for _ in 0..steps {
+            // A particle outside the own layers would index past the cell arrays and panic.
+            part.advance(&accel).unwrap();
+        }
+        assert_eq!(part.total(), 7200);
+        part.gather_state()
+    })
+}
+
+fn bits(s: &State) -> (Vec<[u32; 3]>, Vec<[u64; 3]>) {
+    (
+        s.0.clone(),
+        s.1.iter().map(|v| v.map(f64::to_bits)).collect(),
+    )
+}
+
+#[test]
+fn a_decomposed_solvent_is_bitwise_the_single_rank_one() {
+    let want = bits(&single(5, 40, DRIVE));
+    for ranks in [1, 2, 3, 4] {
+        for (r, got) in decomposed(ranks, 5, 40, DRIVE).iter().enumerate() {
+            assert!(
+                bits(got) == want,
+                "{ranks} ranks: rank {r}'s gathered state differs from the single-rank run"
+            );
+        }
+    }
+}
+
+#[test]
+fn one_layer_per_rank_passes_fast_particles_on() {
+    // 12 ranks of one layer each, a Poiseuille-like cosine drive along x and a strong body
+    // force along z: the grid shift alone moves a particle's cell by up to one layer.
+    let accel = Acceleration::Uniform([0.0, 0.0, 3.0]);
+    let want = bits(&single(8, 25, accel));
+    for got in decomposed(12, 8, 25, accel) {
+        assert!(bits(&got) == want);
+    }
+    let cosine = Acceleration::CosineX {
+        amplitude: 0.5,
+        wavenumber: 2.0 * std::f64::consts::PI / 12.0,
+    };
+    let want = bits(&single(9, 20, cosine));
+    for got in decomposed(6, 9, 20, cosine) {
+        assert!(bits(&got) == want);
+    }
+}
+
+#[test]
+fn a_non_finite_velocity_on_one_rank_stops_every_rank() {
+    // Bad input on rank 2 alone: its drive is infinite.
+    let out = on_ranks(3, |comm| {
+        let mut part = solvent(3).decomposed(comm).unwrap();
+        part.advance(&Acceleration::None).unwrap();
+        let accel = if part.rank() == 2 {
+            Acceleration::Uniform([f64::INFINITY, 0.0, 0.0])
+        } else {
+            Acceleration::None
+        };
+        part.advance(&accel).map(|_| ())
+    });
+    for r in out {
+        match r {
+            Err(MpcdError::NonFinite { step, what, .. }) => {
+                assert_eq!((step, what), (1, "solvent"));
+            }
+            other => panic!("expected a non-finite stop on every rank, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn more_ranks_than_layers_are_refused() {
+    let out = on_ranks(13, |comm| solvent(1).decomposed(comm).err());
+    for e in out {
+        let msg = e
+            .expect("13 ranks for 12 layers must be refused")
+            .to_string();
+        assert!(msg.contains("13 ranks for 12 layers"), "{msg}");
+    }
+}
