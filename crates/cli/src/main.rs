@@ -576,8 +576,8 @@ fn run_cli() -> Result<()> {
     }
 }
 
-/// `colloidsim run` under `mpirun -n N`: one run decomposed in space over the ranks (DPD and
-/// free-draining BD so far; docs/parallel.md). Every rank reads the scenario and builds its
+/// `colloidsim run` under `mpirun -n N`: one run decomposed in space over the ranks (DPD,
+/// free-draining BD and the MPCD solvent so far; docs/parallel.md). Every rank reads the scenario and builds its
 /// share; rank 0 writes the folder a single-rank run writes.
 fn run_on_ranks(
     ranks: &parallel::Ranks,

@@ -516,3 +516,84 @@ fn a_failing_bd_run_on_ranks_stops_every_rank_with_one_message() {
     assert!(t.contains("runs on one rank"), "{t}");
     assert!(!out.exists());
 }
+
+/// The SRD solvent (2560 particles in 8 x 8 x 8 cells) in periodic Poiseuille flow for 300
+/// collisions, with a trajectory of the solvent: the decomposed MPCD runs.
+const TINY_MPCD: &str = r#"
+method = "mpcd"
+seed = 3
+[system]
+box = 8
+[run]
+collisions = 300
+[viscosity]
+[observe]
+every = 10
+[observe.trajectory]
+every = 100
+solvent = true
+"#;
+
+#[test]
+fn an_mpcd_solvent_on_1_to_4_ranks_writes_the_single_process_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "mpcd", TINY_MPCD);
+    for ranks in [1, 2, 3, 4] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let threads = if ranks == 2 { "2" } else { "1" };
+        let args = [
+            "run",
+            &s,
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            threads,
+        ];
+        let o = mpirun(ranks, &args);
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        assert_same_tree(&reference, &out);
+    }
+    // Without the cell thermostat the flow's heat leaves by a global rescaling (a sum over
+    // all ranks every collision).
+    let cold = ["--set", "solvent.thermostat=false", "--quiet"];
+    let one = tmp.path().join("no-thermostat");
+    let o = common::cli(
+        &[&["run", &s, "--out", one.to_str().unwrap()][..], &cold].concat(),
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let three = tmp.path().join("no-thermostat-3");
+    let o = mpirun(
+        3,
+        &[&["run", &s, "--out", three.to_str().unwrap()][..], &cold].concat(),
+    );
+    assert!(o.status.success());
+    assert_same_tree(&one, &three);
+    // Interrupted on 2 ranks, continued on 1 and on 3.
+    for ranks in [1, 3] {
+        let out = tmp.path().join(format!("continued-on-{ranks}"));
+        interrupted_on_2_continued_on(ranks, &s, &out, "150");
+        assert_same_tree(&reference, &out);
+    }
+}
+
+#[test]
+fn mpcd_with_colloids_is_refused_on_several_ranks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join("colloids.toml");
+    std::fs::write(
+        &sc,
+        "method = \"mpcd\"\n[system]\nbox = 10\ncolloids = 1\n[run]\ncollisions = 200\n[observe]\nvacf_lags = 10\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("colloids");
+    let o = mpirun(
+        2,
+        &["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()],
+    );
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(t.contains("runs on one rank"), "{t}");
+    assert!(!out.exists());
+}

@@ -6,7 +6,6 @@
 mod common;
 
 use colloidsim_md::SimBox;
-use colloidsim_md::mpcd::ranks::canonical_state;
 use colloidsim_md::mpcd::{Acceleration, Confinement, MpcdError, Srd, SrdParams};
 use common::on_ranks;
 
@@ -31,25 +30,32 @@ fn solvent(seed: u32) -> Srd {
 /// (thermal motion and the random grid shift move them back and forth too).
 const DRIVE: Acceleration = Acceleration::Uniform([0.3, 0.0, 1.0]);
 
+/// One step of the solvent, on one process or on every rank at once.
+fn step(srd: &mut Srd, accel: &Acceleration) -> Result<(), MpcdError> {
+    let t = (srd.step() + 1) as f64 * srd.params().tau;
+    srd.stream(t, &Confinement::None, accel)?;
+    srd.collide(t, &Confinement::None, None);
+    Ok(())
+}
+
 fn single(seed: u32, steps: u64, accel: Acceleration) -> State {
     let mut srd = solvent(seed);
     for _ in 0..steps {
-        let t = (srd.step() + 1) as f64 * srd.params().tau;
-        srd.stream(t, &Confinement::None, &accel).unwrap();
-        srd.collide(t, &Confinement::None, None);
+        step(&mut srd, &accel).unwrap();
     }
-    canonical_state(&srd)
+    srd.gathered_state()
 }
 
-fn decomposed(ranks: usize, seed: u32, steps: u64, accel: Acceleration) -> Vec<State> {
+fn decomposed(ranks: usize, seed: u32, steps: u64, accel: Acceleration) -> Vec<(State, [u64; 3])> {
     on_ranks(ranks, |comm| {
         let mut part = solvent(seed).decomposed(comm).unwrap();
         for _ in 0..steps {
             // A particle outside the own layers would index past the cell arrays and panic.
-            part.advance(&accel).unwrap();
+            step(&mut part, &accel).unwrap();
         }
-        assert_eq!(part.total(), 7200);
-        part.gather_state()
+        assert_eq!(part.particles(), 7200);
+        // Exact sums: the momentum is the same bits as on one process.
+        (part.gathered_state(), part.momentum().map(f64::to_bits))
     })
 }
 
@@ -63,12 +69,20 @@ fn bits(s: &State) -> (Vec<[u32; 3]>, Vec<[u64; 3]>) {
 #[test]
 fn a_decomposed_solvent_is_bitwise_the_single_rank_one() {
     let want = bits(&single(5, 40, DRIVE));
+    let momentum = {
+        let mut srd = solvent(5);
+        for _ in 0..40 {
+            step(&mut srd, &DRIVE).unwrap();
+        }
+        srd.momentum().map(f64::to_bits)
+    };
     for ranks in [1, 2, 3, 4] {
-        for (r, got) in decomposed(ranks, 5, 40, DRIVE).iter().enumerate() {
+        for (r, (got, p)) in decomposed(ranks, 5, 40, DRIVE).iter().enumerate() {
             assert!(
                 bits(got) == want,
                 "{ranks} ranks: rank {r}'s gathered state differs from the single-rank run"
             );
+            assert_eq!(*p, momentum, "{ranks} ranks: rank {r}'s momentum");
         }
     }
 }
@@ -79,7 +93,7 @@ fn one_layer_per_rank_passes_fast_particles_on() {
     // force along z: the grid shift alone moves a particle's cell by up to one layer.
     let accel = Acceleration::Uniform([0.0, 0.0, 3.0]);
     let want = bits(&single(8, 25, accel));
-    for got in decomposed(12, 8, 25, accel) {
+    for (got, _) in decomposed(12, 8, 25, accel) {
         assert!(bits(&got) == want);
     }
     let cosine = Acceleration::CosineX {
@@ -87,7 +101,7 @@ fn one_layer_per_rank_passes_fast_particles_on() {
         wavenumber: 2.0 * std::f64::consts::PI / 12.0,
     };
     let want = bits(&single(9, 20, cosine));
-    for got in decomposed(6, 9, 20, cosine) {
+    for (got, _) in decomposed(6, 9, 20, cosine) {
         assert!(bits(&got) == want);
     }
 }
@@ -97,13 +111,13 @@ fn a_non_finite_velocity_on_one_rank_stops_every_rank() {
     // Bad input on rank 2 alone: its drive is infinite.
     let out = on_ranks(3, |comm| {
         let mut part = solvent(3).decomposed(comm).unwrap();
-        part.advance(&Acceleration::None).unwrap();
-        let accel = if part.rank() == 2 {
+        step(&mut part, &Acceleration::None).unwrap();
+        let accel = if part.rank().0 == 2 {
             Acceleration::Uniform([f64::INFINITY, 0.0, 0.0])
         } else {
             Acceleration::None
         };
-        part.advance(&accel).map(|_| ())
+        step(&mut part, &accel)
     });
     for r in out {
         match r {
@@ -112,6 +126,21 @@ fn a_non_finite_velocity_on_one_rank_stops_every_rank() {
             }
             other => panic!("expected a non-finite stop on every rank, got {other:?}"),
         }
+    }
+}
+
+#[test]
+fn walls_are_refused_on_every_rank() {
+    let out = on_ranks(2, |comm| {
+        let mut part = solvent(2).decomposed(comm).unwrap();
+        let slab = Confinement::Slab {
+            half_width: 5.0,
+            kind: colloidsim_md::mpcd::WallKind::NoSlip,
+        };
+        part.stream(0.1, &slab, &Acceleration::None).err()
+    });
+    for e in out {
+        assert!(matches!(e, Some(MpcdError::Invalid(m)) if m.contains("not decomposed")));
     }
 }
 

@@ -199,8 +199,8 @@ pub(crate) fn fail_alone_over(comm: Option<&dyn Exchange>, e: anyhow::Error) -> 
 /// Why `colloidsim run` under `mpirun -n N` refuses a method.
 fn not_decomposed(sc: &Scenario, method: &str) -> String {
     format!(
-        "{}: method '{method}' runs on one rank: only 'dpd' and free-draining 'bd' and \
-         'droplet-bd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
+        "{}: method '{method}' runs on one rank: only 'dpd', free-draining 'bd' and \
+         'droplet-bd', and the pure solvent of 'mpcd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
          and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )

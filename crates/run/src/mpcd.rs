@@ -20,6 +20,7 @@ use crate::plot::{
 };
 use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region, VERTICES};
@@ -51,6 +52,19 @@ impl SolventState {
         }
     }
 
+    /// The whole solvent in the canonical order ([`Srd::gathered_state`]; collective when
+    /// decomposed), for a bulk run, whose steps do not depend on the storage order: the same
+    /// checkpoint on any number of ranks.
+    fn gathered(srd: &Srd) -> Self {
+        let (pos, vel) = srd.gathered_state();
+        Self {
+            step: srd.step(),
+            sort_every: srd.sort_every(),
+            pos,
+            vel,
+        }
+    }
+
     fn engine(self, params: colloidsim_md::mpcd::SrdParams, sbox: SimBox) -> Result<Srd> {
         let mut srd = Srd::from_raw(params, sbox, &self.pos, &self.vel, self.step)
             .context("checkpoint.bin: the solvent state")?;
@@ -61,10 +75,22 @@ impl SolventState {
 
 /// A GSD frame of the solvent (type `S`, diameter 0.2 cells, velocities and masses).
 fn solvent_frame(w: &mut GsdWriter, srd: &Srd, log: &[(&str, f64)]) -> Result<()> {
-    let mut p = Particles::monodisperse(srd.positions(), 0.2 * srd.params().cell);
+    solvent_frame_of(w, srd, srd.positions(), srd.velocities(), log)
+}
+
+/// [`solvent_frame`] of the given positions and velocities.
+fn solvent_frame_of(
+    w: &mut GsdWriter,
+    srd: &Srd,
+    pos: Vec<[f64; 3]>,
+    vel: Vec<[f64; 3]>,
+    log: &[(&str, f64)],
+) -> Result<()> {
+    let n = pos.len();
+    let mut p = Particles::monodisperse(pos, 0.2 * srd.params().cell);
     p.type_names = vec!["S".into()];
-    p.vel = srd.velocities();
-    p.mass = vec![srd.params().mass; srd.len()];
+    p.vel = vel;
+    p.mass = vec![srd.params().mass; n];
     w.write_frame(srd.step(), srd.sbox(), &p, false, log)?;
     Ok(())
 }
@@ -318,19 +344,16 @@ impl Method for MpcdBulk {
     }
 
     fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        let p = resolve_bulk(src, seed)?;
-        let colloids = build_bulk_colloids(&p).with_context(|| src.label())?;
-        let srd = build_bulk(&p).with_context(|| src.label())?;
-        let acc = BulkAccum::new(&p);
-        Ok(Box::new(BulkSession {
-            p,
-            srd,
-            colloids,
-            acc,
-            gsd: None,
-            thermo_log: None,
-            com_scratch: Vec::new(),
-        }))
+        start_bulk(src, seed, None)
+    }
+
+    fn start_decomposed(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        start_bulk(src, seed, Some(comm))
     }
 
     fn restore(
@@ -340,33 +363,18 @@ impl Method for MpcdBulk {
         out: &OutputDir,
         envelope: &Envelope,
     ) -> Result<Box<dyn Session>> {
-        let p = resolve_bulk(src, Some(seed))?;
-        let saved: BulkSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
-        if saved.solvent.pos.len() != p.particles {
-            bail!("checkpoint: its solvent does not fit the scenario");
-        }
-        let srd = saved
-            .solvent
-            .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
-        let colloids =
-            restore_colloids(saved.colloids.as_ref(), p.colloids, p.colloid, p.box_edge)?;
-        if p.trajectory_every > 0 {
-            saved
-                .acc
-                .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &[], true)
-                })?;
-        }
-        Ok(Box::new(BulkSession {
-            p,
-            srd,
-            colloids,
-            acc: saved.acc,
-            gsd: None,
-            thermo_log: None,
-            com_scratch: Vec::new(),
-        }))
+        restore_bulk(src, seed, out, envelope, None)
+    }
+
+    fn restore_decomposed(
+        &self,
+        src: &Source,
+        seed: u64,
+        out: &OutputDir,
+        envelope: &Envelope,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Box<dyn Session>> {
+        restore_bulk(src, seed, out, envelope, Some(comm))
     }
 
     fn keys(&self) -> Vec<Key> {
@@ -389,6 +397,83 @@ impl Method for MpcdBulk {
             scratch: Vec::new(),
         }))
     }
+}
+
+/// Under several ranks: the solvent decomposed over them (colloids are not decomposed yet).
+fn decompose(p: &BulkRun, srd: Srd, comm: Option<Box<dyn Exchange>>) -> Result<Srd> {
+    let Some(comm) = comm else {
+        return Ok(srd);
+    };
+    if p.colloids > 0 {
+        bail!(
+            "mpcd with colloids runs on one rank: only the pure solvent is decomposed over MPI \
+             ranks so far (docs/parallel.md); spread replicas over ranks with `colloidsim ensemble`"
+        );
+    }
+    Ok(srd.decomposed(comm)?)
+}
+
+/// A fresh bulk session, decomposed over the ranks of `comm` when given.
+fn start_bulk(
+    src: &Source,
+    seed: Option<u64>,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let p = resolve_bulk(src, seed)?;
+    let colloids = build_bulk_colloids(&p).with_context(|| src.label())?;
+    let srd = build_bulk(&p).with_context(|| src.label())?;
+    let srd = decompose(&p, srd, comm).with_context(|| src.label())?;
+    let acc = BulkAccum::new(&p);
+    Ok(Box::new(BulkSession {
+        momentum: [0.0; 3],
+        p,
+        srd,
+        colloids,
+        acc,
+        gsd: None,
+        thermo_log: None,
+        com_scratch: Vec::new(),
+    }))
+}
+
+/// A bulk session from its checkpoint, on any number of ranks.
+fn restore_bulk(
+    src: &Source,
+    seed: u64,
+    out: &OutputDir,
+    envelope: &Envelope,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Box<dyn Session>> {
+    let p = resolve_bulk(src, Some(seed))?;
+    let saved: BulkSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
+    if saved.solvent.pos.len() != p.particles {
+        bail!("checkpoint: its solvent does not fit the scenario");
+    }
+    let srd = saved
+        .solvent
+        .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+    let writer = comm.as_ref().is_none_or(|c| c.rank() == 0);
+    let srd = decompose(&p, srd, comm)?;
+    let colloids = restore_colloids(saved.colloids.as_ref(), p.colloids, p.colloid, p.box_edge)?;
+    if p.trajectory_every > 0 && writer {
+        saved
+            .acc
+            .digest
+            .restore(&out.join("trajectory.gsd"), |path, frames| {
+                trim_trajectory(path, frames, &[], true)
+            })
+            .map_err(|e| crate::method::fail_alone_over(srd.exchange(), e))?;
+    }
+    Ok(Box::new(BulkSession {
+        momentum: [0.0; 3],
+        p,
+        srd,
+        colloids,
+        acc: saved.acc,
+        gsd: None,
+        thermo_log: None,
+        com_scratch: Vec::new(),
+    }))
 }
 
 /// One row of `thermo.csv` (bulk).
@@ -461,9 +546,26 @@ struct BulkSession {
     thermo_log: Option<CsvLog>,
     /// The colloids' centre-of-mass velocities of the current collision (reused).
     com_scratch: Vec<[f64; 3]>,
+    /// The total momentum at the end of the last chunk of collisions (for the summary, which
+    /// is written without messages between ranks).
+    momentum: [f64; 3],
 }
 
 impl BulkSession {
+    fn is_writer(&self) -> bool {
+        self.srd.rank().0 == 0
+    }
+
+    /// Momentum of the solvent and the colloids (collective when decomposed).
+    fn total_momentum(&self) -> [f64; 3] {
+        let mut momentum = self.srd.momentum();
+        if let Some(col) = &self.colloids {
+            let pc = col.momentum();
+            momentum = std::array::from_fn(|k| momentum[k] + pc[k]);
+        }
+        momentum
+    }
+
     fn wavenumber(&self) -> f64 {
         2.0 * PI / self.p.box_edge
     }
@@ -477,7 +579,7 @@ impl BulkSession {
             let m = p.solvent.srd.mass;
             let temperature = if p.drive.is_some() {
                 // Relative to the driven flow.
-                let n = self.srd.len() as f64;
+                let n = self.srd.particles() as f64;
                 let twice = self.srd.sum(|x, v| {
                     let w = [v[0] - flow * (k * x[2]).cos(), v[1], v[2]];
                     [m * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])]
@@ -502,26 +604,36 @@ impl BulkSession {
                     .map_or(f64::NAN, |c| c.com_temperature()),
             });
             if let (Some(log), Some(row)) = (self.thermo_log.as_mut(), self.acc.rows.last()) {
-                log.append(&row.values(p.solvent.srd.tau))?;
+                log.append(&row.values(p.solvent.srd.tau))
+                    .map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e.into()))?;
             }
             if c > p.equilibrate {
                 self.acc.temperature.push(temperature);
                 let slabs = self.acc.flow_profile.len();
-                let l = p.box_edge;
-                for i in 0..self.srd.len() {
-                    let x = self.srd.position(i);
-                    let b = (((x[2] / l + 0.5) * slabs as f64) as usize).min(slabs - 1);
-                    self.acc.flow_profile[b] += self.srd.velocity(i)[0];
-                    self.acc.flow_counts[b] += 1.0;
+                let (vx, counts) = self.srd.z_profile(slabs, |_, v| v[0]);
+                for b in 0..slabs {
+                    self.acc.flow_profile[b] += vx[b];
+                    self.acc.flow_counts[b] += counts[b];
                 }
             }
         }
-        if let Some(w) = self.gsd.as_mut()
-            && c.is_multiple_of(p.trajectory_every)
-        {
-            match &self.colloids {
-                Some(col) => colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[])?,
-                None => solvent_frame(w, &self.srd, &[])?,
+        if p.trajectory_every > 0 && c.is_multiple_of(p.trajectory_every) {
+            // Every rank takes part in gathering the solvent; the writer writes.
+            let frame = match &self.colloids {
+                Some(_) => None,
+                None => Some(self.srd.gathered_state()),
+            };
+            if let Some(w) = self.gsd.as_mut() {
+                let written = match (&self.colloids, frame) {
+                    (Some(col), _) => colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[]),
+                    (None, Some((pos, vel))) => {
+                        let fixed = *self.srd.fixed_point();
+                        let pos = pos.iter().map(|x| fixed.decode(*x)).collect();
+                        solvent_frame_of(w, &self.srd, pos, vel, &[])
+                    }
+                    (None, None) => unreachable!(),
+                };
+                written.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
             }
             self.acc.frames += 1;
         }
@@ -571,21 +683,36 @@ impl Session for BulkSession {
     }
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
-        self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
-        self.thermo_log = Some(CsvLog::start(
-            out.join("thermo.csv"),
-            &BULK_THERMO,
-            fresh,
-            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
-        )?);
+        if BulkSession::is_writer(self) {
+            self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+            self.thermo_log = Some(CsvLog::start(
+                out.join("thermo.csv"),
+                &BULK_THERMO,
+                fresh,
+                || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
+            )?);
+        }
         if fresh {
             self.record(0)?;
         }
+        self.momentum = self.total_momentum();
         Ok(())
     }
 
     fn next_checkpoint(&self) -> Option<u64> {
         tenth_after(self.position(), self.p.collisions)
+    }
+
+    fn is_writer(&self) -> bool {
+        BulkSession::is_writer(self)
+    }
+
+    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
+        crate::method::agree_over(self.srd.exchange(), chunk, interrupted)
+    }
+
+    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        crate::method::fail_alone_over(self.srd.exchange(), e)
     }
 
     fn advance(&mut self, until: u64) -> Result<Option<String>> {
@@ -603,6 +730,7 @@ impl Session for BulkSession {
         while self.srd.step() < until.min(self.p.collisions) {
             let t = (self.srd.step() + 1) as f64 * tau;
             if let Err(e) = self.srd.stream(t, &conf, &drive) {
+                self.momentum = self.total_momentum();
                 return Ok(Some(e.to_string()));
             }
             if let Some(col) = self.colloids.as_mut()
@@ -649,6 +777,7 @@ impl Session for BulkSession {
             }
             self.record(self.srd.step())?;
         }
+        self.momentum = self.total_momentum();
         Ok(None)
     }
 
@@ -660,20 +789,25 @@ impl Session for BulkSession {
     }
 
     fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
-        if self.p.trajectory_every > 0 {
-            self.flush()?;
-            self.acc
-                .digest
-                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        if self.p.trajectory_every > 0 && BulkSession::is_writer(self) {
+            let extended = self.flush().and_then(|_| {
+                self.acc
+                    .digest
+                    .extend(&out.join("trajectory.gsd"), self.acc.frames)
+            });
+            extended.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
         }
         Ok(bincode::serialize(&BulkSaved {
-            solvent: SolventState::of(&self.srd),
+            solvent: SolventState::gathered(&self.srd),
             colloids: self.colloids.as_ref().map(|c| c.state()),
             acc: self.acc.clone(),
         })?)
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        if !BulkSession::is_writer(self) {
+            return Ok(Vec::new());
+        }
         write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
@@ -684,8 +818,17 @@ impl Session for BulkSession {
         wall_s: f64,
         failure: Option<&str>,
     ) -> Result<Finished> {
+        if !BulkSession::is_writer(&self) {
+            return Ok(Finished {
+                summary: json!({}),
+                files: Vec::new(),
+                message: String::new(),
+                warnings: Vec::new(),
+            });
+        }
         self.flush()?;
         let p = &self.p;
+        let solvent_particles = p.particles;
         let mut files = Vec::new();
         let mut warnings = Vec::new();
         write_thermo(out, p.solvent.srd.tau, &self.acc.rows)?;
@@ -705,15 +848,18 @@ impl Session for BulkSession {
             "collisions": collisions,
             "sampled_collisions": sampled,
             "time": collisions as f64 * p.solvent.srd.tau,
-            "solvent_particles": self.srd.len(),
+            "solvent_particles": solvent_particles,
             "temperature": { "value": t_mean, "standard_error": t_se, "target": p.solvent.srd.kt },
-            "momentum": self.srd.momentum(),
+            "momentum": self.momentum,
             "viscosity_theory": p.solvent.viscosity_theory,
             "wall_seconds": wall_s,
-            "particle_updates_per_second": collisions as f64 * self.srd.len() as f64 / wall_s.max(1e-9),
+            "particle_updates_per_second": collisions as f64 * solvent_particles as f64 / wall_s.max(1e-9),
             "threads": rayon::current_num_threads(),
             "trajectory_frames": self.acc.frames,
         });
+        if self.srd.rank().1 > 1 {
+            summary["ranks"] = json!(self.srd.rank().1);
+        }
         if let Some(probe) = &self.acc.probe {
             let (eta, se) = probe.viscosity();
             let blocks = probe.flow.blocks.len();
@@ -831,7 +977,7 @@ impl Session for BulkSession {
             (Some(f), _) => format!("mpcd stopped at collision {collisions}: {f}"),
             (None, None) if summary.get("colloid_diffusion").is_some() => format!(
                 "mpcd: {collisions} collisions of {} solvent particles and {} colloids; D = {:.6} +- {:.6} (Stokes-Einstein-Hasimoto at a = d/2: {:.6})",
-                self.srd.len(),
+                solvent_particles,
                 p.colloids,
                 summary["colloid_diffusion"]["value"]
                     .as_f64()
@@ -843,14 +989,14 @@ impl Session for BulkSession {
             ),
             (None, Some(v)) => format!(
                 "mpcd: {collisions} collisions of {} solvent particles; viscosity {:.4} +- {:.4} (Kikuchi et al. {:.4})",
-                self.srd.len(),
+                solvent_particles,
                 v["value"].as_f64().unwrap_or(f64::NAN),
                 v["standard_error"].as_f64().unwrap_or(f64::NAN),
                 p.solvent.viscosity_theory
             ),
             (None, None) => format!(
                 "mpcd: {collisions} collisions of {} solvent particles; T = {t_mean:.4} +- {t_se:.4}",
-                self.srd.len()
+                solvent_particles
             ),
         };
         Ok(Finished {

@@ -96,6 +96,7 @@ impl SolventProfile {
         let chunks = n.div_ceil(CHUNK);
         self.parts.resize_with(chunks, Vec::new);
         let scale = bins as f64 / radius;
+        let srd = srd.view();
         self.parts.par_iter_mut().enumerate().for_each(|(c, part)| {
             part.clear();
             part.resize(2 * bins, 0.0);

@@ -100,7 +100,7 @@ impl PoiseuilleProbe {
 
     /// The flow amplitude of the solvent now.
     pub fn amplitude_of(srd: &Srd, wavenumber: f64) -> f64 {
-        let n = srd.len() as f64;
+        let n = srd.particles() as f64;
         2.0 / n * srd.sum(|x, v| [v[0] * (wavenumber * x[2]).cos()])[0]
     }
 

@@ -21,7 +21,6 @@ use colloidsim_core::rng::{Purpose, stream};
 
 pub use boundary::{Confinement, WallKind};
 pub use colloid::{ColloidParams, ColloidState, DiscreteColloids, MpcdSystem, Region};
-pub use ranks::SrdRanks;
 pub use srd::{Acceleration, Embedded, Srd, SrdParams};
 
 /// What a random stream of the MPCD engine is drawn for (the top byte of its index).

@@ -7,17 +7,16 @@
 //! then all on one rank, and nothing else is exchanged.
 //!
 //! A collision is a function of the set of its cell's members (exact sums,
-//! [`super::srd::ExactSum`]) and of random streams keyed by (seed, step, row of cells), so a
-//! decomposed run is **bitwise the single-rank run for any number of ranks**, as a set of
-//! particles: the storage order differs, and [`SrdRanks::gather_state`] and
-//! [`canonical_state`] put both in one canonical order to compare them.
+//! [`super::srd::ExactSum`]) and of random streams keyed by (seed, step, row of cells), and
+//! sums over all particles are exact too ([`super::srd::ExactTotal`]), so a decomposed run is
+//! **bitwise the single-rank run for any number of ranks**, as a set of particles: only the
+//! storage order differs, and [`Srd::gathered_state`] puts either in one canonical order.
 //!
-//! Not decomposed yet: walls (the droplet) and embedded colloids ([`Srd::decomposed`] refuses
-//! nothing itself; the caller must not pass them, and [`SrdRanks::advance`] has no such
-//! arguments).
+//! Not decomposed yet: walls (the droplet; [`Srd::stream`] refuses them) and embedded colloids
+//! (the caller must not pass them to a decomposed [`Srd::collide`]).
 
-use super::srd::{CollisionStats, Srd};
-use super::{Acceleration, Confinement, MpcdError};
+use super::MpcdError;
+use super::srd::{ExactTotal, Srd};
 use crate::domain::Domain;
 use colloidsim_core::exchange::Exchange;
 
@@ -25,19 +24,27 @@ use colloidsim_core::exchange::Exchange;
 /// exact in an `f64`) and the velocity.
 const PER_PARTICLE: usize = 6;
 
-/// The part of an SRD solvent one rank owns (see the module docs).
-pub struct SrdRanks {
-    srd: Srd,
-    domain: Domain,
-    /// Slots leaving in the current migration round.
-    leaving: Vec<u32>,
+impl std::fmt::Debug for Domain {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Domain {{ rank {} of {}, layers {}..{} of {} }}",
+            self.comm.rank(),
+            self.comm.size(),
+            self.z0,
+            self.z1,
+            self.nz
+        )
+    }
 }
 
 impl Srd {
     /// This rank's part of the solvent, decomposed over the ranks of `comm`: every rank passes
-    /// the same whole solvent (built from the same input) and keeps the particles in its
-    /// layers. An error when there are more ranks than layers of cells.
-    pub fn decomposed(mut self, comm: Box<dyn Exchange>) -> Result<SrdRanks, MpcdError> {
+    /// the same whole solvent (built from the same input, at the same step) and keeps the
+    /// particles in its layers. An error when there are more ranks than layers of cells.
+    /// From then on [`Self::stream`], [`Self::sum`], [`Self::particles`],
+    /// [`Self::gathered_state`] and the observables built on them are collective.
+    pub fn decomposed(mut self, comm: Box<dyn Exchange>) -> Result<Srd, MpcdError> {
         let grid = *self.grid();
         let domain = Domain::new(comm, grid.n[2], grid.a).map_err(MpcdError::Invalid)?;
         let s = self.fixed_shift(self.step());
@@ -47,69 +54,112 @@ impl Srd {
             .collect();
         self.remove(&mut leaving);
         self.own_layers(domain.z0, domain.z1);
-        Ok(SrdRanks {
-            srd: self,
-            domain,
-            leaving,
-        })
-    }
-}
-
-impl SrdRanks {
-    /// This rank's particles, as an engine (positions, velocities, step, parameters); its
-    /// collisions are those of the own layers.
-    pub fn local(&self) -> &Srd {
-        &self.srd
+        self.domain = Some(domain);
+        Ok(self)
     }
 
-    /// The owned layers of cells along z.
+    /// The ranks, when decomposed.
+    pub fn exchange(&self) -> Option<&dyn Exchange> {
+        self.domain.as_ref().map(|d| &*d.comm)
+    }
+
+    /// This rank and the number of ranks (`(0, 1)` on one process).
+    pub fn rank(&self) -> (usize, usize) {
+        self.exchange().map_or((0, 1), |c| (c.rank(), c.size()))
+    }
+
+    /// The owned layers of cells along z (all of them on one process).
     pub fn layers(&self) -> std::ops::Range<usize> {
-        self.domain.z0..self.domain.z1
+        self.domain
+            .as_ref()
+            .map_or(0..self.grid().n[2], |d| d.z0..d.z1)
     }
 
-    /// The number of ranks.
-    pub fn ranks(&self) -> usize {
-        self.domain.comm.size()
+    /// The number of particles on all ranks (collective when decomposed; [`Self::len`] is
+    /// this rank's).
+    pub fn particles(&self) -> usize {
+        match self.exchange() {
+            None => self.len(),
+            Some(c) => {
+                let mut all = Vec::new();
+                c.all_gather_same(&[self.len() as f64], &mut all);
+                all.iter().sum::<f64>() as usize
+            }
+        }
     }
 
-    /// The ranks.
-    pub fn exchange(&self) -> &dyn Exchange {
-        &*self.domain.comm
-    }
-
-    /// This rank.
-    pub fn rank(&self) -> usize {
-        self.domain.comm.rank()
-    }
-
-    /// One step on every rank at once: stream for `tau` (driven by `accel`, no walls), hand the
-    /// particles to the owners of their cells on the next collision's grid, collide the own
-    /// cells. A non-finite velocity on any rank stops every rank with the step (and the slot on
-    /// the first rank that has one). Returns this rank's collision counts.
-    pub fn advance(&mut self, accel: &Acceleration) -> Result<CollisionStats, MpcdError> {
-        let t = (self.srd.step() + 1) as f64 * self.srd.params().tau;
-        let bad = match self.srd.stream(t, &Confinement::None, accel) {
-            Ok(_) => None,
-            Err(MpcdError::NonFinite { index, .. }) => Some(index),
-            Err(e) => return Err(e),
+    /// Every rank's partial totals merged (collective; nothing on one process). Integer
+    /// additions: the result does not depend on the split.
+    pub(super) fn merge_over_ranks<const K: usize>(&self, acc: &mut [ExactTotal; K]) {
+        let Some(c) = self.exchange() else {
+            return;
         };
-        self.migrate(bad)?;
-        Ok(self.srd.collide(t, &Confinement::None, None))
+        let mine: Vec<f64> = acc.iter().flat_map(|t| t.words()).collect();
+        let mut all = Vec::new();
+        c.all_gather_same(&mine, &mut all);
+        *acc = [ExactTotal::default(); K];
+        for part in all.chunks_exact(4 * K) {
+            for (d, w) in part.chunks_exact(4).enumerate() {
+                acc[d].merge(ExactTotal::from_words(w));
+            }
+        }
+    }
+
+    /// Sums of `f(position, velocity)` and the particle counts in `bins` slabs along z of the
+    /// box (slab `floor((z / L_z + 1/2) bins)`), exact in any order and over all ranks
+    /// (collective when decomposed).
+    pub fn z_profile(
+        &self,
+        bins: usize,
+        f: impl Fn([f64; 3], [f64; 3]) -> f64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let lz = self.sbox().l[2];
+        let mut sums = vec![ExactTotal::default(); bins];
+        let mut counts = vec![0.0; bins];
+        let view = self.view();
+        for i in 0..view.len() {
+            let (x, v) = (view.position(i), view.velocity(i));
+            let b = (((x[2] / lz + 0.5) * bins as f64) as usize).min(bins - 1);
+            sums[b].add(f(x, v));
+            counts[b] += 1.0;
+        }
+        if let Some(c) = self.exchange() {
+            let mine: Vec<f64> = sums
+                .iter()
+                .zip(&counts)
+                .flat_map(|(t, n)| {
+                    let w = t.words();
+                    [w[0], w[1], w[2], w[3], *n]
+                })
+                .collect();
+            let mut all = Vec::new();
+            c.all_gather_same(&mine, &mut all);
+            sums.iter_mut().for_each(|t| *t = ExactTotal::default());
+            counts.iter_mut().for_each(|n| *n = 0.0);
+            for part in all.chunks_exact(5 * bins) {
+                for (b, w) in part.chunks_exact(5).enumerate() {
+                    sums[b].merge(ExactTotal::from_words(&w[..4]));
+                    counts[b] += w[4];
+                }
+            }
+        }
+        (sums.into_iter().map(ExactTotal::value).collect(), counts)
     }
 
     /// Send every particle whose cell on the grid of the coming collision is not in the own
-    /// layers towards its owner, by the shorter way round, in rounds until none is left.
-    fn migrate(&mut self, bad: Option<usize>) -> Result<(), MpcdError> {
-        let s = self.srd.fixed_shift(self.srd.step());
-        let (nz, z0, z1) = (self.domain.nz, self.domain.z0, self.domain.z1);
+    /// layers towards its owner, by the shorter way round, in rounds until none is left; a
+    /// non-finite velocity on any rank (`bad`: its slot) stops every rank.
+    pub(super) fn migrate(&mut self, bad: Option<usize>) -> Result<(), MpcdError> {
+        let s = self.fixed_shift(self.step());
         loop {
-            let d = &mut self.domain;
+            let mut d = self.domain.take().expect("migrate: a decomposed engine");
+            let (nz, z0, z1) = (d.nz, d.z0, d.z1);
             self.leaving.clear();
             d.send_left.clear();
             d.send_right.clear();
             if bad.is_none() {
-                for i in 0..self.srd.len() {
-                    let z = self.srd.layer_of(i, s);
+                for i in 0..self.len() {
+                    let z = self.layer_of(i, s);
                     if d.owns(z) {
                         continue;
                     }
@@ -120,7 +170,7 @@ impl SrdRanks {
                     } else {
                         &mut d.send_left
                     };
-                    let (x, v) = (self.srd.raw_position(i), self.srd.velocity(i));
+                    let (x, v) = (self.raw_position(i), self.velocity(i));
                     buf.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
                     buf.extend_from_slice(&v);
                     self.leaving.push(i as u32);
@@ -130,73 +180,63 @@ impl SrdRanks {
             d.mine
                 .extend_from_slice(&[self.leaving.len() as f64, bad.map_or(-1.0, |i| i as f64)]);
             d.comm.all_gather_same(&d.mine, &mut d.gathered);
-            if let Some(g) = d.gathered.chunks_exact(2).find(|g| g[1] >= 0.0) {
-                return Err(MpcdError::NonFinite {
-                    step: self.srd.step(),
-                    what: "solvent",
-                    index: g[1] as usize,
-                });
+            let failed = d
+                .gathered
+                .chunks_exact(2)
+                .find(|g| g[1] >= 0.0)
+                .map(|g| g[1]);
+            let done = d.gathered.chunks_exact(2).all(|g| g[0] == 0.0);
+            if failed.is_some() || done {
+                self.domain = Some(d);
+                return match failed {
+                    Some(i) => Err(MpcdError::NonFinite {
+                        step: self.step(),
+                        what: "solvent",
+                        index: i as usize,
+                    }),
+                    None => Ok(()),
+                };
             }
-            if d.gathered.chunks_exact(2).all(|g| g[0] == 0.0) {
-                return Ok(());
-            }
-            self.srd.remove(&mut self.leaving);
+            let mut leaving = std::mem::take(&mut self.leaving);
+            self.remove(&mut leaving);
+            self.leaving = leaving;
             let (left, right) = (d.left(), d.right());
             d.comm.shift(right, &d.send_right, left, &mut d.recv);
-            Self::arrive(&mut self.srd, &d.recv);
+            self.arrive(&d.recv);
             d.comm.shift(left, &d.send_left, right, &mut d.recv);
-            Self::arrive(&mut self.srd, &d.recv);
+            self.arrive(&d.recv);
+            self.domain = Some(d);
         }
     }
 
-    fn arrive(srd: &mut Srd, msg: &[f64]) {
+    fn arrive(&mut self, msg: &[f64]) {
         for p in msg.chunks_exact(PER_PARTICLE) {
-            srd.push([p[0] as u32, p[1] as u32, p[2] as u32], [p[3], p[4], p[5]]);
+            self.push([p[0] as u32, p[1] as u32, p[2] as u32], [p[3], p[4], p[5]]);
         }
     }
 
-    /// Every rank's particles on every rank, in the canonical order of [`canonical_state`]
-    /// (collective).
-    pub fn gather_state(&mut self) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
-        let d = &mut self.domain;
-        d.mine.clear();
-        for i in 0..self.srd.len() {
-            let (x, v) = (self.srd.raw_position(i), self.srd.velocity(i));
-            d.mine
-                .extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64, v[0], v[1], v[2]]);
-        }
-        d.comm.all_gather(&d.mine, &mut d.gathered);
-        let pos: Vec<[u32; 3]> = d
-            .gathered
-            .chunks_exact(PER_PARTICLE)
-            .map(|p| [p[0] as u32, p[1] as u32, p[2] as u32])
-            .collect();
-        let vel: Vec<[f64; 3]> = d
-            .gathered
-            .chunks_exact(PER_PARTICLE)
-            .map(|p| [p[3], p[4], p[5]])
-            .collect();
-        canonical(pos, vel)
+    /// The whole solvent's fixed-point positions and velocities in a canonical order (by
+    /// position z, y, x, then by the velocity's bits), the same on one process and over any
+    /// number of ranks (collective when decomposed: every rank gets all of it).
+    pub fn gathered_state(&self) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
+        let (pos, vel) = match self.exchange() {
+            None => (self.raw_positions(), self.velocities()),
+            Some(c) => {
+                let mut mine = Vec::with_capacity(PER_PARTICLE * self.len());
+                for i in 0..self.len() {
+                    let (x, v) = (self.raw_position(i), self.velocity(i));
+                    mine.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
+                    mine.extend_from_slice(&v);
+                }
+                let mut all = Vec::new();
+                c.all_gather(&mine, &mut all);
+                all.chunks_exact(PER_PARTICLE)
+                    .map(|p| ([p[0] as u32, p[1] as u32, p[2] as u32], [p[3], p[4], p[5]]))
+                    .unzip()
+            }
+        };
+        let mut all: Vec<([u32; 3], [f64; 3])> = pos.into_iter().zip(vel).collect();
+        all.sort_unstable_by_key(|(x, v)| ([x[2], x[1], x[0]], v.map(f64::to_bits)));
+        all.into_iter().unzip()
     }
-
-    /// The number of particles on all ranks (collective).
-    pub fn total(&mut self) -> usize {
-        let d = &mut self.domain;
-        d.mine.clear();
-        d.mine.push(self.srd.len() as f64);
-        d.comm.all_gather_same(&d.mine, &mut d.gathered);
-        d.gathered.iter().sum::<f64>() as usize
-    }
-}
-
-/// The state of a whole (single-rank) solvent in the canonical order: by fixed-point position
-/// (z, y, x), then by the velocity's bits.
-pub fn canonical_state(srd: &Srd) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
-    canonical(srd.raw_positions(), srd.velocities())
-}
-
-fn canonical(pos: Vec<[u32; 3]>, vel: Vec<[f64; 3]>) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
-    let mut all: Vec<([u32; 3], [f64; 3])> = pos.into_iter().zip(vel).collect();
-    all.sort_unstable_by_key(|(x, v)| ([x[2], x[1], x[0]], v.map(f64::to_bits)));
-    all.into_iter().unzip()
 }

@@ -176,6 +176,60 @@ impl Acceleration {
     }
 }
 
+/// A sum over many terms that does not depend on their order and of any size: each term `x`
+/// (|x| < 2^30) as the integers `x 2^32` (truncated) and the 32 bits below, summed in 64-bit
+/// integers (exact for up to 2^31 terms of |x| < 1), the total rounded once. Sums over all
+/// particles ([`Srd::sum`]) use it, so that they are the same bits in any storage order and
+/// over any number of ranks (partial totals merge exactly).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ExactTotal {
+    hi: i64,
+    lo: i64,
+}
+
+impl ExactTotal {
+    const SCALE: f64 = 4294967296.0;
+
+    /// Add `x`.
+    #[inline(always)]
+    pub fn add(&mut self, x: f64) {
+        let a = x * Self::SCALE;
+        let h = a as i64;
+        // a - h is exact (the fraction of a float), and so is its scaling by 2^32.
+        let l = ((a - h as f64) * Self::SCALE) as i64;
+        self.hi = self.hi.wrapping_add(h);
+        self.lo = self.lo.wrapping_add(l);
+    }
+
+    /// Add another total.
+    pub fn merge(&mut self, o: ExactTotal) {
+        self.hi = self.hi.wrapping_add(o.hi);
+        self.lo = self.lo.wrapping_add(o.lo);
+    }
+
+    /// The total, rounded once to the nearest `f64`.
+    pub fn value(self) -> f64 {
+        let total = ((self.hi as i128) << 32) + self.lo as i128;
+        total as f64 / (Self::SCALE * Self::SCALE)
+    }
+
+    /// As four numbers exact in `f64`s (32-bit halves), for a message.
+    pub fn words(self) -> [f64; 4] {
+        let half = |x: i64| [(x >> 32) as f64, (x & 0xffff_ffff) as f64];
+        let (h, l) = (half(self.hi), half(self.lo));
+        [h[0], h[1], l[0], l[1]]
+    }
+
+    /// From [`Self::words`].
+    pub fn from_words(w: &[f64]) -> Self {
+        let whole = |a: f64, b: f64| ((a as i64) << 32) | b as i64;
+        Self {
+            hi: whole(w[0], w[1]),
+            lo: whole(w[2], w[3]),
+        }
+    }
+}
+
 /// Vectors of `f64` stored as bits in `AtomicU64`s, one array per component, so that the
 /// collision pass can write the members of each cell through the cell list from several
 /// threads (see the module docs).
@@ -470,6 +524,40 @@ fn unit_vector(rng: &mut impl Rng) -> [f64; 3] {
     }
 }
 
+/// The particle arrays of an [`Srd`], shareable between threads (the engine itself is not
+/// `Sync` when it holds the ranks of a decomposed run).
+#[derive(Clone, Copy)]
+pub struct View<'a> {
+    pos: &'a [Vec<u32>; 3],
+    vel: &'a SharedVectors,
+    fixed: FixedPoint,
+}
+
+impl View<'_> {
+    /// Number of particles (this rank's).
+    pub fn len(&self) -> usize {
+        self.pos[0].len()
+    }
+
+    /// None?
+    pub fn is_empty(&self) -> bool {
+        self.pos[0].is_empty()
+    }
+
+    /// Position of slot `i`, in `[-L/2, L/2)`.
+    #[inline(always)]
+    pub fn position(&self, i: usize) -> [f64; 3] {
+        self.fixed
+            .decode([self.pos[0][i], self.pos[1][i], self.pos[2][i]])
+    }
+
+    /// Velocity of slot `i`.
+    #[inline(always)]
+    pub fn velocity(&self, i: usize) -> [f64; 3] {
+        self.vel.get(i)
+    }
+}
+
 /// The constants of a collision.
 struct Rule {
     cos: f64,
@@ -519,6 +607,10 @@ pub struct Srd {
     /// Seconds spent in the parts of a step: streaming, binning, storage sorts, cell
     /// collisions.
     pub timers: [f64; 4],
+    /// The ranks and this rank's layers, when decomposed ([`super::ranks`]).
+    pub(super) domain: Option<crate::domain::Domain>,
+    /// Slots leaving in the current migration round (decomposed runs).
+    pub(super) leaving: Vec<u32>,
 }
 
 impl Srd {
@@ -640,6 +732,8 @@ impl Srd {
             emb_mass: Vec::new(),
             bounced: Vec::new(),
             timers: [0.0; 4],
+            domain: None,
+            leaving: Vec::new(),
         })
     }
 
@@ -661,6 +755,15 @@ impl Srd {
         let fixed = FixedPoint::new(&sbox);
         let raw: Vec<[u32; 3]> = pos.iter().map(|x| fixed.encode(*x)).collect();
         Self::from_raw(params, sbox, &raw, vel, step)
+    }
+
+    /// The particle arrays, for work on many threads.
+    pub fn view(&self) -> View<'_> {
+        View {
+            pos: &self.pos,
+            vel: &self.vel,
+            fixed: self.fixed,
+        }
     }
 
     /// Parameters.
@@ -782,7 +885,35 @@ impl Srd {
     /// Stream every particle for `tau` up to time `t1` (driven by `accel`), reflecting at
     /// the walls of `conf`, and wrap into the box. The slots of the reflected particles are
     /// kept for [`Self::bounced`].
+    ///
+    /// Decomposed ([`super::ranks`]), the particles then go to the ranks that own their cells
+    /// on the next collision's grid, and a non-finite velocity on any rank stops every rank
+    /// (collective); walls are not decomposed yet.
     pub fn stream(
+        &mut self,
+        t1: f64,
+        conf: &Confinement,
+        accel: &Acceleration,
+    ) -> Result<StreamStats, MpcdError> {
+        if self.domain.is_none() {
+            return self.stream_own(t1, conf, accel);
+        }
+        if !matches!(conf, Confinement::None) {
+            return Err(MpcdError::Invalid(
+                "an MPCD solvent with walls is not decomposed over ranks yet".into(),
+            ));
+        }
+        let streamed = self.stream_own(t1, conf, accel);
+        let bad = match &streamed {
+            Err(MpcdError::NonFinite { index, .. }) => Some(*index),
+            _ => None,
+        };
+        self.migrate(bad)?;
+        streamed
+    }
+
+    /// [`Self::stream`] of this engine's (this rank's) particles.
+    fn stream_own(
         &mut self,
         t1: f64,
         conf: &Confinement,
@@ -1134,33 +1265,35 @@ impl Srd {
         st
     }
 
-    /// Sums over all particles of `f(position, velocity)` in fixed chunks added in order:
-    /// the same bits on any number of threads.
+    /// Sums over all particles of `f(position, velocity)`, exact in any order ([`ExactTotal`]):
+    /// the same bits on any number of threads and, decomposed, over all ranks (collective).
     pub fn sum<const K: usize>(
         &self,
         f: impl Fn([f64; 3], [f64; 3]) -> [f64; K] + Sync,
     ) -> [f64; K] {
-        let parts: Vec<[f64; K]> = (0..self.len().div_ceil(STREAM_CHUNK))
+        let view = self.view();
+        let parts: Vec<[ExactTotal; K]> = (0..view.len().div_ceil(STREAM_CHUNK))
             .into_par_iter()
             .map(|ci| {
-                let mut acc = [0.0; K];
-                let end = ((ci + 1) * STREAM_CHUNK).min(self.len());
+                let mut acc = [ExactTotal::default(); K];
+                let end = ((ci + 1) * STREAM_CHUNK).min(view.len());
                 for i in ci * STREAM_CHUNK..end {
-                    let r = f(self.position(i), self.vel.get(i));
+                    let r = f(view.position(i), view.velocity(i));
                     for d in 0..K {
-                        acc[d] += r[d];
+                        acc[d].add(r[d]);
                     }
                 }
                 acc
             })
             .collect();
-        let mut acc = [0.0; K];
+        let mut acc = [ExactTotal::default(); K];
         for p in parts {
             for d in 0..K {
-                acc[d] += p[d];
+                acc[d].merge(p[d]);
             }
         }
-        acc
+        self.merge_over_ranks(&mut acc);
+        acc.map(ExactTotal::value)
     }
 
     /// Rescale the velocities relative to the flow field `flow(x)` by one factor so that their
@@ -1168,7 +1301,7 @@ impl Srd {
     /// profile-unbiased thermostat, for measurements without the cell thermostat: it removes
     /// the viscous heat of a driven flow without acting on the cells' relative velocities).
     pub fn rescale_about(&mut self, flow: impl Fn([f64; 3]) -> [f64; 3] + Sync) {
-        let n = self.len();
+        let n = self.particles();
         if n < 2 {
             return;
         }
@@ -1182,12 +1315,16 @@ impl Srd {
             return;
         }
         let scale = (3.0 * (n - 1) as f64 * self.params.kt / twice).sqrt();
-        (0..n).into_par_iter().with_min_len(4096).for_each(|i| {
-            let (x, v) = (self.position(i), self.vel.get(i));
-            let f = flow(x);
-            self.vel
-                .set(i, std::array::from_fn(|k| f[k] + scale * (v[k] - f[k])));
-        });
+        let view = self.view();
+        (0..view.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .for_each(|i| {
+                let (x, v) = (view.position(i), view.velocity(i));
+                let f = flow(x);
+                view.vel
+                    .set(i, std::array::from_fn(|k| f[k] + scale * (v[k] - f[k])));
+            });
     }
 
     /// Total momentum of the solvent.
@@ -1204,7 +1341,7 @@ impl Srd {
 
     /// Kinetic temperature `sum m |v - V|^2 / (3 (N - 1))` relative to the mean velocity `V`.
     pub fn temperature(&self) -> f64 {
-        let n = self.len() as f64;
+        let n = self.particles() as f64;
         if n < 2.0 {
             return f64::NAN;
         }
