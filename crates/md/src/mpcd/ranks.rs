@@ -151,6 +151,10 @@ impl Srd {
     /// non-finite velocity on any rank (`bad`: its slot) stops every rank.
     pub(super) fn migrate(&mut self, bad: Option<usize>) -> Result<(), MpcdError> {
         let s = self.fixed_shift(self.step());
+        // The first round sends the leavers the streaming step found; later rounds look only
+        // at the particles that arrived in the round before (from `first_new` on).
+        let mut first_round = true;
+        let mut first_new = self.len();
         loop {
             let mut d = self.domain.take().expect("migrate: a decomposed engine");
             let (nz, z0, z1) = (d.nz, d.z0, d.z1);
@@ -158,7 +162,12 @@ impl Srd {
             d.send_left.clear();
             d.send_right.clear();
             if bad.is_none() {
-                for i in 0..self.len() {
+                let candidates: Vec<usize> = if first_round {
+                    self.leavers.iter().flatten().map(|&i| i as usize).collect()
+                } else {
+                    (first_new..self.len()).collect()
+                };
+                for i in candidates {
                     let z = self.layer_of(i, s);
                     if d.owns(z) {
                         continue;
@@ -200,6 +209,8 @@ impl Srd {
             let mut leaving = std::mem::take(&mut self.leaving);
             self.remove(&mut leaving);
             self.leaving = leaving;
+            first_round = false;
+            first_new = self.len();
             let (left, right) = (d.left(), d.right());
             d.comm.shift(right, &d.send_right, left, &mut d.recv);
             self.arrive(&d.recv);

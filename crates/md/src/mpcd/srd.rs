@@ -611,6 +611,9 @@ pub struct Srd {
     pub(super) domain: Option<crate::domain::Domain>,
     /// Slots leaving in the current migration round (decomposed runs).
     pub(super) leaving: Vec<u32>,
+    /// Per streaming chunk: slots that left the own layers of the next collision's grid in the
+    /// last streaming step (decomposed runs).
+    pub(super) leavers: Vec<Vec<u32>>,
 }
 
 impl Srd {
@@ -734,6 +737,7 @@ impl Srd {
             timers: [0.0; 4],
             domain: None,
             leaving: Vec::new(),
+            leavers: Vec::new(),
         })
     }
 
@@ -924,6 +928,13 @@ impl Srd {
         let n = self.len();
         let chunks = n.div_ceil(STREAM_CHUNK);
         self.bounced.resize_with(chunks, Vec::new);
+        self.leavers.resize_with(chunks, Vec::new);
+        // Decomposed: which particles leave the own layers of the next collision's grid, found
+        // chunk by chunk while the positions are in cache.
+        let own = self.domain.as_ref().map(|d| {
+            let s = self.raw_shift(self.step)[2];
+            (s, self.grid.n[2] as u64, d.z0..d.z1)
+        });
         let (vel, fixed) = (&self.vel, self.fixed);
         let (accel, conf) = (*accel, *conf);
         let free = matches!(conf, Confinement::None) && matches!(accel, Acceleration::None);
@@ -932,10 +943,11 @@ impl Srd {
             .par_chunks_mut(STREAM_CHUNK)
             .zip(py.par_chunks_mut(STREAM_CHUNK))
             .zip(pz.par_chunks_mut(STREAM_CHUNK))
-            .zip(self.bounced.par_iter_mut())
+            .zip(self.bounced.par_iter_mut().zip(self.leavers.par_iter_mut()))
             .enumerate()
-            .map(|(ci, (((xs, ys), zs), list))| {
+            .map(|(ci, (((xs, ys), zs), (list, leavers)))| {
                 list.clear();
+                leavers.clear();
                 let (mut bounced, mut refl, mut stuck) = (0u64, 0u64, 0u64);
                 let mut bad = None;
                 for k in 0..xs.len() {
@@ -972,6 +984,14 @@ impl Srd {
                     }
                     vel.set(i, v);
                     [xs[k], ys[k], zs[k]] = fixed.encode(x);
+                }
+                if let Some((s, nz, layers)) = &own {
+                    for (k, &z) in zs.iter().enumerate() {
+                        let layer = ((z.wrapping_sub(*s) as u64 * nz) >> 32) as usize;
+                        if !layers.contains(&layer) {
+                            leavers.push((ci * STREAM_CHUNK + k) as u32);
+                        }
+                    }
                 }
                 (bounced, refl, stuck, bad)
             })
