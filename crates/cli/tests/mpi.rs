@@ -1,5 +1,5 @@
 //! `colloidsim` under `mpirun -n 1, 2, 4` (built with `--features mpi`; `.ci/run` runs these
-//! with Open MPI): an ensemble's folder, and a DPD or free-draining Brownian-dynamics run
+//! with Open MPI): an ensemble's folder, and a DPD, free-draining Brownian-dynamics or MPCD run
 //! decomposed in space, are byte for byte
 //! the single-process ones on any number of ranks, also when continued on another number of
 //! ranks, and a failure on one rank stops every rank with its message instead of a hang.
@@ -577,23 +577,37 @@ fn an_mpcd_solvent_on_1_to_4_ranks_writes_the_single_process_folder() {
     }
 }
 
+/// Two colloids of the default diameter (42 vertices each) in the solvent of a cube of 10
+/// cells for 200 collisions, their velocity autocorrelation and a trajectory with the solvent.
+const TINY_MPCD_COLLOIDS: &str = r#"
+method = "mpcd"
+seed = 4
+[system]
+box = 10
+colloids = 2
+[run]
+collisions = 200
+[observe]
+vacf_lags = 10
+[observe.trajectory]
+every = 100
+solvent = true
+"#;
+
 #[test]
-fn mpcd_with_colloids_is_refused_on_several_ranks() {
+fn mpcd_with_colloids_on_2_and_3_ranks_writes_the_single_process_folder() {
     let tmp = tempfile::tempdir().unwrap();
-    let sc = tmp.path().join("colloids.toml");
-    std::fs::write(
-        &sc,
-        "method = \"mpcd\"\n[system]\nbox = 10\ncolloids = 1\n[run]\ncollisions = 200\n[observe]\nvacf_lags = 10\n",
-    )
-    .unwrap();
-    let out = tmp.path().join("colloids");
-    let o = mpirun(
-        2,
-        &["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()],
-    );
-    assert!(!o.status.success());
-    let t = text(&o);
-    assert_eq!(t.matches("error:").count(), 1, "{t}");
-    assert!(t.contains("runs on one rank"), "{t}");
-    assert!(!out.exists());
+    let (s, reference) = reference(tmp.path(), "colloids", TINY_MPCD_COLLOIDS);
+    for ranks in [2, 3] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let o = mpirun(
+            ranks,
+            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
+        );
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        assert_same_tree(&reference, &out);
+    }
+    let out = tmp.path().join("continued-on-3");
+    interrupted_on_2_continued_on(3, &s, &out, "120");
+    assert_same_tree(&reference, &out);
 }

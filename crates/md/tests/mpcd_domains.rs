@@ -154,3 +154,56 @@ fn more_ranks_than_layers_are_refused() {
         assert!(msg.contains("13 ranks for 12 layers"), "{msg}");
     }
 }
+
+/// Four colloids of diameter 3 (42 vertices each, joining the collisions) in a cube of 12
+/// cells, driven along z so that they cross the domain faces: solvent and colloids.
+fn with_colloids(seed: u32) -> colloidsim_md::mpcd::MpcdSystem {
+    use colloidsim_md::mpcd::{ColloidParams, DiscreteColloids, MpcdSystem, Region};
+    let p = SrdParams::standard(seed);
+    let sbox = SimBox::cube(12.0);
+    let srd = Srd::new(p, sbox, &Confinement::None, 0.0).unwrap();
+    let c = DiscreteColloids::random(
+        ColloidParams::standard(3.0, p.kt),
+        sbox,
+        4,
+        Region::Box,
+        p.kt,
+        seed,
+    )
+    .unwrap();
+    MpcdSystem::new(srd, c, Confinement::None, None).unwrap()
+}
+
+#[test]
+fn colloids_replicated_on_every_rank_move_as_on_one_process() {
+    let drive = Acceleration::Uniform([0.0, 0.0, 0.5]);
+    let steps = 30;
+    let mut one = with_colloids(4);
+    for _ in 0..steps {
+        one.step(&drive).unwrap();
+    }
+    let want = (
+        bits(&one.srd.gathered_state()),
+        one.colloids.state(),
+        one.momentum().map(f64::to_bits),
+    );
+    for ranks in [2, 3] {
+        let got = on_ranks(ranks, |comm| {
+            let mut sys = with_colloids(4);
+            sys.srd = sys.srd.decomposed(comm).unwrap();
+            for _ in 0..steps {
+                sys.step(&drive).unwrap();
+            }
+            (
+                bits(&sys.srd.gathered_state()),
+                sys.colloids.state(),
+                sys.momentum().map(f64::to_bits),
+            )
+        });
+        for (r, g) in got.iter().enumerate() {
+            assert!(g.0 == want.0, "{ranks} ranks: rank {r}'s solvent differs");
+            assert_eq!(g.1, want.1, "{ranks} ranks: rank {r}'s colloids differ");
+            assert_eq!(g.2, want.2, "{ranks} ranks: rank {r}'s momentum differs");
+        }
+    }
+}

@@ -200,7 +200,7 @@ pub(crate) fn fail_alone_over(comm: Option<&dyn Exchange>, e: anyhow::Error) -> 
 fn not_decomposed(sc: &Scenario, method: &str) -> String {
     format!(
         "{}: method '{method}' runs on one rank: only 'dpd', free-draining 'bd' and \
-         'droplet-bd', and the pure solvent of 'mpcd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
+         'droplet-bd', and 'mpcd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
          and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )

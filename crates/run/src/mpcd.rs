@@ -95,13 +95,16 @@ fn solvent_frame_of(
     Ok(())
 }
 
+/// The positions and velocities of the solvent in a frame.
+type SolventFrame = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
 /// A GSD frame with colloids: the centres (type `A`, diameter d), the vertices (type `V`) and,
-/// with `solvent`, the solvent (type `S`).
+/// when given, the solvent (type `S`).
 fn colloid_frame(
     w: &mut GsdWriter,
     srd: &Srd,
     col: &DiscreteColloids,
-    solvent: bool,
+    solvent: Option<SolventFrame>,
     log: &[(&str, f64)],
 ) -> Result<()> {
     let sbox = *srd.sbox();
@@ -121,10 +124,10 @@ fn colloid_frame(
         diameter.push(0.25 * srd.params().cell);
         mass.push(cp.vertex_mass);
     }
-    if solvent {
-        pos.extend(srd.positions());
-        vel.extend(srd.velocities());
-        let n = srd.len();
+    if let Some((sp, sv)) = solvent {
+        let n = sp.len();
+        pos.extend(sp);
+        vel.extend(sv);
         typeid.extend(std::iter::repeat_n(2, n));
         diameter.extend(std::iter::repeat_n(0.2 * srd.params().cell, n));
         mass.extend(std::iter::repeat_n(srd.params().mass, n));
@@ -399,18 +402,13 @@ impl Method for MpcdBulk {
     }
 }
 
-/// Under several ranks: the solvent decomposed over them (colloids are not decomposed yet).
-fn decompose(p: &BulkRun, srd: Srd, comm: Option<Box<dyn Exchange>>) -> Result<Srd> {
-    let Some(comm) = comm else {
-        return Ok(srd);
-    };
-    if p.colloids > 0 {
-        bail!(
-            "mpcd with colloids runs on one rank: only the pure solvent is decomposed over MPI \
-             ranks so far (docs/parallel.md); spread replicas over ranks with `colloidsim ensemble`"
-        );
+/// Under several ranks: the solvent decomposed over them (the colloids, few, are replicated
+/// on every rank).
+fn decompose(srd: Srd, comm: Option<Box<dyn Exchange>>) -> Result<Srd> {
+    match comm {
+        None => Ok(srd),
+        Some(comm) => Ok(srd.decomposed(comm)?),
     }
-    Ok(srd.decomposed(comm)?)
 }
 
 /// A fresh bulk session, decomposed over the ranks of `comm` when given.
@@ -422,7 +420,7 @@ fn start_bulk(
     let p = resolve_bulk(src, seed)?;
     let colloids = build_bulk_colloids(&p).with_context(|| src.label())?;
     let srd = build_bulk(&p).with_context(|| src.label())?;
-    let srd = decompose(&p, srd, comm).with_context(|| src.label())?;
+    let srd = decompose(srd, comm).with_context(|| src.label())?;
     let acc = BulkAccum::new(&p);
     Ok(Box::new(BulkSession {
         momentum: [0.0; 3],
@@ -453,7 +451,7 @@ fn restore_bulk(
         .solvent
         .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
     let writer = comm.as_ref().is_none_or(|c| c.rank() == 0);
-    let srd = decompose(&p, srd, comm)?;
+    let srd = decompose(srd, comm)?;
     let colloids = restore_colloids(saved.colloids.as_ref(), p.colloids, p.colloid, p.box_edge)?;
     if p.trajectory_every > 0 && writer {
         saved
@@ -619,19 +617,16 @@ impl BulkSession {
         }
         if p.trajectory_every > 0 && c.is_multiple_of(p.trajectory_every) {
             // Every rank takes part in gathering the solvent; the writer writes.
-            let frame = match &self.colloids {
-                Some(_) => None,
-                None => Some(self.srd.gathered_state()),
-            };
+            let solvent = (self.colloids.is_none() || p.trajectory_solvent).then(|| {
+                let (pos, vel) = self.srd.gathered_state();
+                let fixed = *self.srd.fixed_point();
+                (pos.iter().map(|x| fixed.decode(*x)).collect(), vel)
+            });
             if let Some(w) = self.gsd.as_mut() {
-                let written = match (&self.colloids, frame) {
-                    (Some(col), _) => colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[]),
-                    (None, Some((pos, vel))) => {
-                        let fixed = *self.srd.fixed_point();
-                        let pos = pos.iter().map(|x| fixed.decode(*x)).collect();
-                        solvent_frame_of(w, &self.srd, pos, vel, &[])
-                    }
-                    (None, None) => unreachable!(),
+                let written = match (&self.colloids, solvent) {
+                    (Some(col), solvent) => colloid_frame(w, &self.srd, col, solvent, &[]),
+                    (None, Some((pos, vel))) => solvent_frame_of(w, &self.srd, pos, vel, &[]),
+                    (None, None) => unreachable!("a bulk frame without colloids has the solvent"),
                 };
                 written.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
             }
@@ -753,7 +748,7 @@ impl Session for BulkSession {
                 // Relative to the solvent's mean velocity: the frame of Hasimoto's theory.
                 let (ps, ms) = (
                     self.srd.momentum(),
-                    self.srd.len() as f64 * self.srd.params().mass,
+                    self.srd.particles() as f64 * self.srd.params().mass,
                 );
                 col.com_velocities_into(&mut self.com_scratch);
                 for v in &mut self.com_scratch {
@@ -1391,7 +1386,10 @@ impl DropletSession {
         {
             match &self.colloids {
                 Some(col) => {
-                    colloid_frame(w, &self.srd, col, p.trajectory_solvent, &[("radius", r)])?
+                    let solvent = p
+                        .trajectory_solvent
+                        .then(|| (self.srd.positions(), self.srd.velocities()));
+                    colloid_frame(w, &self.srd, col, solvent, &[("radius", r)])?
                 }
                 None => solvent_frame(w, &self.srd, &[("radius", r)])?,
             }

@@ -12,8 +12,10 @@
 //! **bitwise the single-rank run for any number of ranks**, as a set of particles: only the
 //! storage order differs, and [`Srd::gathered_state`] puts either in one canonical order.
 //!
-//! Not decomposed yet: walls (the droplet; [`Srd::stream`] refuses them) and embedded colloids
-//! (the caller must not pass them to a decomposed [`Srd::collide`]).
+//! Embedded particles (the vertices of colloids, [`super::colloid`]) are replicated on every
+//! rank: each joins the collision of its cell on the rank that owns it, and the new velocities
+//! are then shared with every rank, so colloids move alike everywhere. Not decomposed yet:
+//! walls (the droplet; [`Srd::stream`] refuses them).
 
 use super::MpcdError;
 use super::srd::{ExactTotal, Srd};
@@ -102,6 +104,25 @@ impl Srd {
             for (d, w) in part.chunks_exact(4).enumerate() {
                 acc[d].merge(ExactTotal::from_words(w));
             }
+        }
+    }
+
+    /// After a collision with embedded particles (replicated on every rank, each collided by
+    /// the rank owning its cell): every rank's new velocities of its own embedded particles
+    /// on every rank (collective; nothing on one process).
+    pub(super) fn share_embedded(&self, vel: &mut [[f64; 3]]) {
+        let Some(c) = self.exchange() else {
+            return;
+        };
+        let mut mine = Vec::with_capacity(4 * self.emb.len());
+        for &(_, j) in &self.emb {
+            let v = vel[j as usize];
+            mine.extend_from_slice(&[j as f64, v[0], v[1], v[2]]);
+        }
+        let mut all = Vec::new();
+        c.all_gather(&mine, &mut all);
+        for m in all.chunks_exact(4) {
+            vel[m[0] as usize] = [m[1], m[2], m[3]];
         }
     }
 

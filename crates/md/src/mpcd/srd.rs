@@ -598,8 +598,8 @@ pub struct Srd {
     /// Scratch of the storage sort (one component at a time).
     scratch_pos: Vec<u32>,
     scratch_vel: Vec<AtomicU64>,
-    /// Embedded particles of the current collision: (cell, index), sorted.
-    emb: Vec<(u32, u32)>,
+    /// Embedded particles of the current collision in the own cells: (cell, index), sorted.
+    pub(super) emb: Vec<(u32, u32)>,
     emb_vel: SharedVectors,
     emb_mass: Vec<f64>,
     /// Per streaming chunk: slots of the particles reflected in the last streaming step.
@@ -1274,6 +1274,9 @@ impl Srd {
             for (j, v) in e.vel.iter_mut().enumerate() {
                 *v = self.emb_vel.get(j);
             }
+            // Decomposed: each embedded particle collided on the rank that owns its cell;
+            // every rank takes the new velocities from there.
+            self.share_embedded(e.vel);
         }
         self.timers[3] += clock.elapsed().as_secs_f64();
         self.step += 1;
