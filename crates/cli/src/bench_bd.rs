@@ -55,29 +55,20 @@ const DT: f64 = 1e-4;
 /// stretched `k` times along z, decomposed over the job's ranks, 100 warm-up steps, then
 /// `repeats` timed runs of `steps`; rank 0 prints the rate of the slowest rank.
 fn worker(a: &BenchArgs, k: usize) -> Result<()> {
-    let ranks = crate::parallel::Ranks::init()?;
-    let threads = a.threads.first().copied().unwrap_or(1);
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build_global()
-        .context("thread pool")?;
+    let ranks = crate::bench_dpd_ranks::worker_ranks(&a.threads)?;
     let l = (a.n as f64 * std::f64::consts::PI / 6.0 / a.phi).cbrt();
     let sbox = colloidsim_md::SimBox::new([l, l, k as f64 * l]);
     let n = k * a.n;
     let sim = colloidsim_md::bench::wca_periodic_box(n, sbox, DT, 1, a.skin)?;
     let mut sim = sim.decomposed(ranks.exchange()?)?;
     sim.run(100)?;
-    let mut walls = Vec::new();
-    for _ in 0..a.repeats.max(1) {
-        let start = Instant::now();
-        sim.run(a.steps)?;
-        walls.push(crate::bench_dpd_ranks::walls_of_ranks(
-            sim.exchange(),
-            start.elapsed().as_secs_f64(),
-        ));
-    }
-    crate::bench_dpd_ranks::print_rate(ranks.rank(), n, a.steps, &walls);
-    Ok(())
+    crate::bench_dpd_ranks::time_repeats(
+        &ranks,
+        &mut sim,
+        (n, a.steps, a.repeats),
+        |sim| Ok(sim.run(a.steps)?),
+        |sim| sim.exchange(),
+    )
 }
 
 /// `--ranks`: strong and weak scaling of the decomposed engine.

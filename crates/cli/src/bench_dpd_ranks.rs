@@ -37,12 +37,7 @@ fn water(a: &BenchArgs) -> DpdParams {
 /// job's ranks; rank 0 prints `RATE <median> <min> <max> <beads>` (particle-steps per second of
 /// wall time, the slowest rank's).
 pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
-    let ranks = crate::parallel::Ranks::init()?;
-    let threads = a.threads.first().copied().unwrap_or(1);
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build_global()
-        .context("thread pool")?;
+    let ranks = worker_ranks(&a.threads)?;
     let bytes = std::fs::read(state).with_context(|| state.display().to_string())?;
     let (p, l, step): State = bincode::deserialize(&bytes)?;
     let n = p.len();
@@ -316,6 +311,36 @@ pub fn mpirun_worker(
         .map(|x| x.parse())
         .collect::<Result<_, _>>()?;
     Ok(((f[0], f[1], f[2]), f[3] as usize))
+}
+
+/// A benchmark worker under `mpirun`: the job's ranks, with a global pool of the first of
+/// `threads` (default 1) threads per rank.
+pub fn worker_ranks(threads: &[usize]) -> Result<crate::parallel::Ranks> {
+    let ranks = crate::parallel::Ranks::init()?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.first().copied().unwrap_or(1))
+        .build_global()
+        .context("thread pool")?;
+    Ok(ranks)
+}
+
+/// `repeats` timed calls of `run` on `sim` (each `steps` steps of `n` particles); rank 0 prints
+/// the `RATE` line of the slowest rank ([`print_rate`]).
+pub fn time_repeats<S>(
+    ranks: &crate::parallel::Ranks,
+    sim: &mut S,
+    (n, steps, repeats): (usize, u64, usize),
+    mut run: impl FnMut(&mut S) -> Result<()>,
+    comm: impl Fn(&S) -> Option<&dyn colloidsim_core::exchange::Exchange>,
+) -> Result<()> {
+    let mut walls = Vec::new();
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        run(sim)?;
+        walls.push(walls_of_ranks(comm(sim), start.elapsed().as_secs_f64()));
+    }
+    print_rate(ranks.rank(), n, steps, &walls);
+    Ok(())
 }
 
 /// The wall time of every rank of `comm` (this one's alone on one process), in rank order.

@@ -56,39 +56,28 @@ pub struct BenchArgs {
 /// along z, decomposed over the job's ranks, 5 warm-up steps, then `repeats` timed runs of
 /// `steps`; rank 0 prints the rate of the slowest rank.
 fn worker(a: &BenchArgs, k: usize) -> Result<()> {
-    let ranks = crate::parallel::Ranks::init()?;
-    let threads = a.threads.first().copied().unwrap_or(1);
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build_global()
-        .context("thread pool")?;
+    let ranks = crate::bench_dpd_ranks::worker_ranks(&a.threads)?;
     let l = a.l as f64;
     let sbox = SimBox::new([l, l, k as f64 * l]);
     let srd = Srd::new(SrdParams::standard(7), sbox, &Confinement::None, 0.0)?;
     let n = srd.len();
     let mut part = srd.decomposed(ranks.exchange()?)?;
-    let step = |srd: &mut Srd| -> Result<()> {
-        let t = (srd.step() + 1) as f64 * srd.params().tau;
-        srd.stream(t, &Confinement::None, &Acceleration::None)?;
-        srd.collide(t, &Confinement::None, None);
+    let steps = |srd: &mut Srd, count: u64| -> Result<()> {
+        for _ in 0..count {
+            let t = (srd.step() + 1) as f64 * srd.params().tau;
+            srd.stream(t, &Confinement::None, &Acceleration::None)?;
+            srd.collide(t, &Confinement::None, None);
+        }
         Ok(())
     };
-    for _ in 0..5 {
-        step(&mut part)?;
-    }
-    let mut walls = Vec::new();
-    for _ in 0..a.repeats.max(1) {
-        let start = Instant::now();
-        for _ in 0..a.steps {
-            step(&mut part)?;
-        }
-        walls.push(crate::bench_dpd_ranks::walls_of_ranks(
-            part.exchange(),
-            start.elapsed().as_secs_f64(),
-        ));
-    }
-    crate::bench_dpd_ranks::print_rate(ranks.rank(), n, a.steps, &walls);
-    Ok(())
+    steps(&mut part, 5)?;
+    crate::bench_dpd_ranks::time_repeats(
+        &ranks,
+        &mut part,
+        (n, a.steps, a.repeats),
+        |srd| steps(srd, a.steps),
+        |srd| srd.exchange(),
+    )
 }
 
 /// `--mpi-ranks`: strong and weak scaling of the decomposed solvent.

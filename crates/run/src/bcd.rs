@@ -17,6 +17,7 @@ use colloidsim_bcd::forces::{ExternalForce, NoPair, PairForce};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
 use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
 use colloidsim_bcd::{Bcd, BcdState, Boundary};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem, bulk};
@@ -62,7 +63,13 @@ impl Method for BcdMethod {
         })
     }
 
-    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+    fn start(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let sc = parse(src)?;
         let r = resolve(src, &sc, seed)?;
         session(sc, r, None)
@@ -74,7 +81,9 @@ impl Method for BcdMethod {
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let sc = parse(src)?;
         let r = resolve(src, &sc, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;

@@ -126,17 +126,13 @@ impl Method for BulkBd {
         })
     }
 
-    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        start(src, seed, None)
-    }
-
-    fn start_decomposed(
+    fn start(
         &self,
         src: &Source,
         seed: Option<u64>,
-        comm: Box<dyn Exchange>,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        start(src, seed, Some(comm))
+        start(src, seed, comm)
     }
 
     fn restore(
@@ -145,19 +141,9 @@ impl Method for BulkBd {
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        restore(src, seed, out, envelope, None)
-    }
-
-    fn restore_decomposed(
-        &self,
-        src: &Source,
-        seed: u64,
-        out: &OutputDir,
-        envelope: &Envelope,
-        comm: Box<dyn Exchange>,
-    ) -> Result<Box<dyn Session>> {
-        restore(src, seed, out, envelope, Some(comm))
+        restore(src, seed, out, envelope, comm)
     }
 
     fn keys(&self) -> Vec<Key> {

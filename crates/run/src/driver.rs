@@ -87,10 +87,7 @@ fn run_with(
     if let Some(s) = opts.seed {
         crate::seed32(s)?;
     }
-    let mut session = match comm {
-        None => m.start(sc, opts.seed)?,
-        Some(c) => m.start_decomposed(sc, opts.seed, c)?,
-    };
+    let mut session = m.start(sc, opts.seed, comm)?;
     let mut warnings = session.warnings();
     for w in &warnings {
         ctl.progress().warning(w);
@@ -252,11 +249,9 @@ fn resume_with(
     }
     let m = method::of(&sc)?;
     let seed = seed.unwrap_or(envelope.seed);
-    let mut session = match comm {
-        None => m.restore(&sc, seed, &out, &envelope),
-        Some(c) => m.restore_decomposed(&sc, seed, &out, &envelope, c),
-    }
-    .with_context(|| format!("--restart {}", dir.display()))?;
+    let mut session = m
+        .restore(&sc, seed, &out, &envelope, comm)
+        .with_context(|| format!("--restart {}", dir.display()))?;
     let now = resolved(&*session)?;
     if now != envelope.resolved {
         bail!(

@@ -13,6 +13,7 @@ use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
+use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::{
     CONTACT_BINS, CONTACT_WINDOW, PairDensity, PairHistogram, RadialHistogram, bulk_contact,
@@ -81,7 +82,13 @@ impl Method for HsMc {
         })
     }
 
-    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+    fn start(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve(src, seed)?;
         let mc = build(&p).with_context(|| src.label())?;
         let acc = Accum::new(&p, &mc);
@@ -94,7 +101,9 @@ impl Method for HsMc {
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve(src, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if saved.pos.iter().any(|c| c.len() != p.particles) || saved.acc.blocks.len() != p.blocks {

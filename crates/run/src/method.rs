@@ -47,38 +47,27 @@ pub trait Method: Sync {
     /// Validate a scenario (everything `run` would validate before it starts).
     fn check(&self, sc: &Scenario) -> Result<Checked>;
     /// A fresh session; nothing is written.
-    fn start(&self, sc: &Scenario, seed: Option<u64>) -> Result<Box<dyn Session>>;
+    ///
+    /// With `comm`, the session is decomposed in space over its ranks (docs/parallel.md):
+    /// every rank calls this and then drives its session in step; rank 0 writes. A method that
+    /// runs on one rank refuses it ([`on_one_rank`]).
+    fn start(
+        &self,
+        sc: &Scenario,
+        seed: Option<u64>,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Box<dyn Session>>;
     /// The session a verified checkpoint continues, run with `seed` (the checkpoint's, or the
-    /// one asked for).
+    /// one asked for); decomposed over the ranks of `comm` when given, which need not be as
+    /// many as the interrupted run's.
     fn restore(
         &self,
         sc: &Scenario,
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>>;
-    /// A fresh session decomposed in space over the ranks of `comm` (docs/parallel.md): every
-    /// rank calls this and then drives its session in step; rank 0 writes.
-    fn start_decomposed(
-        &self,
-        sc: &Scenario,
-        _seed: Option<u64>,
-        _comm: Box<dyn Exchange>,
-    ) -> Result<Box<dyn Session>> {
-        bail!(not_decomposed(sc, self.names()[0]))
-    }
-    /// [`Self::restore`] decomposed over the ranks of `comm`, which need not be as many as
-    /// the interrupted run's.
-    fn restore_decomposed(
-        &self,
-        sc: &Scenario,
-        _seed: u64,
-        _out: &OutputDir,
-        _envelope: &Envelope,
-        _comm: Box<dyn Exchange>,
-    ) -> Result<Box<dyn Session>> {
-        bail!(not_decomposed(sc, self.names()[0]))
-    }
     /// Does `colloidsim theory` apply?
     fn has_theory(&self) -> bool {
         false
@@ -194,6 +183,18 @@ pub(crate) fn fail_alone_over(comm: Option<&dyn Exchange>, e: anyhow::Error) -> 
         Some(c) => c.abort(&format!("{e:#}")),
         None => e,
     }
+}
+
+/// For a method that runs on one rank: refuse the ranks of `comm` (before anything is written).
+pub(crate) fn on_one_rank(
+    comm: Option<Box<dyn Exchange>>,
+    sc: &Scenario,
+    method: &str,
+) -> Result<()> {
+    if comm.is_some() {
+        bail!(not_decomposed(sc, method));
+    }
+    Ok(())
 }
 
 /// Why `colloidsim run` under `mpirun -n N` refuses a method.

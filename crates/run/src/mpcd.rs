@@ -346,17 +346,13 @@ impl Method for MpcdBulk {
         })
     }
 
-    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
-        start_bulk(src, seed, None)
-    }
-
-    fn start_decomposed(
+    fn start(
         &self,
         src: &Source,
         seed: Option<u64>,
-        comm: Box<dyn Exchange>,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        start_bulk(src, seed, Some(comm))
+        start_bulk(src, seed, comm)
     }
 
     fn restore(
@@ -365,19 +361,9 @@ impl Method for MpcdBulk {
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        restore_bulk(src, seed, out, envelope, None)
-    }
-
-    fn restore_decomposed(
-        &self,
-        src: &Source,
-        seed: u64,
-        out: &OutputDir,
-        envelope: &Envelope,
-        comm: Box<dyn Exchange>,
-    ) -> Result<Box<dyn Session>> {
-        restore_bulk(src, seed, out, envelope, Some(comm))
+        restore_bulk(src, seed, out, envelope, comm)
     }
 
     fn keys(&self) -> Vec<Key> {
@@ -1125,7 +1111,13 @@ impl Method for DropletMpcd {
         })
     }
 
-    fn start(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn Session>> {
+    fn start(
+        &self,
+        src: &Source,
+        seed: Option<u64>,
+        comm: Option<Box<dyn Exchange>>,
+    ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve_droplet(src, seed)?;
         let colloids = build_colloids(&p).with_context(|| src.label())?;
         let srd = build_droplet(&p).with_context(|| src.label())?;
@@ -1147,7 +1139,9 @@ impl Method for DropletMpcd {
         seed: u64,
         out: &OutputDir,
         envelope: &Envelope,
+        comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
+        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve_droplet(src, Some(seed))?;
         let saved: DropletSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if saved.acc.profiles.len() != p.profile_collisions.len() {
