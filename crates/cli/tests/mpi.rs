@@ -611,3 +611,43 @@ fn mpcd_with_colloids_on_2_and_3_ranks_writes_the_single_process_folder() {
     interrupted_on_2_continued_on(3, &s, &out, "120");
     assert_same_tree(&reference, &out);
 }
+
+/// A drying droplet (R0 = 8 cells, no-slip walls, 6 colloids of d = 4, solvent removed as it
+/// shrinks) for 300 collisions, with profiles and a trajectory with the solvent.
+const TINY_MPCD_DROPLET: &str = r#"
+method = "droplet-mpcd"
+seed = 4
+boundary = "no-slip"
+[system]
+particles = 6
+diameter = 4
+radius = 8
+[drying]
+peclet = 10
+duration = 30
+[observe.profile]
+bins = 8
+[observe.solvent]
+window = 50
+[observe.trajectory]
+every = 50
+solvent = true
+"#;
+
+#[test]
+fn an_mpcd_droplet_on_2_and_3_ranks_writes_the_single_process_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "droplet-mpcd", TINY_MPCD_DROPLET);
+    for ranks in [2, 3] {
+        let out = tmp.path().join(format!("ranks-{ranks}"));
+        let o = mpirun(
+            ranks,
+            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
+        );
+        assert!(o.status.success(), "mpirun -n {ranks}");
+        assert_same_tree(&reference, &out);
+    }
+    let out = tmp.path().join("continued-on-1");
+    interrupted_on_2_continued_on(1, &s, &out, "170");
+    assert_same_tree(&reference, &out);
+}

@@ -129,18 +129,62 @@ fn a_non_finite_velocity_on_one_rank_stops_every_rank() {
     }
 }
 
+/// A drying droplet: the solvent inside a sphere of radius 5 shrinking at alpha = 4 (to 4.4 in
+/// 60 collisions), no-slip walls (virtual particles in the cut cells), the excess removed
+/// from the reflected particles every collision.
+fn droplet_steps(srd: &mut Srd, steps: u64) -> u64 {
+    use colloidsim_md::mpcd::WallKind;
+    use colloidsim_md::mpcd::drying::remove_excess;
+    use colloidsim_md::potential::SphereAreaLaw;
+    let conf = Confinement::Sphere {
+        law: SphereAreaLaw {
+            r0: 5.0,
+            alpha: 4.0,
+        },
+        kind: WallKind::NoSlip,
+    };
+    let tau = srd.params().tau;
+    let (mut removed, mut scratch) = (0, Vec::new());
+    for _ in 0..steps {
+        let step = srd.step();
+        let t = (step + 1) as f64 * tau;
+        srd.stream(t, &conf, &Acceleration::None).unwrap();
+        let expected = (srd.params().density * conf.volume(t, srd.sbox().l)).round() as usize;
+        removed += remove_excess(srd, expected, step, &mut scratch).removed;
+        srd.collide(t, &conf, None);
+    }
+    removed
+}
+
+fn droplet(seed: u32) -> Srd {
+    use colloidsim_md::mpcd::WallKind;
+    use colloidsim_md::potential::SphereAreaLaw;
+    let conf = Confinement::Sphere {
+        law: SphereAreaLaw {
+            r0: 5.0,
+            alpha: 4.0,
+        },
+        kind: WallKind::NoSlip,
+    };
+    Srd::new(SrdParams::standard(seed), SimBox::cube(12.0), &conf, 0.0).unwrap()
+}
+
 #[test]
-fn walls_are_refused_on_every_rank() {
-    let out = on_ranks(2, |comm| {
-        let mut part = solvent(2).decomposed(comm).unwrap();
-        let slab = Confinement::Slab {
-            half_width: 5.0,
-            kind: colloidsim_md::mpcd::WallKind::NoSlip,
-        };
-        part.stream(0.1, &slab, &Acceleration::None).err()
-    });
-    for e in out {
-        assert!(matches!(e, Some(MpcdError::Invalid(m)) if m.contains("not decomposed")));
+fn a_drying_droplet_is_bitwise_the_same_on_any_number_of_ranks() {
+    let mut one = droplet(6);
+    let removed = droplet_steps(&mut one, 60);
+    assert!(removed > 100, "the droplet must lose solvent: {removed}");
+    let want = bits(&one.gathered_state());
+    for ranks in [2, 3, 4] {
+        let got = on_ranks(ranks, |comm| {
+            let mut part = droplet(6).decomposed(comm).unwrap();
+            let r = droplet_steps(&mut part, 60);
+            (bits(&part.gathered_state()), r)
+        });
+        for (r, (g, n)) in got.iter().enumerate() {
+            assert_eq!(*n, removed, "{ranks} ranks: rank {r} removed another count");
+            assert!(*g == want, "{ranks} ranks: rank {r}'s droplet differs");
+        }
     }
 }
 

@@ -281,7 +281,7 @@ fn resume_with(
 /// Write a checkpoint at the session's position (every rank of a decomposed run takes part;
 /// the writer writes).
 fn save(s: &mut dyn Session, out: &OutputDir, env: &mut Envelope, wall: f64) -> Result<()> {
-    s.flush()?;
+    s.flush().map_err(|e| s.fail_alone(e))?;
     env.payload = s.save(out)?;
     env.position = s.position();
     env.wall_seconds = wall;

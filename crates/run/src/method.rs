@@ -201,7 +201,7 @@ pub(crate) fn on_one_rank(
 fn not_decomposed(sc: &Scenario, method: &str) -> String {
     format!(
         "{}: method '{method}' runs on one rank: only 'dpd', free-draining 'bd' and \
-         'droplet-bd', and 'mpcd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
+         'droplet-bd', 'mpcd' and 'droplet-mpcd' are decomposed over MPI ranks so far (docs/parallel.md); spread replicas \
          and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )

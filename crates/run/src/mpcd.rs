@@ -43,15 +43,6 @@ struct SolventState {
 }
 
 impl SolventState {
-    fn of(srd: &Srd) -> Self {
-        Self {
-            step: srd.step(),
-            sort_every: srd.sort_every(),
-            pos: srd.raw_positions(),
-            vel: srd.velocities(),
-        }
-    }
-
     /// The whole solvent in the canonical order ([`Srd::gathered_state`]; collective when
     /// decomposed), for a bulk run, whose steps do not depend on the storage order: the same
     /// checkpoint on any number of ranks.
@@ -73,13 +64,9 @@ impl SolventState {
     }
 }
 
-/// A GSD frame of the solvent (type `S`, diameter 0.2 cells, velocities and masses).
-fn solvent_frame(w: &mut GsdWriter, srd: &Srd, log: &[(&str, f64)]) -> Result<()> {
-    solvent_frame_of(w, srd, srd.positions(), srd.velocities(), log)
-}
-
-/// [`solvent_frame`] of the given positions and velocities.
-fn solvent_frame_of(
+/// A GSD frame of the solvent (type `S`, diameter 0.2 cells, velocities and masses) at the
+/// given positions and velocities.
+fn solvent_frame(
     w: &mut GsdWriter,
     srd: &Srd,
     pos: Vec<[f64; 3]>,
@@ -540,6 +527,71 @@ impl BulkSession {
         self.srd.rank().0 == 0
     }
 
+    /// The collisions up to `until`; `Some(why)` when the run stops early.
+    fn advance_to(&mut self, until: u64) -> Result<Option<String>> {
+        let tau = self.p.solvent.srd.tau;
+        let k = self.wavenumber();
+        let drive = match self.p.drive {
+            Some(g0) => Acceleration::CosineX {
+                amplitude: g0,
+                wavenumber: k,
+            },
+            None => Acceleration::None,
+        };
+        let conf = Confinement::None;
+        let thermostat = self.p.solvent.srd.thermostat;
+        while self.srd.step() < until.min(self.p.collisions) {
+            let t = (self.srd.step() + 1) as f64 * tau;
+            if let Err(e) = self.srd.stream(t, &conf, &drive) {
+                return Ok(Some(e.to_string()));
+            }
+            if let Some(col) = self.colloids.as_mut()
+                && let Err(e) = col.advance(t - tau, tau, &colloidsim_md::NoExternal)
+            {
+                return Ok(Some(e.to_string()));
+            }
+            let sampling = self.srd.step() >= self.p.equilibrate;
+            let before = match (&self.acc.probe, sampling) {
+                (Some(_), true) => PoiseuilleProbe::amplitude_of(&self.srd, k),
+                _ => 0.0,
+            };
+            let emb = self.colloids.as_mut().map(|c| c.embedded());
+            self.srd.collide(t, &conf, emb);
+            if sampling && let (Some(col), Some(vacf)) = (&self.colloids, self.acc.vacf.as_mut()) {
+                // Sample j of the sampling part belongs to block j * blocks / sampling.
+                let j = self.srd.step() - self.p.equilibrate - 1;
+                let n = self.p.collisions - self.p.equilibrate;
+                let b = ((j as u128 * self.p.blocks as u128) / n as u128) as usize;
+                // Relative to the solvent's mean velocity: the frame of Hasimoto's theory.
+                let (ps, ms) = (
+                    self.srd.momentum(),
+                    self.srd.particles() as f64 * self.srd.params().mass,
+                );
+                col.com_velocities_into(&mut self.com_scratch);
+                for v in &mut self.com_scratch {
+                    *v = std::array::from_fn(|k| v[k] - ps[k] / ms);
+                }
+                vacf.push(&self.com_scratch, b);
+            }
+            if let Some(probe) = self.acc.probe.as_mut() {
+                if !thermostat {
+                    // Without the cell thermostat the viscous heat leaves by a global
+                    // rescaling about the flow (measure::poiseuille_viscosity).
+                    let a = PoiseuilleProbe::amplitude_of(&self.srd, k);
+                    self.srd.rescale_about(|x| [a * (k * x[2]).cos(), 0.0, 0.0]);
+                }
+                if sampling {
+                    let after = PoiseuilleProbe::amplitude_of(&self.srd, k);
+                    self.acc.before_after[0] += before;
+                    self.acc.before_after[1] += after;
+                    probe.push(0.5 * (before + after));
+                }
+            }
+            self.record(self.srd.step())?;
+        }
+        Ok(None)
+    }
+
     /// Momentum of the solvent and the colloids (collective when decomposed).
     fn total_momentum(&self) -> [f64; 3] {
         let mut momentum = self.srd.momentum();
@@ -611,7 +663,7 @@ impl BulkSession {
             if let Some(w) = self.gsd.as_mut() {
                 let written = match (&self.colloids, solvent) {
                     (Some(col), solvent) => colloid_frame(w, &self.srd, col, solvent, &[]),
-                    (None, Some((pos, vel))) => solvent_frame_of(w, &self.srd, pos, vel, &[]),
+                    (None, Some((pos, vel))) => solvent_frame(w, &self.srd, pos, vel, &[]),
                     (None, None) => unreachable!("a bulk frame without colloids has the solvent"),
                 };
                 written.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
@@ -697,69 +749,9 @@ impl Session for BulkSession {
     }
 
     fn advance(&mut self, until: u64) -> Result<Option<String>> {
-        let tau = self.p.solvent.srd.tau;
-        let k = self.wavenumber();
-        let drive = match self.p.drive {
-            Some(g0) => Acceleration::CosineX {
-                amplitude: g0,
-                wavenumber: k,
-            },
-            None => Acceleration::None,
-        };
-        let conf = Confinement::None;
-        let thermostat = self.p.solvent.srd.thermostat;
-        while self.srd.step() < until.min(self.p.collisions) {
-            let t = (self.srd.step() + 1) as f64 * tau;
-            if let Err(e) = self.srd.stream(t, &conf, &drive) {
-                self.momentum = self.total_momentum();
-                return Ok(Some(e.to_string()));
-            }
-            if let Some(col) = self.colloids.as_mut()
-                && let Err(e) = col.advance(t - tau, tau, &colloidsim_md::NoExternal)
-            {
-                return Ok(Some(e.to_string()));
-            }
-            let sampling = self.srd.step() >= self.p.equilibrate;
-            let before = match (&self.acc.probe, sampling) {
-                (Some(_), true) => PoiseuilleProbe::amplitude_of(&self.srd, k),
-                _ => 0.0,
-            };
-            let emb = self.colloids.as_mut().map(|c| c.embedded());
-            self.srd.collide(t, &conf, emb);
-            if sampling && let (Some(col), Some(vacf)) = (&self.colloids, self.acc.vacf.as_mut()) {
-                // Sample j of the sampling part belongs to block j * blocks / sampling.
-                let j = self.srd.step() - self.p.equilibrate - 1;
-                let n = self.p.collisions - self.p.equilibrate;
-                let b = ((j as u128 * self.p.blocks as u128) / n as u128) as usize;
-                // Relative to the solvent's mean velocity: the frame of Hasimoto's theory.
-                let (ps, ms) = (
-                    self.srd.momentum(),
-                    self.srd.particles() as f64 * self.srd.params().mass,
-                );
-                col.com_velocities_into(&mut self.com_scratch);
-                for v in &mut self.com_scratch {
-                    *v = std::array::from_fn(|k| v[k] - ps[k] / ms);
-                }
-                vacf.push(&self.com_scratch, b);
-            }
-            if let Some(probe) = self.acc.probe.as_mut() {
-                if !thermostat {
-                    // Without the cell thermostat the viscous heat leaves by a global
-                    // rescaling about the flow (measure::poiseuille_viscosity).
-                    let a = PoiseuilleProbe::amplitude_of(&self.srd, k);
-                    self.srd.rescale_about(|x| [a * (k * x[2]).cos(), 0.0, 0.0]);
-                }
-                if sampling {
-                    let after = PoiseuilleProbe::amplitude_of(&self.srd, k);
-                    self.acc.before_after[0] += before;
-                    self.acc.before_after[1] += after;
-                    probe.push(0.5 * (before + after));
-                }
-            }
-            self.record(self.srd.step())?;
-        }
+        let stopped = self.advance_to(until)?;
         self.momentum = self.total_momentum();
-        Ok(None)
+        Ok(stopped)
     }
 
     fn flush(&mut self) -> Result<()> {
@@ -1117,12 +1109,13 @@ impl Method for DropletMpcd {
         seed: Option<u64>,
         comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve_droplet(src, seed)?;
         let colloids = build_colloids(&p).with_context(|| src.label())?;
         let srd = build_droplet(&p).with_context(|| src.label())?;
         let acc = DropletAccum::new(&p, srd.len());
+        let srd = decompose(srd, comm).with_context(|| src.label())?;
         Ok(Box::new(DropletSession {
+            now: (0, f64::NAN),
             p,
             srd,
             colloids,
@@ -1141,7 +1134,6 @@ impl Method for DropletMpcd {
         envelope: &Envelope,
         comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
-        crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve_droplet(src, Some(seed))?;
         let saved: DropletSaved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if saved.acc.profiles.len() != p.profile_collisions.len() {
@@ -1150,17 +1142,21 @@ impl Method for DropletMpcd {
         let srd = saved
             .solvent
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
+        let writer = comm.as_ref().is_none_or(|c| c.rank() == 0);
+        let srd = decompose(srd, comm)?;
         let colloids =
             restore_colloids(saved.colloids.as_ref(), p.particles, p.colloid, p.box_edge)?;
-        if p.trajectory_every > 0 {
+        if p.trajectory_every > 0 && writer {
             saved
                 .acc
                 .digest
                 .restore(&out.join("trajectory.gsd"), |path, frames| {
                     trim_trajectory(path, frames, &["radius"], true)
-                })?;
+                })
+                .map_err(|e| crate::method::fail_alone_over(srd.exchange(), e))?;
         }
         Ok(Box::new(DropletSession {
+            now: (0, f64::NAN),
             p,
             srd,
             colloids,
@@ -1287,10 +1283,54 @@ struct DropletSession {
     gsd: Option<GsdWriter>,
     /// `thermo.csv`, appended row by row as the run goes.
     thermo_log: Option<CsvLog>,
-    scratch: Vec<u32>,
+    scratch: Vec<(u32, u32)>,
+    /// The solvent count and temperature at the end of the last chunk of collisions (for the
+    /// summary, which is written without messages between ranks).
+    now: (usize, f64),
 }
 
 impl DropletSession {
+    fn is_writer(&self) -> bool {
+        self.srd.rank().0 == 0
+    }
+
+    /// The collisions up to `until`; `Some(why)` when the run stops early.
+    fn advance_to(&mut self, until: u64) -> Result<Option<String>> {
+        let tau = self.p.solvent.srd.tau;
+        let conf = confinement(&self.p);
+        let walls = self.p.boundary != Boundary::None;
+        while self.srd.step() < until.min(self.p.collisions) {
+            let step = self.srd.step();
+            let t = (step + 1) as f64 * tau;
+            let st = match self.srd.stream(t, &conf, &Acceleration::None) {
+                Ok(st) => st,
+                Err(e) => return Ok(Some(e.to_string())),
+            };
+            if let Some(col) = self.colloids.as_mut()
+                && let Err(e) = col.advance(step as f64 * tau, tau, &self.p.harmonic())
+            {
+                return Ok(Some(e.to_string()));
+            }
+            self.acc.bounced += st.bounced;
+            self.acc.reflections += st.reflections;
+            self.acc.stuck += st.stuck;
+            if walls {
+                let expected = self.expected(step + 1) as usize;
+                let r = remove_excess(&mut self.srd, expected, step, &mut self.scratch);
+                self.acc.removed += r.removed;
+                self.acc.residual_max = self.acc.residual_max.max(r.residual);
+                self.acc.residual_last = r.residual;
+            }
+            let emb = self.colloids.as_mut().map(|c| c.embedded());
+            let cs = self.srd.collide(t, &conf, emb);
+            self.acc.virtual_particles += cs.virtual_particles;
+            if let Some(why) = self.record(step + 1, st.bounced)? {
+                return Ok(Some(why));
+            }
+        }
+        Ok(None)
+    }
+
     fn radius(&self, c: u64) -> f64 {
         self.p.law().radius(c as f64 * self.p.solvent.srd.tau)
     }
@@ -1346,22 +1386,33 @@ impl DropletSession {
         }
         if c.is_multiple_of(p.thermo_every) || c == p.collisions {
             if p.boundary != Boundary::None {
-                let r2 = r * r * (1.0 + 1e-9);
-                if let Some(i) = (0..self.srd.len()).find(|&i| {
-                    let x = self.srd.position(i);
-                    x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > r2
-                }) {
-                    let x = self.srd.position(i);
+                // The farthest particle of all (a maximum: the same on any number of ranks).
+                let view = self.srd.view();
+                let far = (0..view.len())
+                    .map(|i| {
+                        let x = view.position(i);
+                        x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
+                    })
+                    .fold(0.0, f64::max);
+                let far = match self.srd.exchange() {
+                    None => far,
+                    Some(comm) => {
+                        let mut all = Vec::new();
+                        comm.all_gather_same(&[far], &mut all);
+                        all.into_iter().fold(0.0, f64::max)
+                    }
+                };
+                if far > r * r * (1.0 + 1e-9) {
                     return Ok(Some(format!(
-                        "solvent particle in slot {i} is outside the droplet at collision {c} (|x| = {:.6}, R = {r:.6})",
-                        (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+                        "a solvent particle is outside the droplet at collision {c} (|x| = {:.6}, R = {r:.6})",
+                        far.sqrt()
                     )));
                 }
             }
             self.acc.rows.push(DropletRow {
                 collision: c,
                 radius: r,
-                solvent: self.srd.len() as u64,
+                solvent: self.srd.particles() as u64,
                 expected: self.expected(c),
                 removed: self.acc.removed,
                 bounced,
@@ -1372,20 +1423,25 @@ impl DropletSession {
                     .map_or(f64::NAN, |c| c.com_temperature()),
             });
             if let (Some(log), Some(row)) = (self.thermo_log.as_mut(), self.acc.rows.last()) {
-                log.append(&row.values(p.solvent.srd.tau))?;
+                log.append(&row.values(p.solvent.srd.tau))
+                    .map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e.into()))?;
             }
         }
-        if let Some(w) = self.gsd.as_mut()
-            && c.is_multiple_of(p.trajectory_every)
-        {
-            match &self.colloids {
-                Some(col) => {
-                    let solvent = p
-                        .trajectory_solvent
-                        .then(|| (self.srd.positions(), self.srd.velocities()));
-                    colloid_frame(w, &self.srd, col, solvent, &[("radius", r)])?
-                }
-                None => solvent_frame(w, &self.srd, &[("radius", r)])?,
+        if p.trajectory_every > 0 && c.is_multiple_of(p.trajectory_every) {
+            // Every rank takes part in gathering the solvent; the writer writes.
+            let solvent = (self.colloids.is_none() || p.trajectory_solvent).then(|| {
+                let (pos, vel) = self.srd.gathered_state();
+                let fixed = *self.srd.fixed_point();
+                (pos.iter().map(|x| fixed.decode(*x)).collect(), vel)
+            });
+            if let Some(w) = self.gsd.as_mut() {
+                let log = [("radius", r)];
+                let written = match (&self.colloids, solvent) {
+                    (Some(col), solvent) => colloid_frame(w, &self.srd, col, solvent, &log),
+                    (None, Some((pos, vel))) => solvent_frame(w, &self.srd, pos, vel, &log),
+                    (None, None) => unreachable!("a frame without colloids has the solvent"),
+                };
+                written.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
             }
             self.acc.frames += 1;
         }
@@ -1440,16 +1496,19 @@ impl Session for DropletSession {
     }
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
-        self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
-        self.thermo_log = Some(CsvLog::start(
-            out.join("thermo.csv"),
-            &DROPLET_THERMO,
-            fresh,
-            || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
-        )?);
+        if DropletSession::is_writer(self) {
+            self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
+            self.thermo_log = Some(CsvLog::start(
+                out.join("thermo.csv"),
+                &DROPLET_THERMO,
+                fresh,
+                || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
+            )?);
+        }
         if fresh && let Some(why) = self.record(0, 0)? {
             bail!("{why}");
         }
+        self.now = (self.srd.particles(), self.srd.temperature());
         Ok(())
     }
 
@@ -1457,42 +1516,23 @@ impl Session for DropletSession {
         tenth_after(self.position(), self.p.collisions)
     }
 
-    fn advance(&mut self, until: u64) -> Result<Option<String>> {
-        let tau = self.p.solvent.srd.tau;
-        let conf = confinement(&self.p);
-        let walls = self.p.boundary != Boundary::None;
-        while self.srd.step() < until.min(self.p.collisions) {
-            let step = self.srd.step();
-            let t = (step + 1) as f64 * tau;
-            let st = match self.srd.stream(t, &conf, &Acceleration::None) {
-                Ok(st) => st,
-                Err(e) => return Ok(Some(e.to_string())),
-            };
-            if let Some(col) = self.colloids.as_mut()
-                && let Err(e) = col.advance(step as f64 * tau, tau, &self.p.harmonic())
-            {
-                return Ok(Some(e.to_string()));
-            }
-            self.acc.bounced += st.bounced;
-            self.acc.reflections += st.reflections;
-            self.acc.stuck += st.stuck;
-            if walls {
-                let expected = self.expected(step + 1) as usize;
-                let r = remove_excess(&mut self.srd, expected, step, &mut self.scratch);
-                self.acc.removed += r.removed;
-                self.acc.residual_max = self.acc.residual_max.max(r.residual);
-                self.acc.residual_last = r.residual;
-            }
-            let emb = self.colloids.as_mut().map(|c| c.embedded());
-            let cs = self.srd.collide(t, &conf, emb);
-            self.acc.virtual_particles += cs.virtual_particles;
-            if let Some(why) = self.record(step + 1, st.bounced)? {
-                return Ok(Some(why));
-            }
-        }
-        Ok(None)
+    fn is_writer(&self) -> bool {
+        DropletSession::is_writer(self)
     }
 
+    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
+        crate::method::agree_over(self.srd.exchange(), chunk, interrupted)
+    }
+
+    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
+        crate::method::fail_alone_over(self.srd.exchange(), e)
+    }
+
+    fn advance(&mut self, until: u64) -> Result<Option<String>> {
+        let stopped = self.advance_to(until)?;
+        self.now = (self.srd.particles(), self.srd.temperature());
+        Ok(stopped)
+    }
     fn flush(&mut self) -> Result<()> {
         if let Some(w) = self.gsd.as_mut() {
             w.sync()?;
@@ -1501,20 +1541,25 @@ impl Session for DropletSession {
     }
 
     fn save(&mut self, out: &OutputDir) -> Result<Vec<u8>> {
-        if self.p.trajectory_every > 0 {
-            self.flush()?;
-            self.acc
-                .digest
-                .extend(&out.join("trajectory.gsd"), self.acc.frames)?;
+        if self.p.trajectory_every > 0 && DropletSession::is_writer(self) {
+            let extended = self.flush().and_then(|_| {
+                self.acc
+                    .digest
+                    .extend(&out.join("trajectory.gsd"), self.acc.frames)
+            });
+            extended.map_err(|e| crate::method::fail_alone_over(self.srd.exchange(), e))?;
         }
         Ok(bincode::serialize(&DropletSaved {
-            solvent: SolventState::of(&self.srd),
+            solvent: SolventState::gathered(&self.srd),
             colloids: self.colloids.as_ref().map(|c| c.state()),
             acc: self.acc.clone(),
         })?)
     }
 
     fn interim_outputs(&mut self, out: &OutputDir) -> Result<Vec<String>> {
+        if !DropletSession::is_writer(self) {
+            return Ok(Vec::new());
+        }
         write_thermo(out, self.p.solvent.srd.tau, &self.acc.rows)?;
         Ok(vec!["thermo.csv".into()])
     }
@@ -1525,7 +1570,16 @@ impl Session for DropletSession {
         wall_s: f64,
         failure: Option<&str>,
     ) -> Result<Finished> {
+        if !DropletSession::is_writer(&self) {
+            return Ok(Finished {
+                summary: json!({}),
+                files: Vec::new(),
+                message: String::new(),
+                warnings: Vec::new(),
+            });
+        }
         self.flush()?;
+        let (solvent_final, temperature_final) = self.now;
         let p = &self.p;
         let tau = p.solvent.srd.tau;
         let n0 = p.solvent.number_density;
@@ -1719,7 +1773,7 @@ impl Session for DropletSession {
                 "stokes_einstein_d0": p.d0,
             })
         });
-        let summary = json!({
+        let mut summary = json!({
             "colloids": colloids,
             "software": crate::software(),
             "method": "droplet-mpcd",
@@ -1732,7 +1786,7 @@ impl Session for DropletSession {
             "wall_speed_at_end": -p.alpha / (8.0 * PI * r),
             "solvent": {
                 "initial": self.acc.solvent0,
-                "final": self.srd.len(),
+                "final": solvent_final,
                 "expected_final": expected,
                 "removed": self.acc.removed,
                 "residual_excess_max": self.acc.residual_max,
@@ -1741,23 +1795,23 @@ impl Session for DropletSession {
                 "reflections": self.acc.reflections,
                 "stuck": self.acc.stuck,
                 "virtual_particles_per_collision": self.acc.virtual_particles as f64 / collisions.max(1) as f64,
-                "temperature_final": self.srd.temperature(),
+                "temperature_final": temperature_final,
             },
             "solvent_uniformity": uniformity,
             "wall_seconds": wall_s,
-            "particle_updates_per_second": collisions as f64 * self.srd.len() as f64 / wall_s.max(1e-9),
+            "particle_updates_per_second": collisions as f64 * solvent_final as f64 / wall_s.max(1e-9),
             "threads": rayon::current_num_threads(),
             "trajectory_frames": self.acc.frames,
             "warnings": warnings,
         });
+        if self.srd.rank().1 > 1 {
+            summary["ranks"] = json!(self.srd.rank().1);
+        }
         let message = match failure {
             Some(f) => format!("droplet-mpcd stopped at collision {collisions}: {f}"),
             None => format!(
                 "droplet-mpcd: {collisions} collisions, R {:.3} -> {r:.3}; solvent {} -> {} (expected {expected}, {} removed)",
-                p.r0,
-                self.acc.solvent0,
-                self.srd.len(),
-                self.acc.removed
+                p.r0, self.acc.solvent0, solvent_final, self.acc.removed
             ),
         };
         Ok(Finished {
@@ -1817,7 +1871,7 @@ struct SolventEngine {
     method: &'static str,
     conf: Confinement,
     drive: Acceleration,
-    scratch: Vec<u32>,
+    scratch: Vec<(u32, u32)>,
 }
 
 impl crate::Engine for SolventEngine {

@@ -14,7 +14,6 @@
 
 use super::{Draw, Srd, draw};
 use rand::RngExt;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -28,33 +27,40 @@ pub struct Removal {
 }
 
 /// Remove `count - expected` particles (if positive) chosen uniformly from those that bounced
-/// in the last streaming step of collision `step`, by a partial Fisher–Yates shuffle of their
-/// slots (in increasing order) driven by the stream `(seed, step, Removal)`. `scratch` is
-/// reused between calls.
-pub fn remove_excess(srd: &mut Srd, expected: usize, step: u64, scratch: &mut Vec<u32>) -> Removal {
-    let excess = srd.len().saturating_sub(expected);
+/// in the last streaming step of collision `step`, by a partial Fisher–Yates shuffle of them
+/// in a canonical order ([`Srd::gathered_bounced`]: by position, then velocity) driven by the
+/// stream `(seed, step, Removal)`: the same particles in any storage order and on any number
+/// of ranks (collective when decomposed; each rank removes its own). `scratch` is reused
+/// between calls.
+pub fn remove_excess(
+    srd: &mut Srd,
+    expected: usize,
+    step: u64,
+    scratch: &mut Vec<(u32, u32)>,
+) -> Removal {
+    let excess = srd.particles().saturating_sub(expected);
     if excess == 0 {
         return Removal::default();
     }
-    scratch.clear();
-    scratch.extend(srd.bounced());
+    srd.gathered_bounced(scratch);
     let take = excess.min(scratch.len());
     let mut rng = draw(srd.params().seed, step, Draw::Removal, 0);
     for k in 0..take {
         let j = rng.random_range(k..scratch.len());
         scratch.swap(k, j);
     }
-    scratch.truncate(take);
-    srd.remove(scratch);
+    let me = srd.rank().0 as u32;
+    let mut mine: Vec<u32> = scratch[..take]
+        .iter()
+        .filter(|c| c.0 == me)
+        .map(|c| c.1)
+        .collect();
+    srd.remove(&mut mine);
     Removal {
         removed: take as u64,
         residual: (excess - take) as u64,
     }
 }
-
-/// Particles per chunk of the profile sums (fixed, so the sums are the same on any number of
-/// threads).
-const CHUNK: usize = 8192;
 
 /// Solvent density and radial velocity against `r / R` over a window of collisions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -71,9 +77,6 @@ pub struct SolventProfile {
     pub samples: Vec<u64>,
     /// Sum of the radii sampled (for the mean radius of the window).
     pub radius_sum: f64,
-    /// Per-chunk partial sums (scratch, not part of the result).
-    #[serde(skip)]
-    parts: Vec<Vec<f64>>,
 }
 
 impl SolventProfile {
@@ -86,39 +89,29 @@ impl SolventProfile {
             r3: vec![0.0; blocks],
             samples: vec![0; blocks],
             radius_sum: 0.0,
-            parts: Vec::new(),
         }
     }
 
-    /// Add the solvent now, in the sphere of radius `radius`, to block `block`.
+    /// Add the solvent now, in the sphere of radius `radius`, to block `block` (exact sums,
+    /// collective when the solvent is decomposed).
     pub fn sample(&mut self, srd: &Srd, radius: f64, block: usize) {
-        let (bins, n) = (self.bins, srd.len());
-        let chunks = n.div_ceil(CHUNK);
-        self.parts.resize_with(chunks, Vec::new);
+        let bins = self.bins;
         let scale = bins as f64 / radius;
-        let srd = srd.view();
-        self.parts.par_iter_mut().enumerate().for_each(|(c, part)| {
-            part.clear();
-            part.resize(2 * bins, 0.0);
-            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                let x = srd.position(i);
-                let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                let b = (r * scale) as usize;
-                if b < bins {
-                    let v = srd.velocity(i);
-                    part[b] += 1.0;
-                    if r > 0.0 {
-                        part[bins + b] += (v[0] * x[0] + v[1] * x[1] + v[2] * x[2]) / r;
-                    }
-                }
+        let radial_bin = |x: [f64; 3]| {
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            Some((r * scale) as usize)
+        };
+        let (radial, counts) = srd.profile(bins, radial_bin, |x, v| {
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            if r > 0.0 {
+                (v[0] * x[0] + v[1] * x[1] + v[2] * x[2]) / r
+            } else {
+                0.0
             }
         });
-        let (counts, radial) = (&mut self.counts[block], &mut self.radial[block]);
-        for part in &self.parts {
-            for b in 0..bins {
-                counts[b] += part[b];
-                radial[b] += part[bins + b];
-            }
+        for b in 0..bins {
+            self.counts[block][b] += counts[b];
+            self.radial[block][b] += radial[b];
         }
         self.r3[block] += radius.powi(3);
         self.samples[block] += 1;

@@ -185,7 +185,7 @@ pub fn poiseuille_viscosity(
     }
     let (eta, standard_error) = probe.viscosity();
     let a = probe.flow.mean();
-    let n = srd.len() as f64;
+    let n = srd.particles() as f64;
     let m = p.mass;
     let twice = srd.sum(|x, v| {
         let w = [v[0] - a * (k * x[2]).cos(), v[1], v[2]];

@@ -14,8 +14,10 @@
 //!
 //! Embedded particles (the vertices of colloids, [`super::colloid`]) are replicated on every
 //! rank: each joins the collision of its cell on the rank that owns it, and the new velocities
-//! are then shared with every rank, so colloids move alike everywhere. Not decomposed yet:
-//! walls (the droplet; [`Srd::stream`] refuses them).
+//! are then shared with every rank, so colloids move alike everywhere. Walls (the droplet)
+//! act on each particle where it streams and on the cells each rank collides; the particles a
+//! drying droplet removes are chosen from every rank's reflected ones in one canonical order
+//! ([`Srd::gathered_bounced`]).
 
 use super::MpcdError;
 use super::srd::{ExactTotal, Srd};
@@ -25,6 +27,12 @@ use colloidsim_core::exchange::Exchange;
 /// Numbers per particle in a message: the position in fixed point (three integers below 2^32,
 /// exact in an `f64`) and the velocity.
 const PER_PARTICLE: usize = 6;
+/// The canonical order of solvent particles: fixed-point position (z, y, x), then the bits
+/// of the velocity.
+type CanonicalKey = ([u32; 3], [u64; 3]);
+
+/// Numbers per migrating particle: those, and whether it was reflected in the streaming step.
+const MIGRANT: usize = PER_PARTICLE + 1;
 
 impl std::fmt::Debug for Domain {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -107,6 +115,96 @@ impl Srd {
         }
     }
 
+    /// Counts summed over all ranks (collective; unchanged on one process).
+    pub(super) fn add_over_ranks<const K: usize>(&self, counts: [u64; K]) -> [u64; K] {
+        let Some(c) = self.exchange() else {
+            return counts;
+        };
+        let mut all = Vec::new();
+        c.all_gather_same(&counts.map(|x| x as f64), &mut all);
+        let mut t = [0u64; K];
+        for part in all.chunks_exact(K) {
+            for (d, x) in part.iter().enumerate() {
+                t[d] += *x as u64;
+            }
+        }
+        t
+    }
+
+    /// The particles every rank reflected in the last streaming step ([`Self::bounced`]), in
+    /// the canonical order of [`Self::gathered_state`], each as (rank, slot on that rank)
+    /// (collective when decomposed), into `out`.
+    pub fn gathered_bounced(&self, out: &mut Vec<(u32, u32)>) {
+        let mut keyed: Vec<(CanonicalKey, (u32, u32))> = Vec::new();
+        let key = |x: [u32; 3], v: [f64; 3]| ([x[2], x[1], x[0]], v.map(f64::to_bits));
+        match self.exchange() {
+            None => keyed.extend(self.bounced().map(|i| {
+                let i = i as usize;
+                (key(self.raw_position(i), self.velocity(i)), (0, i as u32))
+            })),
+            Some(c) => {
+                let mut mine = Vec::new();
+                for i in self.bounced() {
+                    let (x, v) = (self.raw_position(i as usize), self.velocity(i as usize));
+                    mine.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
+                    mine.extend_from_slice(&v);
+                    mine.extend_from_slice(&[c.rank() as f64, i as f64]);
+                }
+                let mut all = Vec::new();
+                c.all_gather(&mine, &mut all);
+                keyed.extend(all.chunks_exact(8).map(|m| {
+                    let x = [m[0] as u32, m[1] as u32, m[2] as u32];
+                    (key(x, [m[3], m[4], m[5]]), (m[6] as u32, m[7] as u32))
+                }));
+            }
+        }
+        keyed.sort_unstable_by_key(|k| k.0);
+        out.clear();
+        out.extend(keyed.into_iter().map(|k| k.1));
+    }
+
+    /// Sums of `f(position, velocity)` and the particle counts in the bins `bin_of(position)`
+    /// gives (`None`: no bin) of `bins`, exact in any order and over all ranks (collective
+    /// when decomposed).
+    pub fn profile(
+        &self,
+        bins: usize,
+        bin_of: impl Fn([f64; 3]) -> Option<usize>,
+        f: impl Fn([f64; 3], [f64; 3]) -> f64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mut sums = vec![ExactTotal::default(); bins];
+        let mut counts = vec![0.0; bins];
+        let view = self.view();
+        for i in 0..view.len() {
+            let x = view.position(i);
+            if let Some(b) = bin_of(x).filter(|&b| b < bins) {
+                sums[b].add(f(x, view.velocity(i)));
+                counts[b] += 1.0;
+            }
+        }
+        if let Some(c) = self.exchange() {
+            let mine: Vec<f64> = sums
+                .iter()
+                .zip(&counts)
+                .flat_map(|(t, n)| {
+                    let w = t.words();
+                    [w[0], w[1], w[2], w[3], *n]
+                })
+                .collect();
+            let mut all = Vec::new();
+            c.all_gather_same(&mine, &mut all);
+            sums.iter_mut().for_each(|t| *t = ExactTotal::default());
+            counts.iter_mut().for_each(|n| *n = 0.0);
+            for part in all.chunks_exact(5 * bins) {
+                for (b, w) in part.chunks_exact(5).enumerate() {
+                    sums[b].merge(ExactTotal::from_words(&w[..4]));
+                    counts[b] += w[4];
+                }
+            }
+        }
+        (sums.into_iter().map(ExactTotal::value).collect(), counts)
+    }
+
     /// After a collision with embedded particles (replicated on every rank, each collided by
     /// the rank owning its cell): every rank's new velocities of its own embedded particles
     /// on every rank (collective; nothing on one process).
@@ -135,75 +233,45 @@ impl Srd {
         f: impl Fn([f64; 3], [f64; 3]) -> f64,
     ) -> (Vec<f64>, Vec<f64>) {
         let lz = self.sbox().l[2];
-        let mut sums = vec![ExactTotal::default(); bins];
-        let mut counts = vec![0.0; bins];
-        let view = self.view();
-        for i in 0..view.len() {
-            let (x, v) = (view.position(i), view.velocity(i));
-            let b = (((x[2] / lz + 0.5) * bins as f64) as usize).min(bins - 1);
-            sums[b].add(f(x, v));
-            counts[b] += 1.0;
-        }
-        if let Some(c) = self.exchange() {
-            let mine: Vec<f64> = sums
-                .iter()
-                .zip(&counts)
-                .flat_map(|(t, n)| {
-                    let w = t.words();
-                    [w[0], w[1], w[2], w[3], *n]
-                })
-                .collect();
-            let mut all = Vec::new();
-            c.all_gather_same(&mine, &mut all);
-            sums.iter_mut().for_each(|t| *t = ExactTotal::default());
-            counts.iter_mut().for_each(|n| *n = 0.0);
-            for part in all.chunks_exact(5 * bins) {
-                for (b, w) in part.chunks_exact(5).enumerate() {
-                    sums[b].merge(ExactTotal::from_words(&w[..4]));
-                    counts[b] += w[4];
-                }
-            }
-        }
-        (sums.into_iter().map(ExactTotal::value).collect(), counts)
+        let slab = |x: [f64; 3]| Some((((x[2] / lz + 0.5) * bins as f64) as usize).min(bins - 1));
+        self.profile(bins, slab, f)
     }
 
     /// Send every particle whose cell on the grid of the coming collision is not in the own
     /// layers towards its owner, by the shorter way round, in rounds until none is left; a
-    /// non-finite velocity on any rank (`bad`: its slot) stops every rank.
+    /// non-finite velocity on any rank (`bad`: its slot) stops every rank. Whether a particle
+    /// was reflected in the streaming step travels with it, so that [`Self::bounced`] lists
+    /// this rank's reflected particles afterwards.
     pub(super) fn migrate(&mut self, bad: Option<usize>) -> Result<(), MpcdError> {
         let s = self.fixed_shift(self.step());
+        // Per slot: reflected in the streaming step.
+        let mut flags = std::mem::take(&mut self.flags);
+        flags.clear();
+        flags.resize(self.len(), false);
+        for i in self.bounced() {
+            flags[i as usize] = true;
+        }
         // The first round sends the leavers the streaming step found; later rounds look only
         // at the particles that arrived in the round before (from `first_new` on).
         let mut first_round = true;
         let mut first_new = self.len();
-        loop {
+        let outcome = loop {
             let mut d = self.domain.take().expect("migrate: a decomposed engine");
-            let (nz, z0, z1) = (d.nz, d.z0, d.z1);
             self.leaving.clear();
             d.send_left.clear();
             d.send_right.clear();
             if bad.is_none() {
-                let candidates: Vec<usize> = if first_round {
-                    self.leavers.iter().flatten().map(|&i| i as usize).collect()
-                } else {
-                    (first_new..self.len()).collect()
-                };
-                for i in candidates {
-                    let z = self.layer_of(i, s);
-                    if d.owns(z) {
-                        continue;
+                if first_round {
+                    for c in 0..self.leavers.len() {
+                        for j in 0..self.leavers[c].len() {
+                            let i = self.leavers[c][j] as usize;
+                            self.send_if_foreign(&mut d, i, s, flags[i]);
+                        }
                     }
-                    let ahead = (z + nz - z1) % nz;
-                    let behind = (z0 + nz - 1 - z) % nz;
-                    let buf = if ahead <= behind {
-                        &mut d.send_right
-                    } else {
-                        &mut d.send_left
-                    };
-                    let (x, v) = (self.raw_position(i), self.velocity(i));
-                    buf.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
-                    buf.extend_from_slice(&v);
-                    self.leaving.push(i as u32);
+                } else {
+                    for i in first_new..self.len() {
+                        self.send_if_foreign(&mut d, i, s, flags[i]);
+                    }
                 }
             }
             d.mine.clear();
@@ -218,7 +286,7 @@ impl Srd {
             let done = d.gathered.chunks_exact(2).all(|g| g[0] == 0.0);
             if failed.is_some() || done {
                 self.domain = Some(d);
-                return match failed {
+                break match failed {
                     Some(i) => Err(MpcdError::NonFinite {
                         step: self.step(),
                         what: "solvent",
@@ -228,22 +296,56 @@ impl Srd {
                 };
             }
             let mut leaving = std::mem::take(&mut self.leaving);
+            // `remove` sorts the slots and fills each, from the highest down, with the last
+            // particle: the flags follow the same moves.
             self.remove(&mut leaving);
+            for &i in leaving.iter().rev() {
+                flags.swap_remove(i as usize);
+            }
             self.leaving = leaving;
             first_round = false;
             first_new = self.len();
             let (left, right) = (d.left(), d.right());
             d.comm.shift(right, &d.send_right, left, &mut d.recv);
-            self.arrive(&d.recv);
+            self.arrive(&d.recv, &mut flags);
             d.comm.shift(left, &d.send_left, right, &mut d.recv);
-            self.arrive(&d.recv);
+            self.arrive(&d.recv, &mut flags);
             self.domain = Some(d);
-        }
+        };
+        // The reflected particles' slots now, in increasing order.
+        self.bounced.truncate(1);
+        self.bounced.resize_with(1, Vec::new);
+        self.bounced[0].clear();
+        self.bounced[0].extend((0..flags.len()).filter(|&i| flags[i]).map(|i| i as u32));
+        self.flags = flags;
+        outcome
     }
 
-    fn arrive(&mut self, msg: &[f64]) {
-        for p in msg.chunks_exact(PER_PARTICLE) {
+    /// Queue slot `i` for its owner's side when its cell is not in the own layers.
+    fn send_if_foreign(&mut self, d: &mut Domain, i: usize, s: [u32; 3], reflected: bool) {
+        let (nz, z0, z1) = (d.nz, d.z0, d.z1);
+        let z = self.layer_of(i, s);
+        if d.owns(z) {
+            return;
+        }
+        let ahead = (z + nz - z1) % nz;
+        let behind = (z0 + nz - 1 - z) % nz;
+        let buf = if ahead <= behind {
+            &mut d.send_right
+        } else {
+            &mut d.send_left
+        };
+        let (x, v) = (self.raw_position(i), self.velocity(i));
+        buf.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
+        buf.extend_from_slice(&v);
+        buf.push(reflected as u8 as f64);
+        self.leaving.push(i as u32);
+    }
+
+    fn arrive(&mut self, msg: &[f64], flags: &mut Vec<bool>) {
+        for p in msg.chunks_exact(MIGRANT) {
             self.push([p[0] as u32, p[1] as u32, p[2] as u32], [p[3], p[4], p[5]]);
+            flags.push(p[6] != 0.0);
         }
     }
 

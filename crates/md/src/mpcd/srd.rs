@@ -176,15 +176,15 @@ impl Acceleration {
     }
 }
 
-/// A sum over many terms that does not depend on their order and of any size: each term `x`
-/// (|x| < 2^30) as the integers `x 2^32` (truncated) and the 32 bits below, summed in 64-bit
-/// integers (exact for up to 2^31 terms of |x| < 1), the total rounded once. Sums over all
-/// particles ([`Srd::sum`]) use it, so that they are the same bits in any storage order and
-/// over any number of ranks (partial totals merge exactly).
+/// A sum over many terms that does not depend on their order: each term `x` (|x| < 2^30) as
+/// the integer `x 2^64` (truncated below 2^-64), summed in a 128-bit integer (no overflow for
+/// any count of such terms below 2^33), the total rounded once; a non-finite term makes the
+/// total NaN. Sums over all particles ([`Srd::sum`]) use it, so that they are the same bits
+/// in any storage order and over any number of ranks (partial totals merge exactly).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ExactTotal {
-    hi: i64,
-    lo: i64,
+    total: i128,
+    non_finite: bool,
 }
 
 impl ExactTotal {
@@ -193,39 +193,63 @@ impl ExactTotal {
     /// Add `x`.
     #[inline(always)]
     pub fn add(&mut self, x: f64) {
+        if !x.is_finite() {
+            self.non_finite = true;
+            return;
+        }
         let a = x * Self::SCALE;
         let h = a as i64;
         // a - h is exact (the fraction of a float), and so is its scaling by 2^32.
         let l = ((a - h as f64) * Self::SCALE) as i64;
-        self.hi = self.hi.wrapping_add(h);
-        self.lo = self.lo.wrapping_add(l);
+        self.total = self
+            .total
+            .wrapping_add(((h as i128) << 32).wrapping_add(l as i128));
     }
 
     /// Add another total.
     pub fn merge(&mut self, o: ExactTotal) {
-        self.hi = self.hi.wrapping_add(o.hi);
-        self.lo = self.lo.wrapping_add(o.lo);
+        self.total = self.total.wrapping_add(o.total);
+        self.non_finite |= o.non_finite;
     }
 
-    /// The total, rounded once to the nearest `f64`.
+    /// The total, rounded once to the nearest `f64` (NaN after a non-finite term).
     pub fn value(self) -> f64 {
-        let total = ((self.hi as i128) << 32) + self.lo as i128;
-        total as f64 / (Self::SCALE * Self::SCALE)
+        if self.non_finite {
+            return f64::NAN;
+        }
+        self.total as f64 / (Self::SCALE * Self::SCALE)
     }
 
-    /// As four numbers exact in `f64`s (32-bit halves), for a message.
+    /// As four numbers exact in `f64`s (32-bit pieces, the top one signed; NaNs for a
+    /// non-finite total), for a message.
     pub fn words(self) -> [f64; 4] {
-        let half = |x: i64| [(x >> 32) as f64, (x & 0xffff_ffff) as f64];
-        let (h, l) = (half(self.hi), half(self.lo));
-        [h[0], h[1], l[0], l[1]]
+        if self.non_finite {
+            return [f64::NAN; 4];
+        }
+        let t = self.total;
+        [
+            (t >> 96) as i32 as f64,
+            ((t >> 64) as u32) as f64,
+            ((t >> 32) as u32) as f64,
+            (t as u32) as f64,
+        ]
     }
 
     /// From [`Self::words`].
     pub fn from_words(w: &[f64]) -> Self {
-        let whole = |a: f64, b: f64| ((a as i64) << 32) | b as i64;
+        if w[..4].iter().any(|x| x.is_nan()) {
+            return Self {
+                total: 0,
+                non_finite: true,
+            };
+        }
+        let total = ((w[0] as i32 as i128) << 96)
+            | ((w[1] as u32 as i128) << 64)
+            | ((w[2] as u32 as i128) << 32)
+            | (w[3] as u32 as i128);
         Self {
-            hi: whole(w[0], w[1]),
-            lo: whole(w[2], w[3]),
+            total,
+            non_finite: false,
         }
     }
 }
@@ -603,7 +627,9 @@ pub struct Srd {
     emb_vel: SharedVectors,
     emb_mass: Vec<f64>,
     /// Per streaming chunk: slots of the particles reflected in the last streaming step.
-    bounced: Vec<Vec<u32>>,
+    pub(super) bounced: Vec<Vec<u32>>,
+    /// Per slot, during a migration: reflected in the streaming step (decomposed runs).
+    pub(super) flags: Vec<bool>,
     /// Seconds spent in the parts of a step: streaming, binning, storage sorts, cell
     /// collisions.
     pub timers: [f64; 4],
@@ -738,6 +764,7 @@ impl Srd {
             domain: None,
             leaving: Vec::new(),
             leavers: Vec::new(),
+            flags: Vec::new(),
         })
     }
 
@@ -891,8 +918,9 @@ impl Srd {
     /// kept for [`Self::bounced`].
     ///
     /// Decomposed ([`super::ranks`]), the particles then go to the ranks that own their cells
-    /// on the next collision's grid, and a non-finite velocity on any rank stops every rank
-    /// (collective); walls are not decomposed yet.
+    /// on the next collision's grid, a non-finite velocity on any rank stops every rank, and
+    /// the counts returned are those of all ranks (collective); [`Self::bounced`] stays this
+    /// rank's.
     pub fn stream(
         &mut self,
         t1: f64,
@@ -902,18 +930,19 @@ impl Srd {
         if self.domain.is_none() {
             return self.stream_own(t1, conf, accel);
         }
-        if !matches!(conf, Confinement::None) {
-            return Err(MpcdError::Invalid(
-                "an MPCD solvent with walls is not decomposed over ranks yet".into(),
-            ));
-        }
         let streamed = self.stream_own(t1, conf, accel);
         let bad = match &streamed {
             Err(MpcdError::NonFinite { index, .. }) => Some(*index),
             _ => None,
         };
         self.migrate(bad)?;
-        streamed
+        let st = streamed?;
+        let t = self.add_over_ranks([st.bounced, st.reflections, st.stuck]);
+        Ok(StreamStats {
+            bounced: t[0],
+            reflections: t[1],
+            stuck: t[2],
+        })
     }
 
     /// [`Self::stream`] of this engine's (this rank's) particles.
@@ -1285,6 +1314,10 @@ impl Srd {
             st.occupied_cells += o;
             st.virtual_particles += v;
         }
+        // Decomposed: the counts of all ranks (collective).
+        let t = self.add_over_ranks([st.occupied_cells, st.virtual_particles]);
+        st.occupied_cells = t[0];
+        st.virtual_particles = t[1];
         st
     }
 
@@ -1875,6 +1908,36 @@ mod tests {
 
     /// The same run on 1 and on 2 threads gives the same bits: bulk with the cosine drive and
     /// storage sorts, and between no-slip walls with embedded particles and virtual particles.
+    #[test]
+    fn exact_totals_travel_as_words_and_do_not_depend_on_the_order() {
+        let terms = [1.5e6, -3.25, 7.0e-9, -1.0e6, 2.0f64.powi(29), -0.1, 0.3];
+        let mut a = ExactTotal::default();
+        for x in terms {
+            a.add(x);
+        }
+        let mut b = ExactTotal::default();
+        for x in terms.iter().rev() {
+            b.add(*x);
+        }
+        assert_eq!(a, b);
+        for t in [a, ExactTotal::default()] {
+            assert_eq!(ExactTotal::from_words(&t.words()), t);
+        }
+        let mut neg = ExactTotal::default();
+        neg.add(-5.0e8);
+        neg.add(-5.0e8);
+        assert_eq!(ExactTotal::from_words(&neg.words()), neg);
+        assert_eq!(neg.value(), -1.0e9);
+        // Two halves merge to the whole, in either order.
+        let (mut h1, mut h2) = (ExactTotal::default(), ExactTotal::default());
+        terms[..3].iter().for_each(|x| h1.add(*x));
+        terms[3..].iter().for_each(|x| h2.add(*x));
+        h2.merge(h1);
+        assert_eq!(h2, a);
+        a.add(f64::NAN);
+        assert!(a.value().is_nan() && ExactTotal::from_words(&a.words()).value().is_nan());
+    }
+
     #[test]
     fn results_do_not_depend_on_the_thread_count() {
         let l = 16.0;
