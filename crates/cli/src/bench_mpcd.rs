@@ -59,9 +59,10 @@ fn worker(a: &BenchArgs, k: usize) -> Result<()> {
     let ranks = crate::bench_dpd_ranks::worker_ranks(&a.threads)?;
     let l = a.l as f64;
     let sbox = SimBox::new([l, l, k as f64 * l]);
-    let srd = Srd::new(SrdParams::standard(7), sbox, &Confinement::None, 0.0)?;
-    let n = srd.len();
-    let mut part = srd.decomposed(ranks.exchange()?)?;
+    let params = SrdParams::standard(7);
+    let conf = Confinement::None;
+    let mut part = Srd::new_decomposed(params, sbox, &conf, 0.0, ranks.exchange()?)?;
+    let n = part.particles();
     let steps = |srd: &mut Srd, count: u64| -> Result<()> {
         for _ in 0..count {
             let t = (srd.step() + 1) as f64 * srd.params().tau;

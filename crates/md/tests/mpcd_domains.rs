@@ -251,3 +251,32 @@ fn colloids_replicated_on_every_rank_move_as_on_one_process() {
         }
     }
 }
+
+#[test]
+fn a_start_drawn_on_the_ranks_is_the_whole_start_decomposed() {
+    use colloidsim_md::mpcd::WallKind;
+    use colloidsim_md::potential::SphereAreaLaw;
+    let conf = Confinement::Sphere {
+        law: SphereAreaLaw {
+            r0: 5.0,
+            alpha: 4.0,
+        },
+        kind: WallKind::Slip,
+    };
+    let p = SrdParams::standard(12);
+    let sbox = SimBox::new([12.0, 10.0, 12.0]);
+    for (conf, n) in [(Confinement::None, 7200), (conf, 2618)] {
+        let want = bits(&Srd::new(p, sbox, &conf, 0.0).unwrap().gathered_state());
+        let got = on_ranks(3, |comm| {
+            let part = Srd::new_decomposed(p, sbox, &conf, 0.0, comm).unwrap();
+            (part.len(), bits(&part.gathered_state()), part.particles())
+        });
+        let held: usize = got.iter().map(|g| g.0).sum();
+        assert_eq!(held, n, "each particle is held by one rank");
+        for (len, state, total) in got {
+            assert_eq!(total, n);
+            assert!(len < n, "a rank holds only its share: {len} of {n}");
+            assert!(state == want, "the drawn start differs from the whole one");
+        }
+    }
+}

@@ -250,12 +250,21 @@ fn resolve_bulk(src: &Source, seed: Option<u64>) -> Result<BulkRun> {
 }
 
 fn build_bulk(p: &BulkRun) -> Result<Srd> {
-    Ok(Srd::new(
-        p.solvent.srd,
-        SimBox::cube(p.box_edge),
-        &Confinement::None,
-        0.0,
-    )?)
+    new_solvent(p.solvent.srd, p.box_edge, &Confinement::None, None)
+}
+
+/// A fresh solvent in the cube of edge `l`; over the ranks of `comm`, each drawing and holding
+/// its share only.
+fn new_solvent(
+    params: colloidsim_md::mpcd::SrdParams,
+    l: f64,
+    conf: &Confinement,
+    comm: Option<Box<dyn Exchange>>,
+) -> Result<Srd> {
+    Ok(match comm {
+        None => Srd::new(params, SimBox::cube(l), conf, 0.0)?,
+        Some(c) => Srd::new_decomposed(params, SimBox::cube(l), conf, 0.0, c)?,
+    })
 }
 
 /// The bulk's colloids: random sequential addition in the box.
@@ -392,8 +401,8 @@ fn start_bulk(
 ) -> Result<Box<dyn Session>> {
     let p = resolve_bulk(src, seed)?;
     let colloids = build_bulk_colloids(&p).with_context(|| src.label())?;
-    let srd = build_bulk(&p).with_context(|| src.label())?;
-    let srd = decompose(srd, comm).with_context(|| src.label())?;
+    let srd = new_solvent(p.solvent.srd, p.box_edge, &Confinement::None, comm)
+        .with_context(|| src.label())?;
     let acc = BulkAccum::new(&p);
     Ok(Box::new(BulkSession {
         momentum: [0.0; 3],
@@ -1059,13 +1068,8 @@ fn confinement(p: &DropletRun) -> Confinement {
     }
 }
 
-fn build_droplet(p: &DropletRun) -> Result<Srd> {
-    Ok(Srd::new(
-        p.solvent.srd,
-        SimBox::cube(p.box_edge),
-        &confinement(p),
-        0.0,
-    )?)
+fn build_droplet(p: &DropletRun, comm: Option<Box<dyn Exchange>>) -> Result<Srd> {
+    new_solvent(p.solvent.srd, p.box_edge, &confinement(p), comm)
 }
 
 /// The colloids at the start: random sequential addition with centres within `R0 - d/2`.
@@ -1111,9 +1115,8 @@ impl Method for DropletMpcd {
     ) -> Result<Box<dyn Session>> {
         let p = resolve_droplet(src, seed)?;
         let colloids = build_colloids(&p).with_context(|| src.label())?;
-        let srd = build_droplet(&p).with_context(|| src.label())?;
-        let acc = DropletAccum::new(&p, srd.len());
-        let srd = decompose(srd, comm).with_context(|| src.label())?;
+        let srd = build_droplet(&p, comm).with_context(|| src.label())?;
+        let acc = DropletAccum::new(&p, srd.particles());
         Ok(Box::new(DropletSession {
             now: (0, f64::NAN),
             p,
@@ -1174,7 +1177,7 @@ impl Method for DropletMpcd {
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve_droplet(src, seed)?;
         Ok(Box::new(SolventEngine {
-            srd: build_droplet(&p)?,
+            srd: build_droplet(&p, None)?,
             colloids: build_colloids(&p)?,
             interface: Some(p.harmonic()),
             method: "droplet-mpcd",

@@ -19,9 +19,11 @@
 //! drying droplet removes are chosen from every rank's reflected ones in one canonical order
 //! ([`Srd::gathered_bounced`]).
 
+use super::Confinement;
 use super::MpcdError;
-use super::srd::{ExactTotal, Srd};
+use super::srd::{ExactTotal, FixedPoint, Grid, Srd, SrdParams};
 use crate::domain::Domain;
+use crate::state::SimBox;
 use colloidsim_core::exchange::Exchange;
 
 /// Numbers per particle in a message: the position in fixed point (three integers below 2^32,
@@ -66,6 +68,28 @@ impl Srd {
         self.own_layers(domain.z0, domain.z1);
         self.domain = Some(domain);
         Ok(self)
+    }
+
+    /// [`Self::new`] decomposed over the ranks of `comm` from the start, without any rank
+    /// holding the whole solvent: each draws the whole start chunk by chunk (the same streams)
+    /// and keeps its own particles, the same as `Srd::new(...).decomposed(comm)`.
+    pub fn new_decomposed(
+        params: SrdParams,
+        sbox: SimBox,
+        conf: &Confinement,
+        t: f64,
+        comm: Box<dyn Exchange>,
+    ) -> Result<Srd, MpcdError> {
+        let grid = Grid::new(&sbox, params.cell)?;
+        let domain = Domain::new(comm, grid.n[2], grid.a).map_err(MpcdError::Invalid)?;
+        let s = Srd::shift_of(&params, &FixedPoint::new(&sbox), 0)[2];
+        let (nz, layers) = (grid.n[2] as u64, domain.z0..domain.z1);
+        let own =
+            |x: [u32; 3]| layers.contains(&(((x[2].wrapping_sub(s) as u64 * nz) >> 32) as usize));
+        let mut srd = Srd::generate(params, sbox, conf, t, own)?;
+        srd.own_layers(domain.z0, domain.z1);
+        srd.domain = Some(domain);
+        Ok(srd)
     }
 
     /// The ranks, when decomposed.

@@ -652,6 +652,20 @@ impl Srd {
         conf: &Confinement,
         t: f64,
     ) -> Result<Self, MpcdError> {
+        Self::generate(params, sbox, conf, t, |_| true)
+    }
+
+    /// The particles of [`Self::new`] for which `keep(position)` holds (all of them for `new`),
+    /// in the same order, with the mean velocity of *all* of them removed: the whole start is
+    /// drawn chunk by chunk, so only the kept particles are held (a rank's share of a
+    /// decomposed start, [`Self::new_decomposed`]).
+    pub(super) fn generate(
+        params: SrdParams,
+        sbox: SimBox,
+        conf: &Confinement,
+        t: f64,
+        keep: impl Fn([u32; 3]) -> bool,
+    ) -> Result<Self, MpcdError> {
         check_params(&params)?;
         Grid::new(&sbox, params.cell)?;
         let volume = conf.volume(t, sbox.l);
@@ -665,46 +679,59 @@ impl Srd {
         let l = sbox.l;
         let sd = (params.kt / params.mass).sqrt();
         let zig = Ziggurat::get();
-        let mut pos = vec![[0.0; 3]; n];
-        let mut vel = vec![[0.0; 3]; n];
-        pos.par_chunks_mut(64)
-            .zip(vel.par_chunks_mut(64))
-            .enumerate()
-            .for_each(|(b, (pc, vc))| {
-                let mut rng = draw(params.seed, 0, Draw::Solvent, b as u64);
-                for (x, v) in pc.iter_mut().zip(vc.iter_mut()) {
-                    loop {
-                        let u: [f64; 3] = [rng.random(), rng.random(), rng.random()];
-                        *x = [
-                            (u[0] - 0.5) * l[0],
-                            (u[1] - 0.5) * l[1],
-                            (u[2] - 0.5) * l[2],
-                        ];
-                        if conf.inside(*x, t) {
-                            break;
+        let fixed = FixedPoint::new(&sbox);
+        // Chunks of 1024 blocks of 64 particles, each block from its own stream.
+        const CHUNK: usize = 1 << 16;
+        let mut pos = vec![[0.0; 3]; CHUNK.min(n)];
+        let mut vel = vec![[0.0; 3]; CHUNK.min(n)];
+        let (mut kept_pos, mut kept_vel) = (Vec::new(), Vec::new());
+        let mut sum = [0.0; 3];
+        for c0 in (0..n).step_by(CHUNK) {
+            let len = CHUNK.min(n - c0);
+            pos[..len]
+                .par_chunks_mut(64)
+                .zip(vel[..len].par_chunks_mut(64))
+                .enumerate()
+                .for_each(|(b, (pc, vc))| {
+                    let block = (c0 / 64 + b) as u64;
+                    let mut rng = draw(params.seed, 0, Draw::Solvent, block);
+                    for (x, v) in pc.iter_mut().zip(vc.iter_mut()) {
+                        loop {
+                            let u: [f64; 3] = [rng.random(), rng.random(), rng.random()];
+                            *x = [
+                                (u[0] - 0.5) * l[0],
+                                (u[1] - 0.5) * l[1],
+                                (u[2] - 0.5) * l[2],
+                            ];
+                            if conf.inside(*x, t) {
+                                break;
+                            }
+                        }
+                        for c in v.iter_mut() {
+                            *c = sd * zig.sample(&mut rng);
                         }
                     }
-                    for c in v.iter_mut() {
-                        *c = sd * zig.sample(&mut rng);
-                    }
-                }
-            });
-        if n > 0 {
-            let mut mean = [0.0; 3];
-            for v in &vel {
+                });
+            // The mean in the order of the whole start, as one sum.
+            for v in &vel[..len] {
                 for k in 0..3 {
-                    mean[k] += v[k] / n as f64;
+                    sum[k] += v[k] / n as f64;
                 }
             }
-            for v in &mut vel {
-                for k in 0..3 {
-                    v[k] -= mean[k];
+            for (x, v) in pos[..len].iter().zip(&vel[..len]) {
+                let raw = fixed.encode(*x);
+                if keep(raw) {
+                    kept_pos.push(raw);
+                    kept_vel.push(*v);
                 }
             }
         }
-        let fixed = FixedPoint::new(&sbox);
-        let pos: Vec<[u32; 3]> = pos.iter().map(|x| fixed.encode(*x)).collect();
-        Self::from_raw(params, sbox, &pos, &vel, 0)
+        for v in &mut kept_vel {
+            for k in 0..3 {
+                v[k] -= sum[k];
+            }
+        }
+        Self::from_raw(params, sbox, &kept_pos, &kept_vel, 0)
     }
 
     /// A solvent in a given state, `step` collisions done: positions in fixed point
@@ -901,11 +928,15 @@ impl Srd {
     }
 
     fn raw_shift(&self, step: u64) -> [u32; 3] {
-        let mut rng = draw(self.params.seed, step, Draw::Shift, 0);
-        let a = self.params.cell;
+        Self::shift_of(&self.params, &self.fixed, step)
+    }
+
+    /// The grid shift of collision `step` in fixed point.
+    pub(super) fn shift_of(params: &SrdParams, fixed: &FixedPoint, step: u64) -> [u32; 3] {
+        let mut rng = draw(params.seed, step, Draw::Shift, 0);
+        let a = params.cell;
         let u: [f64; 3] = [rng.random(), rng.random(), rng.random()];
-        self.fixed
-            .displacement([(u[0] - 0.5) * a, (u[1] - 0.5) * a, (u[2] - 0.5) * a])
+        fixed.displacement([(u[0] - 0.5) * a, (u[1] - 0.5) * a, (u[2] - 0.5) * a])
     }
 
     /// The collision cell of position `x` (any image) at collision `step`.
