@@ -48,24 +48,7 @@ solvent = true
 "#;
 
 /// A drying droplet of R0 = 8 cells with 6 colloids of d = 4 (no-slip), 300 collisions.
-const COLLOIDS: &str = r#"
-method = "droplet-mpcd"
-seed = 4
-boundary = "no-slip"
-[system]
-particles = 6
-diameter = 4
-radius = 8
-[drying]
-peclet = 10
-duration = 30
-[observe.profile]
-bins = 8
-[observe.solvent]
-window = 50
-[observe.trajectory]
-every = 50
-"#;
+const COLLOIDS: &str = common::MPCD_DROPLET_COLLOIDS;
 
 /// Four colloids of d = 3 in a bulk box of 10 cells, 400 collisions, Green-Kubo over 20 lags.
 const BULK_COLLOIDS: &str = r#"

@@ -594,60 +594,36 @@ every = 100
 solvent = true
 "#;
 
-#[test]
-fn mpcd_with_colloids_on_2_and_3_ranks_writes_the_single_process_folder() {
+/// `scenario` under `mpirun` on each of `ranks`, and interrupted on 2 ranks at `at` and
+/// continued on `continued`: every folder is the single-process one.
+fn writes_the_single_process_folder(
+    name: &str,
+    scenario: &str,
+    ranks: &[usize],
+    at: &str,
+    continued: usize,
+) {
     let tmp = tempfile::tempdir().unwrap();
-    let (s, reference) = reference(tmp.path(), "colloids", TINY_MPCD_COLLOIDS);
-    for ranks in [2, 3] {
-        let out = tmp.path().join(format!("ranks-{ranks}"));
-        let o = mpirun(
-            ranks,
-            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
-        );
-        assert!(o.status.success(), "mpirun -n {ranks}");
+    let (s, reference) = reference(tmp.path(), name, scenario);
+    for &r in ranks {
+        let out = tmp.path().join(format!("ranks-{r}"));
+        let o = mpirun(r, &["run", &s, "--out", out.to_str().unwrap(), "--quiet"]);
+        assert!(o.status.success(), "mpirun -n {r}");
         assert_same_tree(&reference, &out);
     }
-    let out = tmp.path().join("continued-on-3");
-    interrupted_on_2_continued_on(3, &s, &out, "120");
+    let out = tmp.path().join(format!("continued-on-{continued}"));
+    interrupted_on_2_continued_on(continued, &s, &out, at);
     assert_same_tree(&reference, &out);
 }
 
-/// A drying droplet (R0 = 8 cells, no-slip walls, 6 colloids of d = 4, solvent removed as it
-/// shrinks) for 300 collisions, with profiles and a trajectory with the solvent.
-const TINY_MPCD_DROPLET: &str = r#"
-method = "droplet-mpcd"
-seed = 4
-boundary = "no-slip"
-[system]
-particles = 6
-diameter = 4
-radius = 8
-[drying]
-peclet = 10
-duration = 30
-[observe.profile]
-bins = 8
-[observe.solvent]
-window = 50
-[observe.trajectory]
-every = 50
-solvent = true
-"#;
+#[test]
+fn mpcd_with_colloids_on_2_and_3_ranks_writes_the_single_process_folder() {
+    writes_the_single_process_folder("colloids", TINY_MPCD_COLLOIDS, &[2, 3], "120", 3);
+}
 
 #[test]
 fn an_mpcd_droplet_on_2_and_3_ranks_writes_the_single_process_folder() {
-    let tmp = tempfile::tempdir().unwrap();
-    let (s, reference) = reference(tmp.path(), "droplet-mpcd", TINY_MPCD_DROPLET);
-    for ranks in [2, 3] {
-        let out = tmp.path().join(format!("ranks-{ranks}"));
-        let o = mpirun(
-            ranks,
-            &["run", &s, "--out", out.to_str().unwrap(), "--quiet"],
-        );
-        assert!(o.status.success(), "mpirun -n {ranks}");
-        assert_same_tree(&reference, &out);
-    }
-    let out = tmp.path().join("continued-on-1");
-    interrupted_on_2_continued_on(1, &s, &out, "170");
-    assert_same_tree(&reference, &out);
+    // With the solvent in the trajectory (the last section).
+    let droplet = format!("{}solvent = true\n", common::MPCD_DROPLET_COLLOIDS);
+    writes_the_single_process_folder("droplet-mpcd", &droplet, &[2, 3], "170", 1);
 }

@@ -571,12 +571,7 @@ impl Session for DpdSession {
         _failure: Option<&str>,
     ) -> Result<Finished> {
         if !self.is_writer() {
-            return Ok(Finished {
-                summary: json!({}),
-                files: Vec::new(),
-                message: String::new(),
-                warnings: Vec::new(),
-            });
+            return Ok(Finished::nothing_written());
         }
         let mut warnings = Vec::new();
         let (files, diffusion) = write_outputs(out, &self.s, &self.sim, &self.obs, &mut warnings)?;

@@ -36,6 +36,18 @@ pub struct Finished {
     pub warnings: Vec<String>,
 }
 
+impl Finished {
+    /// What a rank that does not write reports (a decomposed run's ranks but 0).
+    pub fn nothing_written() -> Self {
+        Self {
+            summary: serde_json::json!({}),
+            files: Vec::new(),
+            message: String::new(),
+            warnings: Vec::new(),
+        }
+    }
+}
+
 /// One method's family of scenarios (`method = "..."`).
 pub trait Method: Sync {
     /// The `method` values this method answers to (the first is its name).

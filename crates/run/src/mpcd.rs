@@ -801,12 +801,7 @@ impl Session for BulkSession {
         failure: Option<&str>,
     ) -> Result<Finished> {
         if !BulkSession::is_writer(&self) {
-            return Ok(Finished {
-                summary: json!({}),
-                files: Vec::new(),
-                message: String::new(),
-                warnings: Vec::new(),
-            });
+            return Ok(Finished::nothing_written());
         }
         self.flush()?;
         let p = &self.p;
@@ -1574,12 +1569,7 @@ impl Session for DropletSession {
         failure: Option<&str>,
     ) -> Result<Finished> {
         if !DropletSession::is_writer(&self) {
-            return Ok(Finished {
-                summary: json!({}),
-                files: Vec::new(),
-                message: String::new(),
-                warnings: Vec::new(),
-            });
+            return Ok(Finished::nothing_written());
         }
         self.flush()?;
         let (solvent_final, temperature_final) = self.now;

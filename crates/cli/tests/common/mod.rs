@@ -181,3 +181,24 @@ pub fn cli(args: &[&str], env: &[(&str, &str)]) -> Output {
     eprintln!("{}", text(&o));
     o
 }
+
+/// A drying MPCD droplet of R0 = 8 cells with 6 colloids of d = 4 (no-slip walls, solvent
+/// removed as it shrinks), 300 collisions, profiles and a trajectory (its section last).
+pub const MPCD_DROPLET_COLLOIDS: &str = r#"
+method = "droplet-mpcd"
+seed = 4
+boundary = "no-slip"
+[system]
+particles = 6
+diameter = 4
+radius = 8
+[drying]
+peclet = 10
+duration = 30
+[observe.profile]
+bins = 8
+[observe.solvent]
+window = 50
+[observe.trajectory]
+every = 50
+"#;
