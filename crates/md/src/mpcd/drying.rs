@@ -49,13 +49,13 @@ pub fn remove_excess(
         let j = rng.random_range(k..scratch.len());
         scratch.swap(k, j);
     }
+    // This rank's chosen slots, in the engine's reused list of leaving slots.
     let me = srd.rank().0 as u32;
-    let mut mine: Vec<u32> = scratch[..take]
-        .iter()
-        .filter(|c| c.0 == me)
-        .map(|c| c.1)
-        .collect();
+    let mut mine = std::mem::take(&mut srd.leaving);
+    mine.clear();
+    mine.extend(scratch[..take].iter().filter(|c| c.0 == me).map(|c| c.1));
     srd.remove(&mut mine);
+    srd.leaving = mine;
     Removal {
         removed: take as u64,
         residual: (excess - take) as u64,

@@ -25,6 +25,7 @@ use super::srd::{ExactTotal, FixedPoint, Grid, Srd, SrdParams};
 use crate::domain::Domain;
 use crate::state::SimBox;
 use colloidsim_core::exchange::Exchange;
+use std::cell::RefMut;
 
 /// Numbers per particle in a message: the position in fixed point (three integers below 2^32,
 /// exact in an `f64`) and the velocity.
@@ -109,30 +110,46 @@ impl Srd {
             .map_or(0..self.grid().n[2], |d| d.z0..d.z1)
     }
 
+    /// Every rank's numbers, that `fill` writes, on every rank: the `.1` of what is returned
+    /// (collective; `None` on one process). The messages go through buffers kept by the
+    /// engine, so that the collectives of a step allocate nothing; `same`: every rank sends as
+    /// many numbers.
+    fn gather_with(
+        &self,
+        same: bool,
+        fill: impl FnOnce(&mut Vec<f64>),
+    ) -> Option<RefMut<'_, (Vec<f64>, Vec<f64>)>> {
+        let c = self.exchange()?;
+        let mut buffers = self.gather_buffers.borrow_mut();
+        let (mine, all) = &mut *buffers;
+        mine.clear();
+        fill(mine);
+        if same {
+            c.all_gather_same(mine, all);
+        } else {
+            c.all_gather(mine, all);
+        }
+        Some(buffers)
+    }
+
     /// The number of particles on all ranks (collective when decomposed; [`Self::len`] is
     /// this rank's).
     pub fn particles(&self) -> usize {
-        match self.exchange() {
+        match self.gather_with(true, |m| m.push(self.len() as f64)) {
+            Some(g) => g.1.iter().sum::<f64>() as usize,
             None => self.len(),
-            Some(c) => {
-                let mut all = Vec::new();
-                c.all_gather_same(&[self.len() as f64], &mut all);
-                all.iter().sum::<f64>() as usize
-            }
         }
     }
 
     /// Every rank's partial totals merged (collective; nothing on one process). Integer
     /// additions: the result does not depend on the split.
     pub(super) fn merge_over_ranks<const K: usize>(&self, acc: &mut [ExactTotal; K]) {
-        let Some(c) = self.exchange() else {
+        let Some(g) = self.gather_with(true, |m| m.extend(acc.iter().flat_map(|t| t.words())))
+        else {
             return;
         };
-        let mine: Vec<f64> = acc.iter().flat_map(|t| t.words()).collect();
-        let mut all = Vec::new();
-        c.all_gather_same(&mine, &mut all);
         *acc = [ExactTotal::default(); K];
-        for part in all.chunks_exact(4 * K) {
+        for part in g.1.chunks_exact(4 * K) {
             for (d, w) in part.chunks_exact(4).enumerate() {
                 acc[d].merge(ExactTotal::from_words(w));
             }
@@ -141,13 +158,11 @@ impl Srd {
 
     /// Counts summed over all ranks (collective; unchanged on one process).
     pub(super) fn add_over_ranks<const K: usize>(&self, counts: [u64; K]) -> [u64; K] {
-        let Some(c) = self.exchange() else {
+        let Some(g) = self.gather_with(true, |m| m.extend(counts.map(|x| x as f64))) else {
             return counts;
         };
-        let mut all = Vec::new();
-        c.all_gather_same(&counts.map(|x| x as f64), &mut all);
         let mut t = [0u64; K];
-        for part in all.chunks_exact(K) {
+        for part in g.1.chunks_exact(K) {
             for (d, x) in part.iter().enumerate() {
                 t[d] += *x as u64;
             }
@@ -159,32 +174,40 @@ impl Srd {
     /// the canonical order of [`Self::gathered_state`], each as (rank, slot on that rank)
     /// (collective when decomposed), into `out`.
     pub fn gathered_bounced(&self, out: &mut Vec<(u32, u32)>) {
-        let mut keyed: Vec<(CanonicalKey, (u32, u32))> = Vec::new();
-        let key = |x: [u32; 3], v: [f64; 3]| ([x[2], x[1], x[0]], v.map(f64::to_bits));
-        match self.exchange() {
-            None => keyed.extend(self.bounced().map(|i| {
-                let i = i as usize;
-                (key(self.raw_position(i), self.velocity(i)), (0, i as u32))
-            })),
-            Some(c) => {
-                let mut mine = Vec::new();
-                for i in self.bounced() {
-                    let (x, v) = (self.raw_position(i as usize), self.velocity(i as usize));
-                    mine.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
-                    mine.extend_from_slice(&v);
-                    mine.extend_from_slice(&[c.rank() as f64, i as f64]);
+        let key = |x: [u32; 3], v: [f64; 3]| -> CanonicalKey {
+            ([x[2], x[1], x[0]], v.map(f64::to_bits))
+        };
+        out.clear();
+        let rank = self.rank().0 as f64;
+        let gathered = self.gather_with(false, |m| {
+            for i in self.bounced() {
+                let (x, v) = (self.raw_position(i as usize), self.velocity(i as usize));
+                m.extend_from_slice(&[x[0] as f64, x[1] as f64, x[2] as f64]);
+                m.extend_from_slice(&v);
+                m.extend_from_slice(&[rank, i as f64]);
+            }
+        });
+        match gathered {
+            Some(g) => {
+                // Entry k of every rank's list, sorted by its key, then named by (rank, slot).
+                let entry = |k: u32| &g.1[8 * k as usize..8 * k as usize + 8];
+                out.extend((0..g.1.len() as u32 / 8).map(|k| (k, 0)));
+                out.sort_unstable_by_key(|&(k, _)| {
+                    let m = entry(k);
+                    key([m[0] as u32, m[1] as u32, m[2] as u32], [m[3], m[4], m[5]])
+                });
+                for e in out.iter_mut() {
+                    let m = entry(e.0);
+                    *e = (m[6] as u32, m[7] as u32);
                 }
-                let mut all = Vec::new();
-                c.all_gather(&mine, &mut all);
-                keyed.extend(all.chunks_exact(8).map(|m| {
-                    let x = [m[0] as u32, m[1] as u32, m[2] as u32];
-                    (key(x, [m[3], m[4], m[5]]), (m[6] as u32, m[7] as u32))
-                }));
+            }
+            None => {
+                out.extend(self.bounced().map(|i| (0, i)));
+                out.sort_unstable_by_key(|&(_, i)| {
+                    key(self.raw_position(i as usize), self.velocity(i as usize))
+                });
             }
         }
-        keyed.sort_unstable_by_key(|k| k.0);
-        out.clear();
-        out.extend(keyed.into_iter().map(|k| k.1));
     }
 
     /// Sums of `f(position, velocity)` and the particle counts in the bins `bin_of(position)`
@@ -206,20 +229,16 @@ impl Srd {
                 counts[b] += 1.0;
             }
         }
-        if let Some(c) = self.exchange() {
-            let mine: Vec<f64> = sums
-                .iter()
-                .zip(&counts)
-                .flat_map(|(t, n)| {
-                    let w = t.words();
-                    [w[0], w[1], w[2], w[3], *n]
-                })
-                .collect();
-            let mut all = Vec::new();
-            c.all_gather_same(&mine, &mut all);
+        let gathered = self.gather_with(true, |m| {
+            for (t, n) in sums.iter().zip(&counts) {
+                m.extend_from_slice(&t.words());
+                m.push(*n);
+            }
+        });
+        if let Some(g) = gathered {
             sums.iter_mut().for_each(|t| *t = ExactTotal::default());
             counts.iter_mut().for_each(|n| *n = 0.0);
-            for part in all.chunks_exact(5 * bins) {
+            for part in g.1.chunks_exact(5 * bins) {
                 for (b, w) in part.chunks_exact(5).enumerate() {
                     sums[b].merge(ExactTotal::from_words(&w[..4]));
                     counts[b] += w[4];
@@ -233,18 +252,16 @@ impl Srd {
     /// the rank owning its cell): every rank's new velocities of its own embedded particles
     /// on every rank (collective; nothing on one process).
     pub(super) fn share_embedded(&self, vel: &mut [[f64; 3]]) {
-        let Some(c) = self.exchange() else {
-            return;
-        };
-        let mut mine = Vec::with_capacity(4 * self.emb.len());
-        for &(_, j) in &self.emb {
-            let v = vel[j as usize];
-            mine.extend_from_slice(&[j as f64, v[0], v[1], v[2]]);
-        }
-        let mut all = Vec::new();
-        c.all_gather(&mine, &mut all);
-        for m in all.chunks_exact(4) {
-            vel[m[0] as usize] = [m[1], m[2], m[3]];
+        let gathered = self.gather_with(false, |m| {
+            for &(_, j) in &self.emb {
+                let v = vel[j as usize];
+                m.extend_from_slice(&[j as f64, v[0], v[1], v[2]]);
+            }
+        });
+        if let Some(g) = gathered {
+            for m in g.1.chunks_exact(4) {
+                vel[m[0] as usize] = [m[1], m[2], m[3]];
+            }
         }
     }
 

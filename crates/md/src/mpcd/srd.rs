@@ -630,6 +630,9 @@ pub struct Srd {
     pub(super) bounced: Vec<Vec<u32>>,
     /// Per slot, during a migration: reflected in the streaming step (decomposed runs).
     pub(super) flags: Vec<bool>,
+    /// The messages of the collective sums and counts (this rank's numbers, every rank's),
+    /// kept between calls (decomposed runs).
+    pub(super) gather_buffers: std::cell::RefCell<(Vec<f64>, Vec<f64>)>,
     /// Seconds spent in the parts of a step: streaming, binning, storage sorts, cell
     /// collisions.
     pub timers: [f64; 4],
@@ -792,6 +795,7 @@ impl Srd {
             leaving: Vec::new(),
             leavers: Vec::new(),
             flags: Vec::new(),
+            gather_buffers: Default::default(),
         })
     }
 
