@@ -46,7 +46,7 @@ run_and_theory() {
 ex=$here/examples
 # Hard-rods paper.
 fig hard-rods-fig3 run "$ex/bcd/hard-rods-cosine.toml"
-fig hard-rods-fig4 run "$ex/bcd/contact-density.toml"
+fig hard-rods-fig4 ensemble "$ex/bcd/contact-density.toml" --replicas 8
 fig hard-rods-fig6 run "$ex/bcd/sticky-rods.toml"
 fig hard-rods-fig7-gamma0 run "$ex/bcd/single-file.toml"
 fig hard-rods-fig7-gamma1 run "$ex/bcd/sticky-single-file.toml"

@@ -198,3 +198,183 @@ fn density_in_cosine_potential_matches_exact_theory() {
     assert!(o.worst < 4.5, "deviation {} standard errors", o.worst);
     assert!(o.chi2_wrong_sigma > 4.0 * o.bins as f64);
 }
+
+/// The exact contact theory checked without BCD: Metropolis Monte Carlo of 200 hard rods
+/// (sigma = 0.5) on a ring of 400 in the hard-rods paper's Fig. 4 wells, `U = 3 cos(2 pi x)`
+/// (U0 = 6 kT). The window estimator (Eq. 27, window 0.02, 25 bins over a period) matches the
+/// grand-canonical expectation of `Equilibrium::window_contact_average` times the canonical
+/// `(N - 1) / N`, bin by bin (chi^2 over 25 bins, errors from 20 blocks) and pooled; Eq. 24's
+/// contact value itself (the window -> 0 limit) and a rod length 2% off are rejected.
+#[test]
+fn exact_contact_density_matches_monte_carlo_in_deep_wells() {
+    use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
+    use rand::{RngExt, SeedableRng, rngs::StdRng};
+    let (n, length, sigma, u0, w) = (200usize, 400.0, 0.5, 6.0, 0.02);
+    let (bins, blocks, sweeps_per_block) = (25usize, 20usize, 25_000usize);
+    let u = move |x: f64| 0.5 * u0 * (std::f64::consts::TAU * x).cos();
+    let mut rng = StdRng::seed_from_u64(11);
+    // Start with one rod in every other well, near its bottom (x = 1/2 mod 1).
+    let mut x: Vec<f64> = (0..n).map(|i| 2.0 * i as f64 + 0.5).collect();
+    let sweep = |x: &mut [f64], rng: &mut StdRng| {
+        for _ in 0..n {
+            let i = rng.random_range(0..n);
+            let new = x[i] + 0.3 * (2.0 * rng.random::<f64>() - 1.0);
+            let left = if i > 0 { x[i - 1] } else { x[n - 1] - length };
+            let right = if i + 1 < n { x[i + 1] } else { x[0] + length };
+            if new - left < sigma || right - new < sigma {
+                continue;
+            }
+            let du = u(new) - u(x[i]);
+            if du <= 0.0 || rng.random::<f64>() < (-du).exp() {
+                x[i] = new;
+            }
+        }
+    };
+    for _ in 0..100_000 {
+        sweep(&mut x, &mut rng);
+    }
+    let mut per_block = vec![vec![0.0; bins]; blocks];
+    for counts in per_block.iter_mut() {
+        for _ in 0..sweeps_per_block {
+            sweep(&mut x, &mut rng);
+            for i in 0..n {
+                let right = if i + 1 < n { x[i + 1] } else { x[0] + length };
+                if right - x[i] < sigma + w {
+                    let b = (x[i].rem_euclid(1.0) * bins as f64) as usize;
+                    counts[b.min(bins - 1)] += 1.0;
+                }
+            }
+        }
+        // Eq. 27: count / (samples dx w (L / lambda)).
+        let norm = sweeps_per_block as f64 * (1.0 / bins as f64) * w * length;
+        counts.iter_mut().for_each(|c| *c /= norm);
+    }
+    let theory = |sigma: f64| {
+        let p = RodsProblem::new(sigma, n as f64 / length, Domain::Periodic { period: 1.0 })
+            .with_dx(sigma / 500.0)
+            .with_potential(BetaPotential::from_fn(1.0, u));
+        let eq = rods::equilibrium(&p).unwrap();
+        let canonical = (n - 1) as f64 / n as f64;
+        let window = eq.window_contact_average(bins, 1.0, w).unwrap().unwrap();
+        let contact = eq.bin_average(bins, 1.0).unwrap().contact_density;
+        let scale = |v: Vec<f64>| v.into_iter().map(|c| c * canonical).collect::<Vec<_>>();
+        (scale(window), scale(contact))
+    };
+    let (mc, err): (Vec<f64>, Vec<f64>) = (0..bins)
+        .map(|b| mean_and_error(&per_block.iter().map(|c| c[b]).collect::<Vec<_>>()))
+        .unzip();
+    let chi2 = |t: &[f64]| -> f64 { (0..bins).map(|b| ((mc[b] - t[b]) / err[b]).powi(2)).sum() };
+    let pooled = |t: &[f64]| t.iter().sum::<f64>();
+    let (mc_pooled, pooled_err) = mean_and_error(
+        &per_block
+            .iter()
+            .map(|c| c.iter().sum::<f64>())
+            .collect::<Vec<_>>(),
+    );
+    let (window, contact) = theory(sigma);
+    let (window_off, _) = theory(1.02 * sigma);
+    eprintln!(
+        "MC pooled {mc_pooled:.4} +- {pooled_err:.4}; window theory {:.4} (chi2 {:.1} over {bins} \
+         bins), Eq. 24 {:.4} (chi2 {:.1}), sigma 2% off {:.4} (chi2 {:.1})",
+        pooled(&window),
+        chi2(&window),
+        pooled(&contact),
+        chi2(&contact),
+        pooled(&window_off),
+        chi2(&window_off)
+    );
+    // chi^2 of 25 bins: mean 25, sd 7; 50 is beyond the 99.8th percentile.
+    assert!(chi2(&window) < 50.0, "chi2 {}", chi2(&window));
+    assert!((mc_pooled - pooled(&window)).abs() < 4.0 * pooled_err);
+    assert!(
+        chi2(&contact) > 100.0,
+        "Eq. 24 without the window: chi2 {}",
+        chi2(&contact)
+    );
+    assert!(
+        chi2(&window_off) > 100.0,
+        "sigma 2% off: chi2 {}",
+        chi2(&window_off)
+    );
+}
+
+/// BCD's contact density in a potential, with errors between independent replicas (blocks of
+/// one run are not independent here: the contact indicator's correlations decay like a random
+/// walk's returns, docs/bcd.md). 50 hard rods (sigma = 0.5) on a ring of 100 in
+/// `U = (1/2) cos(2 pi x)` (U0 = 1 kT), window 0.05, dt = 2e-5, 8 replicas of 100 time units.
+/// Expected, per bin: `(N - 1)/N [rho2_window + (delta / w) rho2_contact]`, the exact window
+/// average (grand canonical, `Equilibrium::window_contact_average`), the canonical factor and
+/// the time-step boundary layer `delta = 0.5826 sqrt(4 D dt)` at contact (docs/bcd.md). Without
+/// the boundary layer (10 % here) the pooled value is rejected.
+#[test]
+fn contact_density_in_a_cosine_potential_matches_the_window_theory() {
+    use colloidsim_bcd::scenario::Field;
+    use colloidsim_core::field1d::{ExternalField, FieldTerm};
+    use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
+    use rayon::prelude::*;
+    let (n, length, sigma, w, dt, u0) = (50usize, 100.0, 0.5, 0.05, 2e-5, 1.0);
+    let (bins, replicas, time, every) = (10usize, 8u32, 100.0, 5u64);
+    let field = ExternalField {
+        terms: vec![FieldTerm::Cosine {
+            amplitude: u0,
+            wavelength: 1.0,
+        }],
+        drive: 0.0,
+    };
+    let profiles: Vec<Vec<f64>> = (1..=replicas)
+        .into_par_iter()
+        .map(|seed| {
+            let c = cfg(length, sigma, dt, seed);
+            let x0 = init::random(&c, n, seed).unwrap();
+            let mut b = Bcd::new(c, x0, Field::new(&field), NoPair).unwrap();
+            b.run((2.0 / dt) as u64).unwrap();
+            let mut cd = ContactDensity::new(bins, w, 1.0, sigma, length, Boundary::Periodic);
+            for _ in 0..(time / dt) as u64 / every {
+                b.run(every).unwrap();
+                cd.sample(b.positions());
+            }
+            cd.profile().1
+        })
+        .collect();
+    let p = RodsProblem::new(sigma, n as f64 / length, Domain::Periodic { period: 1.0 })
+        .with_dx(sigma / 400.0)
+        .with_potential(BetaPotential::from_field(&field, 1.0));
+    let eq = rods::equilibrium(&p).unwrap();
+    let window = eq.window_contact_average(bins, 1.0, w).unwrap().unwrap();
+    let contact = eq.bin_average(bins, 1.0).unwrap().contact_density;
+    let canonical = (n - 1) as f64 / n as f64;
+    let delta = 0.582_597_157_939_010_7 * (4.0 * dt).sqrt();
+    let expected = |layer: f64| -> Vec<f64> {
+        (0..bins)
+            .map(|k| canonical * (window[k] + layer / w * contact[k]))
+            .collect()
+    };
+    let (with_layer, without) = (expected(delta), expected(0.0));
+    let per_bin: Vec<(f64, f64)> = (0..bins)
+        .map(|k| mean_and_error(&profiles.iter().map(|p| p[k]).collect::<Vec<_>>()))
+        .collect();
+    let chi2: f64 = per_bin
+        .iter()
+        .zip(&with_layer)
+        .map(|((m, e), t)| ((m - t) / e).powi(2))
+        .sum();
+    let (pooled, pooled_err) = mean_and_error(
+        &profiles
+            .iter()
+            .map(|p| p.iter().sum::<f64>())
+            .collect::<Vec<_>>(),
+    );
+    let z = |t: &[f64]| (pooled - t.iter().sum::<f64>()) / pooled_err;
+    eprintln!(
+        "pooled {pooled:.4} +- {pooled_err:.4}; expected {:.4} (z {:.2}, chi2 {chi2:.1} over \
+         {bins} bins), without the boundary layer {:.4} (z {:.2})",
+        with_layer.iter().sum::<f64>(),
+        z(&with_layer),
+        without.iter().sum::<f64>(),
+        z(&without)
+    );
+    // chi^2 of 10 bins: 29.6 is the 99.9th percentile.
+    assert!(chi2 < 29.6, "chi2 {chi2}");
+    assert!(z(&with_layer).abs() < 4.0);
+    assert!(z(&without).abs() > 4.0);
+}

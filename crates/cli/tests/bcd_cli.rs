@@ -68,6 +68,7 @@ fn run_writes_documented_outputs_and_refuses_to_overwrite() {
         "density_theory.csv",
         "density.png",
         "contact_density.csv",
+        "contact_density_theory.csv",
         "contact_density.png",
         "msd.csv",
         "msd.png",
@@ -89,6 +90,7 @@ fn run_writes_documented_outputs_and_refuses_to_overwrite() {
     };
     assert_eq!(head("density.csv"), "x,rho,err");
     assert_eq!(head("contact_density.csv"), "x,rho2,err");
+    assert_eq!(head("contact_density_theory.csv"), "x,rho2,rho2_window");
     assert_eq!(head("msd.csv"), "t,msd,err");
     assert_eq!(head("clusters.csv"), "size,probability");
     let summary: serde_json::Value =

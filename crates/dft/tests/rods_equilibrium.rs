@@ -55,6 +55,40 @@ mod rods {
     }
 
     #[test]
+    fn window_estimator_expectation_is_the_tonks_law_and_tends_to_eq24() {
+        // Without a field: rho (1 - exp(-a w)) / w with a = rho / (1 - rho sigma), to rounding.
+        let (sigma, rho, w) = (0.5, 0.5, 0.02);
+        let eq = equilibrium(&periodic(sigma, rho, sigma / 23.7)).unwrap();
+        let a = rho / (1.0 - rho * sigma);
+        let tonks = rho * (1.0 - (-a * w).exp()) / w;
+        for v in eq.window_contact_average(10, 1.0, w).unwrap().unwrap() {
+            assert!((v / tonks - 1.0).abs() < 1e-9, "{v} vs {tonks}");
+        }
+        // In the paper's 6 kT wells: a narrow window reads Eq. 24 (to first order in w), a
+        // window of 0.02 differs by several per cent where the density is steep.
+        let eq =
+            equilibrium(&periodic(sigma, rho, sigma / 400.0).with_potential(cosine(6.0))).unwrap();
+        let b = eq.bin_average(50, 1.0).unwrap();
+        let narrow = eq.window_contact_average(50, 1.0, 1e-5).unwrap().unwrap();
+        let wide = eq.window_contact_average(50, 1.0, 0.02).unwrap().unwrap();
+        let rel = |x: &[f64]| {
+            x.iter()
+                .zip(&b.contact_density)
+                .map(|(v, c)| (v / c - 1.0).abs())
+                .fold(0.0, f64::max)
+        };
+        assert!(rel(&narrow) < 1e-4, "narrow window {:.2e}", rel(&narrow));
+        assert!(rel(&wide) > 0.02, "wide window {:.2e}", rel(&wide));
+        // Sticky rods have no such closed form here.
+        let sticky = equilibrium(
+            &periodic(sigma, rho, sigma / 40.0)
+                .with_interaction(RodInteraction::Sticky { gamma: 1.0 }),
+        )
+        .unwrap();
+        assert!(sticky.window_contact_average(10, 1.0, w).unwrap().is_none());
+    }
+
+    #[test]
     fn homogeneous_sticky_rods_reproduce_the_baxter_equation_of_state() {
         // Exact 1D sticky rods (isobaric solution, see `bulk`): beta p (1 + gamma beta p) = rho/(1 - rho sigma),
         // beta mu = beta p sigma + ln(beta p / (1 + gamma beta p)), contact rho beta p / (1 + gamma beta p).

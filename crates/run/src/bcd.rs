@@ -806,7 +806,7 @@ where
             y: &rho,
             points: true,
         }];
-        if let Some((t, _)) = &theory {
+        if let Some(t) = theory.as_ref().map(|t| &t.density) {
             out.write_table("density_theory.csv", &[("x", &t.centres), ("rho", &t.rho)])?;
             files.push("density_theory.csv".into());
             series.push(Series {
@@ -857,27 +857,35 @@ where
         )?;
         files.push("contact_density.csv".into());
         let mut series = vec![Series {
-            label: "BCD, window estimator (bars: standard error)",
+            label: "BCD (bars: std. error)",
             x: &x,
             y: &rho2,
             points: true,
         }];
-        if let Some((t, hard)) = &theory
-            && *hard
-        {
+        if let Some(t) = theory.as_ref().and_then(|t| t.contact.as_ref()) {
             out.write_table(
                 "contact_density_theory.csv",
-                &[("x", &t.centres), ("rho2", &t.contact_density)],
+                &[
+                    ("x", &t.centres),
+                    ("rho2", &t.contact),
+                    ("rho2_window", &t.window),
+                ],
             )?;
             files.push("contact_density_theory.csv".into());
             series.push(Series {
-                label: theory_label(r),
+                label: "exact, window average",
                 x: &t.centres,
-                y: &t.contact_density,
+                y: &t.window,
+                points: false,
+            });
+            series.push(Series {
+                label: "exact at contact (Eq. 24)",
+                x: &t.centres,
+                y: &t.contact,
                 points: false,
             });
         }
-        let errors = [Some(err.as_slice()), None];
+        let errors = [Some(err.as_slice()), None, None];
         picture(
             line_plot_styled(
                 &out.join("contact_density.png"),
@@ -1031,7 +1039,7 @@ where
         "threads": rayon::current_num_threads(),
         "mean_velocity": mean_velocity,
         "particle_current": mean_velocity.map(|v| v * n as f64 / c.length),
-        "theory": theory.as_ref().map(|(_, _)| "density_theory.csv: exact equilibrium (colloidsim theory) on the same bins"),
+        "theory": theory.as_ref().map(|_| "density_theory.csv: exact equilibrium (colloidsim theory) on the same bins"),
         "ddft": ddft.as_ref().map(|st| json!({
             "file": "density_ddft.csv: 1D DDFT steady state (colloidsim theory, adiabatic approximation) on the same bins",
             "mean_current": st.current,
@@ -1113,14 +1121,31 @@ fn driven_companion(r: &Resolved) -> Option<Result<DrivenState>> {
     Some(driven_steady_state(r, None, Some(DRIVEN_COMPANION_SECONDS)))
 }
 
-/// The exact equilibrium profile averaged over the scenario's density bins, when the scenario
-/// has an equilibrium (no drive, kT > 0, a density observable). Returns (profile, hard rods?).
+/// The exact equilibrium beside a run: the density on the scenario's density bins and, for hard
+/// rods with a contact-density observable, the contact density on its bins.
+struct Counterpart {
+    density: rods::BinnedProfile,
+    contact: Option<ContactTheory>,
+}
+
+/// The exact contact density of hard rods on the contact-density bins.
+struct ContactTheory {
+    centres: Vec<f64>,
+    /// Eq. 24, `rho2(x, x + sigma)`, bin-averaged.
+    contact: Vec<f64>,
+    /// What the window estimator (Eq. 27) reads in exact equilibrium
+    /// ([`rods::Equilibrium::window_contact_average`]).
+    window: Vec<f64>,
+}
+
+/// The exact equilibrium averaged over the scenario's bins, when the scenario has an
+/// equilibrium (no drive, kT > 0, a density observable).
 fn equilibrium_counterpart(
     sc: &Scenario,
     r: &Resolved,
     dx: Option<f64>,
     obs: &Observers,
-) -> Result<Option<(rods::BinnedProfile, bool)>> {
+) -> Result<Option<Counterpart>> {
     let c = &r.config;
     if r.field.drive != 0.0 || c.kt <= 0.0 || obs.density.is_none() {
         return Ok(None);
@@ -1142,8 +1167,20 @@ fn equilibrium_counterpart(
         );
     }
     let eq = solve_theory(r, dx)?;
-    let b = eq.bin_average(bins, r.period)?;
-    Ok(Some((b, r.pair.sticky.is_none())))
+    let density = eq.bin_average(bins, r.period)?;
+    let contact = match (&sc.observe.contact_density, &r.pair.sticky) {
+        (Some(spec), None) => {
+            let b = eq.bin_average(spec.bins, r.period)?;
+            eq.window_contact_average(spec.bins, r.period, spec.window)?
+                .map(|window| ContactTheory {
+                    centres: b.centres,
+                    contact: b.contact_density,
+                    window,
+                })
+        }
+        _ => None,
+    };
+    Ok(Some(Counterpart { density, contact }))
 }
 
 /// Largest grid of the exact theory written beside a run.
@@ -1430,10 +1467,17 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
     let cbins = sc.observe.contact_density.as_ref().map_or(bins, |d| d.bins);
     let bc = eq.bin_average(cbins, r.period)?;
     if r.pair.sticky.is_none() {
-        outdir.write_table(
-            "contact_density.csv",
-            &[("x", &bc.centres), ("rho2", &bc.contact_density)],
-        )?;
+        // With a contact window, also what the window estimator (Eq. 27) reads.
+        let window = match &sc.observe.contact_density {
+            Some(spec) => eq.window_contact_average(cbins, r.period, spec.window)?,
+            None => None,
+        };
+        let mut columns: Vec<(&str, &[f64])> =
+            vec![("x", &bc.centres), ("rho2", &bc.contact_density)];
+        if let Some(w) = &window {
+            columns.push(("rho2_window", w));
+        }
+        outdir.write_table("contact_density.csv", &columns)?;
         files.push("contact_density.csv");
     } else if let Some(bp) = &bc.bonded_pair_density {
         outdir.write_table(

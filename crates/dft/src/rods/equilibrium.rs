@@ -125,6 +125,68 @@ impl Equilibrium {
             bonded_pair_density: bonded,
         })
     }
+
+    /// What the window estimator of the contact density (hard-rods paper Eq. 27: a rod at `x`
+    /// whose right neighbour lies within `[x + sigma, x + sigma + window)`, divided by `window`)
+    /// reads in exact equilibrium, averaged over the same bins as [`Self::bin_average`]; hard
+    /// rods only (`None` for sticky ones).
+    ///
+    /// The nearest-neighbour density of hard rods in a field (grand canonical) is
+    /// `n(x, y) = rho(x) a(y) exp(-int_{x+sigma}^{y} a)`, `y >= x + sigma`, with
+    /// `a = rho / (1 - eta)` and `eta(y) = int_{y-sigma}^{y} rho` (the configurations left of a
+    /// rod and right of the next are independent; `ln R(s)`, the weight of the rods right of `s`,
+    /// falls at the rate `a(s)`). Its integral over the window is
+    /// `rho(x) (1 - exp(-int_{x+sigma}^{x+sigma+window} a)) / window`, which tends to Eq. 24 as
+    /// `window -> 0` and is the Tonks gas' `rho (1 - e^{-a w}) / w` without a field. Canonical
+    /// runs of N rods read about `(N - 1) / N` of it (exact for the Tonks gas on a ring).
+    pub fn window_contact_average(
+        &self,
+        bins: usize,
+        over: f64,
+        window: f64,
+    ) -> Result<Option<Vec<f64>>, RodsError> {
+        param::at_least("bins", bins, 1)?;
+        param::positive("over", over)?;
+        param::positive("window", window)?;
+        if self.gamma > 0.0 {
+            return Ok(None);
+        }
+        let g = &self.grid;
+        let rho = &self.rho_full;
+        let mut cum = vec![0.0; g.m + 1];
+        let mut eta = vec![0.0; g.m];
+        g.prefix(rho, &mut cum);
+        g.window_backward(rho, &cum, &mut eta);
+        let a: Vec<f64> = rho
+            .iter()
+            .zip(&eta)
+            .map(|(&r, &e)| {
+                if r > 0.0 {
+                    r / (1.0 - e).max(f64::MIN_POSITIVE)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut cum_a = vec![0.0; g.m + 1];
+        g.prefix(&a, &mut cum_a);
+        let sigma = (g.n as f64 + g.f) * g.dx;
+        let windowed: Vec<f64> = (0..g.m)
+            .map(|i| {
+                let start = g.x(i) + sigma;
+                let integral = window * g.average(&a, &cum_a, start, start + window);
+                rho[i] * (-(-integral).exp_m1()) / window
+            })
+            .collect();
+        let width = over / bins as f64;
+        let mut cum_w = vec![0.0; g.m + 1];
+        g.prefix(&windowed, &mut cum_w);
+        Ok(Some(
+            (0..bins)
+                .map(|k| g.average(&windowed, &cum_w, k as f64 * width, (k + 1) as f64 * width))
+                .collect(),
+        ))
+    }
 }
 
 /// Solves for the equilibrium profile of `problem` (validated first). Errors: invalid parameters,
