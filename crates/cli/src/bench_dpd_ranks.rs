@@ -125,6 +125,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     println!("kind\tcode\tranks\tbeads\tparticle_steps_per_s\tmin\tmax\tskin");
     let mut strong: Vec<(usize, Rate)> = Vec::new();
     let mut weak: Vec<(usize, Rate)> = Vec::new();
+    let mut apart: Vec<(usize, Rate)> = Vec::new();
     let mut lammps: Vec<(usize, Rate, f64)> = Vec::new();
     let mut lammps_ok = !a.no_lammps;
     for &r in &a.ranks {
@@ -142,6 +143,18 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             } else {
                 weak.push((r, rate));
             }
+        }
+        if r > 1 && strong.first().is_some_and(|s| s.0 == 1) {
+            let args = worker_args(a, &dir.join("state-1.bin"), threads);
+            let (rate, n) = apart_at_once(&a.mpirun, &exe, r, &args)?;
+            println!(
+                "apart\tcolloidsim\t{r}\t{}\t{:.4e}\t{:.4e}\t{:.4e}\t-",
+                n * r,
+                rate.0,
+                rate.1,
+                rate.2
+            );
+            apart.push((r, rate));
         }
         if lammps_ok {
             let n = (a.density * a.l.powi(3)).round() as usize;
@@ -192,6 +205,11 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 100.0 * eff,
                 if r == 2 { "  [target >= 90 %]" } else { "" }
             );
+            if r0 == 1
+                && let Some(&(_, p)) = apart.iter().find(|p| p.0 == r)
+            {
+                print_node_ceiling(r, base.0, p.0, Some(rate.0));
+            }
         }
     }
     for &(r, l, skin) in &lammps {
@@ -263,6 +281,11 @@ fn run_worker(
     ranks: usize,
     threads: usize,
 ) -> Result<(Rate, usize)> {
+    mpirun_worker(&a.mpirun, exe, ranks, &worker_args(a, state, threads))
+}
+
+/// The command line of a worker on `state`.
+fn worker_args(a: &BenchArgs, state: &Path, threads: usize) -> Vec<String> {
     let mut args: Vec<String> = vec!["bench".into(), "dpd".into(), "--worker-state".into()];
     args.push(state.display().to_string());
     for (k, v) in [
@@ -278,7 +301,7 @@ fn run_worker(
     if a.colloids {
         args.push("--colloids".into());
     }
-    mpirun_worker(&a.mpirun, exe, ranks, &args)
+    args
 }
 
 /// `mpirun -n ranks EXE ARGS`, a benchmark worker whose rank 0 prints
@@ -289,11 +312,27 @@ pub fn mpirun_worker(
     ranks: usize,
     args: &[String],
 ) -> Result<(Rate, usize)> {
-    let o = Command::new(mpirun)
-        .args(["-n", &ranks.to_string()])
+    mpirun_worker_bound(mpirun, exe, ranks, args, true)
+}
+
+/// [`mpirun_worker`], with Open MPI's default binding of ranks to cores (`bound`) or none (for
+/// several `mpirun`s at once, which would each bind their rank 0 to the same core).
+fn mpirun_worker_bound(
+    mpirun: &Path,
+    exe: &Path,
+    ranks: usize,
+    args: &[String],
+    bound: bool,
+) -> Result<(Rate, usize)> {
+    let mut cmd = Command::new(mpirun);
+    cmd.args(["-n", &ranks.to_string()])
         .arg(exe)
         .args(args)
-        .envs(OMPI_ENV)
+        .envs(OMPI_ENV);
+    if !bound {
+        cmd.env("OMPI_MCA_hwloc_base_binding_policy", "none");
+    }
+    let o = cmd
         .output()
         .with_context(|| format!("{} (Open MPI's mpirun; --mpirun)", mpirun.display()))?;
     let text = String::from_utf8_lossy(&o.stdout);
@@ -311,6 +350,53 @@ pub fn mpirun_worker(
         .map(|x| x.parse())
         .collect::<Result<_, _>>()?;
     Ok(((f[0], f[1], f[2]), f[3] as usize))
+}
+
+/// `copies` independent one-rank workers of [`mpirun_worker`] started at once (not bound to
+/// cores, so that the system spreads them): the node's
+/// throughput without any decomposition (what `copies` ranks could at best reach on it, as
+/// they share its cores, caches and memory bandwidth): the sum of their rates (median, min,
+/// max) and their particle count.
+pub fn apart_at_once(
+    mpirun: &Path,
+    exe: &Path,
+    copies: usize,
+    args: &[String],
+) -> Result<(Rate, usize)> {
+    let results: Vec<Result<(Rate, usize)>> = std::thread::scope(|s| {
+        let runs: Vec<_> = (0..copies)
+            .map(|_| s.spawn(|| mpirun_worker_bound(mpirun, exe, 1, args, false)))
+            .collect();
+        runs.into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err(anyhow::anyhow!("worker thread")))
+            })
+            .collect()
+    });
+    let mut sum = ((0.0, 0.0, 0.0), 0);
+    for r in results {
+        let ((m, lo, hi), n) = r?;
+        sum.0.0 += m;
+        sum.0.1 += lo;
+        sum.0.2 += hi;
+        sum.1 = n;
+    }
+    Ok(sum)
+}
+
+/// The lines that set a weak-scaling efficiency beside the node's own: `apart`, the summed
+/// rate of R independent one-rank runs at once, against R times the one-rank rate `base`, and
+/// the decomposed weak run's `weak` rate against `apart`.
+pub fn print_node_ceiling(r: usize, base: f64, apart: f64, weak: Option<f64>) {
+    println!(
+        "# node: {r} independent one-rank runs at once: {:.0} % of {r} x one run alone{}",
+        100.0 * apart / (base * r as f64),
+        weak.map_or(String::new(), |w| format!(
+            "; the weak run on {r} ranks reaches {:.0} % of that",
+            100.0 * w / apart
+        ))
+    );
 }
 
 /// A benchmark worker under `mpirun`: the job's ranks, with a global pool of the first of
@@ -387,10 +473,23 @@ pub fn strong_and_weak(
                         100.0 * speedup * r0 as f64 / r as f64
                     );
                 }
-                (_, Some((r0, x0))) => println!(
-                    "# weak: {r} ranks, {r} boxes: efficiency {:.0} %",
-                    100.0 * rate.0 / (x0 * r as f64 / r0 as f64)
-                ),
+                (_, Some((r0, x0))) => {
+                    println!(
+                        "# weak: {r} ranks, {r} boxes: efficiency {:.0} %",
+                        100.0 * rate.0 / (x0 * r as f64 / r0 as f64)
+                    );
+                    if r0 == 1 {
+                        let (apart, n) = apart_at_once(mpirun, &exe, r, &worker_args(1))?;
+                        println!(
+                            "apart\t{r}\t{}\t{:.4e}\t{:.4e}\t{:.4e}",
+                            n * r,
+                            apart.0,
+                            apart.1,
+                            apart.2
+                        );
+                        print_node_ceiling(r, x0, apart.0, Some(rate.0));
+                    }
+                }
                 _ => {}
             }
         }
