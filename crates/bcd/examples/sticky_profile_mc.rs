@@ -10,10 +10,11 @@
 //! move picks the same chain: detailed balance); the chain move lets chains cross the wells,
 //! which single-rod moves at 6.7 kT per bond (gamma = 10) hardly do.
 //!
-//! `cargo run --release -p colloidsim-bcd --example sticky_profile_mc -- N L U0 SIGMA GAMMA EPS SWEEPS SEED BINS`
+//! `cargo run --release -p colloidsim-bcd --example sticky_profile_mc -- N L U0 SIGMA GAMMA EPS SWEEPS SEED BINS [FINAL]`
 //! prints `x,rho,err` on BINS (default 50) bins over one period (errors from 20 blocks), after
 //! SWEEPS / 4 sweeps of equilibration (a sweep: N single-rod moves and N / 4 + 1 chain moves).
-//! `scripts/sticky_profiles_mc.py` runs it for the panels of Fig. 6.
+//! `scripts/sticky_profiles_mc.py` runs it for the panels of Fig. 6. With FINAL, the last
+//! configuration is written there as a CSV column `x` (a BCD scenario's `initial.file`).
 
 use rand::{RngExt, SeedableRng, rngs::StdRng};
 
@@ -155,6 +156,13 @@ fn main() {
         }
         let norm = per_block as f64 * length / bins as f64;
         p.iter_mut().for_each(|v| *v /= norm);
+    }
+    if let Some(path) = a.get(10) {
+        let mut text = String::from("x\n");
+        for x in &ring.x {
+            text.push_str(&format!("{}\n", x.rem_euclid(length)));
+        }
+        std::fs::write(path, text).expect("final configuration");
     }
     println!("x,rho,err");
     for b in 0..bins {
