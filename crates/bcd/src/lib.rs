@@ -8,12 +8,14 @@
 //! - [`forces`]: external fields and pair forces (Baxter sticky rods, Yukawa, tabulated);
 //! - [`engine`]: the time step on a ring or between walls, and the chronological oracle;
 //! - [`observe`]: density, contact density, MSD, current and cluster statistics;
-//! - [`init`]: initial configurations.
+//! - [`init`]: initial configurations;
+//! - [`mc`]: Metropolis Monte Carlo of hard and sticky rods, the time-step-free reference.
 
 pub mod cluster;
 pub mod engine;
 pub mod forces;
 pub mod init;
+pub mod mc;
 pub mod observe;
 mod pava;
 #[doc(hidden)]
