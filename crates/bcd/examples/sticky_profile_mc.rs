@@ -7,7 +7,7 @@
 //! prints `x,rho,err` on BINS (default 50) bins over one period (errors from 20 blocks), after
 //! SWEEPS / 4 sweeps of equilibration. `scripts/sticky_profiles_mc.py` runs it for the panels
 //! of Fig. 6. With FINAL, the last configuration is written there as a CSV column `x` (a BCD
-//! scenario's `initial.file`).
+//! scenario's `initial.file`). On stderr: the pairs closer than `sigma + eps` per rod.
 
 use colloidsim_bcd::mc::StickyRing;
 
@@ -30,10 +30,12 @@ fn main() {
     let blocks = 20u64;
     let per_block = sweeps / blocks;
     let mut profiles = vec![vec![0.0; bins]; blocks as usize];
-    for p in profiles.iter_mut() {
+    let mut bound = vec![0.0; blocks as usize];
+    for (p, bound) in profiles.iter_mut().zip(bound.iter_mut()) {
         for _ in 0..per_block {
             ring.sweep();
             ring.histogram(p);
+            *bound += ring.pairs_within(eps) as f64 / (n as f64 * per_block as f64);
         }
         let norm = per_block as f64 * length / bins as f64;
         p.iter_mut().for_each(|v| *v /= norm);
@@ -45,6 +47,12 @@ fn main() {
         }
         std::fs::write(path, text).expect("final configuration");
     }
+    let m = bound.iter().sum::<f64>() / bound.len() as f64;
+    let var = bound.iter().map(|b| (b - m).powi(2)).sum::<f64>() / (bound.len() - 1) as f64;
+    eprintln!(
+        "pairs closer than sigma + eps, per rod: {m:.5} +- {:.5}",
+        (var / bound.len() as f64).sqrt()
+    );
     println!("x,rho,err");
     for b in 0..bins {
         let v: Vec<f64> = profiles.iter().map(|p| p[b]).collect();

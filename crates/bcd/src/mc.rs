@@ -71,6 +71,14 @@ impl StickyRing {
         }
     }
 
+    /// Pairs of neighbours closer than `sigma + w` (with `w = eps`: the bound pairs).
+    pub fn pairs_within(&self, w: f64) -> usize {
+        let n = self.n() as isize;
+        (0..n)
+            .filter(|&i| self.at(i + 1) - self.at(i) - self.sigma < w)
+            .count()
+    }
+
     fn n(&self) -> usize {
         self.x.len()
     }
