@@ -765,16 +765,8 @@ where
         self.run.after_save(out);
     }
 
-    fn is_writer(&self) -> bool {
-        self.run.is_writer()
-    }
-
-    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        crate::method::agree_over(self.run.exchange(), chunk, interrupted)
-    }
-
-    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
-        self.run.fail_alone(e)
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        self.run.exchange()
     }
 
     fn finish(

@@ -501,16 +501,8 @@ impl Session for DpdSession {
         Some((self.sim.step / self.checkpoint_every + 1) * self.checkpoint_every)
     }
 
-    fn is_writer(&self) -> bool {
-        self.sim.rank().0 == 0
-    }
-
-    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        crate::method::agree_over(self.sim.exchange(), chunk, interrupted)
-    }
-
-    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
-        fail_alone(&self.sim, e)
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        self.sim.exchange()
     }
 
     /// The engine restarts bitwise only where it rebuilds every list.

@@ -148,20 +148,25 @@ pub trait Session: Send {
     fn interim_outputs(&mut self, _out: &OutputDir) -> Result<Vec<String>> {
         Ok(Vec::new())
     }
+    /// The ranks a decomposed run is spread over (`None` on one process); the three methods
+    /// below follow from it.
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        None
+    }
     /// Whether this rank writes the outputs (rank 0 of a decomposed run; always otherwise).
     fn is_writer(&self) -> bool {
-        true
+        self.exchange().is_none_or(|c| c.rank() == 0)
     }
     /// Decomposed runs: every rank's chunk of positions and whether it saw an interrupt,
     /// combined so that all ranks go on alike (rank 0's chunk; interrupted if any rank was).
     fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        (chunk, interrupted)
+        agree_over(self.exchange(), chunk, interrupted)
     }
     /// An error on this rank alone (a file the writer could not write): returned as it is on
     /// one rank; in a decomposed run, where the other ranks cannot learn of it, printed and the
     /// job ended on every rank.
     fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
-        e
+        fail_alone_over(self.exchange(), e)
     }
     /// Write every output; `failure` says why the run stopped early.
     fn finish(

@@ -532,10 +532,6 @@ struct BulkSession {
 }
 
 impl BulkSession {
-    fn is_writer(&self) -> bool {
-        self.srd.rank().0 == 0
-    }
-
     /// The collisions up to `until`; `Some(why)` when the run stops early.
     fn advance_to(&mut self, until: u64) -> Result<Option<String>> {
         let tau = self.p.solvent.srd.tau;
@@ -745,16 +741,8 @@ impl Session for BulkSession {
         tenth_after(self.position(), self.p.collisions)
     }
 
-    fn is_writer(&self) -> bool {
-        BulkSession::is_writer(self)
-    }
-
-    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        crate::method::agree_over(self.srd.exchange(), chunk, interrupted)
-    }
-
-    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
-        crate::method::fail_alone_over(self.srd.exchange(), e)
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        self.srd.exchange()
     }
 
     fn advance(&mut self, until: u64) -> Result<Option<String>> {
@@ -1288,10 +1276,6 @@ struct DropletSession {
 }
 
 impl DropletSession {
-    fn is_writer(&self) -> bool {
-        self.srd.rank().0 == 0
-    }
-
     /// The collisions up to `until`; `Some(why)` when the run stops early.
     fn advance_to(&mut self, until: u64) -> Result<Option<String>> {
         let tau = self.p.solvent.srd.tau;
@@ -1514,16 +1498,8 @@ impl Session for DropletSession {
         tenth_after(self.position(), self.p.collisions)
     }
 
-    fn is_writer(&self) -> bool {
-        DropletSession::is_writer(self)
-    }
-
-    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        crate::method::agree_over(self.srd.exchange(), chunk, interrupted)
-    }
-
-    fn fail_alone(&self, e: anyhow::Error) -> anyhow::Error {
-        crate::method::fail_alone_over(self.srd.exchange(), e)
+    fn exchange(&self) -> Option<&dyn Exchange> {
+        self.srd.exchange()
     }
 
     fn advance(&mut self, until: u64) -> Result<Option<String>> {
