@@ -130,8 +130,34 @@ def main():
         )
     if tau_d:
         print(f"# Peclet number rate * tau_D = {args.rate * tau_d:.1f} (tau_D = {tau_d:.1f})")
+    parts_table(rows)
     if args.plot:
         plot(args, rows, eta0, err0, tau_d)
+
+
+def parts_table(rows):
+    """Each part of the viscosity (summary.json's shear_stress_parts / rate, in units of the
+    solvent's total viscosity) for every phi, and what it adds over the solvent run."""
+    parts0 = rows[0][1].get("shear_stress_parts") or {}
+    names = [k for k in parts0 if k != "note"]
+    if not names:
+        return
+    eta0 = rows[0][1]["shear_viscosity"]
+    print()
+    print("# the viscosity by part, eta_part / eta_solvent (error): " + ", ".join(names))
+    print("| phi | " + " | ".join(names) + " | sum |")
+    print("|---|" + "---|" * (len(names) + 1))
+    for phi, s, _ in rows:
+        parts = s.get("shear_stress_parts") or {}
+        if not all(n in parts for n in names):
+            print(f"| {phi} | " + " | ".join("-" for _ in names) + " | - |")
+            continue
+        cells = [
+            f"{parts[n]['viscosity'] / eta0:.4f} ({parts[n]['viscosity_error'] / eta0:.4f})"
+            for n in names
+        ]
+        total = sum(parts[n]["viscosity"] for n in names) / eta0
+        print(f"| {phi} | " + " | ".join(cells) + f" | {total:.4f} |")
 
 
 def plot(args, rows, eta0, err0, tau_d):

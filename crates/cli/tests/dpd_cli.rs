@@ -619,6 +619,38 @@ fn a_shear_run_writes_its_viscosity_and_profile_and_restarts_bitwise() {
     );
     let stress = s["shear_stress"].as_f64().unwrap();
     assert!((stress / 0.5 - eta).abs() < 1e-12 * eta);
+    // Its parts sum to it; water has no colloid parts. The dissipative part lies below the
+    // mean-field value of Marsh, Backx & Ernst, 2 pi gamma rho^2 rc^5 / 1575 = 0.1616 (g = 1;
+    // the conservative repulsion thins the pairs at short range: 0.135 +- 0.0014 here), and
+    // the kinetic part is the largest (gas-like DPD at kT = 1).
+    let parts = &s["shear_stress_parts"];
+    let part = |name: &str| parts[name]["stress"].as_f64().unwrap();
+    let names = colloidsim_md::dpd::PRESSURE_PARTS;
+    let sum: f64 = names.iter().map(|n| part(n)).sum();
+    assert!(
+        (sum - stress).abs() < 1e-9 * stress.abs(),
+        "{sum} against {stress}"
+    );
+    for n in [
+        "kinetic_colloid",
+        "conservative_colloid",
+        "dissipative_colloid",
+        "contact",
+        "morse",
+        "lubrication",
+    ] {
+        assert_eq!(part(n), 0.0, "{n}");
+    }
+    let eta_d = part("dissipative_solvent") / 0.5;
+    let marsh = 2.0 * std::f64::consts::PI * 4.5 * 9.0 / 1575.0;
+    assert!(
+        eta_d > 0.7 * marsh && eta_d < marsh,
+        "{eta_d} against {marsh}"
+    );
+    assert!(
+        names.iter().all(|n| part(n) <= part("kinetic_solvent")),
+        "{parts}"
+    );
     assert_eq!(s["shear_rate"].as_f64(), Some(0.5));
     assert!(
         s["shear_viscosity_note"]

@@ -28,6 +28,8 @@ struct End {
     snap: Particles,
     forces: Vec<[f64; 3]>,
     thermo: Thermo,
+    /// The pressure tensor by part after the last step.
+    parts: Vec<[f64; 6]>,
     owned: (usize, usize),
 }
 
@@ -49,6 +51,7 @@ fn finish(sim: &mut Dpd, steps: u64) -> End {
         snap: sim.snapshot(),
         forces: sim.forces(),
         thermo,
+        parts: sim.pressure_parts().to_vec(),
         owned,
     }
 }
@@ -69,6 +72,7 @@ fn assert_same(a: &End, b: &End, what: &str) {
     // Bitwise, NaN (the temperature of a type with no particles) included.
     let (ta, tb) = (format!("{:?}", a.thermo), format!("{:?}", b.thermo));
     assert_eq!(ta, tb, "{what}: thermo differs");
+    assert!(a.parts == b.parts, "{what}: pressure parts differ");
 }
 
 #[test]

@@ -486,3 +486,47 @@ fn a_decomposed_shear_run_is_bitwise_the_single_rank_run() {
         }
     }
 }
+
+#[test]
+fn the_pressure_parts_sum_to_the_pressure_tensor() {
+    // The sheared suspension with Morse attraction: every part but none of the classes lost.
+    let setup = suspension(NeighborMode::Verlet, 1.5);
+    let vol = setup.sbox.volume();
+    let mut sim = setup.build().unwrap();
+    sim.run(300).unwrap();
+    let th = sim.advance_with_thermo().unwrap();
+    let parts = sim.pressure_parts();
+    let total = sim.pressure_tensor();
+    let scale = total.iter().map(|x| x.abs()).fold(0.0, f64::max);
+    for k in 0..6 {
+        let sum: f64 = parts.iter().map(|p| p[k]).sum();
+        assert!(
+            (sum - total[k]).abs() < 1e-12 * scale,
+            "component {k}: {sum} against {}",
+            total[k]
+        );
+        // The kinetic parts are thermo's kinetic tensor, split by type.
+        let kin = parts[0][k] + parts[1][k];
+        assert!((kin - th.kinetic[k]).abs() < 1e-12 * scale, "kinetic {k}");
+    }
+    let names = colloidsim_md::dpd::PRESSURE_PARTS;
+    let part = |n: &str| parts[names.iter().position(|m| *m == n).unwrap()];
+    // The colloid classes are there (colloids, their solvent shells, contacts and Morse bonds
+    // in a dense attractive suspension) and the pairs with a colloid are part of their class.
+    for n in [
+        "kinetic_colloid",
+        "conservative_colloid",
+        "dissipative_colloid",
+        "morse",
+    ] {
+        assert!(part(n)[0] != 0.0, "{n} is zero");
+    }
+    let v = &th.virial;
+    for k in 0..6 {
+        let cons = part("conservative_solvent")[k] + part("conservative_colloid")[k];
+        assert!(
+            (cons - v.conservative[k] / vol).abs() < 1e-12 * scale,
+            "conservative {k}"
+        );
+    }
+}

@@ -17,7 +17,7 @@ use colloidsim_analysis::{
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
-use colloidsim_md::dpd::{Dpd, StressAcf, Thermo};
+use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
@@ -370,6 +370,10 @@ impl DpdSession {
         if let Err(e) = result {
             return Ok(Some(e.to_string()));
         }
+        // The shear stress by part (kinetic, each pair force class) from the same step.
+        if let Some(sh) = self.obs.shear.as_mut() {
+            sh.push_parts(next, &self.sim.pressure_parts());
+        }
         // The velocity profile over the second half, every thermo_every (or 100) steps.
         let profile_every = if o.thermo_every > 0 {
             o.thermo_every
@@ -713,6 +717,10 @@ struct ShearObserved {
     chunk: u64,
     /// `sum -P_xy` over the steps `k chunk + 1 ..= (k + 1) chunk` (entry `k`).
     stress: Vec<f64>,
+    /// The same sums of each part of `-P_xy` ([`PRESSURE_PARTS`]); empty in a checkpoint
+    /// written before the parts were recorded.
+    #[serde(default)]
+    parts: Vec<[f64; PRESSURE_PARTS.len()]>,
     /// `sum v_x` and the number of particles per y bin, over the profile samples.
     profile_sum: Vec<f64>,
     profile_count: Vec<f64>,
@@ -725,6 +733,7 @@ impl ShearObserved {
         Self {
             chunk: (steps / 1000).max(1),
             stress: Vec::new(),
+            parts: Vec::new(),
             profile_sum: vec![0.0; bins],
             profile_count: vec![0.0; bins],
             profile_samples: 0,
@@ -740,12 +749,44 @@ impl ShearObserved {
         self.stress[k] -= pressure[3];
     }
 
+    /// Add the parts of `-P_xy` of step `step` (1-based), [`Dpd::pressure_parts`]' xy
+    /// components.
+    fn push_parts(&mut self, step: u64, parts: &[[f64; 6]; PRESSURE_PARTS.len()]) {
+        let k = ((step - 1) / self.chunk) as usize;
+        if self.parts.len() <= k {
+            self.parts.resize(k + 1, [0.0; PRESSURE_PARTS.len()]);
+        }
+        for (s, p) in self.parts[k].iter_mut().zip(parts) {
+            *s -= p[3];
+        }
+    }
+
     /// Mean shear stress `<-P_xy>` over the complete chunks of the second half of `steps`
     /// steps and the standard error of 10 block means (at least 10 chunks), or why not.
     fn mean_stress(&self, steps: u64) -> std::result::Result<(f64, f64, u64), String> {
+        self.block_mean(&self.stress, steps)
+    }
+
+    /// [`Self::mean_stress`] of each part, or why not (also when a run continued from a
+    /// checkpoint without the parts).
+    fn mean_parts(&self, steps: u64) -> std::result::Result<Vec<(f64, f64)>, String> {
+        if self.parts.len() != self.stress.len() {
+            return Err("the run continued from a checkpoint that did not record the parts".into());
+        }
+        (0..PRESSURE_PARTS.len())
+            .map(|p| {
+                let part: Vec<f64> = self.parts.iter().map(|c| c[p]).collect();
+                self.block_mean(&part, steps).map(|(m, e, _)| (m, e))
+            })
+            .collect()
+    }
+
+    /// Mean of the per-step values whose chunk sums are `sums` over the complete chunks of
+    /// the second half, with the standard error of 10 block means.
+    fn block_mean(&self, sums: &[f64], steps: u64) -> std::result::Result<(f64, f64, u64), String> {
         let complete = (steps / self.chunk) as usize;
         let first = complete / 2;
-        let chunks = &self.stress[first.min(self.stress.len())..complete.min(self.stress.len())];
+        let chunks = &sums[first.min(sums.len())..complete.min(sums.len())];
         if chunks.len() < 10 {
             return Err(format!(
                 "the second half holds {} chunks of {} steps; need 10 (a run of at least 20 steps)",
@@ -874,6 +915,8 @@ mod thermo_rows {
                         energy_conservative,
                         energy_contact,
                         energy_morse,
+                        // Not kept in checkpoints: parts of the classes above.
+                        ..PairVirial::default()
                     },
                     pressure: r.pressure,
                     potential_energy: r.potential_energy,
@@ -1299,6 +1342,32 @@ fn summary(
             Err(why) => (None, why),
         },
     };
+    // Each part of the stress: its mean and error, and its share of the viscosity.
+    let shear_parts = match &obs.shear {
+        None => json!(null),
+        Some(sh) => match sh.mean_parts(s.steps) {
+            Ok(parts) => {
+                let mut m = serde_json::Map::new();
+                for (name, (mean, err)) in PRESSURE_PARTS.iter().zip(parts) {
+                    m.insert(
+                        name.to_string(),
+                        json!({
+                            "stress": mean,
+                            "error": err,
+                            "viscosity": mean / rate,
+                            "viscosity_error": err / rate,
+                        }),
+                    );
+                }
+                m.insert(
+                    "note".into(),
+                    json!("-P_xy split into the kinetic stress of solvent and colloids (peculiar velocities) and the pair virial by force class, conservative and dissipative split into solvent-solvent pairs and pairs with a colloid; the same steps and blocks as shear_stress, which they sum to (errors of the parts are not independent)"),
+                );
+                serde_json::Value::Object(m)
+            }
+            Err(why) => json!({ "note": why }),
+        },
+    };
     let slope = obs
         .shear
         .as_ref()
@@ -1336,6 +1405,7 @@ fn summary(
         "shear_viscosity": stress.map(|x| x.0 / rate),
         "shear_viscosity_error": stress.map(|x| x.1 / rate),
         "shear_viscosity_note": shear_note,
+        "shear_stress_parts": shear_parts,
         "velocity_profile_slope": slope,
         "warnings": warnings,
     })

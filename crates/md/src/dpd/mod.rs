@@ -160,6 +160,20 @@ pub enum DpdError {
     },
 }
 
+/// The parts of [`Dpd::pressure_parts`], in order.
+pub const PRESSURE_PARTS: [&str; 10] = [
+    "kinetic_solvent",
+    "kinetic_colloid",
+    "conservative_solvent",
+    "conservative_colloid",
+    "dissipative_solvent",
+    "dissipative_colloid",
+    "random",
+    "contact",
+    "morse",
+    "lubrication",
+];
+
 /// Virial `sum_pairs r_ij (x) F_ij` (xx, yy, zz, xy, xz, yz) of each force class and the
 /// potential energies, accumulated on thermo steps.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -182,10 +196,15 @@ pub struct PairVirial {
     pub energy_contact: f64,
     /// Morse energy.
     pub energy_morse: f64,
+    /// The part of `conservative` from colloid–solvent pairs (included in `conservative`).
+    pub conservative_colloid: [f64; 6],
+    /// The part of `dissipative` from pairs with a colloid (colloid–solvent and
+    /// colloid–colloid; included in `dissipative`).
+    pub dissipative_colloid: [f64; 6],
 }
 
 /// Numbers in [`PairVirial::write`].
-const VIRIAL_NUMBERS: usize = 39;
+const VIRIAL_NUMBERS: usize = 51;
 
 impl PairVirial {
     /// The parts in a flat row of [`VIRIAL_NUMBERS`] numbers (six tensors, three energies).
@@ -206,6 +225,8 @@ impl PairVirial {
         r[36] = self.energy_conservative;
         r[37] = self.energy_contact;
         r[38] = self.energy_morse;
+        r[39..45].copy_from_slice(&self.conservative_colloid);
+        r[45..51].copy_from_slice(&self.dissipative_colloid);
     }
 
     /// The inverse of [`Self::write`].
@@ -221,10 +242,12 @@ impl PairVirial {
             energy_conservative: r[36],
             energy_contact: r[37],
             energy_morse: r[38],
+            conservative_colloid: std::array::from_fn(|k| r[39 + k]),
+            dissipative_colloid: std::array::from_fn(|k| r[45 + k]),
         }
     }
 
-    /// Sum of all parts.
+    /// Sum of all parts (the colloid subsets counted once, inside their classes).
     pub fn total(&self) -> [f64; 6] {
         let mut t = [0.0; 6];
         for p in [
@@ -953,6 +976,49 @@ impl Dpd {
         std::array::from_fn(|k| (t[k] + t[6 + k]) / vol)
     }
 
+    /// The pressure tensor split into [`PRESSURE_PARTS`] (each xx, yy, zz, xy, xz, yz, over
+    /// the volume): the kinetic tensor of the solvent and of the colloids (peculiar velocities
+    /// under shear), then the pair virial by force class, the conservative and dissipative
+    /// classes split into solvent–solvent pairs and pairs with a colloid. Their sum is
+    /// [`Self::pressure_tensor`] to round-off; the virial is the last step taken with it
+    /// ([`Self::advance_with_pressure`] or [`Self::advance_with_thermo`]). Collective.
+    pub fn pressure_parts(&self) -> [[f64; 6]; PRESSURE_PARTS.len()] {
+        const W: usize = 6 * PRESSURE_PARTS.len();
+        let mut t = [0.0; W];
+        self.sum_layers(
+            W,
+            |z, r| {
+                let s = &self.slabs[z];
+                for (i, &k) in (s.start..s.end).zip(&self.key[s.start..s.end]) {
+                    let c = usize::from(k & COLLOID_BIT != 0);
+                    self.kinetic_tensor(i, i + 1, &mut r[6 * c..6 * c + 6]);
+                }
+                let v = &s.virial;
+                let minus = |a: &[f64; 6], b: &[f64; 6]| -> [f64; 6] {
+                    std::array::from_fn(|k| a[k] - b[k])
+                };
+                for (p, part) in [
+                    minus(&v.conservative, &v.conservative_colloid),
+                    v.conservative_colloid,
+                    minus(&v.dissipative, &v.dissipative_colloid),
+                    v.dissipative_colloid,
+                    v.random,
+                    v.contact,
+                    v.morse,
+                    v.lubrication,
+                ]
+                .iter()
+                .enumerate()
+                {
+                    r[12 + 6 * p..18 + 6 * p].copy_from_slice(part);
+                }
+            },
+            &mut t,
+        );
+        let vol = self.sbox.volume();
+        std::array::from_fn(|p| std::array::from_fn(|k| t[6 * p + k] / vol))
+    }
+
     fn step_inner<const THERMO: bool>(&mut self) -> Result<(), DpdError> {
         let dt = self.params.dt;
         let half = 0.5 * dt;
@@ -1602,6 +1668,10 @@ fn particle_forces<const THERMO: bool, const SHEAR: bool>(
             outer(&mut vir.conservative, d, fc, e);
             outer(&mut vir.dissipative, d, fd, e);
             outer(&mut vir.random, d, fr, e);
+            if (ki | kj) & COLLOID_BIT != 0 {
+                outer(&mut vir.conservative_colloid, d, fc, e);
+                outer(&mut vir.dissipative_colloid, d, fd, e);
+            }
             vir.energy_conservative += 0.5 * amp * cut * w * w;
         }
     }
@@ -1664,6 +1734,7 @@ fn particle_forces<const THERMO: bool, const SHEAR: bool>(
                 outer(&mut vir.contact, d, 0.5 * f_con, e);
                 outer(&mut vir.morse, d, 0.5 * f_morse, e);
                 outer(&mut vir.dissipative, d, 0.5 * fd, e);
+                outer(&mut vir.dissipative_colloid, d, 0.5 * fd, e);
                 outer(&mut vir.lubrication, d, 0.5 * flub, e);
                 outer(&mut vir.random, d, 0.5 * fr, e);
                 vir.energy_contact += 0.5 * cf.contact_energy(h, abar);
