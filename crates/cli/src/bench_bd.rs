@@ -42,6 +42,10 @@ pub struct BenchArgs {
     /// Open MPI's `mpirun` for `--ranks`.
     #[arg(long, default_value = "mpirun")]
     pub mpirun: PathBuf,
+    /// With `--ranks`: the weak-scaling efficiency also in this many interleaved rounds (as
+    /// `bench dpd --rounds`).
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
     /// Internal: run as one of the `mpirun` workers of `--ranks`, on the cube stretched this
     /// many times along z.
     #[arg(long, hide = true)]
@@ -87,7 +91,7 @@ fn over_ranks(a: &BenchArgs) -> Result<()> {
     );
     let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
     println!("# load average (1, 5, 15 min) at start: {}", load());
-    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.ranks, |k| {
+    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.ranks, a.rounds, |k| {
         let mut args: Vec<String> = vec!["bench".into(), "bd".into()];
         for (key, v) in [
             ("--worker-stretch", k.to_string()),

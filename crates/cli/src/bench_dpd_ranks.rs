@@ -186,6 +186,13 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             }
         }
     }
+    if a.rounds > 1 {
+        for &r in a.ranks.iter().filter(|&&r| r > 1) {
+            let one = worker_args(a, &dir.join("state-1.bin"), threads);
+            let weak = worker_args(a, &dir.join(format!("state-{r}.bin")), threads);
+            weak_rounds(&a.mpirun, &exe, r, a.rounds, &one, &weak)?;
+        }
+    }
     if a.keep.is_none() {
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -399,6 +406,57 @@ pub fn print_node_ceiling(r: usize, base: f64, apart: f64, weak: Option<f64>) {
     );
 }
 
+/// `--rounds K`: the weak-scaling efficiency on `r` ranks measured in `rounds` rounds, each
+/// one round of the one-rank run (`one`), the decomposed weak run (`weak`) and `r` one-rank
+/// runs at once, back to back, so that each round's ratios see the same machine. On a shared
+/// machine whose load drifts between the blocks of the table above, the median of these
+/// per-round ratios is the steadier figure. Prints a row per round and the medians.
+pub fn weak_rounds(
+    mpirun: &Path,
+    exe: &Path,
+    r: usize,
+    rounds: usize,
+    one: &[String],
+    weak: &[String],
+) -> Result<()> {
+    println!(
+        "round	one_rank	weak_{r}_ranks	apart_{r}	weak_efficiency	node_ceiling	weak_over_apart"
+    );
+    let (mut eff, mut ceil, mut rel) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..rounds {
+        let (x1, _) = mpirun_worker(mpirun, exe, 1, one)?;
+        let (xw, _) = mpirun_worker(mpirun, exe, r, weak)?;
+        let (xa, _) = apart_at_once(mpirun, exe, r, one)?;
+        let ideal = r as f64 * x1.0;
+        let (e, c) = (xw.0 / ideal, xa.0 / ideal);
+        println!(
+            "{}	{:.4e}	{:.4e}	{:.4e}	{:.3}	{:.3}	{:.3}",
+            k + 1,
+            x1.0,
+            xw.0,
+            xa.0,
+            e,
+            c,
+            e / c
+        );
+        eff.push(e);
+        ceil.push(c);
+        rel.push(e / c);
+    }
+    let show = |v: Vec<f64>| {
+        let (m, lo, hi) = median(v);
+        format!("{:.0} % ({:.0}-{:.0} %)", 100.0 * m, 100.0 * lo, 100.0 * hi)
+    };
+    println!(
+        "# weak, {rounds} interleaved rounds, median (range): efficiency {}{}; node ceiling {}; weak / apart {}",
+        show(eff),
+        if r == 2 { " [target >= 90 %]" } else { "" },
+        show(ceil),
+        show(rel)
+    );
+    Ok(())
+}
+
 /// A benchmark worker under `mpirun`: the job's ranks, with a global pool of the first of
 /// `threads` (default 1) threads per rank.
 pub fn worker_ranks(threads: &[usize]) -> Result<crate::parallel::Ranks> {
@@ -449,6 +507,7 @@ pub fn walls_of_ranks(
 pub fn strong_and_weak(
     mpirun: &Path,
     ranks: &[usize],
+    rounds: usize,
     worker_args: impl Fn(usize) -> Vec<String>,
 ) -> Result<()> {
     let exe = std::env::current_exe()?;
@@ -492,6 +551,11 @@ pub fn strong_and_weak(
                 }
                 _ => {}
             }
+        }
+    }
+    if rounds > 1 {
+        for &r in ranks.iter().filter(|&&r| r > 1) {
+            weak_rounds(mpirun, &exe, r, rounds, &worker_args(1), &worker_args(r))?;
         }
     }
     Ok(())

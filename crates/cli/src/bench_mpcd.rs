@@ -43,6 +43,10 @@ pub struct BenchArgs {
     /// per rank. LAMMPS is not run.
     #[arg(long, value_delimiter = ',')]
     pub mpi_ranks: Vec<usize>,
+    /// With `--mpi-ranks`: the weak-scaling efficiency also in this many interleaved rounds (as
+    /// `bench dpd --rounds`).
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
     /// Open MPI's `mpirun` for `--mpi-ranks`.
     #[arg(long, default_value = "mpirun")]
     pub mpirun: PathBuf,
@@ -96,7 +100,7 @@ fn over_ranks(a: &BenchArgs) -> Result<()> {
     );
     let load = || load_average().map_or("unknown".into(), |[x, y, z]| format!("{x} {y} {z}"));
     println!("# load average (1, 5, 15 min) at start: {}", load());
-    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.mpi_ranks, |k| {
+    crate::bench_dpd_ranks::strong_and_weak(&a.mpirun, &a.mpi_ranks, a.rounds, |k| {
         let mut args: Vec<String> = vec!["bench".into(), "mpcd".into()];
         for (key, v) in [
             ("--worker-stretch", k.to_string()),

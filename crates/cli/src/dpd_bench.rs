@@ -71,6 +71,11 @@ pub struct BenchArgs {
     /// `mpirun`).
     #[arg(long)]
     pub lammps_mpirun: Option<PathBuf>,
+    /// With `--ranks`: also measure the weak-scaling efficiency in this many interleaved
+    /// rounds (one rank, the weak run, the one-rank runs at once, back to back), whose
+    /// per-round ratios are steadier on a shared machine than the table's.
+    #[arg(long, default_value_t = 1)]
+    pub rounds: usize,
     /// Internal: run as one of the `mpirun` workers of `--ranks` on this saved state.
     #[arg(long, hide = true)]
     pub worker_state: Option<PathBuf>,
