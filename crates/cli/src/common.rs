@@ -23,7 +23,14 @@ pub fn load_average() -> Option<[f64; 3]> {
 /// Median, min and max of `v` (not empty).
 pub fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
     v.sort_by(f64::total_cmp);
-    (v[v.len() / 2], v[0], v[v.len() - 1])
+    let n = v.len();
+    // An even count: the mean of the two middle values.
+    let m = if n % 2 == 0 {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    } else {
+        v[n / 2]
+    };
+    (m, v[0], v[n - 1])
 }
 
 /// The timed loop of a LAMMPS screen output: the last "Loop time of T on P procs for S steps
@@ -100,4 +107,14 @@ pub fn write_lammps_data(
         }
     }
     std::fs::write(path, s).with_context(|| format!("{}", path.display()))
+}
+
+#[cfg(test)]
+mod median_tests {
+    #[test]
+    fn the_median_of_an_even_count_is_the_mean_of_the_middle_two() {
+        assert_eq!(super::median(vec![3.0, 1.0, 2.0]), (2.0, 1.0, 3.0));
+        assert_eq!(super::median(vec![4.0, 1.0, 3.0, 2.0]), (2.5, 1.0, 4.0));
+        assert_eq!(super::median(vec![5.0]), (5.0, 5.0, 5.0));
+    }
 }
