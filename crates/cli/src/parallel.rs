@@ -281,6 +281,32 @@ impl Exchange for MpiExchange {
         send_receive_into(send, &dest, recv, &source);
     }
 
+    fn all_gather_and_shift(
+        &self,
+        (mine, all): (&[f64], &mut Vec<f64>),
+        to: usize,
+        send: &[f64],
+        from: usize,
+        recv: &mut [f64],
+    ) {
+        use mpi::collective::CommunicatorCollectives;
+        use mpi::point_to_point::send_receive_into;
+        use mpi::traits::Communicator;
+        let world = Self::world();
+        all.clear();
+        all.resize(mine.len() * self.size(), 0.0);
+        let (dest, source) = (
+            world.process_at_rank(to as i32),
+            world.process_at_rank(from as i32),
+        );
+        // The all-gather progresses while the shift waits for its message.
+        mpi::request::scope(|scope| {
+            let gather = world.immediate_all_gather_into(scope, mine, &mut all[..]);
+            send_receive_into(send, &dest, recv, &source);
+            gather.wait();
+        });
+    }
+
     fn abort(&self, message: &str) -> ! {
         use mpi::traits::Communicator;
         eprintln!("error: {message}");

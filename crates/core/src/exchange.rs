@@ -35,6 +35,21 @@ pub trait Exchange: Send {
         );
         recv.copy_from_slice(&m);
     }
+    /// [`Self::all_gather_same`] of `mine` into `all` and [`Self::shift_exact`] of `send` at
+    /// once: an implementation may overlap the two (MPI: a non-blocking all-gather in flight
+    /// during the shift), so that the ranks wait once instead of twice. By default one after
+    /// the other.
+    fn all_gather_and_shift(
+        &self,
+        (mine, all): (&[f64], &mut Vec<f64>),
+        to: usize,
+        send: &[f64],
+        from: usize,
+        recv: &mut [f64],
+    ) {
+        self.all_gather_same(mine, all);
+        self.shift_exact(to, send, from, recv);
+    }
     /// Stop every rank after a failure on this one alone (a file rank 0 could not write),
     /// which the others cannot learn of at their next message: print `error: message` and
     /// end the job (`MPI_Abort`; a panic for threads).

@@ -947,7 +947,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 pass.integrate(lo, out, (g1 + c * CHUNK / BLOCK) as u64, 0)
             })
             .reduce(|| first, ChunkReport::merge);
-        let (max_disp2, blow_up) = self.agree_on_step(report);
+        let (max_disp2, blow_up) = self.agree_on_step(report, &mut new_pos);
         if let Some(e) = blow_up {
             self.new_pos = new_pos;
             return Err(e);
@@ -965,9 +965,8 @@ impl<P: Pair, E: External> Brownian<P, E> {
         // the rebuild is skipped and the next step reports the blow-up.
         if max_disp2 > self.rebuild_disp2 || (every > 0 && self.step.is_multiple_of(every)) {
             self.sort_and_rebuild()?;
-        } else {
-            self.refresh_ghosts();
         }
+        // Otherwise the ghosts' positions came with the agreement.
         Ok(())
     }
 

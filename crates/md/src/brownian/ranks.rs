@@ -6,7 +6,8 @@
 //!   forces its last slab exerts on the ghosts (the halo) go to their owner, who adds them where
 //!   one process adds the previous slab's halo.
 //! - **Between list builds** the ghosts' positions are refreshed each step (the owner's first
-//!   layer goes left); the largest displacement and any blow-up are agreed on (one all-gather).
+//!   layer goes left) in the same exchange as the agreement on the largest displacement and
+//!   any blow-up (an all-gather, overlapped with the shift under MPI).
 //! - **At a list build** positions are wrapped, particles that left their rank's layers migrate
 //!   to the neighbour that owns them, the ghost layer is fetched whole, and the rank sorts its
 //!   particles and ghosts into the same global cells (ties by tag) as one process would.
@@ -292,30 +293,15 @@ impl<P: Pair, E: External> Brownian<P, E> {
         }
     }
 
-    /// Between list builds: the ghosts' positions, in the same slots.
-    pub(super) fn refresh_ghosts(&mut self) {
-        let Some(d) = self.domain.as_mut() else {
-            return;
-        };
-        let first = &self.slabs[d.z0];
-        d.send_left.clear();
-        for x in &self.particles.pos[first.start..first.end] {
-            d.send_left.extend_from_slice(x);
-        }
-        let g = &self.slabs[d.ghost_layer()];
-        d.recv.resize(3 * (g.end - g.start), 0.0);
-        d.comm
-            .shift_exact(d.left(), &d.send_left, d.right(), &mut d.recv);
-        for (x, m) in self.particles.pos[g.start..g.end]
-            .iter_mut()
-            .zip(d.recv.chunks_exact(3))
-        {
-            *x = [m[0], m[1], m[2]];
-        }
-    }
-
-    /// The step's largest squared displacement and blow-up of lowest tag, over all ranks.
-    pub(super) fn agree_on_step(&mut self, report: ChunkReport) -> (f64, Option<BdError>) {
+    /// The step's largest squared displacement and blow-up of lowest tag, over all ranks; and,
+    /// in the same exchange, the ghosts' new positions into their slots of `new_pos` (this
+    /// step's positions, the right neighbour's first layer): between list builds the same
+    /// slots hold the same particles, and at a build the migration fetches the ghosts anew.
+    pub(super) fn agree_on_step(
+        &mut self,
+        report: ChunkReport,
+        new_pos: &mut [[f64; 3]],
+    ) -> (f64, Option<BdError>) {
         let local = self.blow_up_error(&report);
         let Some(d) = self.domain.as_mut() else {
             return (report.max_disp2, local);
@@ -337,7 +323,27 @@ impl<P: Pair, E: External> Brownian<P, E> {
             }
             _ => d.mine.extend_from_slice(&[-1.0; AGREE - 1]),
         }
-        d.comm.all_gather_same(&d.mine, &mut d.gathered);
+        let first = &self.slabs[d.z0];
+        d.send_left.clear();
+        for x in &new_pos[first.start..first.end] {
+            d.send_left.extend_from_slice(x);
+        }
+        let g = &self.slabs[d.ghost_layer()];
+        d.recv.resize(3 * (g.end - g.start), 0.0);
+        let (left, right) = (d.left(), d.right());
+        d.comm.all_gather_and_shift(
+            (&d.mine, &mut d.gathered),
+            left,
+            &d.send_left,
+            right,
+            &mut d.recv,
+        );
+        for (x, m) in new_pos[g.start..g.end]
+            .iter_mut()
+            .zip(d.recv.chunks_exact(3))
+        {
+            *x = [m[0], m[1], m[2]];
+        }
         // NaN never wins, as in one process's reduction.
         let max_disp2 = d
             .gathered
