@@ -25,7 +25,7 @@ pub fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     // An even count: the mean of the two middle values.
-    let m = if n % 2 == 0 {
+    let m = if n.is_multiple_of(2) {
         0.5 * (v[n / 2 - 1] + v[n / 2])
     } else {
         v[n / 2]
