@@ -22,6 +22,9 @@ pub(crate) struct Domain {
     pub recv: Vec<f64>,
     /// Particles that would have to skip a rank (an error, reported after the exchange).
     pub lost: Vec<f64>,
+    /// The lowest tag of such a particle since the last agreement on it (`u32::MAX`: none);
+    /// DPD agrees on it with the step's velocity check, at the step's end.
+    pub lost_tag: u32,
     /// The layer of each owned slot during a migration.
     pub layer: Vec<u32>,
     /// All-gather results.
@@ -51,6 +54,7 @@ impl Domain {
             send_right: Vec::new(),
             recv: Vec::new(),
             lost: Vec::new(),
+            lost_tag: u32::MAX,
             layer: Vec::new(),
             gathered: Vec::new(),
             mine: Vec::new(),
@@ -93,6 +97,11 @@ impl Domain {
         self.mine.clear();
         self.mine.extend_from_slice(&[value, tag, other, bad]);
         self.comm.all_gather_same(&self.mine, &mut self.gathered);
+        self.reduce_max()
+    }
+
+    /// [`Self::agree_max`] of the rows `[value, tag, other, bad]` already gathered.
+    pub fn reduce_max(&self) -> [f64; 4] {
         let mut out = [f64::NEG_INFINITY, -1.0, f64::NEG_INFINITY, -1.0];
         for g in self.gathered.chunks_exact(4) {
             // NaN never wins, as in the single-rank reduction; an infinity does.
@@ -114,11 +123,15 @@ impl Domain {
         out
     }
 
-    /// The smallest of every rank's `x`.
-    pub fn agree_min(&mut self, x: u32) -> u32 {
+    /// The smallest of every rank's `x`, and of every rank's `y` (one all-gather).
+    pub fn agree_min(&mut self, x: u32, y: u32) -> (u32, u32) {
         self.mine.clear();
-        self.mine.push(x as f64);
+        self.mine.extend_from_slice(&[x as f64, y as f64]);
         self.comm.all_gather_same(&self.mine, &mut self.gathered);
-        self.gathered.iter().fold(u32::MAX, |m, &g| m.min(g as u32))
+        self.gathered
+            .chunks_exact(2)
+            .fold((u32::MAX, u32::MAX), |(a, b), g| {
+                (a.min(g[0] as u32), b.min(g[1] as u32))
+            })
     }
 }

@@ -1108,13 +1108,10 @@ impl Dpd {
         };
         let fast_tag = tag_of(fast);
         // Every rank must agree on errors and on rebuilding the lists.
-        let (max_step2, fast_tag, max_disp2, bad) = match self.domain.as_mut() {
-            None => (max_step2, fast_tag, max_disp2, bad),
-            Some(d) => {
-                let [s, t, m, b] = d.agree_max(max_step2, fast_tag, max_disp2, bad);
-                (s, t, m, b)
-            }
-        };
+        // Verlet lists: the ghosts are refreshed in the same exchange (used unless a sort
+        // follows).
+        let [max_step2, fast_tag, max_disp2, bad] =
+            self.agree_and_refresh([max_step2, fast_tag, max_disp2, bad], verlet);
         if !max_step2.is_finite() || !max_disp2.is_finite() {
             return Err(DpdError::NonFinite {
                 step: self.step,
@@ -1150,8 +1147,8 @@ impl Dpd {
             self.build_lists();
             self.update_colloid_list(true)?;
         } else {
-            // The same slots as at the last sort: refresh the ghosts and the colloid copies.
-            self.refresh_ghosts();
+            // The same slots as at the last sort: the ghosts came with the agreement; refresh
+            // the colloid copies.
             if self.cc_tag.len() >= 2 {
                 self.gather_colloids();
             }
@@ -1186,10 +1183,19 @@ impl Dpd {
                 .min()
                 .unwrap_or(u32::MAX)
         };
-        let bad = match self.domain.as_mut() {
-            None => bad,
-            Some(d) => d.agree_min(bad),
+        let (lost, bad) = match self.domain.as_mut() {
+            None => (u32::MAX, bad),
+            Some(d) => {
+                let lost = std::mem::replace(&mut d.lost_tag, u32::MAX);
+                d.agree_min(lost, bad)
+            }
         };
+        if lost != u32::MAX {
+            return Err(DpdError::Invalid(format!(
+                "particle {lost} crossed more than one domain in a step at step {}; reduce run.dt",
+                self.step
+            )));
+        }
         if bad != u32::MAX {
             return Err(DpdError::NonFinite {
                 step: self.step,
