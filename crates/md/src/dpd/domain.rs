@@ -11,11 +11,12 @@
 //! run**, for any number of ranks. Colloids are few: their positions and velocities are
 //! gathered on every rank each step, and the colloid–colloid list is built from that copy.
 //!
-//! Per step: the drift's largest displacement is agreed on (one all-gather), particles that
-//! left their rank's layers migrate to the neighbour (at every sort: every step with cells,
-//! at list rebuilds with Verlet lists), the ghost layer is sent left (whole at a sort, positions
-//! and velocities in between), the halo forces are sent right, and thermodynamic sums are
-//! gathered layer by layer and added in layer order.
+//! Per step: the drift's largest displacement is agreed on (one all-gather; with Verlet lists
+//! the ghosts' positions and velocities travel in the same exchange), particles that left
+//! their rank's layers migrate to the neighbour and the ghost layer is fetched whole (at every
+//! sort: every step with cells, at list rebuilds with Verlet lists), the halo forces are sent
+//! right, and the step ends with one agreement on a non-finite velocity or a particle lost in
+//! the migration; thermodynamic sums are gathered layer by layer and added in layer order.
 
 use super::{COLLOID_BIT, Dpd, DpdError};
 use crate::cells::CellSort;
