@@ -150,12 +150,8 @@ impl Ensemble {
                 })
                 .collect();
         }
-        let checked = crate::check(sc)?;
-        let seed_first = checked
-            .resolved
-            .get("seed")
-            .and_then(Value::as_u64)
-            .unwrap_or(1);
+        crate::check(sc)?;
+        let seed_first = sc.seed()?;
         crate::seed32(seed_first + opts.replicas as u64 - 1).context(
             "--replicas: the replicas' seeds (seed, seed + 1, ...) must stay below 2^32",
         )?;
@@ -665,6 +661,24 @@ mod tests {
         ] {
             let e = format!("{:#}", parse_vary(bad).unwrap_err());
             assert!(e.contains("--vary"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_replicas_take_the_scenario_s_seed_for_every_method() {
+        // DPD's resolved parameters do not list the seed: the ensemble once started at 1.
+        for text in [
+            "method = \"dpd\"\nseed = 7\n[system]\nbox_length = 6.0\n[run]\nsteps = 10\n",
+            "method = \"bcd\"\nseed = 7\n[system]\nlength = 10.0\nparticles = 5\ndiameter = 0.5\n[run]\ndt = 1e-4\ntime = 0.01\n",
+        ] {
+            let sc = Scenario::from_toml(text, std::path::Path::new(".")).unwrap();
+            let opts = EnsembleOptions {
+                replicas: 2,
+                ..Default::default()
+            };
+            let e = Ensemble::plan(&sc, &opts).unwrap();
+            let seeds: Vec<u64> = e.members.iter().map(|m| m.seed).collect();
+            assert_eq!(seeds, [7, 8], "{text}");
         }
     }
 

@@ -69,11 +69,8 @@ pub fn extrapolate(sc: &Scenario, opts: &ExtrapolateOptions, ctl: &Control) -> R
         .clone()
         .unwrap_or_else(|| format!("{}-extrapolated", sc.name()).into());
     let out = OutputDir::create(&out_path, opts.force)?;
-    let base_seed = crate::check(sc)?
-        .resolved
-        .get("seed")
-        .and_then(|s| s.as_u64())
-        .unwrap_or(1);
+    crate::check(sc)?;
+    let base_seed = sc.seed()?;
     let mut folders: [Vec<PathBuf>; 2] = [Vec::new(), Vec::new()];
     let mut warnings = Vec::new();
     for (j, h) in [dt, 0.5 * dt].into_iter().enumerate() {

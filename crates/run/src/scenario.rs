@@ -135,6 +135,20 @@ impl Scenario {
         })
     }
 
+    /// The top-level `seed` key (1 when absent; its range is checked with the scenario). Read
+    /// from the scenario itself, not from a method's resolved parameters, which need not
+    /// list it.
+    pub fn seed(&self) -> Result<u64> {
+        match self.table()?.get("seed") {
+            None => Ok(1),
+            Some(toml::Value::Integer(k)) if *k >= 0 => Ok(*k as u64),
+            Some(other) => bail!(
+                "{}: key 'seed' must be a non-negative integer, got {other}",
+                self.label()
+            ),
+        }
+    }
+
     /// The `method` key.
     pub fn method(&self) -> Result<String> {
         let t = self.table()?;
