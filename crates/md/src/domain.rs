@@ -100,6 +100,20 @@ impl Domain {
         self.reduce_max()
     }
 
+    /// The all-gather of `mine` into `gathered` and, in the same exchange, `send_left` to the
+    /// left neighbour while the right one's message arrives in `recv` (sized by the caller):
+    /// a step's agreement with the ghosts' refresh.
+    pub fn agree_and_fetch_ghosts(&mut self) {
+        let (left, right) = (self.left(), self.right());
+        self.comm.all_gather_and_shift(
+            (&self.mine, &mut self.gathered),
+            left,
+            &self.send_left,
+            right,
+            &mut self.recv,
+        );
+    }
+
     /// [`Self::agree_max`] of the rows `[value, tag, other, bad]` already gathered.
     pub fn reduce_max(&self) -> [f64; 4] {
         let mut out = [f64::NEG_INFINITY, -1.0, f64::NEG_INFINITY, -1.0];

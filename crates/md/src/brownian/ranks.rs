@@ -330,14 +330,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         }
         let g = &self.slabs[d.ghost_layer()];
         d.recv.resize(3 * (g.end - g.start), 0.0);
-        let (left, right) = (d.left(), d.right());
-        d.comm.all_gather_and_shift(
-            (&d.mine, &mut d.gathered),
-            left,
-            &d.send_left,
-            right,
-            &mut d.recv,
-        );
+        d.agree_and_fetch_ghosts();
         for (x, m) in new_pos[g.start..g.end]
             .iter_mut()
             .zip(d.recv.chunks_exact(3))

@@ -210,18 +210,11 @@ impl Dpd {
             d.send_left.extend_from_slice(&self.pos[i]);
             d.send_left.extend_from_slice(&self.vel[i]);
         }
-        let (left, right) = (d.left(), d.right());
         let g = &self.slabs[d.ghost_layer()];
         d.recv.resize(6 * (g.end - g.start), 0.0);
         d.mine.clear();
         d.mine.extend_from_slice(&row);
-        d.comm.all_gather_and_shift(
-            (&d.mine, &mut d.gathered),
-            left,
-            &d.send_left,
-            right,
-            &mut d.recv,
-        );
+        d.agree_and_fetch_ghosts();
         for (k, m) in d.recv.chunks_exact(6).enumerate() {
             self.pos[g.start + k] = [m[0], m[1], m[2]];
             self.vel[g.start + k] = [m[3], m[4], m[5]];
