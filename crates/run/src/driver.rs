@@ -88,6 +88,8 @@ fn run_with(
         crate::seed32(s)?;
     }
     let mut session = m.start(sc, opts.seed, comm)?;
+    // Saved (scenario.toml, checkpoint) with the seed it ran with, so that it reruns this run.
+    let sc = &as_run(sc, opts.seed)?;
     let mut warnings = session.warnings();
     for w in &warnings {
         ctl.progress().warning(w);
@@ -123,6 +125,17 @@ fn run_with(
         return Err(session.fail_alone(e));
     }
     drive(session, out, envelope, ctl, warnings)
+}
+
+/// The scenario as a run with `seed` runs it: with its `seed` key set when `--seed` (or an
+/// ensemble member's seed) differs from it, so that the saved `scenario.toml` reruns the run.
+fn as_run(sc: &Scenario, seed: Option<u64>) -> Result<Scenario> {
+    match seed {
+        Some(s) if sc.seed()? != s => {
+            sc.with_values(&[("seed".to_string(), toml::Value::Integer(s as i64))])
+        }
+        _ => Ok(sc.clone()),
+    }
 }
 
 /// `--force`: remove the files an earlier run of this method left (so that none mixes with the
@@ -230,7 +243,15 @@ fn resume_with(
     }
     let envelope = checkpoint::read(&file)?;
     let sc = match sc {
-        Some(s) => {
+        Some(given) => {
+            // The checkpoint keeps the scenario with the run's seed (since 2026-12-04; before,
+            // without a `--seed` override): either matches.
+            let seeded = as_run(given, Some(seed.unwrap_or(envelope.seed)))?;
+            let s = if seeded.text() == envelope.scenario {
+                seeded
+            } else {
+                given.clone()
+            };
             if s.text() != envelope.scenario {
                 bail!(
                     "--restart {}: {} differs from the scenario this run started with (saved as {})",
