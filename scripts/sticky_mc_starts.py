@@ -1,28 +1,31 @@
 #!/usr/bin/env python3
-"""The dense, strongly sticky panel of the hard-rods paper's Fig. 6 (sigma = rho = 0.8,
-gamma = 10, eps = 0.05, U0 = 6 kT) by BCD from many equilibrated starts.
+"""A panel of the hard-rods paper's Fig. 6 (sticky rods, sigma = rho, U0 = 6 kT, p = 3, L = 100)
+by BCD from equilibrated starts, at one or several time steps, against the exact equilibrium of
+the finite well BCD simulates and the eps -> 0 theory.
 
-One BCD run of a few time units sits in one of two states (a bound chain across the barrier of
-the potential or not) and does not leave it, while Monte Carlo of the same finite well with
-rigid chain moves visits both (docs/data/sticky-fig6/gamma10-dense-mc-starts.md). So each seed
-here is one Monte Carlo run of the finite well (crates/bcd/examples/sticky_profile_mc.rs; its
-last configuration the start) and one BCD run from it (`colloidsim run
-examples/bcd/sticky-rods.toml` with the panel's settings, `initial.placement = "file"`); the
-BCD runs together sample the two states with the weights of equilibrium, and their mean
-profile, with errors between seeds, is compared with the Monte Carlo runs' (the equilibrium
-of the finite well) and with the eps -> 0 theory.
+BCD runs from random starts can stay out of equilibrium for longer than a run: at gamma = 10 a
+dense run sits in one of two states (a bound chain across the barrier of the potential or not),
+and at sigma = rho = 0.2 the number of bound pairs per well changes only by Kramers hops
+(docs/figures.md). Monte Carlo of the same finite well with rigid chain moves
+(crates/bcd/examples/sticky_profile_mc.rs) visits those states quickly. So each seed here is one
+Monte Carlo run (its last configuration the start, its profile the exact equilibrium) and one
+BCD run from that start at each time step (`colloidsim run examples/bcd/sticky-rods.toml` with
+the panel's settings, `initial.placement = "file"`). The seeds together sample the slow states
+with the weights of equilibrium; the runs of one seed at different steps share the start, so the
+dependence on the step is measured seed by seed (paired), and its extrapolation to dt = 0 (a
+straight line in dt, and one in sqrt(dt)) is fitted per seed and averaged over the seeds.
 
     cargo build --release -p colloidsim-cli && \\
         cargo build --release -p colloidsim-bcd --example sticky_profile_mc
-    python3 scripts/sticky_gamma10_mc_starts.py OUT [--seeds 32] [--jobs 2] [--dt 1.25e-6]
+    python3 scripts/sticky_mc_starts.py OUT [--sigma 0.8] [--gamma 10] [--dts 1.25e-6]
+        [--seeds 32] [--jobs 2] [--equilibrate 1] [--time 5]
 
-Writes OUT/table.md: the density at the barrier (mean of the first and last of 50 bins) and
-the peak's deviation from the theory (three bins around its maximum), for Monte Carlo and for
-BCD, as mean +- standard error over the seeds, and each seed's barrier density. A seed whose
-outputs exist is not run again.
+Writes OUT/table.md: for Monte Carlo and for BCD at each step the density at the barrier (mean
+of the first and last bin), the peak's deviation from the theory (three bins around its
+maximum) and chi^2 per bin against Monte Carlo, as mean +- standard error over the seeds; with
+two or more steps the extrapolations to dt = 0. Runs whose outputs exist are not run again.
 """
 import argparse
-import csv
 import math
 import os
 import statistics
@@ -30,116 +33,164 @@ import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 
-HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENARIO = os.path.join(HERE, "examples", "bcd", "sticky-rods.toml")
-N, L, U0, SIGMA, GAMMA, EPS, BINS = 80, 100, 6, 0.8, 10.0, 0.05, 50
+from sticky_common import COLLOIDSIM, L, SCENARIO, STICKY_MC, U0, peak, rods, table, theory
 
 
-def column(path, name):
-    with open(path) as f:
-        return [float(r[name]) for r in csv.DictReader(f)]
-
-
-def one_seed(a, k):
-    """Monte Carlo start and BCD run of seed k (both skipped when done)."""
+def monte_carlo(a, k):
+    """Seed k's Monte Carlo profile and last configuration (skipped when done)."""
     start = os.path.join(a.out, f"start-{k}.csv")
     mc = os.path.join(a.out, f"mc-{k}.csv")
     if not os.path.exists(mc):
         with open(mc + ".part", "w") as f:
-            subprocess.run([a.mc, str(N), str(L), str(U0), str(SIGMA), str(GAMMA), str(EPS),
-                            str(int(a.sweeps)), str(k + 100), str(BINS), start],
+            subprocess.run([a.mc, str(rods(a.sigma)), str(L), str(U0), str(a.sigma), str(a.gamma),
+                            str(a.eps), str(int(a.sweeps)), str(k + 100), str(a.bins), start],
                            stdout=f, stderr=subprocess.DEVNULL, check=True)
         os.replace(mc + ".part", mc)
-    run = os.path.join(a.out, f"bcd-{k}")
+    return table(mc)["rho"]
+
+
+def bcd(a, dt, k):
+    """Seed k's BCD profile at step dt from the Monte Carlo start (skipped when done)."""
+    run = os.path.join(a.out, f"bcd-dt{dt:g}-{k}")
     if not os.path.exists(os.path.join(run, "summary.json")):
+        start = os.path.abspath(os.path.join(a.out, f"start-{k}.csv"))
         subprocess.run([a.bin, "run", SCENARIO, "--out", run, "--force", "--quiet",
                         "--threads", "1", "--seed", str(k),
-                        "--set", f"system.diameter={SIGMA}",
-                        "--set", f"system.particles={N}",
-                        "--set", f"interaction.sticky.gamma={GAMMA}",
-                        "--set", f"run.dt={a.dt}",
+                        "--set", f"system.diameter={a.sigma}",
+                        "--set", f"system.particles={rods(a.sigma)}",
+                        "--set", f"interaction.sticky.gamma={a.gamma}",
+                        "--set", f"interaction.sticky.range={a.eps}",
+                        "--set", f"run.dt={dt}",
                         "--set", f"run.equilibrate={a.equilibrate}",
                         "--set", f"run.time={a.time}",
-                        "--set", f"observe.density.bins={BINS}",
+                        "--set", f"observe.density.bins={a.bins}",
                         "--set", 'initial.placement="file"',
-                        "--set", f'initial.file="{os.path.abspath(start)}"'],
+                        "--set", f'initial.file="{start}"'],
                        check=True)
-    return column(mc, "rho"), column(os.path.join(run, "density.csv"), "rho")
+    return table(os.path.join(run, "density.csv"))["rho"]
 
 
-def summary(profiles, theory):
-    """Barrier density and peak deviation of each profile; their means and standard errors."""
-    top = max(range(len(theory)), key=lambda i: theory[i])
-    window = [(top + j) % len(theory) for j in (-1, 0, 1)]
-    pt = sum(theory[i] for i in window)
-    barrier = [0.5 * (p[0] + p[-1]) for p in profiles]
-    peak = [sum(p[i] for i in window) / pt - 1.0 for p in profiles]
+def mse(v):
+    return statistics.fmean(v), statistics.stdev(v) / math.sqrt(len(v))
 
-    def mse(v):
-        return statistics.fmean(v), statistics.stdev(v) / math.sqrt(len(v))
 
-    return barrier, mse(barrier), mse(peak)
+def fit_line(xs, ys):
+    """Least-squares intercept and slope of y = a + b x."""
+    mx, my = statistics.fmean(xs), statistics.fmean(ys)
+    b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    return my - b * mx, b
+
+
+class Panel:
+    """The observables of one set of profiles (one per seed) against the theory."""
+
+    def __init__(self, profiles, th):
+        self.profiles = profiles
+        self.barrier = [0.5 * (p[0] + p[-1]) for p in profiles]
+        self.peak = [peak(p, th) for p in profiles]
+
+    def mean_profile(self):
+        """Per-bin mean and standard error over the seeds."""
+        cols = list(zip(*self.profiles))
+        return [mse(c) for c in cols]
+
+
+def chi2_per_bin(p, q):
+    return statistics.fmean((a[0] - b[0]) ** 2 / (a[1] ** 2 + b[1] ** 2)
+                            for a, b in zip(p.mean_profile(), q.mean_profile()))
+
+
+def pct(m):
+    return f"{100 * m[0]:+.2f} % +- {100 * m[1]:.2f} %"
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
-    ap.add_argument("--bin", default=os.path.join(HERE, "target", "release", "colloidsim"))
-    ap.add_argument("--mc", default=os.path.join(HERE, "target", "release", "examples",
-                                                 "sticky_profile_mc"))
+    ap.add_argument("--bin", default=COLLOIDSIM)
+    ap.add_argument("--mc", default=STICKY_MC)
+    ap.add_argument("--sigma", type=float, default=0.8, help="rod length = mean density")
+    ap.add_argument("--gamma", type=float, default=10.0, help="stickiness (Baxter)")
+    ap.add_argument("--eps", type=float, default=0.05, help="width of the well")
+    ap.add_argument("--dts", default="1.25e-6", help="time steps, comma separated")
     ap.add_argument("--seeds", type=int, default=32)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--sweeps", type=float, default=2e6)
-    ap.add_argument("--dt", type=float, default=1.25e-6)
-    ap.add_argument("--equilibrate", type=float, default=1.0)
-    ap.add_argument("--time", type=float, default=5.0)
+    ap.add_argument("--sweeps", type=float, default=2e6, help="Monte Carlo sweeps per seed")
+    ap.add_argument("--equilibrate", type=float, default=1.0, help="BCD time before sampling")
+    ap.add_argument("--time", type=float, default=5.0, help="BCD time sampled")
+    ap.add_argument("--bins", type=int, default=50)
     a = ap.parse_args()
     for exe in (a.bin, a.mc):
         if not os.access(exe, os.X_OK):
             sys.exit(f"{exe} missing: build it as the docstring says")
     if a.seeds < 2:
         sys.exit("--seeds must be at least 2 (errors are taken between seeds)")
+    if not 0 < a.sigma < 1:
+        sys.exit(f"--sigma must lie in (0, 1) (rods of length sigma at density sigma), got {a.sigma}")
+    try:
+        dts = sorted({float(x) for x in a.dts.split(",")}, reverse=True)
+    except ValueError:
+        sys.exit(f"--dts must be numbers separated by commas, got {a.dts!r}")
+    if not dts or min(dts) <= 0:
+        sys.exit(f"--dts must be positive, got {a.dts!r}")
+    seeds = range(1, a.seeds + 1)
     os.makedirs(a.out, exist_ok=True)
     with ThreadPoolExecutor(a.jobs) as pool:
-        results = list(pool.map(lambda k: one_seed(a, k), range(1, a.seeds + 1)))
-    theory_dir = os.path.join(a.out, "theory")
-    if not os.path.exists(os.path.join(theory_dir, "density.csv")):
-        subprocess.run([a.bin, "theory", SCENARIO, "--out", theory_dir, "--force",
-                        "--set", f"system.diameter={SIGMA}",
-                        "--set", f"system.particles={N}",
-                        "--set", f"interaction.sticky.gamma={GAMMA}",
-                        "--set", f"observe.density.bins={BINS}"],
-                       check=True, stdout=subprocess.DEVNULL)
-    theory = column(os.path.join(theory_dir, "density.csv"), "rho")
-    mc_b, mc_bar, mc_peak = summary([r[0] for r in results], theory)
-    bcd_b, bcd_bar, bcd_peak = summary([r[1] for r in results], theory)
-    th_bar = 0.5 * (theory[0] + theory[-1])
+        mc = list(pool.map(lambda k: monte_carlo(a, k), seeds))
+        runs = {dt: pool.map(lambda k, dt=dt: bcd(a, dt, k), seeds) for dt in dts}
+        runs = {dt: list(r) for dt, r in runs.items()}
+    th = theory(a.bin, os.path.join(a.out, "theory"), a.sigma, a.gamma, a.bins)
+    mcp = Panel(mc, th)
+    panels = {dt: Panel(runs[dt], th) for dt in dts}
+    th_bar = 0.5 * (th[0] + th[-1])
+    mb, mp = mse(mcp.barrier), mse(mcp.peak)
     lines = [
-        f"Sticky rods, sigma = rho = {SIGMA}, gamma = {GAMMA}, eps = {EPS}, U0 = {U0} kT, "
-        f"L = {L}: {a.seeds} seeds, each a Monte Carlo run of the finite well ({a.sweeps:g} "
-        f"sweeps) and a BCD run from its last configuration (dt = {a.dt:g}, "
-        f"{a.equilibrate:g} + {a.time:g} time units, {BINS} bins); mean +- standard error over "
-        f"the seeds.",
+        f"Sticky rods, sigma = rho = {a.sigma}, gamma = {a.gamma}, eps = {a.eps}, U0 = {U0} kT, "
+        f"L = {L} ({rods(a.sigma)} rods): {a.seeds} seeds, each a Monte Carlo run of the finite well "
+        f"({a.sweeps:g} sweeps) and BCD runs from its last configuration ({a.equilibrate:g} + "
+        f"{a.time:g} time units, {a.bins} bins); mean +- standard error over the seeds. The "
+        f"theory is the eps -> 0 limit.",
         "",
-        "| | barrier density | peak against the eps -> 0 theory |",
-        "|---|---|---|",
-        f"| eps -> 0 theory | {th_bar:.4f} | 0 |",
-        f"| Monte Carlo of the finite well | {mc_bar[0]:.4f} +- {mc_bar[1]:.4f} | "
-        f"{100 * mc_peak[0]:+.2f} % +- {100 * mc_peak[1]:.2f} % |",
-        f"| BCD from the Monte Carlo starts | {bcd_bar[0]:.4f} +- {bcd_bar[1]:.4f} | "
-        f"{100 * bcd_peak[0]:+.2f} % +- {100 * bcd_peak[1]:.2f} % |",
-        "",
-        "BCD minus Monte Carlo: barrier "
-        f"{(bcd_bar[0] - mc_bar[0]) / math.hypot(bcd_bar[1], mc_bar[1]):+.1f} combined errors, "
-        f"peak {(bcd_peak[0] - mc_peak[0]) / math.hypot(bcd_peak[1], mc_peak[1]):+.1f}.",
-        "",
-        "Barrier density per seed, BCD: " + ", ".join(f"{b:.4f}" for b in bcd_b),
-        "",
-        "Barrier density per seed, Monte Carlo: " + ", ".join(f"{b:.4f}" for b in mc_b),
+        "| | barrier density | peak against the theory | BCD - MC (peak, errors) "
+        "| chi^2 per bin against MC |",
+        "|---|---|---|---|---|",
+        f"| eps -> 0 theory | {th_bar:.4f} | 0 | | |",
+        f"| Monte Carlo of the finite well | {mb[0]:.4f} +- {mb[1]:.4f} | {pct(mp)} | | |",
     ]
+    for dt in dts:
+        p = panels[dt]
+        bb, bp = mse(p.barrier), mse(p.peak)
+        lines.append(
+            f"| BCD, dt = {dt:g} | {bb[0]:.4f} +- {bb[1]:.4f} | {pct(bp)} | "
+            f"{(bp[0] - mp[0]) / math.hypot(bp[1], mp[1]):+.1f} | {chi2_per_bin(p, mcp):.2f} |")
+    if len(dts) >= 2:
+        lines += ["", "Extrapolation of the peak to dt = 0, fitted seed by seed (a straight "
+                  "line through all steps) and averaged over the seeds; the residual at each "
+                  "step in standard errors over the seeds:", "",
+                  "| model | peak at dt = 0 | minus MC (errors) | residuals |", "|---|---|---|---|"]
+        for name, f in (("linear in dt", lambda x: x), ("linear in sqrt(dt)", math.sqrt)):
+            xs = [f(dt) for dt in dts]
+            fits = [fit_line(xs, [panels[dt].peak[i] for dt in dts]) for i in range(a.seeds)]
+            a0 = mse([fa for fa, _ in fits])
+            res = [mse([panels[dt].peak[i] - fits[i][0] - fits[i][1] * x
+                        for i in range(a.seeds)]) for dt, x in zip(dts, xs)]
+            lines.append(
+                f"| {name} | {pct(a0)} | {(a0[0] - mp[0]) / math.hypot(a0[1], mp[1]):+.1f} | "
+                + ", ".join(f"{r[0] / r[1]:+.1f}" if r[1] > 0 else "0" for r in res) + " |")
+    lines += ["", "Barrier density per seed, Monte Carlo: "
+              + ", ".join(f"{b:.4f}" for b in mcp.barrier)]
+    for dt in dts:
+        lines += ["", f"Barrier density per seed, BCD at dt = {dt:g}: "
+                  + ", ".join(f"{b:.4f}" for b in panels[dt].barrier)]
     text = "\n".join(lines) + "\n"
     with open(os.path.join(a.out, "table.md"), "w") as f:
         f.write(text)
+    # For plots: dt = 0 is the Monte Carlo of the finite well.
+    with open(os.path.join(a.out, "peaks.csv"), "w") as f:
+        f.write("dt,peak,peak_err,barrier,barrier_err\n")
+        for dt, p in [(0.0, mcp)] + [(dt, panels[dt]) for dt in dts]:
+            (pm, pe), (bm, be) = mse(p.peak), mse(p.barrier)
+            f.write(f"{dt:g},{pm:.6g},{pe:.3g},{bm:.6g},{be:.3g}\n")
     print(text)
 
 

@@ -14,22 +14,14 @@ Writes OUT/<column>/ (the ensembles), OUT/table.md (per panel: the largest devia
 errors over the bins, chi^2 per bin, and the peak's deviation) and OUT/fig6.png.
 """
 import argparse
-import csv
-import math
 import os
 import shlex
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENARIO = os.path.join(HERE, "examples", "bcd", "sticky-rods.toml")
+from sticky_common import COLLOIDSIM, SCENARIO, peak, rods, table
+
 GAMMAS = [0.1, 1.0, 10.0]
-
-
-def table(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def compare(folder):
@@ -42,17 +34,13 @@ def compare(folder):
         for r, t, e in zip(sim["rho"], th["rho"], sim["rho_err"])
         if e > 0
     ]
-    k = max(range(len(th["rho"])), key=lambda i: th["rho"][i])
-    window = [(k + j) % len(th["rho"]) for j in (-1, 0, 1)]
-    peak_t = sum(th["rho"][i] for i in window)
-    peak = sum(sim["rho"][i] for i in window) / peak_t - 1.0
-    peak_err = math.sqrt(sum(sim["rho_err"][i] ** 2 for i in window)) / peak_t
+    dev, dev_err = peak(sim["rho"], th["rho"], sim["rho_err"])
     return {
         "worst": max(abs(v) for v in z),
         "chi2": sum(v * v for v in z) / len(z),
         "bins": len(z),
-        "peak": peak,
-        "peak_err": peak_err,
+        "peak": dev,
+        "peak_err": dev_err,
         "sim": sim,
         "theory": th,
     }
@@ -61,7 +49,7 @@ def compare(folder):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
-    ap.add_argument("--bin", default=os.path.join(HERE, "target", "release", "colloidsim"))
+    ap.add_argument("--bin", default=COLLOIDSIM)
     ap.add_argument("--mpirun", default="", help='e.g. "mpirun -n 2" (an MPI build of --bin)')
     ap.add_argument("--replicas", type=int, default=4)
     ap.add_argument("--time", type=float, default=20.0, help="sampled time per replica")
@@ -88,7 +76,7 @@ def main():
                 "--replicas", str(a.replicas),
                 "--vary", "interaction.sticky.gamma=[" + ", ".join(map(str, GAMMAS)) + "]",
                 "--set", f"system.diameter={sigma}",
-                "--set", f"system.particles={round(sigma * 100)}",
+                "--set", f"system.particles={rods(sigma)}",
                 "--set", f"interaction.sticky.range={eps}",
                 "--set", f"run.dt={dt}",
                 "--set", f"run.time={a.time}",

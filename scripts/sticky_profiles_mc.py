@@ -15,31 +15,23 @@ the density at the barrier (first bin) and chi^2 per bin, errors from the runs' 
 Writes OUT/table.md.
 """
 import argparse
-import csv
 import math
 import os
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENARIO = os.path.join(HERE, "examples", "bcd", "sticky-rods.toml")
+from sticky_common import COLLOIDSIM, STICKY_MC, peak, rods, table, theory
+
 PANELS = [(s, g, 0.05) for s in (0.2, 0.5, 0.8) for g in (0.1, 1.0, 10.0)] + [
     (0.8, g, e) for e in (0.025, 0.0125) for g in (0.1, 1.0, 10.0)
 ]
 
 
-def table(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
-    ap.add_argument("--bin", default=os.path.join(HERE, "target", "release", "colloidsim"))
-    ap.add_argument("--mc", default=os.path.join(HERE, "target", "release", "examples",
-                                                 "sticky_profile_mc"))
+    ap.add_argument("--bin", default=COLLOIDSIM)
+    ap.add_argument("--mc", default=STICKY_MC)
     ap.add_argument("--sweeps", type=float, default=2e6)
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--jobs", type=int, default=2)
@@ -50,7 +42,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     jobs = []
     for sigma, gamma, eps in PANELS:
-        n = round(100 * sigma)
+        n = rods(sigma)
         for seed in range(1, a.seeds + 1):
             path = os.path.join(a.out, f"mc-{sigma}-{gamma}-{eps}-{seed}.csv")
             if not os.path.exists(path):
@@ -81,28 +73,16 @@ def main():
         "|---|---|---|---|---|---|",
     ]
     for sigma, gamma, eps in PANELS:
-        theory_dir = os.path.join(a.out, f"theory-{sigma}-{gamma}")
-        if not os.path.exists(os.path.join(theory_dir, "density.csv")):
-            subprocess.run([a.bin, "theory", SCENARIO, "--out", theory_dir,
-                            "--set", f"system.diameter={sigma}",
-                            "--set", f"system.particles={round(100 * sigma)}",
-                            "--set", f"interaction.sticky.gamma={gamma}",
-                            "--set", "observe.density.bins=50"],
-                           check=True, stdout=subprocess.DEVNULL)
-        th = table(os.path.join(theory_dir, "density.csv"))["rho"]
+        th = theory(a.bin, os.path.join(a.out, f"theory-{sigma}-{gamma}"), sigma, gamma)
         runs = [table(os.path.join(a.out, f"mc-{sigma}-{gamma}-{eps}-{s}.csv"))
                 for s in range(1, a.seeds + 1)]
         k = len(runs)
         rho = [sum(r["rho"][b] for r in runs) / k for b in range(len(th))]
         err = [math.sqrt(sum(r["err"][b] ** 2 for r in runs)) / k for b in range(len(th))]
-        top = max(range(len(th)), key=lambda i: th[i])
-        window = [(top + j) % len(th) for j in (-1, 0, 1)]
-        pt = sum(th[i] for i in window)
-        peak = sum(rho[i] for i in window) / pt - 1.0
-        peak_err = math.sqrt(sum(err[i] ** 2 for i in window)) / pt
+        dev, dev_err = peak(rho, th, err)
         chi2 = sum(((r - t) / e) ** 2 for r, t, e in zip(rho, th, err) if e > 0) / len(th)
         lines.append(
-            f"| {sigma} | {eps} | {gamma} | {100 * peak:+.2f} % +- {100 * peak_err:.2f} % | "
+            f"| {sigma} | {eps} | {gamma} | {100 * dev:+.2f} % +- {100 * dev_err:.2f} % | "
             f"{rho[0]:.4f} +- {err[0]:.4f} / {th[0]:.4f} | {chi2:.1f} |"
         )
     text = "\n".join(lines) + "\n"
