@@ -13,7 +13,8 @@ BCD run from that start at each time step (`colloidsim run examples/bcd/sticky-r
 the panel's settings, `initial.placement = "file"`). The seeds together sample the slow states
 with the weights of equilibrium; the runs of one seed at different steps share the start, so the
 dependence on the step is measured seed by seed (paired), and its extrapolation to dt = 0 (a
-straight line in dt, and one in sqrt(dt)) is fitted per seed and averaged over the seeds.
+straight line in dt, one in sqrt(dt), and with three or more steps a quadratic in sqrt(dt)) is
+fitted per seed and averaged over the seeds.
 
     cargo build --release -p colloidsim-cli && \\
         cargo build --release -p colloidsim-bcd --example sticky_profile_mc
@@ -74,11 +75,20 @@ def mse(v):
     return statistics.fmean(v), statistics.stdev(v) / math.sqrt(len(v))
 
 
-def fit_line(xs, ys):
-    """Least-squares intercept and slope of y = a + b x."""
-    mx, my = statistics.fmean(xs), statistics.fmean(ys)
-    b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
-    return my - b * mx, b
+def fit(xs, ys, degree):
+    """Least-squares coefficients `c` of y = c0 + c1 x + ... + c_degree x^degree (normal
+    equations, solved by Gaussian elimination; degree + 1 <= len(xs))."""
+    m = degree + 1
+    a = [[sum(x ** (i + j) for x in xs) for j in range(m)]
+         + [sum(y * x ** i for x, y in zip(xs, ys))] for i in range(m)]
+    for c in range(m):
+        piv = max(range(c, m), key=lambda r: abs(a[r][c]))
+        a[c], a[piv] = a[piv], a[c]
+        for r in range(m):
+            if r != c:
+                f = a[r][c] / a[c][c]
+                a[r] = [v - f * w for v, w in zip(a[r], a[c])]
+    return [a[i][m] / a[i][i] for i in range(m)]
 
 
 class Panel:
@@ -164,15 +174,18 @@ def main():
             f"| BCD, dt = {dt:g} | {bb[0]:.4f} +- {bb[1]:.4f} | {pct(bp)} | "
             f"{(bp[0] - mp[0]) / math.hypot(bp[1], mp[1]):+.1f} | {chi2_per_bin(p, mcp):.2f} |")
     if len(dts) >= 2:
-        lines += ["", "Extrapolation of the peak to dt = 0, fitted seed by seed (a straight "
-                  "line through all steps) and averaged over the seeds; the residual at each "
-                  "step in standard errors over the seeds:", "",
+        lines += ["", "Extrapolation of the peak to dt = 0, fitted seed by seed through all "
+                  "steps and averaged over the seeds; the residual at each step in standard "
+                  "errors over the seeds:", "",
                   "| model | peak at dt = 0 | minus MC (errors) | residuals |", "|---|---|---|---|"]
-        for name, f in (("linear in dt", lambda x: x), ("linear in sqrt(dt)", math.sqrt)):
+        models = [("linear in dt", lambda x: x, 1), ("linear in sqrt(dt)", math.sqrt, 1)]
+        if len(dts) >= 3:
+            models.append(("quadratic in sqrt(dt)", math.sqrt, 2))
+        for name, f, degree in models:
             xs = [f(dt) for dt in dts]
-            fits = [fit_line(xs, [panels[dt].peak[i] for dt in dts]) for i in range(a.seeds)]
-            a0 = mse([fa for fa, _ in fits])
-            res = [mse([panels[dt].peak[i] - fits[i][0] - fits[i][1] * x
+            fits = [fit(xs, [panels[dt].peak[i] for dt in dts], degree) for i in range(a.seeds)]
+            a0 = mse([c[0] for c in fits])
+            res = [mse([panels[dt].peak[i] - sum(ck * x ** k for k, ck in enumerate(fits[i]))
                         for i in range(a.seeds)]) for dt, x in zip(dts, xs)]
             lines.append(
                 f"| {name} | {pct(a0)} | {(a0[0] - mp[0]) / math.hypot(a0[1], mp[1]):+.1f} | "
