@@ -225,6 +225,29 @@ fn a_dpd_run_on_1_2_3_and_4_ranks_writes_the_single_process_folder() {
     }
 }
 
+#[test]
+fn a_dpd_run_on_a_grid_of_2_x_2_ranks_writes_the_single_process_folder() {
+    // Cut along y as well as z (`run.rank_grid`): each rank holds fringe rows of ghosts and
+    // computes the pairs across the y cut itself; the folder is still the single-process one.
+    let tmp = tempfile::tempdir().unwrap();
+    let text_2x2 = TINY_DPD.replace("steps = 400", "steps = 400\nrank_grid = [2, 2]");
+    let (s, reference) = reference(tmp.path(), "dpd-grid", &text_2x2);
+    let out = tmp.path().join("grid");
+    let o = mpirun(4, &["run", &s, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_same_tree(&reference, &out);
+    // A grid that is not the number of ranks: refused once, naming the key.
+    let out = tmp.path().join("three");
+    let o = mpirun(3, &["run", &s, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(!o.status.success());
+    let t = text(&o);
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(
+        t.contains("run.rank_grid") && t.contains("for 3 ranks"),
+        "{t}"
+    );
+}
+
 /// DPD water sheared by Lees–Edwards boundaries (`examples/dpd/shear.toml`, shortened): 1536
 /// beads in a box of 8 layers of cells, 600 steps.
 const SHEARED_DPD: &str = r#"

@@ -2,10 +2,16 @@
 //! owns, its neighbours, the buffers of its messages and the agreements every step needs. The
 //! engines ([`crate::dpd`], [`crate::brownian`]) keep their particles; this is what they share.
 //!
-//! Rank `r` of `P` owns the layers `z0 = r nz / P .. z1 = (r + 1) nz / P` of `nz`. The half
-//! stencil of cells ([`crate::cells`]) reaches only the own and the next layer, so a rank needs
-//! one ghost layer, `z1 mod nz` (the right neighbour's first layer), and sends the forces its
-//! last layer exerts on the ghosts (the *halo*) back to their owner.
+//! The ranks form a grid of `py` columns along y by `pz` slabs along z (`rank = rz py + ry`;
+//! `py = 1`, slabs, for every engine but DPD). Rank `(ry, rz)` owns the layers
+//! `z0 = rz nz / pz .. z1 = (rz + 1) nz / pz` of `nz` and in them the rows of cells
+//! `y0 = ry ny / py .. y1 = (ry + 1) ny / py` of `ny`. The half stencil of cells
+//! ([`crate::cells`]) reaches only the own and the next layer, so a rank needs one ghost layer,
+//! `z1 mod nz` (the first layer of the rank above), and sends the forces its last layer exerts
+//! on the ghosts (the *halo*) back to their owner. Along y the stencil reaches a row either
+//! way: a rank cut along y holds one *fringe* row of ghosts on each side and computes the
+//! pairs across the cut itself (the rank on the other side computes them too), so that every
+//! pair of an owned particle is met in the order of one rank (module `dpd::domain`).
 
 use colloidsim_core::exchange::Exchange;
 
@@ -17,6 +23,14 @@ pub(crate) struct Domain {
     /// Owned layers `z0..z1`.
     pub z0: usize,
     pub z1: usize,
+    /// Rows of cells along y (1 when the grid has one column).
+    pub ny: usize,
+    /// Owned rows `y0..y1` of every owned layer.
+    pub y0: usize,
+    pub y1: usize,
+    /// Ranks along y and along z (`py pz` ranks).
+    pub py: usize,
+    pub pz: usize,
     pub send_left: Vec<f64>,
     pub send_right: Vec<f64>,
     pub recv: Vec<f64>,
@@ -25,8 +39,6 @@ pub(crate) struct Domain {
     /// The lowest tag of such a particle since the last agreement on it (`u32::MAX`: none);
     /// DPD agrees on it with the step's velocity check, at the step's end.
     pub lost_tag: u32,
-    /// The layer of each owned slot during a migration.
-    pub layer: Vec<u32>,
     /// All-gather results.
     pub gathered: Vec<f64>,
     /// This rank's part of an all-gather.
@@ -34,45 +46,154 @@ pub(crate) struct Domain {
 }
 
 impl Domain {
-    /// The domain of `comm`'s rank for `nz` layers; an error when there are more ranks than
-    /// layers.
+    /// The domain of `comm`'s rank for `nz` layers cut into slabs; an error when there are
+    /// more ranks than layers.
     pub fn new(comm: Box<dyn Exchange>, nz: usize, cell_range: f64) -> Result<Self, String> {
         let p = comm.size();
-        if nz < p {
+        Self::grid(comm, [1, nz], [1, p], cell_range)
+    }
+
+    /// The domain of `comm`'s rank on a grid of `py` by `pz` ranks (`[py, pz]`) over `ny` rows
+    /// and `nz` layers of cells (`[ny, nz]`); an error naming the limit when the grid does not
+    /// fit: a layer per slab, and with `py > 1` a row per column and two rows more than a
+    /// column holds (its two fringe rows must be other rows than its own).
+    pub fn grid(
+        comm: Box<dyn Exchange>,
+        [ny, nz]: [usize; 2],
+        [py, pz]: [usize; 2],
+        cell_range: f64,
+    ) -> Result<Self, String> {
+        let p = comm.size();
+        if py * pz != p {
+            return Err(format!(
+                "a grid of {py} x {pz} ranks (y x z) for {p} ranks: the product must be the \
+                 number of ranks"
+            ));
+        }
+        if nz < pz && py == 1 {
             return Err(format!(
                 "{p} ranks for {nz} layers of cells along z (cells at least {cell_range:.3} \
                  wide): each rank needs a layer; use at most {nz} ranks or a longer box"
             ));
         }
+        if nz < pz {
+            return Err(format!(
+                "{pz} ranks along z for {nz} layers of cells (cells at least {cell_range:.3} \
+                 wide): each rank needs a layer; use at most {nz} ranks along z or a longer box"
+            ));
+        }
+        if py > 1 && (py > ny || ny.div_ceil(py) + 2 > ny) {
+            return Err(format!(
+                "{py} ranks along y for {ny} rows of cells (cells at least {cell_range:.3} \
+                 wide): a rank cut along y needs its rows and a fringe row on each side; use \
+                 fewer ranks along y or a wider box"
+            ));
+        }
         let r = comm.rank();
+        let (ry, rz) = (r % py, r / py);
         Ok(Self {
-            z0: r * nz / p,
-            z1: (r + 1) * nz / p,
+            z0: rz * nz / pz,
+            z1: (rz + 1) * nz / pz,
             nz,
+            y0: ry * ny / py,
+            y1: (ry + 1) * ny / py,
+            ny,
+            py,
+            pz,
             comm,
             send_left: Vec::new(),
             send_right: Vec::new(),
             recv: Vec::new(),
             lost: Vec::new(),
             lost_tag: u32::MAX,
-            layer: Vec::new(),
             gathered: Vec::new(),
             mine: Vec::new(),
         })
     }
 
+    /// The rank below along z (same column).
     pub fn left(&self) -> usize {
         let p = self.comm.size();
-        (self.comm.rank() + p - 1) % p
+        (self.comm.rank() + p - self.py) % p
     }
 
+    /// The rank above along z (same column).
     pub fn right(&self) -> usize {
-        (self.comm.rank() + 1) % self.comm.size()
+        (self.comm.rank() + self.py) % self.comm.size()
     }
 
+    /// The rank of the same slab in the column before along y.
+    pub fn y_left(&self) -> usize {
+        let r = self.comm.rank();
+        r - r % self.py + (r % self.py + self.py - 1) % self.py
+    }
+
+    /// The rank of the same slab in the column after along y.
+    pub fn y_right(&self) -> usize {
+        let r = self.comm.rank();
+        r - r % self.py + (r % self.py + 1) % self.py
+    }
+
+    /// The rank of this column that owns layer `z`.
     pub fn owner(&self, z: usize) -> usize {
-        let p = self.comm.size();
-        (0..p).find(|&r| z < (r + 1) * self.nz / p).unwrap_or(p - 1)
+        let rz = (0..self.pz)
+            .find(|&k| z < (k + 1) * self.nz / self.pz)
+            .unwrap_or(self.pz - 1);
+        rz * self.py + self.comm.rank() % self.py
+    }
+
+    /// The rank of this slab that owns row `y`.
+    pub fn y_owner(&self, y: usize) -> usize {
+        let ry = (0..self.py)
+            .find(|&k| y < (k + 1) * self.ny / self.py)
+            .unwrap_or(self.py - 1);
+        self.comm.rank() - self.comm.rank() % self.py + ry
+    }
+
+    /// The layers `z0..z1` and rows `y0..y1` rank `r` owns, as `[z0, z1, y0, y1]`.
+    pub fn block_of(&self, r: usize) -> [usize; 4] {
+        let (ry, rz) = (r % self.py, r / self.py);
+        [
+            rz * self.nz / self.pz,
+            (rz + 1) * self.nz / self.pz,
+            ry * self.ny / self.py,
+            (ry + 1) * self.ny / self.py,
+        ]
+    }
+
+    /// Whether row `y` is this rank's.
+    pub fn owns_row(&self, y: usize) -> bool {
+        (self.y0..self.y1).contains(&y)
+    }
+
+    /// The grid `[py, pz]` for `p` ranks over `[nx, ny, nz]` cells that holds the fewest ghost
+    /// cells per rank (ties: fewer columns), among those [`Self::grid`] accepts; `y_cuts`
+    /// false: slabs only. A slab holds a ghost layer (`nx ny` cells when `pz > 1`); a column
+    /// also a fringe row on each side of each of its layers, whose pairs it computes too.
+    pub fn choose_grid(p: usize, [nx, ny, nz]: [usize; 3], y_cuts: bool) -> [usize; 2] {
+        let mut best: Option<(usize, [usize; 2])> = None;
+        for py in 1..=p {
+            if !p.is_multiple_of(py) || (py > 1 && (!y_cuts || py > ny || ny.div_ceil(py) + 2 > ny))
+            {
+                continue;
+            }
+            let pz = p / py;
+            if nz < pz {
+                continue;
+            }
+            let slab = if pz > 1 {
+                nx * (ny.div_ceil(py) + if py > 1 { 2 } else { 0 })
+            } else {
+                0
+            };
+            let fringe = if py > 1 { 2 * nx * nz.div_ceil(pz) } else { 0 };
+            let cost = slab + fringe;
+            if best.is_none_or(|(c, _)| cost < c) {
+                best = Some((cost, [py, pz]));
+            }
+        }
+        // None fits: slabs, refused by `grid` with the limit in the message.
+        best.map_or([1, p], |(_, g)| g)
     }
 
     /// Whether layer `z` is this rank's.

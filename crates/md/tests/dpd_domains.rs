@@ -165,9 +165,102 @@ fn every_rank_stops_with_the_same_error() {
     for e in errs {
         assert_eq!(e, one);
     }
-    // More ranks than layers of cells: refused on every rank, naming the limit.
-    let errs = on_ranks(6, |c| setup.build_decomposed(c).err().unwrap().to_string());
+    // More ranks than any grid fits (5 x 5 x 5 cells: at most 5 slabs of at most 5 columns,
+    // and a column needs two rows besides its own): refused on every rank, naming the limit.
+    let errs = on_ranks(30, |c| setup.build_decomposed(c).err().unwrap().to_string());
     for e in errs {
-        assert!(e.contains("6 ranks for 5 layers"), "{e}");
+        assert!(e.contains("30 ranks for 5 layers"), "{e}");
+    }
+    // A grid given that does not fit, or is not the number of ranks: refused, naming it.
+    for (grid, ranks, says) in [
+        ([6, 1], 6, "6 ranks along y for 5 rows"),
+        ([2, 2], 3, "a grid of 2 x 2 ranks (y x z) for 3 ranks"),
+    ] {
+        let mut s = setup.clone();
+        s.params.rank_grid = Some(grid);
+        for e in on_ranks(ranks, |c| s.build_decomposed(c).err().unwrap().to_string()) {
+            assert!(e.contains(says), "{e}");
+        }
+    }
+}
+
+fn on_grid(setup: &DpdSetup, grid: [usize; 2], steps: u64) -> Vec<End> {
+    let mut s = setup.clone();
+    s.params.rank_grid = Some(grid);
+    decomposed(&s, grid[0] * grid[1], steps)
+}
+
+#[test]
+fn a_grid_cut_along_y_and_z_is_bitwise_the_single_rank_run() {
+    // Columns along y hold a fringe row of ghosts on each side and compute the pairs across
+    // the cut on both sides: each owned particle's pairs are met in the single-rank order.
+    // The suspension's box has 4 cells a side (lists) and 5 (cells); water's 5 and 7.
+    for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
+        let setup = suspension(mode);
+        let one = serial(&setup, 200);
+        for grid in [[2, 1], [2, 2], [3, 1]] {
+            for (r, e) in on_grid(&setup, grid, 200).iter().enumerate() {
+                assert_same(&one, e, &format!("{mode:?}, rank {r} of grid {grid:?}"));
+                assert!(e.owned.1 < one.snap.len(), "{mode:?}: {:?}", e.owned);
+            }
+        }
+        let mut setup = water(7.0);
+        setup.params.neighbors = mode;
+        let one = serial(&setup, 60);
+        for grid in [[2, 2], [3, 2]] {
+            for (r, e) in on_grid(&setup, grid, 60).iter().enumerate() {
+                assert_same(
+                    &one,
+                    e,
+                    &format!("water, {mode:?}, rank {r} of grid {grid:?}"),
+                );
+            }
+        }
+    }
+    // More ranks than layers: the grid chosen cuts along y too (6 ranks, 5 layers of lists).
+    let setup = water(7.0);
+    let one = serial(&setup, 60);
+    for (r, e) in decomposed(&setup, 6, 60).iter().enumerate() {
+        assert_same(&one, e, &format!("water on 6 ranks, rank {r}"));
+    }
+}
+
+#[test]
+fn a_checkpoint_of_a_grid_continues_bitwise_on_slabs_and_on_one_rank() {
+    let setup = suspension(NeighborMode::Verlet);
+    let mut on_2x2 = setup.clone();
+    on_2x2.params.rank_grid = Some([2, 2]);
+    let (snap, forces) = on_ranks(4, |c| {
+        let mut sim = on_2x2.build_decomposed(c).unwrap();
+        sim.set_sync_every(50);
+        sim.run(100).unwrap();
+        (sim.snapshot(), sim.forces())
+    })
+    .remove(0);
+    let mut a = setup.build().unwrap();
+    a.set_sync_every(50);
+    a.run(200).unwrap();
+    for ranks in [1, 2] {
+        let ends = on_ranks(ranks, |c| {
+            let mut b = Dpd::restart_on(
+                snap.clone(),
+                &forces,
+                setup.sbox,
+                setup.params,
+                DpdSetup::colloid_types(),
+                100,
+                50,
+                Some(c),
+            )
+            .unwrap();
+            b.run(100).unwrap();
+            b.snapshot()
+        });
+        for b in ends {
+            assert!(
+                a.snapshot() == b,
+                "restart of a 2 x 2 grid on {ranks} ranks differs"
+            );
+        }
     }
 }

@@ -1224,6 +1224,13 @@ pub static DPD: &[Spec] = &[
         Closed(0.0, 10.0),
         "Lees-Edwards shear rate gamma_dot: flow along x, gradient along y (0: no shear); the run reports the shear stress, the viscosity and velocity_profile.csv",
     ),
+    key(
+        "run.rank_grid",
+        "ranks",
+        "unset",
+        Numbers(1.0, 1e6, Some(2)),
+        "MPI runs: the grid [py, pz] of ranks, columns along y by slabs along z, product the number of ranks (unset: the grid with the fewest ghost cells; slabs when sheared); the run is bitwise the same on any grid",
+    ),
     key("observe", "-", "defaults", Table, "what to measure"),
     key(
         "observe.thermo_every",

@@ -18,7 +18,7 @@
 //! right, and the step ends with one agreement on a non-finite velocity or a particle lost in
 //! the migration; thermodynamic sums are gathered layer by layer and added in layer order.
 
-use super::{COLLOID_BIT, Dpd, DpdError};
+use super::{COLLOID_BIT, Dpd, DpdError, PairVirial};
 use crate::cells::CellSort;
 use crate::domain::Domain;
 
@@ -27,28 +27,40 @@ const MIGRANT: usize = 10;
 /// Numbers per ghost at a sort: key, position, velocity.
 const GHOST: usize = 7;
 
+/// The axis a migration stage crosses.
+#[derive(Clone, Copy, PartialEq)]
+enum Axis {
+    Y,
+    Z,
+}
+
 impl Dpd {
-    /// The z-layer of cells of a wrapped position, as [`CellSort::sort`] finds it.
-    fn layer_of(&self, x: &[f64; 3], nz: usize) -> usize {
-        CellSort::cell_coordinate(x[2], self.sbox.l[2], nz)
+    /// The row (along y) and layer (along z) of cells of a wrapped position, as
+    /// [`CellSort::sort`] finds them.
+    fn row_layer_of(&self, x: &[f64; 3], d: &Domain) -> (usize, usize) {
+        (
+            CellSort::cell_coordinate(x[1], self.sbox.l[1], d.ny),
+            CellSort::cell_coordinate(x[2], self.sbox.l[2], d.nz),
+        )
     }
 
-    /// Keep the particles of this rank's layers (at construction, from the full set).
+    /// Keep the particles of this rank's cells (at construction, from the full set).
     pub(super) fn keep_own(&mut self) {
-        let Some(d) = self.domain.as_ref() else {
+        let Some(d) = self.domain.take() else {
             return;
         };
-        let (z0, z1, nz) = (d.z0, d.z1, d.nz);
         let mut w = 0;
         for i in 0..self.pos.len() {
-            let z = self.layer_of(&self.pos[i], nz);
-            if (z0..z1).contains(&z) {
+            let (y, z) = self.row_layer_of(&self.pos[i], &d);
+            if d.owns(z) && d.owns_row(y) {
                 self.move_slot(i, w);
                 w += 1;
             }
         }
         self.truncate_slots(w);
         self.own = (0, w);
+        self.ghost.clear();
+        self.domain = Some(d);
     }
 
     fn move_slot(&mut self, from: usize, to: usize) {
@@ -75,8 +87,9 @@ impl Dpd {
         self.inv_mass.push(inv_mass);
     }
 
-    /// Send the owned particles that left this rank's layers to the neighbours, take theirs,
-    /// drop the old ghosts and fetch the new ghost layer from the right. The caller sorts.
+    /// Send the owned particles that left this rank's cells to the neighbours, take theirs,
+    /// drop the old ghosts and fetch the new ones (the fringe rows, then the ghost layer with
+    /// its fringe rows). The caller sorts.
     pub(super) fn migrate_and_fetch_ghosts(&mut self) -> Result<(), DpdError> {
         let Some(mut d) = self.domain.take() else {
             return Ok(());
@@ -87,40 +100,93 @@ impl Dpd {
     }
 
     fn migrate(&mut self, d: &mut Domain) -> Result<(), DpdError> {
-        let (left, right) = (d.left(), d.right());
+        // Drop the ghosts (the order does not matter: a sort follows).
+        let mut w = 0;
+        for i in 0..self.pos.len() {
+            if !self.ghost.get(i).copied().unwrap_or(false) {
+                self.move_slot(i, w);
+                w += 1;
+            }
+        }
+        self.truncate_slots(w);
+        self.ghost.clear();
+        // Leavers go to the neighbours: along z, then along y (a particle crossing a corner
+        // takes both steps).
+        let mut lost = None;
+        if d.pz > 1 {
+            self.send_leavers(d, Axis::Z, &mut lost);
+        }
+        if d.py > 1 {
+            self.send_leavers(d, Axis::Y, &mut lost);
+        }
+        let n_own = self.pos.len();
+        self.own = (0, n_own);
+        // Fringe rows: this rank's first row goes to the column before (it is that column's
+        // upper fringe), its last row to the column after.
+        if d.py > 1 {
+            for (first, to, from) in [
+                (true, d.y_left(), d.y_right()),
+                (false, d.y_right(), d.y_left()),
+            ] {
+                let row = if first { d.y0 } else { d.y1 - 1 };
+                d.send_left.clear();
+                for i in 0..n_own {
+                    if self.row_layer_of(&self.pos[i], d).0 == row {
+                        self.push_ghost_row(i, &mut d.send_left);
+                    }
+                }
+                d.comm.shift(to, &d.send_left, from, &mut d.recv);
+                self.take_ghosts(&d.recv);
+            }
+        }
+        // The ghost layer: this rank's first layer, fringe rows included, goes to the rank
+        // below (it is that rank's ghost layer).
+        if d.pz > 1 {
+            d.send_left.clear();
+            for i in 0..self.pos.len() {
+                if self.row_layer_of(&self.pos[i], d).1 == d.z0 {
+                    self.push_ghost_row(i, &mut d.send_left);
+                }
+            }
+            d.comm.shift(d.left(), &d.send_left, d.right(), &mut d.recv);
+            self.take_ghosts(&d.recv);
+        }
+        // The ranks agree on whether one lost a particle at the step's end, with the velocity
+        // check (one all-gather fewer; the step's time-step check makes it all but impossible:
+        // a cell is wider than the half cut-off a particle may move).
+        d.lost_tag = d.lost_tag.min(lost.unwrap_or(u32::MAX));
+        Ok(())
+    }
+
+    /// Send the owned particles outside this rank's layers (`Axis::Z`) or rows (`Axis::Y`) to
+    /// the neighbour along that axis and take the neighbours' (the last slot fills a hole).
+    fn send_leavers(&mut self, d: &mut Domain, axis: Axis, lost: &mut Option<u32>) {
+        let (left, right) = match axis {
+            Axis::Z => (d.left(), d.right()),
+            Axis::Y => (d.y_left(), d.y_right()),
+        };
         d.send_left.clear();
         d.send_right.clear();
-        // Drop the ghosts, which lie before or after the owned slots: move the owned slots at
-        // the end into the ghosts' place (the order does not matter: a sort follows).
-        let (o0, o1) = self.own;
-        let n_own = o1 - o0;
-        for k in 0..o0.min(n_own) {
-            self.move_slot(o1 - 1 - k, k);
-        }
-        self.truncate_slots(n_own);
-        // Leavers go to the neighbours; the last slot fills the hole.
-        let mut lost = None;
-        let mut n = n_own;
+        let mut n = self.pos.len();
         let mut i = 0;
-        d.layer.clear();
         while i < n {
-            let z = self.layer_of(&self.pos[i], d.nz);
-            if d.owns(z) {
-                d.layer.push(z as u32);
+            let (y, z) = self.row_layer_of(&self.pos[i], d);
+            let (mine, to) = match axis {
+                Axis::Z => (d.owns(z), d.owner(z)),
+                Axis::Y => (d.owns_row(y), d.y_owner(y)),
+            };
+            if mine {
                 i += 1;
                 continue;
             }
-            let to = d.owner(z);
             let buf = if to == right {
                 &mut d.send_right
             } else if to == left {
                 &mut d.send_left
             } else {
+                lost.get_or_insert(self.key[i] & !COLLOID_BIT);
                 &mut d.lost
             };
-            if to != right && to != left {
-                lost.get_or_insert(self.key[i] & !COLLOID_BIT);
-            }
             let (x, v, im) = (self.pos[i], self.vel[i], self.image[i]);
             buf.push(self.key[i] as f64);
             buf.extend_from_slice(&x);
@@ -131,30 +197,23 @@ impl Dpd {
         }
         self.truncate_slots(n);
         d.lost.clear();
-        // With two ranks left and right are one rank, and everything went right.
+        // With two ranks along the axis left and right are one rank, and everything went right.
         d.comm.shift(right, &d.send_right, left, &mut d.recv);
         self.take_migrants(&d.recv);
         if left != right {
             d.comm.shift(left, &d.send_left, right, &mut d.recv);
             self.take_migrants(&d.recv);
         }
-        let n_own = self.pos.len();
-        self.own = (0, n_own);
-        for i in d.layer.len()..n_own {
-            let z = self.layer_of(&self.pos[i], d.nz);
-            d.layer.push(z as u32);
-        }
-        // Ghosts: this rank's first layer goes left (it is the left rank's ghost layer).
-        d.send_left.clear();
-        for (i, &z) in d.layer.iter().enumerate() {
-            if z as usize == d.z0 {
-                d.send_left.push(self.key[i] as f64);
-                d.send_left.extend_from_slice(&self.pos[i]);
-                d.send_left.extend_from_slice(&self.vel[i]);
-            }
-        }
-        d.comm.shift(left, &d.send_left, right, &mut d.recv);
-        for g in d.recv.chunks_exact(GHOST) {
+    }
+
+    fn push_ghost_row(&self, i: usize, buf: &mut Vec<f64>) {
+        buf.push(self.key[i] as f64);
+        buf.extend_from_slice(&self.pos[i]);
+        buf.extend_from_slice(&self.vel[i]);
+    }
+
+    fn take_ghosts(&mut self, recv: &[f64]) {
+        for g in recv.chunks_exact(GHOST) {
             self.push_slot(
                 g[0] as u32,
                 [g[1], g[2], g[3]],
@@ -163,11 +222,6 @@ impl Dpd {
                 0.0,
             );
         }
-        // The ranks agree on whether one lost a particle at the step's end, with the velocity
-        // check (one all-gather fewer; the step's time-step check makes it all but impossible:
-        // a layer is wider than the half cut-off a particle may move).
-        d.lost_tag = d.lost_tag.min(lost.unwrap_or(u32::MAX));
-        Ok(())
     }
 
     fn take_migrants(&mut self, recv: &[f64]) {
@@ -184,50 +238,118 @@ impl Dpd {
         }
     }
 
-    /// After a sort: the owned slots are the owned layers' (contiguous, as layers are stored in
-    /// z order and the ghost layer is before or after them).
+    /// The storage slots of row `y` of layer `z` (after a sort).
+    fn row_slots(&self, z: usize, y: usize) -> (usize, usize) {
+        let [nx, ny, _] = self.grid.n_cells;
+        let c = (z * ny + y) * nx;
+        (
+            self.grid.cell_start[c] as usize,
+            self.grid.cell_start[c + nx] as usize,
+        )
+    }
+
+    /// After a sort: the slots of the owned layers (contiguous, as layers are stored in z
+    /// order and the ghost layer is before or after them), and which of them are ghosts (the
+    /// fringe rows, when the run is cut along y).
     pub(super) fn set_own_range(&mut self) {
-        self.own = match &self.domain {
-            None => (0, self.pos.len()),
-            Some(d) => (self.grid.layer(d.z0).0, self.grid.layer(d.z1 - 1).1),
+        let n = self.pos.len();
+        self.ghost.clear();
+        let Some(d) = &self.domain else {
+            self.own = (0, n);
+            self.ghost.resize(n, false);
+            return;
         };
+        self.own = (self.grid.layer(d.z0).0, self.grid.layer(d.z1 - 1).1);
+        self.ghost.resize(n, true);
+        for z in d.z0..d.z1 {
+            let (a, _) = self.row_slots(z, d.y0);
+            let (_, b) = self.row_slots(z, d.y1 - 1);
+            self.ghost[a..b].iter_mut().for_each(|g| *g = false);
+        }
     }
 
     /// [`Domain::agree_max`] of the step's `[value, tag, other, bad]`, and in the same
     /// exchange (Verlet lists: `refresh`) the ghosts' positions and velocities into the same
-    /// slots, as they stand after the drift. The refreshed ghosts are not used when the
-    /// agreement calls for a sort: the migration fetches the ghost layer anew.
+    /// slots, as they stand after the drift (the fringe rows first, then the ghost layer with
+    /// its fringe rows). The refreshed ghosts are not used when the agreement calls for a
+    /// sort: the migration fetches the ghosts anew.
     pub(super) fn agree_and_refresh(&mut self, row: [f64; 4], refresh: bool) -> [f64; 4] {
-        let Some(d) = self.domain.as_mut() else {
+        let Some(mut d) = self.domain.take() else {
             return row;
         };
-        if !refresh {
-            return d.agree_max(row[0], row[1], row[2], row[3]);
+        if refresh && d.py > 1 {
+            self.refresh_fringe(&mut d);
         }
-        let (a, b) = (self.slabs[d.z0].start, self.slabs[d.z0].end);
-        d.send_left.clear();
-        for i in a..b {
-            d.send_left.extend_from_slice(&self.pos[i]);
-            d.send_left.extend_from_slice(&self.vel[i]);
-        }
-        let g = &self.slabs[d.ghost_layer()];
-        d.recv.resize(6 * (g.end - g.start), 0.0);
-        d.mine.clear();
-        d.mine.extend_from_slice(&row);
-        d.agree_and_fetch_ghosts();
-        for (k, m) in d.recv.chunks_exact(6).enumerate() {
-            self.pos[g.start + k] = [m[0], m[1], m[2]];
-            self.vel[g.start + k] = [m[3], m[4], m[5]];
-        }
-        d.reduce_max()
+        let out = if !refresh || d.pz == 1 {
+            d.agree_max(row[0], row[1], row[2], row[3])
+        } else {
+            let (a, b) = (self.slabs[d.z0].start, self.slabs[d.z0].end);
+            d.send_left.clear();
+            for i in a..b {
+                d.send_left.extend_from_slice(&self.pos[i]);
+                d.send_left.extend_from_slice(&self.vel[i]);
+            }
+            let g = &self.slabs[d.ghost_layer()];
+            d.recv.resize(6 * (g.end - g.start), 0.0);
+            d.mine.clear();
+            d.mine.extend_from_slice(&row);
+            d.agree_and_fetch_ghosts();
+            for (k, m) in d.recv.chunks_exact(6).enumerate() {
+                self.pos[g.start + k] = [m[0], m[1], m[2]];
+                self.vel[g.start + k] = [m[3], m[4], m[5]];
+            }
+            d.reduce_max()
+        };
+        self.domain = Some(d);
+        out
     }
 
-    /// After the forces: the last owned slab's forces on the ghost layer go right; the left
-    /// rank's on the first owned layer arrive into the slab before it.
+    /// Verlet lists between sorts: the positions and velocities of the fringe rows' ghosts,
+    /// from the owners' first and last rows of every owned layer (the same particles in the
+    /// same order as at the last sort).
+    fn refresh_fringe(&mut self, d: &mut Domain) {
+        let ny = d.ny;
+        let below = (d.y0 + ny - 1) % ny;
+        for (send, to, recv, from) in [
+            (d.y0, d.y_left(), d.y1 % ny, d.y_right()),
+            (d.y1 - 1, d.y_right(), below, d.y_left()),
+        ] {
+            d.send_left.clear();
+            let mut m = 0;
+            for z in d.z0..d.z1 {
+                let (a, b) = self.row_slots(z, send);
+                for i in a..b {
+                    d.send_left.extend_from_slice(&self.pos[i]);
+                    d.send_left.extend_from_slice(&self.vel[i]);
+                }
+                let (a, b) = self.row_slots(z, recv);
+                m += b - a;
+            }
+            d.recv.resize(6 * m, 0.0);
+            d.comm.shift_exact(to, &d.send_left, from, &mut d.recv);
+            let mut k = 0;
+            for z in d.z0..d.z1 {
+                let (a, b) = self.row_slots(z, recv);
+                for i in a..b {
+                    let r = &d.recv[6 * k..6 * k + 6];
+                    self.pos[i] = [r[0], r[1], r[2]];
+                    self.vel[i] = [r[3], r[4], r[5]];
+                    k += 1;
+                }
+            }
+        }
+    }
+
+    /// After the forces: the last owned slab's forces on the ghost layer go to the rank
+    /// above; the rank below's on the first owned layer arrive into the slab before it (with
+    /// one slab along z the halo stays on the rank).
     pub(super) fn exchange_halo(&mut self) {
         let Some(d) = self.domain.as_mut() else {
             return;
         };
+        if d.pz == 1 {
+            return;
+        }
         d.send_right.clear();
         for f in &self.slabs[d.z1 - 1].halo {
             d.send_right.extend_from_slice(f);
@@ -258,7 +380,7 @@ impl Dpd {
                 d.mine.clear();
                 for i in self.own.0..self.own.1 {
                     let k = self.key[i];
-                    if k & COLLOID_BIT != 0 {
+                    if k & COLLOID_BIT != 0 && !self.ghost[i] {
                         d.mine.push((k & !COLLOID_BIT) as f64);
                         d.mine.extend_from_slice(&self.pos[i]);
                         d.mine.extend_from_slice(&self.vel[i]);
@@ -274,36 +396,59 @@ impl Dpd {
         }
     }
 
-    /// Every rank's `record(layer)` for its owned layers, in layer order, summed element-wise
-    /// in layer order into `total` (`width` numbers a layer): the same additions on any
-    /// number of ranks.
-    pub(super) fn sum_layers(
+    /// Every rank's `record((start, end, virial), numbers)` for each of its rows of cells
+    /// (the slots `start..end` of a row of a layer, the virial of the pairs met from it), the
+    /// rows summed element-wise in the global order of the rows (layer by layer, row by row)
+    /// into `total` (`width` numbers a row): the same additions on any number of ranks.
+    pub(super) fn sum_rows(
         &self,
         width: usize,
-        record: impl Fn(usize, &mut [f64]),
+        record: impl Fn((usize, usize, &PairVirial), &mut [f64]),
         total: &mut [f64],
     ) {
-        let nz = self.slabs.len();
-        let (z0, z1) = self.domain.as_ref().map_or((0, nz), |d| (d.z0, d.z1));
+        let [_, ny, nz] = self.grid.n_cells;
+        let [z0, z1, y0, y1] = self
+            .domain
+            .as_ref()
+            .map_or([0, nz, 0, ny], |d| d.block_of(d.comm.rank()));
         // Buffers kept between calls: the pressure is summed every step of a viscosity run.
         let mut guard = self.layer_sums.borrow_mut();
-        let (mine, all) = &mut *guard;
+        let (mine, all, at) = &mut *guard;
         mine.clear();
-        mine.resize(width * (z1 - z0), 0.0);
-        for (z, r) in (z0..z1).zip(mine.chunks_exact_mut(width)) {
-            record(z, r);
-        }
-        let rows = match &self.domain {
-            None => &*mine,
-            Some(d) => {
-                d.comm.all_gather(mine, all);
-                &*all
+        mine.resize(width * (z1 - z0) * (y1 - y0), 0.0);
+        let mut rows = mine.chunks_exact_mut(width);
+        for z in z0..z1 {
+            for y in y0..y1 {
+                let (a, b) = self.row_slots(z, y);
+                record((a, b, &self.slabs[z].row_virial[y]), rows.next().unwrap());
             }
-        };
+        }
         total.iter_mut().for_each(|t| *t = 0.0);
-        for r in rows.chunks_exact(width) {
+        let mut add = |r: &[f64]| {
             for (t, x) in total.iter_mut().zip(r) {
                 *t += x;
+            }
+        };
+        match &self.domain {
+            None => mine.chunks_exact(width).for_each(&mut add),
+            Some(d) => {
+                d.comm.all_gather(mine, all);
+                // Where each row lies among the ranks' blocks (in rank order).
+                at.clear();
+                at.resize(nz * ny, 0);
+                let mut k = 0;
+                for r in 0..d.comm.size() {
+                    let [z0, z1, y0, y1] = d.block_of(r);
+                    for z in z0..z1 {
+                        for y in y0..y1 {
+                            at[z * ny + y] = k;
+                            k += 1;
+                        }
+                    }
+                }
+                for &k in at.iter() {
+                    add(&all[k * width..(k + 1) * width]);
+                }
             }
         }
     }
@@ -313,9 +458,11 @@ impl Dpd {
     pub(super) fn gather_own(&self, width: usize, row: impl Fn(usize, &mut Vec<f64>)) -> Vec<f64> {
         let mut mine = Vec::with_capacity((self.own.1 - self.own.0) * width);
         for i in self.own.0..self.own.1 {
-            row(i, &mut mine);
+            if !self.ghost[i] {
+                row(i, &mut mine);
+            }
         }
-        debug_assert_eq!(mine.len(), (self.own.1 - self.own.0) * width);
+        debug_assert_eq!(mine.len(), self.owned() * width);
         match &self.domain {
             None => mine,
             Some(d) => {

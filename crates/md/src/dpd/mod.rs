@@ -90,6 +90,10 @@ pub struct DpdParams {
     /// flow along x, gradient along y, streaming profile `u_x(y) = gamma_dot y` (see
     /// [`Dpd`]'s module docs).
     pub shear_rate: f64,
+    /// The grid of ranks `[py, pz]` (columns along y by slabs along z) of a decomposed run;
+    /// `None`: the grid with the fewest ghost cells per rank ([`crate::domain`]). Not physics:
+    /// the run is the same on any grid.
+    pub rank_grid: Option<[usize; 2]>,
 }
 
 impl DpdParams {
@@ -117,6 +121,7 @@ impl DpdParams {
             neighbors: NeighborMode::Auto,
             seed,
             shear_rate: 0.0,
+            rank_grid: None,
         }
     }
 }
@@ -349,7 +354,10 @@ struct Slab {
     force: Vec<[f64; 3]>,
     /// Forces on the next slab's particles from this slab's pairs.
     halo: Vec<[f64; 3]>,
-    virial: PairVirial,
+    /// The virial of the pairs met from each row of cells (along y) of this slab, by the row
+    /// of the particle that meets them: summed row by row in the global order of the rows, the
+    /// total is the same whether the rows are on one rank or on several.
+    row_virial: Vec<PairVirial>,
 }
 
 /// A DPD simulation of solvent beads and colloids.
@@ -392,12 +400,16 @@ pub struct Dpd {
     cc_vel: Vec<[f64; 3]>,
     /// Number of particles (on all ranks).
     n_total: usize,
-    /// Storage range of the particles this rank integrates (all but the ghosts).
+    /// Storage range of the layers this rank integrates: its own particles and, when the run
+    /// is cut along y, the ghosts of its fringe rows ([`Self::ghost`]).
     own: (usize, usize),
+    /// Whether each slot is a ghost (empty when the run is not decomposed).
+    ghost: Vec<bool>,
     /// This rank's layers when the run is decomposed over ranks.
     domain: Option<Domain>,
-    /// Per-layer sums of this rank and of all ranks (buffers of [`Self::sum_layers`]).
-    layer_sums: std::cell::RefCell<(Vec<f64>, Vec<f64>)>,
+    /// Per-row sums of this rank and of all ranks, and where each row's sum lies among them
+    /// (buffers of [`Self::sum_rows`]).
+    layer_sums: std::cell::RefCell<(Vec<f64>, Vec<f64>, Vec<usize>)>,
     /// Range of the cells: interaction range, plus the skin in Verlet mode.
     cell_range: f64,
     builds: u64,
@@ -644,6 +656,7 @@ impl Dpd {
             cc_vel: Vec::new(),
             n_total: n,
             own: (0, n),
+            ghost: Vec::new(),
             domain: None,
             layer_sums: Default::default(),
             cell_range,
@@ -656,8 +669,27 @@ impl Dpd {
             scratch_f64: Vec::new(),
         };
         if let Some(comm) = comm.filter(|c| c.size() > 1) {
-            let nz = CellSort::cells_for(&sbox, cell_range)[2];
-            s.domain = Some(Domain::new(comm, nz, cell_range).map_err(DpdError::Invalid)?);
+            let nc = CellSort::cells_for(&sbox, cell_range);
+            let sheared = p.shear_rate != 0.0;
+            let grid = match p.rank_grid {
+                Some([py, _]) if py > 1 && sheared => {
+                    return Err(DpdError::Invalid(format!(
+                        "rank grid {py} x {} (y x z): a sheared run is cut along z only (py = 1)",
+                        comm.size() / py
+                    )));
+                }
+                Some(g) => g,
+                None => Domain::choose_grid(comm.size(), nc, !sheared),
+            };
+            let d = Domain::grid(comm, [nc[1], nc[2]], grid, cell_range).map_err(|e| {
+                let key = if p.rank_grid.is_some() {
+                    "run.rank_grid: "
+                } else {
+                    ""
+                };
+                DpdError::Invalid(format!("{key}{e}"))
+            });
+            s.domain = Some(d?);
             s.keep_own();
             s.migrate_and_fetch_ghosts()?;
         }
@@ -722,7 +754,9 @@ impl Dpd {
         }
         for slab in &mut s.slabs {
             slab.halo.iter_mut().for_each(|h| *h = [0.0; 3]);
-            slab.virial = PairVirial::default();
+            slab.row_virial
+                .iter_mut()
+                .for_each(|v| *v = PairVirial::default());
         }
         Ok(s)
     }
@@ -756,7 +790,8 @@ impl Dpd {
 
     /// Number of particles this rank integrates (all without a decomposition).
     pub fn owned(&self) -> usize {
-        self.own.1 - self.own.0
+        let (o0, o1) = self.own;
+        o1 - o0 - self.ghost[o0..o1].iter().filter(|&&g| g).count()
     }
 
     /// This rank and the number of ranks the run is decomposed over (`(0, 1)`: not
@@ -795,14 +830,10 @@ impl Dpd {
         }
         let ly = self.sbox.l[1];
         let mut total = vec![0.0; 2 * bins];
-        self.sum_layers(
+        self.sum_rows(
             2 * bins,
-            |z, r| {
-                let s = &self.slabs[z];
-                for (x, v) in self.pos[s.start..s.end]
-                    .iter()
-                    .zip(&self.vel[s.start..s.end])
-                {
+            |(a, b, _), r| {
+                for (x, v) in self.pos[a..b].iter().zip(&self.vel[a..b]) {
                     let k = CellSort::cell_coordinate(x[1], ly, bins);
                     r[k] += v[0];
                     r[bins + k] += 1.0;
@@ -912,14 +943,10 @@ impl Dpd {
     /// Total momentum (summed layer by layer, in layer order).
     pub fn momentum(&self) -> [f64; 3] {
         let mut m = [0.0; 3];
-        self.sum_layers(
+        self.sum_rows(
             3,
-            |z, r| {
-                let s = &self.slabs[z];
-                for (v, w) in self.vel[s.start..s.end]
-                    .iter()
-                    .zip(&self.inv_mass[s.start..s.end])
-                {
+            |(a, b, _), r| {
+                for (v, w) in self.vel[a..b].iter().zip(&self.inv_mass[a..b]) {
                     for k in 0..3 {
                         r[k] += v[k] / w;
                     }
@@ -963,12 +990,11 @@ impl Dpd {
     /// with it ([`Self::thermo`]'s `pressure`, without the rest).
     pub fn pressure_tensor(&self) -> [f64; 6] {
         let mut t = [0.0; 12];
-        self.sum_layers(
+        self.sum_rows(
             12,
-            |z, r| {
-                let s = &self.slabs[z];
-                self.kinetic_tensor(s.start, s.end, &mut r[..6]);
-                r[6..].copy_from_slice(&s.virial.total());
+            |(a, b, virial), r| {
+                self.kinetic_tensor(a, b, &mut r[..6]);
+                r[6..].copy_from_slice(&virial.total());
             },
             &mut t,
         );
@@ -985,15 +1011,13 @@ impl Dpd {
     pub fn pressure_parts(&self) -> [[f64; 6]; PRESSURE_PARTS.len()] {
         const W: usize = 6 * PRESSURE_PARTS.len();
         let mut t = [0.0; W];
-        self.sum_layers(
+        self.sum_rows(
             W,
-            |z, r| {
-                let s = &self.slabs[z];
-                for (i, &k) in (s.start..s.end).zip(&self.key[s.start..s.end]) {
+            |(a, b, v), r| {
+                for (i, &k) in (a..b).zip(&self.key[a..b]) {
                     let c = usize::from(k & COLLOID_BIT != 0);
                     self.kinetic_tensor(i, i + 1, &mut r[6 * c..6 * c + 6]);
                 }
-                let v = &s.virial;
                 let minus = |a: &[f64; 6], b: &[f64; 6]| -> [f64; 6] {
                     std::array::from_fn(|k| a[k] - b[k])
                 };
@@ -1036,6 +1060,7 @@ impl Dpd {
             let slab_of = &self.slab_of;
             let inv_mass = &self.inv_mass;
             let ref_pos = &self.ref_pos;
+            let ghost = &self.ghost;
             let n_slabs = slabs.len();
             self.pos[o0..o1]
                 .par_iter_mut()
@@ -1045,6 +1070,9 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(k, ((x, v), img))| {
                     let i = o0 + k;
+                    if ghost[i] {
+                        return (0.0, usize::MAX, 0.0);
+                    }
                     let f = total_force(slabs, slab_of, n_slabs, i);
                     let im = inv_mass[i] * half;
                     let mut step2 = 0.0;
@@ -1100,7 +1128,7 @@ impl Dpd {
             (o0..o1)
                 .find(|&i| {
                     let (x, v) = (self.pos[i], self.vel[i]);
-                    x.iter().chain(&v).any(|a| !a.is_finite())
+                    !self.ghost[i] && x.iter().chain(&v).any(|a| !a.is_finite())
                 })
                 .map_or(-1.0, tag_of)
         } else {
@@ -1162,6 +1190,7 @@ impl Dpd {
             let slab_of = &self.slab_of;
             let inv_mass = &self.inv_mass;
             let key = &self.key;
+            let ghost = &self.ghost;
             let n_slabs = slabs.len();
             self.vel[o0..o1]
                 .par_iter_mut()
@@ -1169,6 +1198,9 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(k, v)| {
                     let i = o0 + k;
+                    if ghost[i] {
+                        return u32::MAX;
+                    }
                     let f = total_force(slabs, slab_of, n_slabs, i);
                     let im = inv_mass[i] * half;
                     for k in 0..3 {
@@ -1249,12 +1281,11 @@ impl Dpd {
         let nt = self.type_names.len().max(1);
         let width = 9 + 2 * nt + VIRIAL_NUMBERS;
         let mut sums = vec![0.0; width];
-        self.sum_layers(
+        self.sum_rows(
             width,
-            |z, r| {
-                let s = &self.slabs[z];
-                self.kinetic_tensor(s.start, s.end, &mut r[..6]);
-                for (i, &k) in (s.start..s.end).zip(&self.key[s.start..s.end]) {
+            |(a, b, virial), r| {
+                self.kinetic_tensor(a, b, &mut r[..6]);
+                for (i, &k) in (a..b).zip(&self.key[a..b]) {
                     let q = &self.props[(k & !COLLOID_BIT) as usize];
                     let m = q.mass;
                     let (v, u) = (self.vel[i], self.peculiar(i));
@@ -1264,7 +1295,7 @@ impl Dpd {
                         r[6 + k] += m * v[k];
                     }
                 }
-                s.virial.write(&mut r[9 + 2 * nt..]);
+                virial.write(&mut r[9 + 2 * nt..]);
             },
             &mut sums,
         );
@@ -1322,6 +1353,7 @@ impl Dpd {
         self.grid.layer_of_slots(&mut self.slab_of);
         self.slab_start.clear();
         self.slab_start.extend(self.slabs.iter().map(|s| s.start));
+        let ny = self.grid.n_cells[1];
         for z in 0..nz {
             let next = &self.slabs[(z + 1) % nz];
             let m = next.end - next.start;
@@ -1329,6 +1361,7 @@ impl Dpd {
             let s = &mut self.slabs[z];
             s.force.resize(own, [0.0; 3]);
             s.halo.resize(m, [0.0; 3]);
+            s.row_virial.resize_with(ny, PairVirial::default);
         }
         self.set_own_range();
     }
@@ -1536,13 +1569,21 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         nbr,
         force,
         halo,
-        virial,
+        row_virial,
         cand,
     } = slab;
     let (start, end) = (*start, *end);
     force.iter_mut().for_each(|f| *f = [0.0; 3]);
     halo.iter_mut().for_each(|f| *f = [0.0; 3]);
+    row_virial
+        .iter_mut()
+        .for_each(|v| *v = PairVirial::default());
     let mut vir = PairVirial::default();
+    // The virial goes to the row of the particle meeting the pair: storage is by row, so the
+    // accumulator moves on to the next row at each row's last slot.
+    let [nx, ny, _] = c.n_cells;
+    let row_end = |y: usize| c.cell_start[(z * ny + y + 1) * nx] as usize;
+    let (mut row, mut row_stop) = (0, row_end(0));
     let mut out = Out {
         start,
         end,
@@ -1562,6 +1603,13 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
             SHEAR.then_some(c.shear_offset),
             cand,
             |i, cands| {
+                if THERMO {
+                    while i >= row_stop {
+                        row_virial[row] = std::mem::take(&mut *out.vir);
+                        row += 1;
+                        row_stop = row_end(row);
+                    }
+                }
                 particle_forces::<THERMO, SHEAR>(
                     c,
                     i,
@@ -1573,6 +1621,13 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         );
     } else {
         for i in start..end {
+            if THERMO {
+                while i >= row_stop {
+                    row_virial[row] = std::mem::take(&mut *out.vir);
+                    row += 1;
+                    row_stop = row_end(row);
+                }
+            }
             let xi = c.pos[i];
             let k0 = nbr_start[i - start] as usize;
             let k1 = nbr_start[i - start + 1] as usize;
@@ -1589,7 +1644,9 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
             particle_forces::<THERMO, SHEAR>(c, i, pairs, &mut out, has_cc);
         }
     }
-    *virial = if THERMO { vir } else { PairVirial::default() };
+    if THERMO {
+        row_virial[row] = vir;
+    }
 }
 
 /// Where one slab's forces go.

@@ -227,6 +227,11 @@ pub struct RunSection {
     /// gradient along y.
     #[serde(default)]
     pub shear_rate: f64,
+    /// The grid of MPI ranks `[py, pz]` of a decomposed run: columns along y by slabs along z
+    /// (their product the number of ranks); unset: the grid with the fewest ghost cells. Not
+    /// physics: the run is bitwise the same on any grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rank_grid: Option<[usize; 2]>,
 }
 
 fn d_auto() -> String {
@@ -259,6 +264,7 @@ impl Default for RunSection {
             temperature_window: d_window(),
             neighbors: d_auto(),
             shear_rate: 0.0,
+            rank_grid: None,
         }
     }
 }
@@ -515,6 +521,20 @@ impl DpdScenario {
         let dt = positive("run.dt", r.dt)?;
         let skin = in_range("run.skin", r.skin, 0.05, 2.0)?;
         let shear_rate = in_range("run.shear_rate", r.shear_rate, 0.0, 10.0)?;
+        if let Some([py, pz]) = r.rank_grid {
+            if py == 0 || pz == 0 {
+                return Err(ParamError::new(
+                    "run.rank_grid",
+                    format!("[{py}, {pz}]: ranks along y and along z, each at least 1"),
+                ));
+            }
+            if py > 1 && shear_rate > 0.0 {
+                return Err(ParamError::new(
+                    "run.rank_grid",
+                    format!("[{py}, {pz}]: a sheared run is cut along z only (py = 1)"),
+                ));
+            }
+        }
         let max_drift = in_range(
             "run.max_temperature_drift",
             r.max_temperature_drift,
@@ -646,6 +666,7 @@ impl DpdScenario {
             neighbors,
             seed,
             shear_rate,
+            rank_grid: r.rank_grid,
         };
         Ok(DpdSetup {
             params,
