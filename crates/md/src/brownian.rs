@@ -245,11 +245,13 @@ pub struct Brownian<P: Pair, E: External> {
     lm_step: Option<u64>,
     /// A run decomposed over ranks ([`Self::decomposed`]): this rank's layers and messages.
     domain: Option<Domain>,
-    /// The owned slots (all, on one rank; the ghosts lie before or after them).
+    /// The span of the owned layers' slots (all, on one rank; the ghost layer lies before or
+    /// after it, the fringe rows of a run cut along y inside it).
     own: (usize, usize),
-    /// Slot of the first owned particle in the storage order of the whole system (the noise
-    /// streams are keyed by that order).
-    first_slot: usize,
+    /// The owned slots as runs `(start, end, g)` of consecutive slots, `g` the slot of `start`
+    /// in the storage order of the whole system (the noise streams are keyed by that order):
+    /// one run on one rank or on slabs, a run per owned layer on a grid cut along y.
+    runs: Vec<(usize, usize, usize)>,
     /// Decomposed: every particle's constants (type, diameter, mass, velocity) in input order.
     whole: Option<Box<Particles>>,
 }
@@ -560,7 +562,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
             lm_step: None,
             domain: None,
             own: (0, n),
-            first_slot: 0,
+            runs: vec![(0, n, 0)],
             whole: None,
         };
         if params.integrator == Integrator::Lm {
@@ -932,21 +934,24 @@ impl<P: Pair, E: External> Brownian<P, E> {
             lm: lm.then_some((&self.lm_now[..], &self.lm_next[..])),
         };
         // The owned slots, whose noise comes from the blocks of the whole system's storage
-        // order: a first, partial block when this domain starts inside one, then whole chunks.
-        let (a, b) = self.own;
-        let g0 = self.first_slot;
-        let head = ((BLOCK - g0 % BLOCK) % BLOCK).min(b - a);
-        let (head_out, rest) = new_pos[a..b].split_at_mut(head);
-        let first = pass.integrate(a, head_out, (g0 / BLOCK) as u64, g0 % BLOCK);
-        let g1 = (g0 + head) / BLOCK;
-        let report = rest
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(c, out)| {
-                let lo = a + head + c * CHUNK;
-                pass.integrate(lo, out, (g1 + c * CHUNK / BLOCK) as u64, 0)
-            })
-            .reduce(|| first, ChunkReport::merge);
+        // order: run by run, a first, partial block when the run starts inside one, then
+        // whole chunks.
+        let mut report = ChunkReport::EMPTY;
+        for &(a, b, g0) in &self.runs {
+            let head = ((BLOCK - g0 % BLOCK) % BLOCK).min(b - a);
+            let (head_out, rest) = new_pos[a..b].split_at_mut(head);
+            let first = pass.integrate(a, head_out, (g0 / BLOCK) as u64, g0 % BLOCK);
+            let g1 = (g0 + head) / BLOCK;
+            let run = rest
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(c, out)| {
+                    let lo = a + head + c * CHUNK;
+                    pass.integrate(lo, out, (g1 + c * CHUNK / BLOCK) as u64, 0)
+                })
+                .reduce(|| first, ChunkReport::merge);
+            report = ChunkReport::merge(report, run);
+        }
         let (max_disp2, blow_up) = self.agree_on_step(report, &mut new_pos);
         if let Some(e) = blow_up {
             self.new_pos = new_pos;

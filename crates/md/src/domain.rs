@@ -161,15 +161,30 @@ impl Domain {
         ]
     }
 
+    /// Whether this rank holds particles of layer `z`: its own, or the ghost layer.
+    pub fn holds_layer(&self, z: usize) -> bool {
+        self.owns(z) || (self.pz > 1 && z == self.ghost_layer())
+    }
+
+    /// Whether this rank holds particles of row `y`: its own, or a fringe row.
+    pub fn holds_row(&self, y: usize) -> bool {
+        self.py == 1
+            || self.owns_row(y)
+            || y == self.y1 % self.ny
+            || y == (self.y0 + self.ny - 1) % self.ny
+    }
+
     /// Whether row `y` is this rank's.
     pub fn owns_row(&self, y: usize) -> bool {
         (self.y0..self.y1).contains(&y)
     }
 
-    /// The grid `[py, pz]` for `p` ranks over `[nx, ny, nz]` cells that holds the fewest ghost
-    /// cells per rank (ties: fewer columns), among those [`Self::grid`] accepts; `y_cuts`
+    /// The grid `[py, pz]` for `p` ranks over `[nx, ny, nz]` cells that costs the least per
+    /// rank in ghosts (ties: fewer columns), among those [`Self::grid`] accepts; `y_cuts`
     /// false: slabs only. A slab holds a ghost layer (`nx ny` cells when `pz > 1`); a column
-    /// also a fringe row on each side of each of its layers, whose pairs it computes too.
+    /// also a fringe row on each side of each of its layers, whose pairs it computes too: a
+    /// fringe cell counts as four ghost-layer cells (sorted and copied, a third of a cell's
+    /// step, against a whole step and that; docs/parallel.md). So slabs wherever they fit.
     pub fn choose_grid(p: usize, [nx, ny, nz]: [usize; 3], y_cuts: bool) -> [usize; 2] {
         let mut best: Option<(usize, [usize; 2])> = None;
         for py in 1..=p {
@@ -187,7 +202,7 @@ impl Domain {
                 0
             };
             let fringe = if py > 1 { 2 * nx * nz.div_ceil(pz) } else { 0 };
-            let cost = slab + fringe;
+            let cost = slab + 4 * fringe;
             if best.is_none_or(|(c, _)| cost < c) {
                 best = Some((cost, [py, pz]));
             }
@@ -268,5 +283,23 @@ impl Domain {
             .fold((u32::MAX, u32::MAX), |(a, b), g| {
                 (a.min(g[0] as u32), b.min(g[1] as u32))
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Domain;
+
+    #[test]
+    fn the_grid_chosen_is_slabs_where_they_fit_and_columns_beyond() {
+        // The L = 30 water box: slabs up to 30 ranks.
+        assert_eq!(Domain::choose_grid(4, [30, 30, 30], true), [1, 4]);
+        assert_eq!(Domain::choose_grid(30, [30, 30, 30], true), [1, 30]);
+        // Beyond: as few columns as the layers allow, each with two fringe rows.
+        assert_eq!(Domain::choose_grid(60, [30, 30, 30], true), [2, 30]);
+        assert_eq!(Domain::choose_grid(6, [5, 5, 5], true), [2, 3]);
+        // Sheared runs (no y cuts), and grids that do not fit: slabs, refused by `grid`.
+        assert_eq!(Domain::choose_grid(6, [5, 5, 5], false), [1, 6]);
+        assert_eq!(Domain::choose_grid(13, [11, 11, 11], true), [1, 13]);
     }
 }

@@ -192,6 +192,16 @@ final_volume_fraction = 0.3
         });
         assert!(got.iter().all(|e| e == &want), "{ranks} ranks differ");
     }
+    let got = on_ranks(4, |c| {
+        let mut sim = dp
+            .build_replica(0)
+            .unwrap()
+            .decomposed_on(c, Some([2, 2]))
+            .unwrap();
+        steps(&mut sim, n_steps);
+        end(&sim)
+    });
+    assert!(got.iter().all(|e| e == &want), "a 2 x 2 grid differs");
 }
 
 /// A time step far too large stops every rank with the single-rank run's error.
@@ -212,11 +222,91 @@ fn a_blow_up_stops_every_rank_with_one_error() {
 }
 
 #[test]
-fn more_ranks_than_layers_are_refused() {
+fn more_ranks_than_any_grid_fits_are_refused() {
+    // 11 x 11 x 11 cells: 13 ranks (prime) fit neither as slabs nor as columns.
     let (p, sbox, params) = sedimenting(Integrator::Euler);
-    let got = on_ranks(12, |c| build(&p, sbox, params, None, 0).decomposed(c).err());
+    let got = on_ranks(13, |c| build(&p, sbox, params, None, 0).decomposed(c).err());
     for e in got {
         let msg = e.unwrap().to_string();
-        assert!(msg.contains("12 ranks for 11 layers"), "{msg}");
+        assert!(msg.contains("13 ranks for 11 layers"), "{msg}");
     }
+}
+
+/// Grids cut along y as well as z: each rank holds a fringe row of ghosts on each side of its
+/// rows and sums the pairs across the cut itself; its owned slots are a run per layer, each
+/// drawing its noise from where it starts in the whole system's order.
+#[test]
+fn sedimenting_spheres_on_grids_cut_along_y_are_the_single_rank_run() {
+    let (p, sbox, params) = sedimenting(Integrator::Euler);
+    let mut one = build(&p, sbox, params, None, 0);
+    one.run(600).unwrap();
+    let want = end(&one);
+    for grid in [[2, 1], [2, 2], [3, 2]] {
+        let got = on_ranks(grid[0] * grid[1], |c| {
+            let mut sim = build(&p, sbox, params, None, 0)
+                .decomposed_on(c, Some(grid))
+                .unwrap();
+            let owned = run_counting(&mut sim, 600);
+            (end(&sim), owned)
+        });
+        for (r, (e, owned)) in got.iter().enumerate() {
+            assert!(
+                e == &want,
+                "grid {grid:?}: rank {r} differs from one process"
+            );
+            assert!(owned.0 < owned.1, "grid {grid:?}: rank {r} owned {owned:?}");
+        }
+    }
+    // More ranks than layers: the grid chosen cuts along y (12 ranks, 11 layers).
+    let got = on_ranks(12, |c| {
+        let mut sim = build(&p, sbox, params, None, 0).decomposed(c).unwrap();
+        steps(&mut sim, 600);
+        end(&sim)
+    });
+    assert!(got.iter().all(|e| e == &want), "12 ranks differ");
+}
+
+#[test]
+fn leimkuhler_matthews_and_a_checkpoint_on_a_2_x_2_grid_are_the_single_rank_run() {
+    let (p, sbox, params) = sedimenting(Integrator::Lm);
+    let mut one = build(&p, sbox, params, None, 0);
+    one.run(150).unwrap();
+    let want = end(&one);
+    let got = on_ranks(4, |c| {
+        let mut sim = build(&p, sbox, params, None, 0)
+            .decomposed_on(c, Some([2, 2]))
+            .unwrap();
+        steps(&mut sim, 150);
+        end(&sim)
+    });
+    assert!(got.iter().all(|e| e == &want));
+    // Euler: a checkpoint (particles and list state) of a 2 x 2 grid continues on slabs and on
+    // one process as the uninterrupted run.
+    let (p, sbox, params) = sedimenting(Integrator::Euler);
+    let mut one = build(&p, sbox, params, None, 0);
+    one.run(300).unwrap();
+    let want = end(&one);
+    let saved = on_ranks(4, |c| {
+        let mut sim = build(&p, sbox, params, None, 0)
+            .decomposed_on(c, Some([2, 2]))
+            .unwrap();
+        steps(&mut sim, 170);
+        (sim.snapshot(), sim.list_state(), sim.step)
+    });
+    let (snap, list, step) = &saved[0];
+    assert!(saved.iter().all(|s| &s.0 == snap && &s.1 == list));
+    let got = on_ranks(3, |c| {
+        let mut sim = build(snap, sbox, params, Some(list), *step)
+            .decomposed(c)
+            .unwrap();
+        steps(&mut sim, 130);
+        end(&sim)
+    });
+    assert!(
+        got.iter()
+            .all(|e| e.snap == want.snap && e.forces == want.forces)
+    );
+    let mut back = build(snap, sbox, params, Some(list), *step);
+    back.run(130).unwrap();
+    assert_eq!(end(&back).snap, want.snap);
 }

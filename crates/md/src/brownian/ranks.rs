@@ -42,7 +42,19 @@ impl<P: Pair, E: External> Brownian<P, E> {
     /// (the same particles, or the same checkpoint) and keeps its layers and the ghosts. One
     /// rank: the engine unchanged. An error when the run has no pair forces (no cells to cut)
     /// or more ranks than z-layers of cells.
-    pub fn decomposed(mut self, comm: Box<dyn Exchange>) -> Result<Self, BdError> {
+    pub fn decomposed(self, comm: Box<dyn Exchange>) -> Result<Self, BdError> {
+        self.decomposed_on(comm, None)
+    }
+
+    /// [`Self::decomposed`] on the grid `[py, pz]` of ranks (columns along y by slabs along z;
+    /// `None`: the grid with the fewest ghost cells per rank, [`Domain::choose_grid`]). Cut
+    /// along y, a rank also holds a fringe row of ghosts on each side of its rows and sums the
+    /// pairs across the cut itself: the run is the same on any grid.
+    pub fn decomposed_on(
+        mut self,
+        comm: Box<dyn Exchange>,
+        grid: Option<[usize; 2]>,
+    ) -> Result<Self, BdError> {
         if comm.size() == 1 {
             return Ok(self);
         }
@@ -53,19 +65,26 @@ impl<P: Pair, E: External> Brownian<P, E> {
                     .into(),
             ));
         }
-        let nz = self.grid.n_cells[2];
-        let d = Domain::new(comm, nz, self.range).map_err(BdError::Invalid)?;
+        let nc = self.grid.n_cells;
+        let [nx, ny, nz] = nc;
+        let g = grid.unwrap_or_else(|| Domain::choose_grid(comm.size(), nc, true));
+        let d = Domain::grid(comm, [ny, nz], g, self.range).map_err(BdError::Invalid)?;
         // The constants of every particle, by tag (positions unused).
         self.whole = Some(Box::new(self.snapshot()));
-        let own = (self.grid.layer(d.z0).0, self.grid.layer(d.z1 - 1).1);
-        let ghost = self.grid.layer(d.ghost_layer());
-        self.first_slot = own.0;
-        // Keep the owned and the ghost slots, in storage order (each moves down or stays).
-        let keep: Vec<usize> = if ghost.0 < own.0 {
-            (ghost.0..ghost.1).chain(own.0..own.1).collect()
-        } else {
-            (own.0..own.1).chain(ghost.0..ghost.1).collect()
-        };
+        // Where each owned layer's rows start in the whole system's order.
+        let starts: Vec<usize> = (d.z0..d.z1)
+            .map(|z| self.grid.cell_start[(z * ny + d.y0) * nx] as usize)
+            .collect();
+        // Keep the cells this rank holds, in storage order (each slot moves down or stays).
+        let mut keep = Vec::new();
+        for z in (0..nz).filter(|&z| d.holds_layer(z)) {
+            for y in (0..ny).filter(|&y| d.holds_row(y)) {
+                let c = (z * ny + y) * nx;
+                keep.extend(
+                    self.grid.cell_start[c] as usize..self.grid.cell_start[c + nx] as usize,
+                );
+            }
+        }
         for (to, &from) in keep.iter().enumerate() {
             self.move_slot(from, to);
             self.ref_pos[to] = self.ref_pos[from];
@@ -73,7 +92,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.truncate_slots(keep.len());
         self.ref_pos.truncate(keep.len());
         self.domain = Some(d);
-        self.sort_local();
+        self.sort_local(&starts);
         // The lists of the owned layers again: not a build of the run's.
         let builds = self.builds;
         self.build_lists();
@@ -94,7 +113,12 @@ impl<P: Pair, E: External> Brownian<P, E> {
 
     /// Particles this rank owns (all on one process).
     pub fn owned(&self) -> usize {
-        self.own.1 - self.own.0
+        self.runs.iter().map(|&(a, b, _)| b - a).sum()
+    }
+
+    /// The owned slots, in increasing order.
+    fn owned_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        self.runs.iter().flat_map(|&(a, b, _)| a..b)
     }
 
     /// Particles in the whole system (on every rank).
@@ -145,14 +169,25 @@ impl<P: Pair, E: External> Brownian<P, E> {
     }
 
     /// Sort the stored particles and ghosts into the global cells by their reference positions
-    /// (ties by tag) and find the owned slots.
-    fn sort_local(&mut self) {
+    /// (ties by tag) and find the owned slots: a run per owned layer, starting at `starts[k]`
+    /// in the whole system's order (merged where consecutive in both orders: one run on slabs).
+    fn sort_local(&mut self, starts: &[usize]) {
         self.grid
             .sort(&self.sbox, &self.ref_pos, &self.tag, self.range);
         self.apply_perm();
         permute(&mut self.ref_pos, &self.grid.perm, &mut self.scratch3);
         let d = self.domain.as_ref().expect("decomposed");
         self.own = (self.grid.layer(d.z0).0, self.grid.layer(d.z1 - 1).1);
+        let [nx, ny, _] = self.grid.n_cells;
+        let slot = |z: usize, y: usize| self.grid.cell_start[(z * ny + y) * nx] as usize;
+        self.runs.clear();
+        for (z, &g) in (d.z0..d.z1).zip(starts) {
+            let (a, b) = (slot(z, d.y0), slot(z, d.y1 - 1 + 1));
+            match self.runs.last_mut() {
+                Some(r) if r.1 == a && r.2 + (r.1 - r.0) == g => r.1 = b,
+                _ => self.runs.push((a, b, g)),
+            }
+        }
     }
 
     /// A list build of a decomposed run: wrap, migrate, fetch the ghost layer, sort, agree on
@@ -160,25 +195,42 @@ impl<P: Pair, E: External> Brownian<P, E> {
     pub(super) fn rebuild_decomposed(&mut self) -> Result<(), BdError> {
         let mut d = self.domain.take().expect("decomposed");
         let lost = self.migrate(&mut d);
-        // Where this rank's slots start, and whether a particle was lost on any rank.
-        let n_own = self.own.1 - self.own.0;
+        // Where this rank's rows of each owned layer start in the whole system's order: every
+        // rank's particles per owned layer, and whether a particle was lost on any rank.
         d.mine.clear();
-        d.mine
-            .extend_from_slice(&[n_own as f64, lost.map_or(-1.0, |t| t as f64)]);
-        d.comm.all_gather_same(&d.mine, &mut d.gathered);
-        let r = d.comm.rank();
-        self.first_slot = d
-            .gathered
-            .chunks_exact(2)
-            .take(r)
-            .map(|g| g[0] as usize)
-            .sum();
-        let lost = d
-            .gathered
-            .chunks_exact(2)
-            .filter(|g| g[1] >= 0.0)
-            .map(|g| g[1] as u32)
-            .min();
+        d.mine.push(lost.map_or(-1.0, |t| t as f64));
+        d.mine.resize(1 + d.z1 - d.z0, 0.0);
+        let l = self.sbox.l[2];
+        for k in self.owned_slots() {
+            let z = CellSort::cell_coordinate(self.particles.pos[k][2], l, d.nz);
+            d.mine[1 + z - d.z0] += 1.0;
+        }
+        d.comm.all_gather(&d.mine, &mut d.gathered);
+        // count[z * py + ry]: the particles of layer z in column ry.
+        let mut count = vec![0usize; d.nz * d.py];
+        let mut lost = None::<u32>;
+        let mut at = 0;
+        for r in 0..d.comm.size() {
+            let [z0, z1, ..] = d.block_of(r);
+            let g = &d.gathered[at..at + 1 + z1 - z0];
+            if g[0] >= 0.0 {
+                lost = Some(lost.map_or(g[0] as u32, |t| t.min(g[0] as u32)));
+            }
+            for z in z0..z1 {
+                count[z * d.py + r % d.py] = g[1 + z - z0] as usize;
+            }
+            at += 1 + z1 - z0;
+        }
+        let ry = d.comm.rank() % d.py;
+        let before: usize = count[..d.z0 * d.py].iter().sum();
+        let starts: Vec<usize> = (d.z0..d.z1)
+            .scan(before, |g, z| {
+                let row = &count[z * d.py..(z + 1) * d.py];
+                let start = *g + row[..ry].iter().sum::<usize>();
+                *g += row.iter().sum::<usize>();
+                Some(start)
+            })
+            .collect();
         self.domain = Some(d);
         if let Some(tag) = lost {
             return Err(BdError::Invalid(format!(
@@ -189,45 +241,109 @@ impl<P: Pair, E: External> Brownian<P, E> {
         }
         self.ref_pos.clear();
         self.ref_pos.extend_from_slice(&self.particles.pos);
-        self.sort_local();
+        self.sort_local(&starts);
         self.build_lists();
         Ok(())
     }
 
-    /// Drop the ghosts, wrap, send the leavers to their neighbour and take the arrivals, fetch
-    /// the ghost layer. Returns the lowest tag of a particle that skipped a rank (dropped).
+    /// Drop the ghosts, wrap, send the leavers to their neighbours (along z, then along y)
+    /// and take the arrivals, fetch the fringe rows and the ghost layer. Returns the lowest tag
+    /// of a particle that skipped a rank (dropped).
     fn migrate(&mut self, d: &mut Domain) -> Option<u32> {
-        let (a, b) = self.own;
-        for k in 0..b - a {
-            self.move_slot(a + k, k);
+        let mut n = 0;
+        for k in 0..self.runs.len() {
+            let (a, b, _) = self.runs[k];
+            for i in a..b {
+                self.move_slot(i, n);
+                n += 1;
+            }
         }
-        self.truncate_slots(b - a);
+        self.truncate_slots(n);
         let sbox = self.sbox;
         let p = &mut self.particles;
         for (x, img) in p.pos.iter_mut().zip(p.image.iter_mut()) {
             sbox.wrap(x, img);
         }
-        let (left, right) = (d.left(), d.right());
+        let mut lost: Option<u32> = None;
+        if d.pz > 1 {
+            self.send_leavers(d, true, &mut lost);
+        }
+        if d.py > 1 {
+            self.send_leavers(d, false, &mut lost);
+        }
+        let n_own = self.tag.len();
+        self.own = (0, n_own);
+        self.runs.clear();
+        self.runs.push((0, n_own, 0));
+        let cell = |x: &[f64; 3], k: usize, n: usize| CellSort::cell_coordinate(x[k], sbox.l[k], n);
+        // Fringe rows: the first owned row is the upper fringe of the column before, the last
+        // the lower fringe of the column after.
+        if d.py > 1 {
+            for (row, to, from) in [
+                (d.y0, d.y_left(), d.y_right()),
+                (d.y1 - 1, d.y_right(), d.y_left()),
+            ] {
+                d.send_left.clear();
+                for k in 0..n_own {
+                    let x = self.particles.pos[k];
+                    if cell(&x, 1, d.ny) == row {
+                        d.send_left.push(self.tag[k] as f64);
+                        d.send_left.extend_from_slice(&x);
+                    }
+                }
+                d.comm.shift(to, &d.send_left, from, &mut d.recv);
+                self.take_ghosts(d);
+            }
+        }
+        // The first layer, fringe rows included, is the ghost layer of the rank below.
+        if d.pz > 1 {
+            d.send_left.clear();
+            for k in 0..self.tag.len() {
+                let x = self.particles.pos[k];
+                if cell(&x, 2, d.nz) == d.z0 {
+                    d.send_left.push(self.tag[k] as f64);
+                    d.send_left.extend_from_slice(&x);
+                }
+            }
+            d.comm.shift(d.left(), &d.send_left, d.right(), &mut d.recv);
+            self.take_ghosts(d);
+        }
+        lost
+    }
+
+    /// Send the owned particles outside this rank's layers (`along_z`) or rows to the
+    /// neighbour along that axis and take the neighbours' (the last slot fills a hole).
+    fn send_leavers(&mut self, d: &mut Domain, along_z: bool, lost: &mut Option<u32>) {
+        let sbox = self.sbox;
+        let (left, right) = if along_z {
+            (d.left(), d.right())
+        } else {
+            (d.y_left(), d.y_right())
+        };
         d.send_left.clear();
         d.send_right.clear();
-        let mut lost: Option<u32> = None;
-        let (mut i, mut n) = (0, b - a);
+        let (mut i, mut n) = (0, self.tag.len());
         while i < n {
             let x = self.particles.pos[i];
-            let z = CellSort::cell_coordinate(x[2], sbox.l[2], d.nz);
-            if d.owns(z) {
+            let (mine, to) = if along_z {
+                let z = CellSort::cell_coordinate(x[2], sbox.l[2], d.nz);
+                (d.owns(z), d.owner(z))
+            } else {
+                let y = CellSort::cell_coordinate(x[1], sbox.l[1], d.ny);
+                (d.owns_row(y), d.y_owner(y))
+            };
+            if mine {
                 i += 1;
                 continue;
             }
             let tag = self.tag[i];
-            let to = d.owner(z);
-            // With two ranks the left and the right neighbour are one rank.
+            // With two ranks along the axis the left and the right neighbour are one rank.
             let buf = if to == right {
                 Some(&mut d.send_right)
             } else if to == left {
                 Some(&mut d.send_left)
             } else {
-                lost = Some(lost.map_or(tag, |l| l.min(tag)));
+                *lost = Some(lost.map_or(tag, |l| l.min(tag)));
                 None
             };
             if let Some(buf) = buf {
@@ -245,24 +361,15 @@ impl<P: Pair, E: External> Brownian<P, E> {
             d.comm.shift(left, &d.send_left, right, &mut d.recv);
             self.take_migrants(&d.recv);
         }
-        let n_own = self.tag.len();
-        self.own = (0, n_own);
-        // This rank's first layer is the left rank's ghost layer.
-        d.send_left.clear();
-        for k in 0..n_own {
-            let x = self.particles.pos[k];
-            if CellSort::cell_coordinate(x[2], sbox.l[2], d.nz) == d.z0 {
-                d.send_left.push(self.tag[k] as f64);
-                d.send_left.extend_from_slice(&x);
-            }
-        }
-        d.comm.shift(left, &d.send_left, right, &mut d.recv);
+    }
+
+    /// The ghosts just received (tag, position).
+    fn take_ghosts(&mut self, d: &mut Domain) {
         let recv = std::mem::take(&mut d.recv);
         for g in recv.chunks_exact(GHOST) {
             self.push_slot(g[0] as u32, [g[1], g[2], g[3]], [0; 3]);
         }
         d.recv = recv;
-        lost
     }
 
     fn take_migrants(&mut self, recv: &[f64]) {
@@ -278,6 +385,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let Some(d) = self.domain.as_mut() else {
             return;
         };
+        if d.pz == 1 {
+            return;
+        }
         let last = &self.slabs[d.z1 - 1];
         d.send_right.clear();
         for f in &last.acc[last.end - last.start..] {
@@ -323,19 +433,56 @@ impl<P: Pair, E: External> Brownian<P, E> {
             }
             _ => d.mine.extend_from_slice(&[-1.0; AGREE - 1]),
         }
-        let first = &self.slabs[d.z0];
-        d.send_left.clear();
-        for x in &new_pos[first.start..first.end] {
-            d.send_left.extend_from_slice(x);
+        if d.py > 1 {
+            // The fringe rows first: the ghost layer sent below includes them.
+            let [nx, ny, _] = self.grid.n_cells;
+            let rows = |z: usize, y: usize| {
+                let c = (z * ny + y) * nx;
+                self.grid.cell_start[c] as usize..self.grid.cell_start[c + nx] as usize
+            };
+            let below = (d.y0 + ny - 1) % ny;
+            for (send, to, recv, from) in [
+                (d.y0, d.y_left(), d.y1 % ny, d.y_right()),
+                (d.y1 - 1, d.y_right(), below, d.y_left()),
+            ] {
+                d.send_left.clear();
+                let mut m = 0;
+                for z in d.z0..d.z1 {
+                    for x in &new_pos[rows(z, send)] {
+                        d.send_left.extend_from_slice(x);
+                    }
+                    m += rows(z, recv).len();
+                }
+                d.recv.resize(3 * m, 0.0);
+                d.comm.shift_exact(to, &d.send_left, from, &mut d.recv);
+                let mut k = 0;
+                for z in d.z0..d.z1 {
+                    for x in &mut new_pos[rows(z, recv)] {
+                        *x = [d.recv[k], d.recv[k + 1], d.recv[k + 2]];
+                        k += 3;
+                    }
+                }
+            }
         }
-        let g = &self.slabs[d.ghost_layer()];
-        d.recv.resize(3 * (g.end - g.start), 0.0);
-        d.agree_and_fetch_ghosts();
-        for (x, m) in new_pos[g.start..g.end]
-            .iter_mut()
-            .zip(d.recv.chunks_exact(3))
-        {
-            *x = [m[0], m[1], m[2]];
+        if d.pz > 1 {
+            let first = &self.slabs[d.z0];
+            d.send_left.clear();
+            for x in &new_pos[first.start..first.end] {
+                d.send_left.extend_from_slice(x);
+            }
+            let g = &self.slabs[d.ghost_layer()];
+            d.recv.resize(3 * (g.end - g.start), 0.0);
+            d.agree_and_fetch_ghosts();
+            for (x, m) in new_pos[g.start..g.end]
+                .iter_mut()
+                .zip(d.recv.chunks_exact(3))
+            {
+                *x = [m[0], m[1], m[2]];
+            }
+        } else {
+            let mine = std::mem::take(&mut d.mine);
+            d.comm.all_gather_same(&mine, &mut d.gathered);
+            d.mine = mine;
         }
         // NaN never wins, as in one process's reduction.
         let max_disp2 = d
@@ -364,24 +511,25 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let d = self.domain.as_ref().expect("decomposed");
         let mut slabs = self.slabs.clone();
         all_pair_forces(&mut slabs[d.z0..d.z1], &self.particles, &self.pair);
-        let last = &slabs[d.z1 - 1];
-        let send: Vec<f64> = last.acc[last.end - last.start..]
-            .iter()
-            .flatten()
-            .copied()
-            .collect();
-        let before = &mut slabs[d.before_layer()];
-        let halo = &mut before.acc[before.end - before.start..];
-        let mut recv = vec![0.0; 3 * halo.len()];
-        d.comm.shift_exact(d.right(), &send, d.left(), &mut recv);
-        for (f, m) in halo.iter_mut().zip(recv.chunks_exact(3)) {
-            *f = [m[0], m[1], m[2]];
+        if d.pz > 1 {
+            let last = &slabs[d.z1 - 1];
+            let send: Vec<f64> = last.acc[last.end - last.start..]
+                .iter()
+                .flatten()
+                .copied()
+                .collect();
+            let before = &mut slabs[d.before_layer()];
+            let halo = &mut before.acc[before.end - before.start..];
+            let mut recv = vec![0.0; 3 * halo.len()];
+            d.comm.shift_exact(d.right(), &send, d.left(), &mut recv);
+            for (f, m) in halo.iter_mut().zip(recv.chunks_exact(3)) {
+                *f = [m[0], m[1], m[2]];
+            }
         }
         let t = self.time();
-        let (a, b) = self.own;
-        let mut cursor = PairForceCursor::new(&slabs, &self.slab_of, a);
-        let mut mine = Vec::with_capacity(4 * (b - a));
-        for k in a..b {
+        let mut cursor = PairForceCursor::new(&slabs, &self.slab_of, self.own.0);
+        let mut mine = Vec::with_capacity(4 * self.owned());
+        for k in self.owned_slots() {
             let fp = cursor.force(k);
             let fe = self.external.force(self.particles.pos[k], t);
             mine.push(self.tag[k] as f64);
@@ -405,9 +553,8 @@ impl<P: Pair, E: External> Brownian<P, E> {
 
     /// [`Self::snapshot`] of a decomposed run (collective).
     pub(super) fn snapshot_decomposed(&self) -> Particles {
-        let (a, b) = self.own;
-        let mut mine = Vec::with_capacity(7 * (b - a));
-        for k in a..b {
+        let mut mine = Vec::with_capacity(7 * self.owned());
+        for k in self.owned_slots() {
             let (mut x, mut img) = (self.particles.pos[k], self.particles.image[k]);
             self.sbox.wrap(&mut x, &mut img);
             mine.push(self.tag[k] as f64);
@@ -423,18 +570,25 @@ impl<P: Pair, E: External> Brownian<P, E> {
         p
     }
 
-    /// [`Self::list_state`] of a decomposed run (collective): the owned slots of the ranks in
-    /// rank order are the whole system's storage order.
+    /// [`Self::list_state`] of a decomposed run (collective), in the whole system's storage
+    /// order (each owned slot sent with its place in it).
     pub(super) fn list_state_decomposed(&self) -> ListState {
-        let (a, b) = self.own;
-        let mut mine = Vec::with_capacity(10 * (b - a));
-        for k in a..b {
-            mine.push(self.tag[k] as f64);
-            mine.extend_from_slice(&self.ref_pos[k]);
-            mine.extend_from_slice(&self.particles.pos[k]);
-            mine.extend(self.particles.image[k].iter().map(|&i| i as f64));
+        let mut mine = Vec::with_capacity(11 * self.owned());
+        for &(a, b, g) in &self.runs {
+            for k in a..b {
+                mine.push((g + k - a) as f64);
+                mine.push(self.tag[k] as f64);
+                mine.extend_from_slice(&self.ref_pos[k]);
+                mine.extend_from_slice(&self.particles.pos[k]);
+                mine.extend(self.particles.image[k].iter().map(|&i| i as f64));
+            }
         }
-        let all = self.gather(&mine);
+        let gathered = self.gather(&mine);
+        let mut all = vec![0.0; gathered.len() / 11 * 10];
+        for row in gathered.chunks_exact(11) {
+            let g = row[0] as usize;
+            all[10 * g..10 * g + 10].copy_from_slice(&row[1..]);
+        }
         let rows = all.chunks_exact(10);
         ListState {
             order: rows.clone().map(|g| g[0] as u32).collect(),
@@ -450,16 +604,15 @@ impl<P: Pair, E: External> Brownian<P, E> {
     /// decomposed; no allocation on one process once `out` has its length).
     pub fn unwrapped_into(&self, out: &mut Vec<[f64; 3]>) {
         out.resize(self.n_particles(), [0.0; 3]);
-        let (a, b) = self.own;
         let p = &self.particles;
         if self.domain.is_none() {
-            for k in a..b {
+            for k in self.owned_slots() {
                 out[self.tag[k] as usize] = self.sbox.unwrap(p.pos[k], p.image[k]);
             }
             return;
         }
-        let mut mine = Vec::with_capacity(4 * (b - a));
-        for k in a..b {
+        let mut mine = Vec::with_capacity(4 * self.owned());
+        for k in self.owned_slots() {
             mine.push(self.tag[k] as f64);
             mine.extend_from_slice(&self.sbox.unwrap(p.pos[k], p.image[k]));
         }
