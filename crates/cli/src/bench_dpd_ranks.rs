@@ -51,6 +51,11 @@ pub fn worker(a: &BenchArgs, state: &Path) -> Result<()> {
     for _ in 0..a.repeats.max(1) {
         let comm = ranks.exchange()?;
         let types = types.clone();
+        let mut params = params;
+        params.rank_grid = match a.rank_grid.as_deref() {
+            Some(&[py, pz]) if py * pz == comm.size() => Some([py, pz]),
+            _ => None,
+        };
         let mut sim = Dpd::decomposed(p.clone(), SimBox::new(l), params, types, step, comm)?;
         let start = Instant::now();
         sim.run(a.steps)?;
@@ -70,6 +75,17 @@ pub type Rate = (f64, f64, f64);
 pub fn bench(a: &BenchArgs) -> Result<()> {
     if a.ranks.contains(&0) || a.steps == 0 {
         bail!("--ranks must be at least 1 and --steps > 0");
+    }
+    if let Some(g) = &a.rank_grid {
+        if g.len() != 2 || g.contains(&0) {
+            bail!("--rank-grid takes PY,PZ (ranks along y and along z), each at least 1");
+        }
+        println!(
+            "# the runs on {} ranks on a grid of {} x {} (y x z); the others on the grid colloidsim chooses",
+            g[0] * g[1],
+            g[0],
+            g[1]
+        );
     }
     let threads = a.threads.first().copied().unwrap_or(1);
     let exe = std::env::current_exe()?;
@@ -307,6 +323,10 @@ fn worker_args(a: &BenchArgs, state: &Path, threads: usize) -> Vec<String> {
     }
     if a.colloids {
         args.push("--colloids".into());
+    }
+    if let Some(g) = &a.rank_grid {
+        args.push("--rank-grid".into());
+        args.push(format!("{},{}", g[0], g[1]));
     }
     args
 }

@@ -76,6 +76,11 @@ pub struct BenchArgs {
     /// per-round ratios are steadier on a shared machine than the table's.
     #[arg(long, default_value_t = 1)]
     pub rounds: usize,
+    /// With `--ranks`: the grid `PY,PZ` of ranks (columns along y by slabs along z, as the
+    /// scenario key `run.rank_grid`) for the runs on `PY x PZ` ranks; the others take the
+    /// grid colloidsim chooses (slabs where they fit).
+    #[arg(long, value_delimiter = ',')]
+    pub rank_grid: Option<Vec<usize>>,
     /// Internal: run as one of the `mpirun` workers of `--ranks` on this saved state.
     #[arg(long, hide = true)]
     pub worker_state: Option<PathBuf>,

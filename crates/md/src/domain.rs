@@ -184,7 +184,8 @@ impl Domain {
     /// false: slabs only. A slab holds a ghost layer (`nx ny` cells when `pz > 1`); a column
     /// also a fringe row on each side of each of its layers, whose pairs it computes too: a
     /// fringe cell counts as four ghost-layer cells (sorted and copied, a third of a cell's
-    /// step, against a whole step and that; docs/parallel.md). So slabs wherever they fit.
+    /// step, against a whole step and that; docs/parallel.md). So slabs for a few ranks, and
+    /// columns as the ranks approach or pass the number of layers.
     pub fn choose_grid(p: usize, [nx, ny, nz]: [usize; 3], y_cuts: bool) -> [usize; 2] {
         let mut best: Option<(usize, [usize; 2])> = None;
         for py in 1..=p {
