@@ -15,6 +15,42 @@
 
 use colloidsim_core::exchange::Exchange;
 
+/// What the ghosts of the fringe rows carry between sorts ([`Domain::refresh_fringe`]).
+pub(crate) trait FringeState {
+    /// Numbers per slot.
+    const WIDTH: usize;
+    /// Append slot `i`'s numbers to `out`.
+    fn read(&self, i: usize, out: &mut Vec<f64>);
+    /// Set slot `i` from its numbers.
+    fn write(&mut self, i: usize, numbers: &[f64]);
+}
+
+/// Positions alone (Brownian dynamics).
+impl FringeState for [[f64; 3]] {
+    const WIDTH: usize = 3;
+    fn read(&self, i: usize, out: &mut Vec<f64>) {
+        out.extend_from_slice(&self[i]);
+    }
+    fn write(&mut self, i: usize, m: &[f64]) {
+        self[i] = [m[0], m[1], m[2]];
+    }
+}
+
+/// Positions and velocities (DPD).
+pub(crate) struct PosVel<'a>(pub &'a mut [[f64; 3]], pub &'a mut [[f64; 3]]);
+
+impl FringeState for PosVel<'_> {
+    const WIDTH: usize = 6;
+    fn read(&self, i: usize, out: &mut Vec<f64>) {
+        out.extend_from_slice(&self.0[i]);
+        out.extend_from_slice(&self.1[i]);
+    }
+    fn write(&mut self, i: usize, m: &[f64]) {
+        self.0[i] = [m[0], m[1], m[2]];
+        self.1[i] = [m[3], m[4], m[5]];
+    }
+}
+
 /// This rank's share of a decomposed run.
 pub(crate) struct Domain {
     pub comm: Box<dyn Exchange>,
@@ -172,6 +208,41 @@ impl Domain {
             || self.owns_row(y)
             || y == self.y1 % self.ny
             || y == (self.y0 + self.ny - 1) % self.ny
+    }
+
+    /// Between sorts: the fringe rows' ghosts refreshed from their owners, who send the first
+    /// and the last row of every owned layer (the same particles in the same order as at the
+    /// last sort). `rows(z, y)` are the slots of row `y` of layer `z`; `state` reads and writes
+    /// a slot's numbers.
+    pub fn refresh_fringe<S: FringeState + ?Sized>(
+        &mut self,
+        rows: impl Fn(usize, usize) -> std::ops::Range<usize>,
+        state: &mut S,
+    ) {
+        let ny = self.ny;
+        let below = (self.y0 + ny - 1) % ny;
+        for (send, to, recv, from) in [
+            (self.y0, self.y_left(), self.y1 % ny, self.y_right()),
+            (self.y1 - 1, self.y_right(), below, self.y_left()),
+        ] {
+            self.send_left.clear();
+            let mut m = 0;
+            for z in self.z0..self.z1 {
+                for i in rows(z, send) {
+                    state.read(i, &mut self.send_left);
+                }
+                m += rows(z, recv).len();
+            }
+            self.recv.resize(S::WIDTH * m, 0.0);
+            self.comm
+                .shift_exact(to, &self.send_left, from, &mut self.recv);
+            let mut numbers = self.recv.chunks_exact(S::WIDTH);
+            for z in self.z0..self.z1 {
+                for i in rows(z, recv) {
+                    state.write(i, numbers.next().expect("one row per slot"));
+                }
+            }
+        }
     }
 
     /// Whether row `y` is this rank's.

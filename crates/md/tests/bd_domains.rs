@@ -131,16 +131,17 @@ fn leimkuhler_matthews_on_3_ranks_is_the_single_rank_run() {
     assert!(got.iter().all(|e| e == &want));
 }
 
-/// A checkpoint of a run on 2 ranks (particles and list state) continues on 3 ranks and on one
-/// process as the uninterrupted run.
-#[test]
-fn checkpoint_of_2_ranks_continues_on_3_and_on_1() {
+/// A checkpoint (particles and list state) at step 170 of a run on `ranks` ranks on `grid`
+/// (`None`: the grid chosen) continues on 3 ranks and on one process as the uninterrupted run.
+fn checkpoint_continues_on_3_and_on_1(ranks: usize, grid: Option<[usize; 2]>) {
     let (p, sbox, params) = sedimenting(Integrator::Euler);
     let mut one = build(&p, sbox, params, None, 0);
     one.run(300).unwrap();
     let want = end(&one);
-    let saved = on_ranks(2, |c| {
-        let mut sim = build(&p, sbox, params, None, 0).decomposed(c).unwrap();
+    let saved = on_ranks(ranks, |c| {
+        let mut sim = build(&p, sbox, params, None, 0)
+            .decomposed_on(c, grid)
+            .unwrap();
         steps(&mut sim, 170);
         (sim.snapshot(), sim.list_state(), sim.step)
     });
@@ -155,11 +156,17 @@ fn checkpoint_of_2_ranks_continues_on_3_and_on_1() {
     });
     assert!(
         got.iter()
-            .all(|e| e.snap == want.snap && e.forces == want.forces)
+            .all(|e| e.snap == want.snap && e.forces == want.forces),
+        "saved on {ranks} ranks ({grid:?}), continued on 3"
     );
     let mut back = build(snap, sbox, params, Some(list), *step);
     back.run(130).unwrap();
     assert_eq!(end(&back).snap, want.snap);
+}
+
+#[test]
+fn checkpoint_of_2_ranks_continues_on_3_and_on_1() {
+    checkpoint_continues_on_3_and_on_1(2, None);
 }
 
 /// A drying droplet (the `droplet-bd` engine: harmonic interface shrinking in a periodic box)
@@ -282,31 +289,5 @@ fn leimkuhler_matthews_and_a_checkpoint_on_a_2_x_2_grid_are_the_single_rank_run(
     assert!(got.iter().all(|e| e == &want));
     // Euler: a checkpoint (particles and list state) of a 2 x 2 grid continues on slabs and on
     // one process as the uninterrupted run.
-    let (p, sbox, params) = sedimenting(Integrator::Euler);
-    let mut one = build(&p, sbox, params, None, 0);
-    one.run(300).unwrap();
-    let want = end(&one);
-    let saved = on_ranks(4, |c| {
-        let mut sim = build(&p, sbox, params, None, 0)
-            .decomposed_on(c, Some([2, 2]))
-            .unwrap();
-        steps(&mut sim, 170);
-        (sim.snapshot(), sim.list_state(), sim.step)
-    });
-    let (snap, list, step) = &saved[0];
-    assert!(saved.iter().all(|s| &s.0 == snap && &s.1 == list));
-    let got = on_ranks(3, |c| {
-        let mut sim = build(snap, sbox, params, Some(list), *step)
-            .decomposed(c)
-            .unwrap();
-        steps(&mut sim, 130);
-        end(&sim)
-    });
-    assert!(
-        got.iter()
-            .all(|e| e.snap == want.snap && e.forces == want.forces)
-    );
-    let mut back = build(snap, sbox, params, Some(list), *step);
-    back.run(130).unwrap();
-    assert_eq!(end(&back).snap, want.snap);
+    checkpoint_continues_on_3_and_on_1(4, Some([2, 2]));
 }

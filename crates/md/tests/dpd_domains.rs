@@ -111,45 +111,53 @@ fn water_is_bitwise_the_single_rank_run_with_lists_and_with_cells() {
     }
 }
 
+/// A checkpoint at step 100 (synchronised every 50 steps) of `setup` run on `ranks` ranks
+/// continues on each of `on` ranks bitwise as the uninterrupted single-rank run to step 250.
+fn checkpoint_continues(setup: &DpdSetup, ranks: usize, on: &[usize]) {
+    let (snap, forces) = on_ranks(ranks, |c| {
+        let mut sim = setup.build_decomposed(c).unwrap();
+        sim.set_sync_every(50);
+        sim.run(100).unwrap();
+        (sim.snapshot(), sim.forces())
+    })
+    .remove(0);
+    // The uninterrupted run, on one rank.
+    let mut a = setup.build().unwrap();
+    a.set_sync_every(50);
+    a.run(250).unwrap();
+    let mut params = setup.params;
+    params.rank_grid = None;
+    for &ranks_after in on {
+        let ends = on_ranks(ranks_after, |c| {
+            let mut b = Dpd::restart_on(
+                snap.clone(),
+                &forces,
+                setup.sbox,
+                params,
+                DpdSetup::colloid_types(),
+                100,
+                50,
+                Some(c),
+            )
+            .unwrap();
+            b.run(150).unwrap();
+            b.snapshot()
+        });
+        for b in ends {
+            assert!(
+                a.snapshot() == b,
+                "{:?}: saved on {ranks} ranks ({:?}), continued on {ranks_after}: differs",
+                setup.params.neighbors,
+                setup.params.rank_grid
+            );
+        }
+    }
+}
+
 #[test]
 fn a_checkpoint_continues_bitwise_on_another_number_of_ranks() {
     for mode in [NeighborMode::Verlet, NeighborMode::Cells] {
-        let setup = suspension(mode);
-        // Checkpoint at step 100 of a run on 2 ranks, synchronised every 50 steps.
-        let (snap, forces) = on_ranks(2, |c| {
-            let mut sim = setup.build_decomposed(c).unwrap();
-            sim.set_sync_every(50);
-            sim.run(100).unwrap();
-            (sim.snapshot(), sim.forces())
-        })
-        .remove(0);
-        // The uninterrupted run, on one rank.
-        let mut a = setup.build().unwrap();
-        a.set_sync_every(50);
-        a.run(250).unwrap();
-        for ranks in [1, 3] {
-            let ends = on_ranks(ranks, |c| {
-                let mut b = Dpd::restart_on(
-                    snap.clone(),
-                    &forces,
-                    setup.sbox,
-                    setup.params,
-                    DpdSetup::colloid_types(),
-                    100,
-                    50,
-                    Some(c),
-                )
-                .unwrap();
-                b.run(150).unwrap();
-                b.snapshot()
-            });
-            for b in ends {
-                assert!(
-                    a.snapshot() == b,
-                    "{mode:?}: restart on {ranks} ranks differs"
-                );
-            }
-        }
+        checkpoint_continues(&suspension(mode), 2, &[1, 3]);
     }
 }
 
@@ -227,40 +235,7 @@ fn a_grid_cut_along_y_and_z_is_bitwise_the_single_rank_run() {
 
 #[test]
 fn a_checkpoint_of_a_grid_continues_bitwise_on_slabs_and_on_one_rank() {
-    let setup = suspension(NeighborMode::Verlet);
-    let mut on_2x2 = setup.clone();
+    let mut on_2x2 = suspension(NeighborMode::Verlet);
     on_2x2.params.rank_grid = Some([2, 2]);
-    let (snap, forces) = on_ranks(4, |c| {
-        let mut sim = on_2x2.build_decomposed(c).unwrap();
-        sim.set_sync_every(50);
-        sim.run(100).unwrap();
-        (sim.snapshot(), sim.forces())
-    })
-    .remove(0);
-    let mut a = setup.build().unwrap();
-    a.set_sync_every(50);
-    a.run(200).unwrap();
-    for ranks in [1, 2] {
-        let ends = on_ranks(ranks, |c| {
-            let mut b = Dpd::restart_on(
-                snap.clone(),
-                &forces,
-                setup.sbox,
-                setup.params,
-                DpdSetup::colloid_types(),
-                100,
-                50,
-                Some(c),
-            )
-            .unwrap();
-            b.run(100).unwrap();
-            b.snapshot()
-        });
-        for b in ends {
-            assert!(
-                a.snapshot() == b,
-                "restart of a 2 x 2 grid on {ranks} ranks differs"
-            );
-        }
-    }
+    checkpoint_continues(&on_2x2, 4, &[1, 2]);
 }

@@ -440,29 +440,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 let c = (z * ny + y) * nx;
                 self.grid.cell_start[c] as usize..self.grid.cell_start[c + nx] as usize
             };
-            let below = (d.y0 + ny - 1) % ny;
-            for (send, to, recv, from) in [
-                (d.y0, d.y_left(), d.y1 % ny, d.y_right()),
-                (d.y1 - 1, d.y_right(), below, d.y_left()),
-            ] {
-                d.send_left.clear();
-                let mut m = 0;
-                for z in d.z0..d.z1 {
-                    for x in &new_pos[rows(z, send)] {
-                        d.send_left.extend_from_slice(x);
-                    }
-                    m += rows(z, recv).len();
-                }
-                d.recv.resize(3 * m, 0.0);
-                d.comm.shift_exact(to, &d.send_left, from, &mut d.recv);
-                let mut k = 0;
-                for z in d.z0..d.z1 {
-                    for x in &mut new_pos[rows(z, recv)] {
-                        *x = [d.recv[k], d.recv[k + 1], d.recv[k + 2]];
-                        k += 3;
-                    }
-                }
-            }
+            d.refresh_fringe(rows, &mut new_pos[..]);
         }
         if d.pz > 1 {
             let first = &self.slabs[d.z0];

@@ -20,7 +20,7 @@
 
 use super::{COLLOID_BIT, Dpd, DpdError, PairVirial};
 use crate::cells::CellSort;
-use crate::domain::Domain;
+use crate::domain::{Domain, PosVel};
 
 /// Numbers per migrating particle: key, position, velocity, image.
 const MIGRANT: usize = 10;
@@ -278,7 +278,13 @@ impl Dpd {
             return row;
         };
         if refresh && d.py > 1 {
-            self.refresh_fringe(&mut d);
+            let [nx, ny, _] = self.grid.n_cells;
+            let cell_start = &self.grid.cell_start;
+            let rows = |z: usize, y: usize| {
+                let c = (z * ny + y) * nx;
+                cell_start[c] as usize..cell_start[c + nx] as usize
+            };
+            d.refresh_fringe(rows, &mut PosVel(&mut self.pos, &mut self.vel));
         }
         let out = if !refresh || d.pz == 1 {
             d.agree_max(row[0], row[1], row[2], row[3])
@@ -302,42 +308,6 @@ impl Dpd {
         };
         self.domain = Some(d);
         out
-    }
-
-    /// Verlet lists between sorts: the positions and velocities of the fringe rows' ghosts,
-    /// from the owners' first and last rows of every owned layer (the same particles in the
-    /// same order as at the last sort).
-    fn refresh_fringe(&mut self, d: &mut Domain) {
-        let ny = d.ny;
-        let below = (d.y0 + ny - 1) % ny;
-        for (send, to, recv, from) in [
-            (d.y0, d.y_left(), d.y1 % ny, d.y_right()),
-            (d.y1 - 1, d.y_right(), below, d.y_left()),
-        ] {
-            d.send_left.clear();
-            let mut m = 0;
-            for z in d.z0..d.z1 {
-                let (a, b) = self.row_slots(z, send);
-                for i in a..b {
-                    d.send_left.extend_from_slice(&self.pos[i]);
-                    d.send_left.extend_from_slice(&self.vel[i]);
-                }
-                let (a, b) = self.row_slots(z, recv);
-                m += b - a;
-            }
-            d.recv.resize(6 * m, 0.0);
-            d.comm.shift_exact(to, &d.send_left, from, &mut d.recv);
-            let mut k = 0;
-            for z in d.z0..d.z1 {
-                let (a, b) = self.row_slots(z, recv);
-                for i in a..b {
-                    let r = &d.recv[6 * k..6 * k + 6];
-                    self.pos[i] = [r[0], r[1], r[2]];
-                    self.vel[i] = [r[3], r[4], r[5]];
-                    k += 1;
-                }
-            }
-        }
     }
 
     /// After the forces: the last owned slab's forces on the ghost layer go to the rank
