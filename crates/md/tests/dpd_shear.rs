@@ -441,7 +441,10 @@ fn bad_shear_rates_are_refused_with_the_key() {
     // A sheared run is cut into slabs only (the y boundary moves the images along x), and a
     // grid needs at least one rank along each axis.
     for (bad, says) in [
-        ("shear_rate = 0.5\nrank_grid = [2, 1]", "sheared run is cut along z only"),
+        (
+            "shear_rate = 0.5\nrank_grid = [2, 1]",
+            "sheared run is cut along z only",
+        ),
         ("rank_grid = [0, 2]", "each at least 1"),
     ] {
         let e = DpdScenario::from_toml(&format!("{base}{bad}\n"))
@@ -449,7 +452,10 @@ fn bad_shear_rates_are_refused_with_the_key() {
             .validate()
             .unwrap_err()
             .to_string();
-        assert!(e.contains("run.rank_grid") && e.contains(says), "{bad}: {e}");
+        assert!(
+            e.contains("run.rank_grid") && e.contains(says),
+            "{bad}: {e}"
+        );
     }
     // The engine refuses a non-finite rate too.
     let mut setup = water(8.0, 0.04, 0.0, 1);

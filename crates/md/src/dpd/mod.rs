@@ -358,6 +358,8 @@ struct Slab {
     /// of the particle that meets them: summed row by row in the global order of the rows, the
     /// total is the same whether the rows are on one rank or on several.
     row_virial: Vec<PairVirial>,
+    /// Whether `row_virial` holds a thermo step's sums (else it is zero).
+    virial_set: bool,
 }
 
 /// A DPD simulation of solvent beads and colloids.
@@ -1061,6 +1063,7 @@ impl Dpd {
             let inv_mass = &self.inv_mass;
             let ref_pos = &self.ref_pos;
             let ghost = &self.ghost;
+            let decomposed = self.domain.is_some();
             let n_slabs = slabs.len();
             self.pos[o0..o1]
                 .par_iter_mut()
@@ -1070,7 +1073,7 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(k, ((x, v), img))| {
                     let i = o0 + k;
-                    if ghost[i] {
+                    if decomposed && ghost[i] {
                         return (0.0, usize::MAX, 0.0);
                     }
                     let f = total_force(slabs, slab_of, n_slabs, i);
@@ -1191,6 +1194,7 @@ impl Dpd {
             let inv_mass = &self.inv_mass;
             let key = &self.key;
             let ghost = &self.ghost;
+            let decomposed = self.domain.is_some();
             let n_slabs = slabs.len();
             self.vel[o0..o1]
                 .par_iter_mut()
@@ -1198,7 +1202,7 @@ impl Dpd {
                 .with_min_len(1024)
                 .map(|(k, v)| {
                     let i = o0 + k;
-                    if ghost[i] {
+                    if decomposed && ghost[i] {
                         return u32::MAX;
                     }
                     let f = total_force(slabs, slab_of, n_slabs, i);
@@ -1570,20 +1574,22 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         force,
         halo,
         row_virial,
+        virial_set,
         cand,
     } = slab;
     let (start, end) = (*start, *end);
     force.iter_mut().for_each(|f| *f = [0.0; 3]);
     halo.iter_mut().for_each(|f| *f = [0.0; 3]);
-    row_virial
-        .iter_mut()
-        .for_each(|v| *v = PairVirial::default());
+    // A thermo step sums the virial afresh; a plain step leaves it zero (as `thermo` reports
+    // after `advance`), which costs a pass only after a thermo step.
+    if THERMO || *virial_set {
+        row_virial
+            .iter_mut()
+            .for_each(|v| *v = PairVirial::default());
+        *virial_set = THERMO;
+    }
     let mut vir = PairVirial::default();
-    // The virial goes to the row of the particle meeting the pair: storage is by row, so the
-    // accumulator moves on to the next row at each row's last slot.
     let [nx, ny, _] = c.n_cells;
-    let row_end = |y: usize| c.cell_start[(z * ny + y + 1) * nx] as usize;
-    let (mut row, mut row_stop) = (0, row_end(0));
     let mut out = Out {
         start,
         end,
@@ -1591,6 +1597,14 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         force,
         halo,
         vir: &mut vir,
+        rows: Rows {
+            virial: row_virial,
+            row: 0,
+            stop: c.cell_start[(z * ny + 1) * nx] as usize,
+            cell_start: c.cell_start,
+            first_cell: z * ny * nx,
+            nx,
+        },
     };
     if c.cells_mode {
         scan_layer_sheared(
@@ -1603,13 +1617,6 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
             SHEAR.then_some(c.shear_offset),
             cand,
             |i, cands| {
-                if THERMO {
-                    while i >= row_stop {
-                        row_virial[row] = std::mem::take(&mut *out.vir);
-                        row += 1;
-                        row_stop = row_end(row);
-                    }
-                }
                 particle_forces::<THERMO, SHEAR>(
                     c,
                     i,
@@ -1621,13 +1628,6 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         );
     } else {
         for i in start..end {
-            if THERMO {
-                while i >= row_stop {
-                    row_virial[row] = std::mem::take(&mut *out.vir);
-                    row += 1;
-                    row_stop = row_end(row);
-                }
-            }
             let xi = c.pos[i];
             let k0 = nbr_start[i - start] as usize;
             let k1 = nbr_start[i - start + 1] as usize;
@@ -1645,8 +1645,22 @@ fn slab_forces<const THERMO: bool, const SHEAR: bool>(
         }
     }
     if THERMO {
-        row_virial[row] = vir;
+        let Out { rows, vir, .. } = out;
+        rows.virial[rows.row] = std::mem::take(vir);
     }
+}
+
+/// The virial of each row of cells of a slab: the pairs a particle meets go to its row's
+/// accumulator (storage is by row, so the accumulator moves on at each row's last slot).
+struct Rows<'a> {
+    virial: &'a mut [PairVirial],
+    /// The row being summed, and the slot after its last.
+    row: usize,
+    stop: usize,
+    cell_start: &'a [u32],
+    /// The slab's first cell, and cells per row.
+    first_cell: usize,
+    nx: usize,
 }
 
 /// Where one slab's forces go.
@@ -1657,6 +1671,20 @@ struct Out<'a> {
     force: &'a mut [[f64; 3]],
     halo: &'a mut [[f64; 3]],
     vir: &'a mut PairVirial,
+    rows: Rows<'a>,
+}
+
+impl Out<'_> {
+    /// Thermo steps: move the virial accumulator on to the row of slot `i`.
+    #[inline(always)]
+    fn enter_row(&mut self, i: usize) {
+        let r = &mut self.rows;
+        while i >= r.stop {
+            r.virial[r.row] = std::mem::take(&mut *self.vir);
+            r.row += 1;
+            r.stop = r.cell_start[r.first_cell + (r.row + 1) * r.nx] as usize;
+        }
+    }
 }
 
 /// All forces of particle `i`'s pairs: solvent and colloid–solvent pairs `(j, x_i - x_j)` from
@@ -1673,6 +1701,9 @@ fn particle_forces<const THERMO: bool, const SHEAR: bool>(
     out: &mut Out,
     has_cc: bool,
 ) {
+    if THERMO {
+        out.enter_row(i);
+    }
     let (start, end, next_start) = (out.start, out.end, out.next_start);
     let xi = c.pos[i];
     let vi = c.vel[i];
