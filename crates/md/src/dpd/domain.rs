@@ -100,15 +100,26 @@ impl Dpd {
     }
 
     fn migrate(&mut self, d: &mut Domain) -> Result<(), DpdError> {
-        // Drop the ghosts (the order does not matter: a sort follows).
-        let mut w = 0;
-        for i in 0..self.pos.len() {
-            if !self.ghost.get(i).copied().unwrap_or(false) {
-                self.move_slot(i, w);
-                w += 1;
+        // Drop the ghosts: the last owned slots fill their places (the order does not matter:
+        // a sort follows), so a ghost layer after the owned slots costs no move at all.
+        let is_ghost = |g: &[bool], i: usize| g.get(i).copied().unwrap_or(false);
+        let mut end = self.pos.len();
+        let mut i = 0;
+        while i < end {
+            if !is_ghost(&self.ghost, i) {
+                i += 1;
+                continue;
+            }
+            end -= 1;
+            while end > i && is_ghost(&self.ghost, end) {
+                end -= 1;
+            }
+            if end > i {
+                self.move_slot(end, i);
+                i += 1;
             }
         }
-        self.truncate_slots(w);
+        self.truncate_slots(end);
         self.ghost.clear();
         // Leavers go to the neighbours: along z, then along y (a particle crossing a corner
         // takes both steps).
