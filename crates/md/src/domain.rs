@@ -67,6 +67,10 @@ pub(crate) struct Domain {
     /// Ranks along y and along z (`py pz` ranks).
     pub py: usize,
     pub pz: usize,
+    /// This rank and the number of ranks (kept: asking MPI costs a call, and the migration
+    /// asks for every leaver).
+    rank: usize,
+    size: usize,
     pub send_left: Vec<f64>,
     pub send_right: Vec<f64>,
     pub recv: Vec<f64>,
@@ -136,6 +140,8 @@ impl Domain {
             ny,
             py,
             pz,
+            rank: r,
+            size: p,
             comm,
             send_left: Vec::new(),
             send_right: Vec::new(),
@@ -149,24 +155,24 @@ impl Domain {
 
     /// The rank below along z (same column).
     pub fn left(&self) -> usize {
-        let p = self.comm.size();
-        (self.comm.rank() + p - self.py) % p
+        let p = self.size;
+        (self.rank + p - self.py) % p
     }
 
     /// The rank above along z (same column).
     pub fn right(&self) -> usize {
-        (self.comm.rank() + self.py) % self.comm.size()
+        (self.rank + self.py) % self.size
     }
 
     /// The rank of the same slab in the column before along y.
     pub fn y_left(&self) -> usize {
-        let r = self.comm.rank();
+        let r = self.rank;
         r - r % self.py + (r % self.py + self.py - 1) % self.py
     }
 
     /// The rank of the same slab in the column after along y.
     pub fn y_right(&self) -> usize {
-        let r = self.comm.rank();
+        let r = self.rank;
         r - r % self.py + (r % self.py + 1) % self.py
     }
 
@@ -175,7 +181,7 @@ impl Domain {
         let rz = (0..self.pz)
             .find(|&k| z < (k + 1) * self.nz / self.pz)
             .unwrap_or(self.pz - 1);
-        rz * self.py + self.comm.rank() % self.py
+        rz * self.py + self.rank % self.py
     }
 
     /// The rank of this slab that owns row `y`.
@@ -183,7 +189,7 @@ impl Domain {
         let ry = (0..self.py)
             .find(|&k| y < (k + 1) * self.ny / self.py)
             .unwrap_or(self.py - 1);
-        self.comm.rank() - self.comm.rank() % self.py + ry
+        self.rank - self.rank % self.py + ry
     }
 
     /// The layers `z0..z1` and rows `y0..y1` rank `r` owns, as `[z0, z1, y0, y1]`.

@@ -327,15 +327,16 @@ impl<P: Pair, E: External> Brownian<P, E> {
             let x = self.particles.pos[i];
             let (mine, to) = if along_z {
                 let z = CellSort::cell_coordinate(x[2], sbox.l[2], d.nz);
-                (d.owns(z), d.owner(z))
+                (d.owns(z), z)
             } else {
                 let y = CellSort::cell_coordinate(x[1], sbox.l[1], d.ny);
-                (d.owns_row(y), d.y_owner(y))
+                (d.owns_row(y), y)
             };
             if mine {
                 i += 1;
                 continue;
             }
+            let to = if along_z { d.owner(to) } else { d.y_owner(to) };
             let tag = self.tag[i];
             // With two ranks along the axis the left and the right neighbour are one rank.
             let buf = if to == right {

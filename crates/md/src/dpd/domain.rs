@@ -142,7 +142,7 @@ impl Dpd {
                 let row = if first { d.y0 } else { d.y1 - 1 };
                 d.send_left.clear();
                 for i in 0..n_own {
-                    if self.row_layer_of(&self.pos[i], d).0 == row {
+                    if CellSort::cell_coordinate(self.pos[i][1], self.sbox.l[1], d.ny) == row {
                         self.push_ghost_row(i, &mut d.send_left);
                     }
                 }
@@ -155,7 +155,7 @@ impl Dpd {
         if d.pz > 1 {
             d.send_left.clear();
             for i in 0..self.pos.len() {
-                if self.row_layer_of(&self.pos[i], d).1 == d.z0 {
+                if CellSort::cell_coordinate(self.pos[i][2], self.sbox.l[2], d.nz) == d.z0 {
                     self.push_ghost_row(i, &mut d.send_left);
                 }
             }
@@ -181,15 +181,23 @@ impl Dpd {
         let mut n = self.pos.len();
         let mut i = 0;
         while i < n {
-            let (y, z) = self.row_layer_of(&self.pos[i], d);
-            let (mine, to) = match axis {
-                Axis::Z => (d.owns(z), d.owner(z)),
-                Axis::Y => (d.owns_row(y), d.y_owner(y)),
+            let (k, cells) = match axis {
+                Axis::Z => (2, d.nz),
+                Axis::Y => (1, d.ny),
+            };
+            let c = CellSort::cell_coordinate(self.pos[i][k], self.sbox.l[k], cells);
+            let mine = match axis {
+                Axis::Z => d.owns(c),
+                Axis::Y => d.owns_row(c),
             };
             if mine {
                 i += 1;
                 continue;
             }
+            let to = match axis {
+                Axis::Z => d.owner(c),
+                Axis::Y => d.y_owner(c),
+            };
             let buf = if to == right {
                 &mut d.send_right
             } else if to == left {
