@@ -1,6 +1,8 @@
-//! Brownian dynamics decomposed in space over ranks ([`Exchange`]), on the slabs of
-//! [`crate::domain`]: rank `r` owns the z-layers of cells `z0..z1` and the particles in them,
-//! and keeps a copy of the next rank's first layer (the ghosts).
+//! Brownian dynamics decomposed in space over ranks ([`Exchange`]), on the grid of
+//! [`crate::domain`]: a rank owns the z-layers of cells `z0..z1` (and, cut along y, the rows
+//! `y0..y1` of them) and the particles in them, and keeps a copy of the next rank's first layer
+//! (the ghosts) and, cut along y, a fringe row of ghosts on each side of its rows, whose pairs
+//! with its own it computes itself.
 //!
 //! - **Forces.** Every rank sums the pairs of its own slabs ([`super::all_pair_forces`]); the
 //!   forces its last slab exerts on the ghosts (the halo) go to their owner, who adds them where
@@ -13,10 +15,10 @@
 //!   particles and ghosts into the same global cells (ties by tag) as one process would.
 //! - **Noise.** The Euler noise of a particle is keyed by its slot in the storage order of the
 //!   whole system (blocks of [`BLOCK`](colloidsim_core::rng::BLOCK) slots,
-//!   [`super::StepPass::integrate`]). The owned layers' slots are a contiguous run of that
-//!   order, starting after the particles of the ranks before (agreed on at every build), so a
-//!   rank draws its particles' deviates from the same streams, skipping the deviates of a block
-//!   it shares with the rank before.
+//!   [`super::StepPass::integrate`]). The owned slots are runs of that order (one on slabs, one
+//!   per layer cut along y), each starting where the counts of every rank per layer put it
+//!   (agreed on at every build), so a rank draws its particles' deviates from the same streams,
+//!   skipping the deviates of a block a run shares with the particles before it.
 //!
 //! So each pair is met in the same order and summed in the same place, and every particle gets
 //! the same deviates, as on one rank: **a decomposed run is bitwise the single-rank run** for
@@ -182,7 +184,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let slot = |z: usize, y: usize| self.grid.cell_start[(z * ny + y) * nx] as usize;
         self.runs.clear();
         for (z, &g) in (d.z0..d.z1).zip(starts) {
-            let (a, b) = (slot(z, d.y0), slot(z, d.y1 - 1 + 1));
+            let (a, b) = (slot(z, d.y0), slot(z, d.y1));
             match self.runs.last_mut() {
                 Some(r) if r.1 == a && r.2 + (r.1 - r.0) == g => r.1 = b,
                 _ => self.runs.push((a, b, g)),

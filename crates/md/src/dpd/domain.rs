@@ -8,15 +8,19 @@
 //! exactly where a single process adds the previous slab's halo. Every rank sorts its particles
 //! and ghosts into the same global cells (ties by tag), so each pair is met in the same order
 //! and summed in the same place as on one rank: **a decomposed run is bitwise the single-rank
-//! run**, for any number of ranks. Colloids are few: their positions and velocities are
+//! run**, for any number of ranks. On a grid cut along y as well ([`crate::domain`]) a rank
+//! also holds a fringe row of ghosts on each side of its rows and computes the pairs across
+//! the y cut itself (no forces go back along y), so every pair of an owned particle is still
+//! met in the single-rank order. Colloids are few: their positions and velocities are
 //! gathered on every rank each step, and the colloid–colloid list is built from that copy.
 //!
 //! Per step: the drift's largest displacement is agreed on (one all-gather; with Verlet lists
 //! the ghosts' positions and velocities travel in the same exchange), particles that left
-//! their rank's layers migrate to the neighbour and the ghost layer is fetched whole (at every
-//! sort: every step with cells, at list rebuilds with Verlet lists), the halo forces are sent
-//! right, and the step ends with one agreement on a non-finite velocity or a particle lost in
-//! the migration; thermodynamic sums are gathered layer by layer and added in layer order.
+//! their rank's cells migrate to the neighbour (along z, then along y) and the ghosts are
+//! fetched whole (the fringe rows, then the ghost layer; at every sort: every step with cells,
+//! at list rebuilds with Verlet lists), the halo forces are sent up, and the step ends with one
+//! agreement on a non-finite velocity or a particle lost in the migration; thermodynamic sums
+//! are gathered row of cells by row and added in the global order of the rows.
 
 use super::{COLLOID_BIT, Dpd, DpdError, PairVirial};
 use crate::cells::CellSort;
@@ -135,11 +139,10 @@ impl Dpd {
         // Fringe rows: this rank's first row goes to the column before (it is that column's
         // upper fringe), its last row to the column after.
         if d.py > 1 {
-            for (first, to, from) in [
-                (true, d.y_left(), d.y_right()),
-                (false, d.y_right(), d.y_left()),
+            for (row, to, from) in [
+                (d.y0, d.y_left(), d.y_right()),
+                (d.y1 - 1, d.y_right(), d.y_left()),
             ] {
-                let row = if first { d.y0 } else { d.y1 - 1 };
                 d.send_left.clear();
                 for i in 0..n_own {
                     if CellSort::cell_coordinate(self.pos[i][1], self.sbox.l[1], d.ny) == row {
