@@ -44,6 +44,24 @@ impl CellSort {
         (((x + 0.5 * l) * scale).max(0.0) as usize).min(n - 1)
     }
 
+    /// The cells `c0..c1` of an axis of length `l` cut into `n`, as a test on coordinates
+    /// that agrees with [`Self::cell_coordinate`] (see [`CellRange::contains`]).
+    pub fn range(l: f64, n: usize, c0: usize, c1: usize) -> CellRange {
+        let w = l / n as f64;
+        // Far above the round-off of `cell_coordinate` (1e-16 of a cell), far below a cell.
+        let eps = 1e-9 * w;
+        let edge = |c: usize| c as f64 * w - 0.5 * l;
+        CellRange {
+            lo: if c0 == 0 { f64::NEG_INFINITY } else { edge(c0) },
+            hi: if c1 >= n { f64::INFINITY } else { edge(c1) },
+            eps,
+            l,
+            n,
+            c0,
+            c1,
+        }
+    }
+
     /// Sort wrapped positions `pos` into cells at least `range` wide (z-major; inside a cell by
     /// increasing `tie`, so that the order is a function of the positions and ties alone, not of
     /// the threads). Fills [`Self::perm`] and [`Self::cell_start`] (in the new order).
@@ -148,25 +166,41 @@ impl CellSort {
 
     /// `slab_of[i]`: the z-layer of slot `i` (after [`Self::sort`]).
     pub fn layer_of_slots(&self, slab_of: &mut Vec<u32>) {
-        let n = self.perm.len();
         let nz = self.n_cells[2];
-        let layer = self.n_cells[0] * self.n_cells[1];
-        let starts = &self.cell_start;
-        slab_of.resize(n, 0);
-        slab_of
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(4096)
-            .for_each(|(i, s)| {
-                let mut z = (i * nz / n.max(1)).min(nz - 1);
-                while starts[z * layer] as usize > i {
-                    z -= 1;
-                }
-                while starts[(z + 1) * layer] as usize <= i {
-                    z += 1;
-                }
-                *s = z as u32;
-            });
+        slab_of.resize(self.perm.len(), 0);
+        // A layer's slots are one run (empty for the layers a rank does not hold): fill each.
+        for z in 0..nz {
+            let (a, b) = self.layer(z);
+            slab_of[a..b].fill(z as u32);
+        }
+    }
+}
+
+/// A run of cells along one axis, tested by comparing coordinates with its edges
+/// ([`CellSort::range`]); only a coordinate within round-off of an edge takes the exact
+/// [`CellSort::cell_coordinate`], so the answer is always that formula's.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CellRange {
+    lo: f64,
+    hi: f64,
+    eps: f64,
+    l: f64,
+    n: usize,
+    c0: usize,
+    c1: usize,
+}
+
+impl CellRange {
+    /// Whether `cell_coordinate(x)` lies in the run.
+    #[inline(always)]
+    pub fn contains(&self, x: f64) -> bool {
+        let inside = x > self.lo + self.eps && x < self.hi - self.eps;
+        let outside = x < self.lo - self.eps || x > self.hi + self.eps;
+        if inside || outside {
+            inside
+        } else {
+            (self.c0..self.c1).contains(&CellSort::cell_coordinate(x, self.l, self.n))
+        }
     }
 }
 
@@ -348,6 +382,44 @@ pub(crate) fn scan_layer_sheared(
                     }
                 }
                 f(i, &buf[..m]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `CellRange::contains` is the exact formula's answer, also a few ulps from every edge and
+    /// outside the box (the clamped end cells).
+    #[test]
+    fn a_cell_range_agrees_with_the_cell_formula() {
+        for (l, n) in [(30.0, 20), (8.0, 4), (7.3, 7), (150.0, 150)] {
+            let w = l / n as f64;
+            let mut xs = vec![-0.5 * l - 1.0, 0.5 * l + 1.0, f64::NAN];
+            for c in 0..=n {
+                let edge = c as f64 * w - 0.5 * l;
+                let mut x = edge;
+                for _ in 0..4 {
+                    x = x.next_down();
+                }
+                for _ in 0..9 {
+                    xs.push(x);
+                    x = x.next_up();
+                }
+                xs.push(edge + 0.37 * w);
+                xs.push(edge + 1e-9 * w);
+                xs.push(edge - 1e-9 * w);
+            }
+            for c0 in 0..n {
+                for c1 in c0 + 1..=n {
+                    let r = CellSort::range(l, n, c0, c1);
+                    for &x in &xs {
+                        let exact = (c0..c1).contains(&CellSort::cell_coordinate(x, l, n));
+                        assert_eq!(r.contains(x), exact, "x = {x:e}, cells {c0}..{c1} of {n}");
+                    }
+                }
             }
         }
     }

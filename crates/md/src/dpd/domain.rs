@@ -144,8 +144,9 @@ impl Dpd {
                 (d.y1 - 1, d.y_right(), d.y_left()),
             ] {
                 d.send_left.clear();
+                let rows = CellSort::range(self.sbox.l[1], d.ny, row, row + 1);
                 for i in 0..n_own {
-                    if CellSort::cell_coordinate(self.pos[i][1], self.sbox.l[1], d.ny) == row {
+                    if rows.contains(self.pos[i][1]) {
                         self.push_ghost_row(i, &mut d.send_left);
                     }
                 }
@@ -157,8 +158,9 @@ impl Dpd {
         // below (it is that rank's ghost layer).
         if d.pz > 1 {
             d.send_left.clear();
+            let first = CellSort::range(self.sbox.l[2], d.nz, d.z0, d.z0 + 1);
             for i in 0..self.pos.len() {
-                if CellSort::cell_coordinate(self.pos[i][2], self.sbox.l[2], d.nz) == d.z0 {
+                if first.contains(self.pos[i][2]) {
                     self.push_ghost_row(i, &mut d.send_left);
                 }
             }
@@ -181,22 +183,18 @@ impl Dpd {
         };
         d.send_left.clear();
         d.send_right.clear();
+        let (k, cells, mine) = match axis {
+            Axis::Z => (2, d.nz, CellSort::range(self.sbox.l[2], d.nz, d.z0, d.z1)),
+            Axis::Y => (1, d.ny, CellSort::range(self.sbox.l[1], d.ny, d.y0, d.y1)),
+        };
         let mut n = self.pos.len();
         let mut i = 0;
         while i < n {
-            let (k, cells) = match axis {
-                Axis::Z => (2, d.nz),
-                Axis::Y => (1, d.ny),
-            };
-            let c = CellSort::cell_coordinate(self.pos[i][k], self.sbox.l[k], cells);
-            let mine = match axis {
-                Axis::Z => d.owns(c),
-                Axis::Y => d.owns_row(c),
-            };
-            if mine {
+            if mine.contains(self.pos[i][k]) {
                 i += 1;
                 continue;
             }
+            let c = CellSort::cell_coordinate(self.pos[i][k], self.sbox.l[k], cells);
             let to = match axis {
                 Axis::Z => d.owner(c),
                 Axis::Y => d.y_owner(c),
