@@ -56,6 +56,7 @@ use crate::state::{Particles, SimBox};
 use colloidsim_core::exchange::Exchange;
 pub use forces::{ColloidForces, LubricationNoise, colloid_solvent_cutoff, pair_noise, step_key};
 use rayon::prelude::*;
+use std::collections::HashMap;
 pub use viscosity::StressAcf;
 
 /// Parameters of a DPD colloid simulation (DPD units: lengths in `rc`, energies in `kT`
@@ -320,6 +321,56 @@ struct Props {
     cs_amp: f64,
 }
 
+impl Props {
+    /// The constants as bits, to find equal ones.
+    fn bits(&self) -> (u32, bool, [u64; 6]) {
+        let f = [
+            self.mass,
+            self.diameter,
+            self.radius,
+            self.cs_cut,
+            self.cs_inv_cut,
+            self.cs_amp,
+        ];
+        (self.typeid, self.colloid, f.map(f64::to_bits))
+    }
+}
+
+/// [`Props`] by tag, each distinct set stored once (the solvent beads of a type share one, a
+/// colloid of another size has its own): 4 bytes a particle, on every rank of a decomposed run.
+#[derive(Debug, Clone, Default)]
+struct PropsTable {
+    kinds: Vec<Props>,
+    /// The kind of each tag.
+    kind: Vec<u32>,
+}
+
+impl PropsTable {
+    /// Append the constants of the next tag (`seen`: the kinds so far, by their bits).
+    fn push(&mut self, q: Props, seen: &mut HashMap<(u32, bool, [u64; 6]), u32>) {
+        let kinds = &mut self.kinds;
+        let k = *seen.entry(q.bits()).or_insert_with(|| {
+            kinds.push(q);
+            kinds.len() as u32 - 1
+        });
+        self.kind.push(k);
+    }
+
+    /// The constants of every tag, in tag order.
+    fn iter(&self) -> impl Iterator<Item = &Props> + '_ {
+        self.kind.iter().map(|&k| &self.kinds[k as usize])
+    }
+}
+
+impl std::ops::Index<usize> for PropsTable {
+    type Output = Props;
+
+    #[inline(always)]
+    fn index(&self, tag: usize) -> &Props {
+        &self.kinds[self.kind[tag] as usize]
+    }
+}
+
 /// Bit of [`Dpd::key`] that marks a colloid (the low bits are the tag).
 const COLLOID_BIT: u32 = 1 << 31;
 
@@ -379,7 +430,7 @@ pub struct Dpd {
     key: Vec<u32>,
     inv_mass: Vec<f64>,
     /// Constants by tag.
-    props: Vec<Props>,
+    props: PropsTable,
     /// Storage index of each tag.
     by_tag: Vec<u32>,
     cells_mode: bool,
@@ -430,7 +481,7 @@ struct Ctx<'a> {
     pos: &'a [[f64; 3]],
     vel: &'a [[f64; 3]],
     key: &'a [u32],
-    props: &'a [Props],
+    props: &'a PropsTable,
     cc_list: &'a NeighborList,
     cc_pos: &'a [[f64; 3]],
     cc_vel: &'a [[f64; 3]],
@@ -532,7 +583,8 @@ impl Dpd {
                 "{n} particles (need at least 2, fewer than 2^31)"
             )));
         }
-        let mut props = Vec::with_capacity(n);
+        let mut props = PropsTable::default();
+        let mut kinds_seen = HashMap::new();
         let mut max_cs_centre: f64 = 0.0;
         let mut max_radius: f64 = 0.0;
         let mut min_mass = f64::INFINITY;
@@ -555,7 +607,7 @@ impl Dpd {
             };
             max_cs_centre = max_cs_centre.max(radius + cs_cut);
             max_radius = max_radius.max(radius);
-            props.push(Props {
+            let q = Props {
                 typeid: particles.typeid[i],
                 colloid,
                 mass: m,
@@ -564,7 +616,8 @@ impl Dpd {
                 cs_cut,
                 cs_inv_cut: 1.0 / cs_cut,
                 cs_amp: p.repulsion_cs * p.kt / cs_cut,
-            });
+            };
+            props.push(q, &mut kinds_seen);
         }
         // Cells or lists: a Verlet list pays off when it lasts a few steps. The fastest of N
         // particles moves about 5 thermal velocities sqrt(kT / m) per unit time.
@@ -1842,4 +1895,42 @@ fn particle_forces<const THERMO: bool, const SHEAR: bool>(
     f[0] += fi[0];
     f[1] += fi[1];
     f[2] += fi[2];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Equal constants are stored once; every tag reads its own.
+    #[test]
+    fn the_props_table_stores_each_kind_once() {
+        let bead = Props {
+            typeid: 0,
+            colloid: false,
+            mass: 1.0,
+            diameter: 1.0,
+            radius: 0.0,
+            cs_cut: 1.0,
+            cs_inv_cut: 1.0,
+            cs_amp: 25.0,
+        };
+        let colloid = |r: f64| Props {
+            typeid: 1,
+            colloid: true,
+            radius: r,
+            diameter: 2.0 * r,
+            ..bead
+        };
+        let by_tag = [bead, colloid(1.0), bead, colloid(1.5), colloid(1.0), bead];
+        let mut t = PropsTable::default();
+        let mut seen = HashMap::new();
+        for q in by_tag {
+            t.push(q, &mut seen);
+        }
+        assert_eq!(t.kinds.len(), 3);
+        for (tag, q) in by_tag.iter().enumerate() {
+            assert_eq!(&t[tag], q, "tag {tag}");
+        }
+        assert!(t.iter().eq(by_tag.iter()));
+    }
 }
