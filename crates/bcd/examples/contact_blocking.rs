@@ -6,8 +6,8 @@
 //!
 //! `cargo run --release -p colloidsim-bcd --example contact_blocking -- DT TIME SEED W U0`
 
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 

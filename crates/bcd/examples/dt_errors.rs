@@ -36,9 +36,9 @@
 //! maximum (error from the seeds' spread); the same for the contact density in windows w.
 //! The rows go to stdout as a markdown table and, with `--csv`, to a file for `dt_errors_plot`.
 
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::{NoPair, PairForce, Sticky};
 use colloidsim_bcd::observe::{ContactDensity, DensityProfile};
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, BcdState, Boundary, Integrator, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};

@@ -9,8 +9,8 @@
 //!
 //! `RAYON_NUM_THREADS=1 taskset -c 0 cargo run --release -p colloidsim-bcd --example
 //! integrator_bench -- [N,N,..] [REPEATS] [WORK]` (default 10000,100000, 5, 2e7).
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Integrator, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_core::timing::thread_cpu_seconds;

@@ -17,9 +17,9 @@
 //! 20 time units with the scheme and dt it is run with, then samples the MSD over 100 time
 //! units with time origins every 5 time units. Errors are standard errors over the replicas.
 
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
 use colloidsim_bcd::observe::Msd;
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Integrator, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use rayon::prelude::*;

@@ -2,9 +2,9 @@
 //! `cargo run --release -p colloidsim-bcd --example observer_bench` (wall time, median of
 //! 7 rounds of 500 samples; compare with `colloidsim bench bcd`'s ns per particle-step).
 
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
 use colloidsim_bcd::observe::{ClusterSizes, DensityProfile};
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use std::time::Instant;

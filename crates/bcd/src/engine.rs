@@ -88,26 +88,27 @@ pub struct BcdConfig {
 }
 
 impl BcdConfig {
-    /// Check ranges for `n` rods; errors name the scenario key.
+    /// Check ranges for `n` rods; errors name the parameter (`length`, `sigma`, `mobility`, `kt`,
+    /// `dt`, `n`).
     pub fn validate(&self, n: usize) -> Result<(), ParamError> {
-        param::positive("system.length", self.length)?;
-        param::positive("system.diameter", self.sigma)?;
-        param::positive("system.mobility", self.mobility)?;
-        param::non_negative("system.kT", self.kt)?;
-        param::positive("run.dt", self.dt)?;
-        param::at_least("system.particles", n, 1)?;
+        param::positive("length", self.length)?;
+        param::positive("sigma", self.sigma)?;
+        param::positive("mobility", self.mobility)?;
+        param::non_negative("kt", self.kt)?;
+        param::positive("dt", self.dt)?;
+        param::at_least("n", n, 1)?;
         if n > u32::MAX as usize / 4 {
             return Err(ParamError::new(
-                "system.particles",
+                "n",
                 format!("at most {} rods, got {n}", u32::MAX / 4),
             ));
         }
         let packed = n as f64 * self.sigma;
         if packed >= self.length {
             return Err(ParamError::new(
-                "system.particles",
+                "n",
                 format!(
-                    "{n} rods of length {} fill {packed} >= system.length {}: N sigma must be < L",
+                    "{n} rods of length {} fill {packed} >= the length {}: N sigma must be < L",
                     self.sigma, self.length
                 ),
             ));
@@ -132,7 +133,7 @@ pub enum BcdError {
     Positions(String),
     /// A force or position became NaN or infinite.
     #[error(
-        "the run went non-finite at step {step}: rod {particle} at x = {position} has velocity {velocity}; reduce run.dt or check the potential"
+        "the run went non-finite at step {step}: rod {particle} at x = {position} has velocity {velocity}; reduce the time step or check the potential"
     )]
     NonFinite {
         /// Step at which it happened.

@@ -457,25 +457,25 @@ pub struct Sticky {
 }
 
 impl Sticky {
-    /// Validate the sticky parameters (`interaction.sticky.*`).
+    /// Validate the sticky parameters; errors name the parameter (`gamma`, `eps`, `order`, `kt`).
     pub fn new(gamma: f64, eps: f64, order: f64, sigma: f64, kt: f64) -> Result<Self, ParamError> {
-        colloidsim_core::param::positive("interaction.sticky.gamma", gamma)?;
-        colloidsim_core::param::positive("interaction.sticky.range", eps)?;
+        colloidsim_core::param::positive("gamma", gamma)?;
+        colloidsim_core::param::positive("eps", eps)?;
         if !(order > 1.0 && order.is_finite()) {
             return Err(ParamError::new(
-                "interaction.sticky.order",
+                "order",
                 format!("must be a finite number > 1 for a continuous force (Eq. 32), got {order}"),
             ));
         }
         if eps >= sigma {
             return Err(ParamError::new(
-                "interaction.sticky.range",
+                "eps",
                 format!("must be much smaller than the rod length {sigma}, got {eps}"),
             ));
         }
         if kt <= 0.0 {
             return Err(ParamError::new(
-                "system.kT",
+                "kt",
                 "sticky rods are defined by a Boltzmann factor and need kT > 0",
             ));
         }
@@ -535,13 +535,13 @@ pub struct Yukawa {
 }
 
 impl Yukawa {
-    /// Validate (`interaction.yukawa.*`).
+    /// Validate; errors name the parameter (`strength`, `screening`, `cutoff`).
     pub fn new(strength: f64, screening: f64, cutoff: f64, sigma: f64) -> Result<Self, ParamError> {
-        colloidsim_core::param::finite("interaction.yukawa.strength", strength)?;
-        colloidsim_core::param::positive("interaction.yukawa.screening", screening)?;
+        colloidsim_core::param::finite("strength", strength)?;
+        colloidsim_core::param::positive("screening", screening)?;
         if !(cutoff > sigma && cutoff.is_finite()) {
             return Err(ParamError::new(
-                "interaction.yukawa.cutoff",
+                "cutoff",
                 format!("must exceed the rod length {sigma}, got {cutoff}"),
             ));
         }
@@ -579,10 +579,10 @@ pub struct TabulatedPair {
 }
 
 impl TabulatedPair {
-    /// Validate a table (`interaction.table`): at least 2 rows, strictly increasing r starting
+    /// Validate a table (errors name the parameter `table`): at least 2 rows, strictly increasing r starting
     /// at or below sigma, finite values, last force 0.
     pub fn new(r: Vec<f64>, f: Vec<f64>, sigma: f64) -> Result<Self, ParamError> {
-        let key = "interaction.table";
+        let key = "table";
         if r.len() < 2 || r.len() != f.len() {
             return Err(ParamError::new(key, "needs at least 2 rows of (r, f)"));
         }
@@ -640,6 +640,125 @@ impl<A: PairForce, B: PairForce> PairForce for PairSum<A, B> {
     #[inline]
     fn force(&self, r: f64) -> f64 {
         self.0.force(r) + self.1.force(r)
+    }
+}
+
+/// External force as the engine sees it.
+#[derive(Debug, Clone)]
+pub enum Field {
+    /// No field.
+    None,
+    /// Cosine potentials (and a drive), evaluated exactly.
+    Cosine(CosineForce),
+    /// Periodic field from a table (exact to 1e-9).
+    Table(ForceTable),
+    /// Non-periodic field evaluated exactly.
+    Exact(ExternalField),
+}
+
+impl Field {
+    /// The fastest exact form of `field`: none, cosines evaluated directly, other periodic
+    /// fields from a table, the rest evaluated term by term.
+    pub fn new(field: &ExternalField) -> Self {
+        if field.is_zero() {
+            Field::None
+        } else if let Some(c) = CosineForce::from_field(field) {
+            Field::Cosine(c)
+        } else if let Some(t) = ForceTable::from_field(field) {
+            Field::Table(t)
+        } else {
+            Field::Exact(field.clone())
+        }
+    }
+}
+
+impl ExternalForce for Field {
+    #[inline]
+    fn force(&self, x: f64) -> f64 {
+        match self {
+            Field::None => 0.0,
+            Field::Cosine(c) => c.force(x),
+            Field::Table(t) => t.force(x),
+            Field::Exact(f) => f.force(x),
+        }
+    }
+
+    /// One dispatch per run of rods, then the field's own batched loop.
+    #[inline]
+    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
+        match self {
+            Field::None => out.fill(0.0),
+            Field::Cosine(c) => c.force_block(x, offset, out),
+            Field::Table(t) => t.force_block(x, offset, out),
+            Field::Exact(f) => f.force_block(x, offset, out),
+        }
+    }
+
+    #[inline]
+    fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
+        match self {
+            Field::None => out.fill(0.0),
+            Field::Cosine(c) => c.force_block_reduced(y, first, sigma, out),
+            Field::Table(t) => t.force_block_reduced(y, first, sigma, out),
+            Field::Exact(f) => f.force_block_reduced(y, first, sigma, out),
+        }
+    }
+}
+
+/// Pair force as the engine sees it: any combination of the specified terms.
+#[derive(Debug, Clone, Default)]
+pub struct Pair {
+    /// Sticky contact.
+    pub sticky: Option<Sticky>,
+    /// Yukawa.
+    pub yukawa: Option<Yukawa>,
+    /// Tabulated.
+    pub table: Option<TabulatedPair>,
+    range: f64,
+}
+
+impl Pair {
+    /// The sum of the terms given; its range is the longest of theirs.
+    pub fn new(
+        sticky: Option<Sticky>,
+        yukawa: Option<Yukawa>,
+        table: Option<TabulatedPair>,
+    ) -> Self {
+        let range = [
+            sticky.as_ref().map(|s| s.range()),
+            yukawa.as_ref().map(|y| y.range()),
+            table.as_ref().map(|t| t.range()),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f64::max);
+        Self {
+            sticky,
+            yukawa,
+            table,
+            range,
+        }
+    }
+}
+
+impl PairForce for Pair {
+    #[inline]
+    fn range(&self) -> f64 {
+        self.range
+    }
+    #[inline]
+    fn force(&self, r: f64) -> f64 {
+        let mut f = 0.0;
+        if let Some(s) = &self.sticky {
+            f += s.force(r);
+        }
+        if let Some(y) = &self.yukawa {
+            f += y.force(r);
+        }
+        if let Some(t) = &self.table {
+            f += t.force(r);
+        }
+        f
     }
 }
 

@@ -37,7 +37,7 @@ pub fn from_positions(cfg: &BcdConfig, mut x: Vec<f64>) -> Result<Vec<f64>, Para
     cfg.validate(x.len())?;
     if let Some(i) = x.iter().position(|v| !v.is_finite()) {
         return Err(ParamError::new(
-            "initial.file",
+            "positions",
             format!("position #{i} is not a finite number"),
         ));
     }

@@ -21,6 +21,5 @@ mod pava;
 #[doc(hidden)]
 pub use pava::PoolBench;
 mod ring;
-pub mod scenario;
 
 pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Integrator, Update};

@@ -308,7 +308,7 @@ fn exact_contact_density_matches_monte_carlo_in_deep_wells() {
 /// the boundary layer (10 % here) the pooled value is rejected.
 #[test]
 fn contact_density_in_a_cosine_potential_matches_the_window_theory() {
-    use colloidsim_bcd::scenario::Field;
+    use colloidsim_bcd::forces::Field;
     use colloidsim_core::field1d::{ExternalField, FieldTerm};
     use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
     use rayon::prelude::*;

@@ -1,8 +1,8 @@
 //! `colloidsim bench bcd`: the fast-bcd scaling case (fast-bcd Fig. 6).
 
 use anyhow::Result;
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
-use colloidsim_bcd::scenario::Field;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use std::time::Instant;

@@ -205,7 +205,7 @@ enum Command {
 enum KeyFormat {
     /// Aligned columns.
     Text,
-    /// A Markdown table (as in docs/).
+    /// The reference page of docs/keys/METHOD.md (a Markdown table under a heading).
     Markdown,
     /// JSON.
     Json,
@@ -560,7 +560,7 @@ fn run_cli() -> Result<()> {
             let keys = colloidsim_run::keys(&method)?;
             match format {
                 KeyFormat::Json => println!("{}", serde_json::to_string_pretty(&keys)?),
-                KeyFormat::Markdown => print!("{}", colloidsim_run::keys::markdown(&keys)),
+                KeyFormat::Markdown => print!("{}", colloidsim_run::keys_page(&method)?),
                 KeyFormat::Text => print!("{}", colloidsim_run::keys::text(&keys)),
             }
             Ok(())

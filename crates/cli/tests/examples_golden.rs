@@ -34,7 +34,11 @@ const EXAMPLES: &[(&str, &[&str])] = &[
     ),
     (
         "bcd/contact-density.toml",
-        &["run.equilibrate=0.0005", "run.time=0.002", "observe.every=8"],
+        &[
+            "run.equilibrate=0.0005",
+            "run.time=0.002",
+            "observe.every=8",
+        ],
     ),
     (
         "bcd/hard-rods-cosine.toml",
@@ -42,7 +46,11 @@ const EXAMPLES: &[(&str, &[&str])] = &[
     ),
     (
         "bcd/single-file.toml",
-        &["run.equilibrate=1.0", "run.time=4.0", "observe.msd.max_lag=2.0"],
+        &[
+            "run.equilibrate=1.0",
+            "run.time=4.0",
+            "observe.msd.max_lag=2.0",
+        ],
     ),
     (
         "bcd/sticky-rods.toml",
@@ -50,11 +58,19 @@ const EXAMPLES: &[(&str, &[&str])] = &[
     ),
     (
         "bcd/sticky-single-file.toml",
-        &["run.equilibrate=0.01", "run.time=0.2", "observe.msd.max_lag=0.1"],
+        &[
+            "run.equilibrate=0.01",
+            "run.time=0.2",
+            "observe.msd.max_lag=0.1",
+        ],
     ),
     (
         "bcd/sticky-washboard-msd.toml",
-        &["run.equilibrate=0.01", "run.time=0.2", "observe.msd.max_lag=0.1"],
+        &[
+            "run.equilibrate=0.01",
+            "run.time=0.2",
+            "observe.msd.max_lag=0.1",
+        ],
     ),
     (
         "bcd/tilted-washboard.toml",
@@ -89,7 +105,10 @@ const EXAMPLES: &[(&str, &[&str])] = &[
             "observe.thermo_every=10",
         ],
     ),
-    ("dpd/shear.toml", &["run.steps=200", "observe.thermo_every=20"]),
+    (
+        "dpd/shear.toml",
+        &["run.steps=200", "observe.thermo_every=20"],
+    ),
     (
         "droplet/drying-bd-paper.toml",
         &[
@@ -202,7 +221,13 @@ fn canonical(v: &serde_json::Value) -> String {
             keys.sort();
             let items: Vec<String> = keys
                 .into_iter()
-                .map(|k| format!("{}:{}", serde_json::Value::from(k.as_str()), canonical(&m[k])))
+                .map(|k| {
+                    format!(
+                        "{}:{}",
+                        serde_json::Value::from(k.as_str()),
+                        canonical(&m[k])
+                    )
+                })
                 .collect();
             format!("{{{}}}\n", items.join(","))
         }
@@ -252,10 +277,7 @@ fn every_example_writes_the_outputs_of_before() {
         return;
     }
     let want = std::fs::read_to_string(reference()).unwrap();
-    let want: BTreeMap<&str, &str> = want
-        .lines()
-        .map(|l| l.split_once(' ').unwrap())
-        .collect();
+    let want: BTreeMap<&str, &str> = want.lines().map(|l| l.split_once(' ').unwrap()).collect();
     let got: BTreeMap<&str, &str> = text.lines().map(|l| l.split_once(' ').unwrap()).collect();
     let differ: Vec<String> = want
         .keys()

@@ -29,7 +29,7 @@ use crate::bd_replica::{
 };
 use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
@@ -146,8 +146,8 @@ impl Method for BulkBd {
         restore(src, seed, out, envelope, comm)
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::bulk()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::BULK
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

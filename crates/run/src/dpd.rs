@@ -5,7 +5,7 @@ use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
 use crate::engine::flat;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
 use crate::trajectory::FrameDigest;
@@ -81,8 +81,8 @@ impl Method for DpdMethod {
         restore(src, seed, out, envelope, comm)
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::dpd()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::DPD
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

@@ -9,7 +9,7 @@ use crate::bd_replica::{
 };
 use crate::checkpoint::Envelope;
 use crate::control::Control;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{
     Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
@@ -101,8 +101,8 @@ impl Method for DropletBd {
         crate::theory_droplet::theory(src, opts, ctl)
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::droplet()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::DROPLET
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

@@ -7,7 +7,7 @@
 use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
 use crate::engine::flat;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
@@ -125,8 +125,8 @@ impl Method for HsMc {
         Ok(Box::new(McSession::new(p, mc, saved.acc)))
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::mc()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::MC
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

@@ -14,11 +14,11 @@ pub mod ensemble;
 pub mod extrapolate;
 pub mod keys;
 pub mod method;
+pub mod methods;
 pub mod plot;
 pub mod scenario;
 pub mod trajectory;
 
-mod bcd;
 mod bd_replica;
 mod bulk;
 mod dpd;
@@ -141,7 +141,41 @@ pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Res
 
 /// Every key of a method's scenarios (`colloidsim keys METHOD`).
 pub fn keys(method: &str) -> anyhow::Result<Vec<keys::Key>> {
-    Ok(method::find(method)?.keys())
+    Ok(method::find(method)?
+        .keys()
+        .iter()
+        .map(keys::Key::from)
+        .collect())
+}
+
+/// The reference page of a method's keys (`colloidsim keys METHOD --format markdown`, kept as
+/// `docs/keys/METHOD.md`; a test fails when the page differs from what the binary prints).
+pub fn keys_page(method: &str) -> anyhow::Result<String> {
+    let m = method::find(method)?;
+    let name = m.names()[0];
+    let docs = m.docs().strip_prefix("docs/").unwrap_or(m.docs());
+    let listed: Vec<keys::Key> = m.keys().iter().map(keys::Key::from).collect();
+    let also = match m.names() {
+        [_] => String::new(),
+        [_, rest @ ..] => format!(
+            " (also `method = {}`)",
+            rest.iter()
+                .map(|n| format!("\"{n}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        [] => String::new(),
+    };
+    Ok(format!(
+        "# Keys of `{name}` scenarios\n\n\
+         <!-- Written by `colloidsim keys {name} --format markdown` from the keys' declarations; \
+         do not edit by hand. -->\n\n\
+         {}{also}. Every key with its unit, its default (what the method takes when the key is \
+         left out) and the values allowed; unknown keys are errors. How to use them: \
+         [{docs}](../{docs}).\n\n{}",
+        m.about(),
+        keys::markdown(&listed)
+    ))
 }
 
 /// An engine built from a scenario, to be stepped by hand.

@@ -7,7 +7,7 @@
 
 use crate::checkpoint::Envelope;
 use crate::control::Control;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::{Report, TheoryOptions};
 use anyhow::{Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -92,8 +92,8 @@ pub trait Method: Sync {
             self.names()[0]
         )
     }
-    /// Every scenario key with its unit, default and allowed range.
-    fn keys(&self) -> Vec<Key>;
+    /// Every scenario key, declared once: unit, default, allowed range and meaning.
+    fn keys(&self) -> &'static [Spec];
     /// An engine a script can step by hand (Python's engine classes).
     fn engine(&self, sc: &Scenario, seed: Option<u64>) -> Result<Box<dyn crate::Engine>>;
 }
@@ -226,7 +226,7 @@ fn not_decomposed(sc: &Scenario, method: &str) -> String {
 
 /// Every method, in the order `--help` lists them. New methods register here.
 static METHODS: &[&dyn Method] = &[
-    &crate::bcd::BcdMethod,
+    &crate::methods::bcd::BcdMethod,
     &crate::droplet::DropletBd,
     &crate::bulk::BulkBd,
     &crate::dpd::DpdMethod,

@@ -13,7 +13,7 @@
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::droplet::trim_trajectory;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
@@ -362,8 +362,8 @@ impl Method for MpcdBulk {
         restore_bulk(src, seed, out, envelope, comm)
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::mpcd()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::MPCD
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
@@ -1153,8 +1153,8 @@ impl Method for DropletMpcd {
         }))
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::droplet_mpcd()
+    fn keys(&self) -> &'static [Spec] {
+        crate::keys::DROPLET_MPCD
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

@@ -6,7 +6,6 @@
 //! `COLLOIDSIM_FUZZ_RANDOM=1 cargo test -p colloidsim-run --test fuzz` draws new ones, and a
 //! failure found so is saved in `fuzz.proptest-regressions` and replayed by every later run.
 
-use colloidsim_run::keys::{self, Spec};
 use colloidsim_run::{Control, RunOptions, Scenario};
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -26,10 +25,10 @@ fn fuzz_config(cases: u32) -> ProptestConfig {
     }
 }
 
-/// Small, fast scenarios of each method (the mutations start from these).
-const BASES: [(&str, &[Spec]); 10] = [
-    (
-        r#"method = "bcd"
+/// Small, fast scenarios of each method (the mutations start from these); every registered
+/// method has one (tested), and the keys mutated are the registry's declarations.
+const BASES: [&str; 11] = [
+    r#"method = "bcd"
 seed = 3
 [system]
 length = 20.0
@@ -47,10 +46,7 @@ msd = { points = 5 }
 clusters = true
 current = true
 "#,
-        keys::BCD,
-    ),
-    (
-        r#"method = "bcd"
+    r#"method = "bcd"
 [system]
 length = 10.0
 particles = 5
@@ -66,10 +62,7 @@ time = 0.001
 [observe]
 density = { bins = 10 }
 "#,
-        keys::BCD,
-    ),
-    (
-        r#"method = "droplet-bd"
+    r#"method = "droplet-bd"
 [system]
 particles = 30
 phi0 = 0.05
@@ -80,10 +73,7 @@ final_volume_fraction = 0.06
 bins = 10
 fractions = [0.0, 1.0]
 "#,
-        keys::DROPLET,
-    ),
-    (
-        r#"method = "droplet-bd"
+    r#"method = "droplet-bd"
 [system]
 particles = 30
 phi0 = 0.05
@@ -97,10 +87,7 @@ method = "direct"
 bins = 10
 fractions = [0.0, 1.0]
 "#,
-        keys::DROPLET,
-    ),
-    (
-        r#"method = "droplet-bd"
+    r#"method = "droplet-bd"
 [system]
 particles = 30
 phi0 = 0.05
@@ -114,10 +101,7 @@ method = "pse"
 bins = 10
 fractions = [0.0, 1.0]
 "#,
-        keys::DROPLET,
-    ),
-    (
-        r#"method = "bd"
+    r#"method = "bd"
 [system]
 particles = 20
 box_length = 8.0
@@ -130,10 +114,7 @@ every = 10
 [hydrodynamics]
 model = "rpy"
 "#,
-        keys::BULK,
-    ),
-    (
-        r#"method = "bd"
+    r#"method = "bd"
 [system]
 particles = 30
 box_length = 6.0
@@ -142,10 +123,7 @@ dt = 0.01
 time = 0.4
 integrator = "lm"
 "#,
-        keys::BULK,
-    ),
-    (
-        r#"method = "dpd"
+    r#"method = "dpd"
 [system]
 box_length = 7.0
 phi = 0.05
@@ -155,10 +133,7 @@ steps = 20
 thermo_every = 5
 structure_every = 10
 "#,
-        keys::DPD,
-    ),
-    (
-        r#"method = "mpcd"
+    r#"method = "mpcd"
 [system]
 box = 6.0
 [run]
@@ -168,10 +143,7 @@ collisions = 20
 every = 10
 solvent = true
 "#,
-        keys::MPCD,
-    ),
-    (
-        r#"method = "droplet-mpcd"
+    r#"method = "droplet-mpcd"
 boundary = "no-slip"
 [system]
 radius = 3.0
@@ -180,9 +152,38 @@ duration = 5.0
 [observe.solvent]
 window = 5
 "#,
-        keys::DROPLET_MPCD,
-    ),
+    r#"method = "hs-mc"
+[system]
+geometry = "hard-wall"
+particles = 20
+radius = 3.0
+[mc]
+sweeps = 20
+warmup_sweeps = 10
+blocks = 2
+[output]
+profile_bins = 10
+"#,
 ];
+
+/// The method a base scenario names.
+fn method_of(text: &str) -> String {
+    let t: toml::Table = toml::from_str(text).unwrap();
+    t["method"].as_str().unwrap().to_string()
+}
+
+#[test]
+fn every_registered_method_has_a_base_scenario() {
+    for m in colloidsim_run::method::all() {
+        assert!(
+            BASES
+                .iter()
+                .any(|b| m.names().contains(&method_of(b).as_str())),
+            "no base scenario of {}",
+            m.names()[0]
+        );
+    }
+}
 
 /// Values a hostile user types.
 fn hostile() -> impl Strategy<Value = toml::Value> {
@@ -256,7 +257,8 @@ proptest! {
         base in 0..BASES.len(),
         picks in proptest::collection::vec((any::<prop::sample::Index>(), hostile()), 1..4),
     ) {
-        let (text, spec) = BASES[base];
+        let text = BASES[base];
+        let spec = colloidsim_run::method::find(&method_of(text)).unwrap().keys();
         let mut doc: toml::Table = toml::from_str(text).unwrap();
         for (k, v) in picks {
             set(&mut doc, k.get(spec).path, v);
@@ -270,7 +272,7 @@ proptest! {
 #[test]
 fn damaged_initial_gsd_files_are_refused_not_panicked_on() {
     let dir = tempfile::tempdir().unwrap();
-    let base = BASES[2].0;
+    let base = BASES[2];
     let sc = Scenario::from_toml(base, dir.path()).unwrap();
     let opts = RunOptions {
         out: Some(dir.path().join("run")),
@@ -310,7 +312,7 @@ fn damaged_initial_gsd_files_are_refused_not_panicked_on() {
 #[test]
 fn damaged_checkpoints_are_refused_by_the_restart() {
     let dir = tempfile::tempdir().unwrap();
-    let text = BASES[0].0.replace("time = 0.01", "time = 0.05");
+    let text = BASES[0].replace("time = 0.01", "time = 0.05");
     let sc = Scenario::from_toml(&text, dir.path()).unwrap();
     let out = dir.path().join("run");
     let ctl = Control::default();
@@ -453,7 +455,7 @@ proptest! {
 /// The mutations start from valid scenarios (else they would test nothing but the refusal).
 #[test]
 fn every_base_scenario_is_valid_and_steps() {
-    for (text, _) in BASES {
+    for text in BASES {
         let sc = Scenario::from_toml(text, Path::new(".")).unwrap();
         colloidsim_run::check(&sc).unwrap_or_else(|e| panic!("{e:#}\n{text}"));
         let mut e = colloidsim_run::engine(&sc, None).unwrap();

@@ -1,10 +1,13 @@
 //! Brownian cluster dynamics scenarios (`method = "bcd"`, `"bcd-chronological"`): the run's
 //! session (engine, observers on their triggers, GSD frames), its outputs beside the exact
-//! theory, and `theory`.
+//! theory, and `theory`. Its keys are declared in [`keys`] and read in [`params`].
+
+pub mod keys;
+pub mod params;
 
 use crate::checkpoint::Envelope;
 use crate::control::Control;
-use crate::keys::Key;
+use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{
     Labels, Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors,
@@ -13,15 +16,16 @@ use crate::plot::{
 use crate::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
+use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::{ExternalForce, NoPair, PairForce};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
-use colloidsim_bcd::scenario::{Field, Resolved, Scenario};
 use colloidsim_bcd::{Bcd, BcdState, Boundary};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem, bulk};
 use hoomd_gsd::file_layer::{GsdFile, Mode};
+use params::{Resolved, Scenario};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::time::Instant;
@@ -29,13 +33,9 @@ use std::time::Instant;
 /// The BCD family of scenarios.
 pub struct BcdMethod;
 
-fn parse(src: &Source) -> Result<Scenario> {
-    crate::keys::validate(&src.table()?, crate::keys::BCD).with_context(|| src.label())?;
-    toml::from_str(src.text()).with_context(|| src.label())
-}
-
-fn resolve(src: &Source, sc: &Scenario, seed: Option<u64>) -> Result<Resolved> {
-    sc.resolve(src.base(), seed).with_context(|| src.label())
+/// The scenario as given and resolved (with `seed` replacing the scenario's).
+fn read(src: &Source, seed: Option<u64>) -> Result<(Scenario, Resolved)> {
+    params::read(&src.table()?, src.base(), seed).with_context(|| src.label())
 }
 
 impl Method for BcdMethod {
@@ -52,8 +52,7 @@ impl Method for BcdMethod {
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
-        let sc = parse(src)?;
-        let r = resolve(src, &sc, None)?;
+        let (sc, r) = read(src, None)?;
         // Building the engine checks the initial positions (overlaps, walls).
         Bcd::new(r.config.clone(), r.initial.clone(), Field::None, NoPair)
             .with_context(|| src.label())?;
@@ -70,8 +69,7 @@ impl Method for BcdMethod {
         comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
         crate::method::on_one_rank(comm, src, self.names()[0])?;
-        let sc = parse(src)?;
-        let r = resolve(src, &sc, seed)?;
+        let (sc, r) = read(src, seed)?;
         session(sc, r, None)
     }
 
@@ -84,8 +82,7 @@ impl Method for BcdMethod {
         comm: Option<Box<dyn Exchange>>,
     ) -> Result<Box<dyn Session>> {
         crate::method::on_one_rank(comm, src, self.names()[0])?;
-        let sc = parse(src)?;
-        let r = resolve(src, &sc, Some(seed))?;
+        let (sc, r) = read(src, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if sc.observe.trajectory.is_some() {
             let b = RodBox::of(&r.config);
@@ -106,13 +103,12 @@ impl Method for BcdMethod {
         theory(src, opts)
     }
 
-    fn keys(&self) -> Vec<Key> {
-        crate::keys::bcd()
+    fn keys(&self) -> &'static [Spec] {
+        keys::KEYS
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
-        let sc = parse(src)?;
-        let r = resolve(src, &sc, seed)?;
+        let (sc, r) = read(src, seed)?;
         let bcd = Bcd::new(
             r.config.clone(),
             r.initial.clone(),
@@ -251,14 +247,14 @@ fn observers(sc: &Scenario, r: &Resolved) -> Observers {
     let o = &sc.observe;
     let n = r.initial.len() as f64;
     let msd = o.msd.as_ref().map(|m| {
-        let max_lag = m.max_lag.unwrap_or(0.5 * sc.run.time);
+        let max_lag = r.msd_max_lag;
         let max_steps = ((max_lag / c.dt).round() as u64).max(1);
         let lags = log_spaced(1, max_steps, m.points);
         // ~100 time origins over the sampled run.
         Msd::new(lags, (r.sampled_steps / 100).max(1))
     });
     // Density and contact density samples over the run, in DENSITY_BLOCKS blocks.
-    let samples = r.sampled_steps / o.every.unwrap_or(1).max(1);
+    let samples = r.sampled_steps / r.every.max(1);
     Observers {
         density: o.density.as_ref().map(|d| {
             DensityProfile::new(d.bins, r.period, c.length).with_blocks(samples, DENSITY_BLOCKS)
@@ -301,7 +297,7 @@ impl Triggers {
         Self {
             equilibrate: r.equilibrate_steps,
             total,
-            every: sc.observe.every.unwrap_or(1),
+            every: r.every,
             current_every: (r.sampled_steps / 200).max(1),
             trajectory: sc.observe.trajectory.as_ref().map(|t| t.every),
             trajectory_equilibration: sc
@@ -719,7 +715,7 @@ fn trim_trajectory(path: &std::path::Path, frames: u64, b: &RodBox) -> Result<()
 
 /// A BCD engine stepped by hand.
 struct BcdEngine {
-    bcd: Bcd<Field, colloidsim_bcd::scenario::Pair>,
+    bcd: Bcd<Field, colloidsim_bcd::forces::Pair>,
     method: String,
 }
 
@@ -1437,8 +1433,7 @@ fn solve_theory(r: &Resolved, dx: Option<f64>) -> Result<rods::Equilibrium> {
 
 /// `colloidsim theory`: the exact equilibrium of a BCD scenario on the simulation's bins.
 fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
-    let sc = parse(src)?;
-    let r = resolve(src, &sc, None)?;
+    let (sc, r) = read(src, None)?;
     let dx = opts.dx;
     let c = &r.config;
     if c.kt <= 0.0 {

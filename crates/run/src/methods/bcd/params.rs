@@ -1,59 +1,48 @@
-//! The BCD scenario file (TOML) and its resolution into validated parameters.
+//! A `bcd` scenario read through its key declarations ([`super::keys`]) into the parameters
+//! the engine takes, with every check that relates several keys.
 //!
-//! Every key is documented in `docs/bcd.md` with its unit and default; unknown keys are errors.
 //! Units: lengths in the unit of `system.length`, energies in units of the energy scale of the
 //! potential (kT = 1 by default), time in (length unit)^2 / D when mobility = kT = 1.
 
-use crate::engine::{BcdConfig, Boundary, Integrator, Update};
-use crate::forces::{CosineForce, ForceTable, PairForce, Sticky, TabulatedPair, Yukawa};
-use crate::init;
+use super::keys::*;
+use crate::keys::{Reader, rekey};
+use colloidsim_bcd::forces::{Field, Pair, Sticky, TabulatedPair, Yukawa};
+use colloidsim_bcd::init;
+use colloidsim_bcd::{BcdConfig, Boundary, Integrator, Update};
 use colloidsim_core::ParamError;
 use colloidsim_core::field1d::{ExternalField, FieldTerm, PeriodicSpline};
 use colloidsim_core::output::read_table;
 use colloidsim_core::param;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The most steps a run may have (2^50).
 const MAX_STEPS: f64 = 1_125_899_906_842_624.0;
 
-/// A BCD scenario as written in the TOML file.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// A BCD scenario as given (the sections `summary.json` records as written; optional keys the
+/// scenario leaves out stay `None`, their defaults come from the declarations).
+#[derive(Debug, Clone, Serialize)]
 pub struct Scenario {
     /// `bcd` (premerging) or `bcd-chronological`.
     pub method: String,
-    /// Seed of all random streams (0 ..= 4294967295).
-    #[serde(default = "one")]
+    /// Seed of all random streams.
     pub seed: u64,
     /// Physical system.
     pub system: System,
     /// External potential.
-    #[serde(default)]
     pub potential: Potential,
     /// Pair interactions beyond the hard core.
-    #[serde(default)]
     pub interaction: Interaction,
     /// Initial configuration.
-    #[serde(default)]
     pub initial: Initial,
     /// Time stepping.
     pub run: Run,
     /// Observables.
-    #[serde(default)]
     pub observe: Observe,
 }
 
-fn one() -> u64 {
-    1
-}
-fn unit() -> f64 {
-    1.0
-}
-
 /// `[system]`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct System {
     /// Length L of the ring or channel.
     pub length: f64,
@@ -61,29 +50,21 @@ pub struct System {
     pub particles: usize,
     /// Rod length sigma (the hard-core diameter).
     pub diameter: f64,
-    /// Mobility mu (default 1).
-    #[serde(default = "unit")]
+    /// Mobility mu.
     pub mobility: f64,
-    /// Thermal energy kT (default 1; 0 for deterministic dynamics).
-    #[serde(default = "unit", rename = "kT")]
+    /// Thermal energy kT (0 for deterministic dynamics).
+    #[serde(rename = "kT")]
     pub kt: f64,
-    /// `periodic` (default) or `walls`.
-    #[serde(default = "periodic")]
+    /// A ring or hard walls.
     pub boundary: Boundary,
 }
 
-fn periodic() -> Boundary {
-    Boundary::Periodic
-}
-
 /// `[potential]`: a sum of the terms given.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Potential {
     /// `U = (amplitude/2) cos(2 pi x / wavelength)`.
     pub cosine: Option<Cosine>,
     /// Constant force (tilted washboard).
-    #[serde(default)]
     pub drive: f64,
     /// `U = stiffness/2 (x - centre)^2`.
     pub harmonic: Option<Harmonic>,
@@ -94,8 +75,7 @@ pub struct Potential {
 }
 
 /// `potential.cosine`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Cosine {
     /// Peak-to-peak height U0.
     pub amplitude: f64,
@@ -104,32 +84,27 @@ pub struct Cosine {
 }
 
 /// `potential.harmonic`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Harmonic {
     /// Spring constant.
     pub stiffness: f64,
-    /// Trap centre (default L/2).
+    /// Trap centre, if given.
     pub centre: Option<f64>,
 }
 
 /// `potential.fourier`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Fourier {
     /// Fundamental period.
     pub wavelength: f64,
     /// Cosine amplitudes of modes 1, 2, ...
-    #[serde(default)]
     pub cos: Vec<f64>,
     /// Sine amplitudes of modes 1, 2, ...
-    #[serde(default)]
     pub sin: Vec<f64>,
 }
 
 /// `[interaction]`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Interaction {
     /// Baxter sticky contact (hard-rods paper Eq. 33).
     pub sticky: Option<StickySpec>,
@@ -140,28 +115,18 @@ pub struct Interaction {
 }
 
 /// `interaction.sticky`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct StickySpec {
     /// Strength gamma.
     pub gamma: f64,
-    /// Virtual range eps (default 0.05).
-    #[serde(default = "eps_default")]
+    /// Virtual range eps.
     pub range: f64,
-    /// Order p (default 3).
-    #[serde(default = "order_default")]
+    /// Order p.
     pub order: f64,
-}
-fn eps_default() -> f64 {
-    0.05
-}
-fn order_default() -> f64 {
-    3.0
 }
 
 /// `interaction.yukawa`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct YukawaSpec {
     /// Energy at contact.
     pub strength: f64,
@@ -172,49 +137,33 @@ pub struct YukawaSpec {
 }
 
 /// `[initial]`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Initial {
-    /// `random` (default), `lattice` or `file`.
-    #[serde(default = "random")]
+    /// `random`, `lattice` or `file`.
     pub placement: String,
     /// CSV file with a column `x` (placement = "file").
     pub file: Option<PathBuf>,
 }
-fn random() -> String {
-    "random".into()
-}
-impl Default for Initial {
-    fn default() -> Self {
-        Self {
-            placement: random(),
-            file: None,
-        }
-    }
-}
 
 /// `[run]`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Run {
     /// Time step.
     pub dt: f64,
-    /// Time run before sampling starts (default 0).
-    #[serde(default)]
+    /// Time run before sampling starts.
     pub equilibrate: f64,
     /// Time sampled.
     pub time: f64,
-    /// Steps between checkpoints (default: about every 10% of the run).
+    /// Steps between checkpoints, if given.
     pub checkpoint_every: Option<u64>,
-    /// Integrator of the free motion: `euler` (default) or `lm` (Leimkuhler–Matthews).
+    /// Integrator of the free motion: `euler` or `lm` (Leimkuhler–Matthews).
     pub integrator: Option<String>,
 }
 
 /// `[observe]`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Observe {
-    /// Steps between samples of density, contact density and clusters (default 1).
+    /// Steps between samples of density, contact density and clusters, if given.
     pub every: Option<u64>,
     /// Density histogram.
     pub density: Option<Bins>,
@@ -223,26 +172,22 @@ pub struct Observe {
     /// Mean-square displacement.
     pub msd: Option<MsdSpec>,
     /// Mean particle current.
-    #[serde(default)]
     pub current: bool,
     /// Cluster-size distribution.
-    #[serde(default)]
     pub clusters: bool,
     /// GSD trajectory.
     pub trajectory: Option<Trajectory>,
 }
 
 /// `observe.density`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Bins {
     /// Number of bins over one period (or over L without a periodic potential).
     pub bins: usize,
 }
 
 /// `observe.contact_density`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct ContactSpec {
     /// Number of bins.
     pub bins: usize,
@@ -251,122 +196,145 @@ pub struct ContactSpec {
 }
 
 /// `observe.msd`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct MsdSpec {
-    /// Number of log-spaced lag times (default 40).
-    #[serde(default = "msd_points")]
+    /// Number of log-spaced lag times.
     pub points: usize,
-    /// Longest lag time (default: half the sampled time).
+    /// Longest lag time, if given.
     pub max_lag: Option<f64>,
-}
-fn msd_points() -> usize {
-    40
 }
 
 /// `observe.trajectory`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Serialize)]
 pub struct Trajectory {
     /// Steps between frames (from the first production step).
     pub every: u64,
     /// Also write frames during equilibration (from step 0).
-    #[serde(default)]
     pub equilibration: bool,
 }
 
-/// External force as the engine sees it.
-#[derive(Debug, Clone)]
-pub enum Field {
-    /// No field.
-    None,
-    /// Cosine potentials (and a drive), evaluated exactly.
-    Cosine(CosineForce),
-    /// Periodic field from a table (exact to 1e-9).
-    Table(ForceTable),
-    /// Non-periodic field evaluated exactly.
-    Exact(ExternalField),
-}
-
-impl Field {
-    /// The fastest exact form of `field`: none, cosines evaluated directly, other periodic
-    /// fields from a table, the rest evaluated term by term.
-    pub fn new(field: &ExternalField) -> Self {
-        if field.is_zero() {
-            Field::None
-        } else if let Some(c) = CosineForce::from_field(field) {
-            Field::Cosine(c)
-        } else if let Some(t) = ForceTable::from_field(field) {
-            Field::Table(t)
-        } else {
-            Field::Exact(field.clone())
-        }
-    }
-}
-
-impl crate::forces::ExternalForce for Field {
-    #[inline]
-    fn force(&self, x: f64) -> f64 {
-        match self {
-            Field::None => 0.0,
-            Field::Cosine(c) => c.force(x),
-            Field::Table(t) => t.force(x),
-            Field::Exact(f) => f.force(x),
-        }
-    }
-
-    /// One dispatch per run of rods, then the field's own batched loop.
-    #[inline]
-    fn force_block(&self, x: &[f64], offset: f64, out: &mut [f64]) {
-        match self {
-            Field::None => out.fill(0.0),
-            Field::Cosine(c) => c.force_block(x, offset, out),
-            Field::Table(t) => t.force_block(x, offset, out),
-            Field::Exact(f) => f.force_block(x, offset, out),
-        }
-    }
-
-    #[inline]
-    fn force_block_reduced(&self, y: &[f64], first: usize, sigma: f64, out: &mut [f64]) {
-        match self {
-            Field::None => out.fill(0.0),
-            Field::Cosine(c) => c.force_block_reduced(y, first, sigma, out),
-            Field::Table(t) => t.force_block_reduced(y, first, sigma, out),
-            Field::Exact(f) => f.force_block_reduced(y, first, sigma, out),
-        }
-    }
-}
-
-/// Pair force as the engine sees it: any combination of the specified terms.
-#[derive(Debug, Clone, Default)]
-pub struct Pair {
-    /// Sticky contact.
-    pub sticky: Option<Sticky>,
-    /// Yukawa.
-    pub yukawa: Option<Yukawa>,
-    /// Tabulated.
-    pub table: Option<TabulatedPair>,
-    range: f64,
-}
-
-impl PairForce for Pair {
-    #[inline]
-    fn range(&self) -> f64 {
-        self.range
-    }
-    #[inline]
-    fn force(&self, r: f64) -> f64 {
-        let mut f = 0.0;
-        if let Some(s) = &self.sticky {
-            f += s.force(r);
-        }
-        if let Some(y) = &self.yukawa {
-            f += y.force(r);
-        }
-        if let Some(t) = &self.table {
-            f += t.force(r);
-        }
-        f
+impl Scenario {
+    /// The scenario as given, read through the declarations of [`super::keys`] (which have
+    /// checked every key's type and range).
+    pub fn read(r: &Reader) -> anyhow::Result<Self> {
+        let count = |k| -> anyhow::Result<usize> { Ok(r.count(k)? as usize) };
+        let section = |k| r.has(k);
+        Ok(Self {
+            method: r.word(&METHOD)?,
+            seed: r.count(&SEED)?,
+            system: System {
+                length: r.number(&SYSTEM_LENGTH)?,
+                particles: count(&SYSTEM_PARTICLES)?,
+                diameter: r.number(&SYSTEM_DIAMETER)?,
+                mobility: r.number(&SYSTEM_MOBILITY)?,
+                kt: r.number(&SYSTEM_KT)?,
+                boundary: match r.word(&SYSTEM_BOUNDARY)?.as_str() {
+                    "walls" => Boundary::Walls,
+                    _ => Boundary::Periodic,
+                },
+            },
+            potential: Potential {
+                cosine: section(&POTENTIAL_COSINE)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(Cosine {
+                            amplitude: r.number(&POTENTIAL_COSINE_AMPLITUDE)?,
+                            wavelength: r.number(&POTENTIAL_COSINE_WAVELENGTH)?,
+                        })
+                    })
+                    .transpose()?,
+                drive: r.number(&POTENTIAL_DRIVE)?,
+                harmonic: section(&POTENTIAL_HARMONIC)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(Harmonic {
+                            stiffness: r.number(&POTENTIAL_HARMONIC_STIFFNESS)?,
+                            centre: r
+                                .given(&POTENTIAL_HARMONIC_CENTRE)
+                                .and(Some(r.number(&POTENTIAL_HARMONIC_CENTRE)?)),
+                        })
+                    })
+                    .transpose()?,
+                fourier: section(&POTENTIAL_FOURIER)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(Fourier {
+                            wavelength: r.number(&POTENTIAL_FOURIER_WAVELENGTH)?,
+                            cos: r.numbers(&POTENTIAL_FOURIER_COS)?,
+                            sin: r.numbers(&POTENTIAL_FOURIER_SIN)?,
+                        })
+                    })
+                    .transpose()?,
+                table: r.file(&POTENTIAL_TABLE),
+            },
+            interaction: Interaction {
+                sticky: section(&INTERACTION_STICKY)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(StickySpec {
+                            gamma: r.number(&INTERACTION_STICKY_GAMMA)?,
+                            range: r.number(&INTERACTION_STICKY_RANGE)?,
+                            order: r.number(&INTERACTION_STICKY_ORDER)?,
+                        })
+                    })
+                    .transpose()?,
+                yukawa: section(&INTERACTION_YUKAWA)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(YukawaSpec {
+                            strength: r.number(&INTERACTION_YUKAWA_STRENGTH)?,
+                            screening: r.number(&INTERACTION_YUKAWA_SCREENING)?,
+                            cutoff: r.number(&INTERACTION_YUKAWA_CUTOFF)?,
+                        })
+                    })
+                    .transpose()?,
+                table: r.file(&INTERACTION_TABLE),
+            },
+            initial: Initial {
+                placement: r.word(&INITIAL_PLACEMENT)?,
+                file: r.file(&INITIAL_FILE),
+            },
+            run: Run {
+                dt: r.number(&RUN_DT)?,
+                equilibrate: r.number(&RUN_EQUILIBRATE)?,
+                time: r.number(&RUN_TIME)?,
+                checkpoint_every: r.opt_count(&RUN_CHECKPOINT_EVERY)?,
+                integrator: r.given(&RUN_INTEGRATOR).and(Some(r.word(&RUN_INTEGRATOR)?)),
+            },
+            observe: Observe {
+                every: r.given(&OBSERVE_EVERY).and(Some(r.count(&OBSERVE_EVERY)?)),
+                density: section(&OBSERVE_DENSITY)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(Bins {
+                            bins: count(&OBSERVE_DENSITY_BINS)?,
+                        })
+                    })
+                    .transpose()?,
+                contact_density: section(&OBSERVE_CONTACT_DENSITY)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(ContactSpec {
+                            bins: count(&OBSERVE_CONTACT_DENSITY_BINS)?,
+                            window: r.number(&OBSERVE_CONTACT_DENSITY_WINDOW)?,
+                        })
+                    })
+                    .transpose()?,
+                msd: section(&OBSERVE_MSD)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(MsdSpec {
+                            points: count(&OBSERVE_MSD_POINTS)?,
+                            max_lag: r
+                                .given(&OBSERVE_MSD_MAX_LAG)
+                                .and(Some(r.number(&OBSERVE_MSD_MAX_LAG)?)),
+                        })
+                    })
+                    .transpose()?,
+                current: r.flag(&OBSERVE_CURRENT)?,
+                clusters: r.flag(&OBSERVE_CLUSTERS)?,
+                trajectory: section(&OBSERVE_TRAJECTORY)
+                    .then(|| -> anyhow::Result<_> {
+                        Ok(Trajectory {
+                            every: r.count(&OBSERVE_TRAJECTORY_EVERY)?,
+                            equilibration: r.flag(&OBSERVE_TRAJECTORY_EQUILIBRATION)?,
+                        })
+                    })
+                    .transpose()?,
+            },
+        })
     }
 }
 
@@ -391,13 +359,46 @@ pub struct Resolved {
     pub sampled_steps: u64,
     /// Folding period of profiles (the potential's period, or L).
     pub period: f64,
+    /// Steps between samples of density, contact density and clusters.
+    pub every: u64,
+    /// Longest lag time of the MSD.
+    pub msd_max_lag: f64,
     /// Warnings worth showing to the user.
     pub warnings: Vec<String>,
 }
 
+/// The engine's names of its parameters, and the keys that set them.
+const ENGINE_NAMES: &[(&str, &crate::keys::Spec)] = &[
+    ("length", &SYSTEM_LENGTH),
+    ("sigma", &SYSTEM_DIAMETER),
+    ("mobility", &SYSTEM_MOBILITY),
+    ("kt", &SYSTEM_KT),
+    ("dt", &RUN_DT),
+    ("n", &SYSTEM_PARTICLES),
+    ("positions", &INITIAL_FILE),
+    ("gamma", &INTERACTION_STICKY_GAMMA),
+    ("eps", &INTERACTION_STICKY_RANGE),
+    ("order", &INTERACTION_STICKY_ORDER),
+    ("strength", &INTERACTION_YUKAWA_STRENGTH),
+    ("screening", &INTERACTION_YUKAWA_SCREENING),
+    ("cutoff", &INTERACTION_YUKAWA_CUTOFF),
+    ("table", &INTERACTION_TABLE),
+];
+
+/// An engine's error about one of its parameters, naming the scenario key instead.
+fn keyed(e: ParamError) -> ParamError {
+    rekey(e, ENGINE_NAMES)
+}
+
 impl Scenario {
-    /// Validate and resolve. Relative file names are taken relative to `base`.
-    pub fn resolve(&self, base: &Path, seed_override: Option<u64>) -> Result<Resolved, ParamError> {
+    /// Validate and resolve; `r` gives the defaults the scenario leaves out. Relative file
+    /// names are taken relative to `base`.
+    pub fn resolve(
+        &self,
+        r: &Reader,
+        base: &Path,
+        seed_override: Option<u64>,
+    ) -> anyhow::Result<Resolved> {
         let update = match self.method.as_str() {
             "bcd" => Update::Premerge,
             "bcd-chronological" => Update::Chronological,
@@ -405,7 +406,8 @@ impl Scenario {
                 return Err(ParamError::new(
                     "method",
                     format!("'{m}' is not a BCD method (bcd, bcd-chronological)"),
-                ));
+                )
+                .into());
             }
         };
         let integrator = match self.run.integrator.as_deref() {
@@ -417,7 +419,8 @@ impl Scenario {
                     format!(
                         "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
                     ),
-                ));
+                )
+                .into());
             }
         };
         let seed = seed_override.unwrap_or(self.seed);
@@ -433,11 +436,11 @@ impl Scenario {
             seed,
             update,
         };
-        config.validate(s.particles)?;
+        config.validate(s.particles).map_err(keyed)?;
         let mut warnings = Vec::new();
         self.check_memory()?;
 
-        let field = self.field(base)?;
+        let field = self.field(r, base)?;
         if let (Some(p), Boundary::Periodic) = (field.period(), s.boundary) {
             let k = s.length / p;
             if (k - k.round()).abs() > 1e-9 * k {
@@ -447,12 +450,12 @@ impl Scenario {
                         "on a ring the length must be a whole number of potential periods ({p}); got {} = {k} periods",
                         s.length
                     ),
-                ));
+                ).into());
             }
         }
         let engine_field = Field::new(&field);
 
-        let pair = self.pair(base, s.diameter, s.kt)?;
+        let pair = self.pair(base, s.diameter, s.kt).map_err(keyed)?;
         if let Some(st) = &pair.sticky {
             // Time-step criterion, hard-rods paper Eq. (34): mu max|f| dt << eps.
             let jump = s.mobility * st.max_force() * self.run.dt;
@@ -464,7 +467,7 @@ impl Scenario {
                         st.eps,
                         0.1 * st.eps / (s.mobility * st.max_force())
                     ),
-                ));
+                ).into());
             } else if jump > 0.1 * st.eps {
                 warnings.push(format!(
                     "run.dt: mu max|f| dt = {jump:.3e} is not much smaller than the sticky range {} (Eq. 34); results may depend on dt",
@@ -483,8 +486,8 @@ impl Scenario {
         }
 
         let initial = match self.initial.placement.as_str() {
-            "random" => init::random(&config, s.particles, seed)?,
-            "lattice" => init::lattice(&config, s.particles)?,
+            "random" => init::random(&config, s.particles, seed).map_err(keyed)?,
+            "lattice" => init::lattice(&config, s.particles).map_err(keyed)?,
             "file" => {
                 let f = self.initial.file.as_ref().ok_or_else(|| {
                     ParamError::new("initial.file", "placement = \"file\" needs a file name")
@@ -500,15 +503,19 @@ impl Scenario {
                             x.len(),
                             s.particles
                         ),
-                    ));
+                    )
+                    .into());
                 }
-                init::from_positions(&config, x).map_err(naming(&path))?
+                init::from_positions(&config, x)
+                    .map_err(keyed)
+                    .map_err(naming(&path))?
             }
             p => {
                 return Err(ParamError::new(
                     "initial.placement",
                     format!("'{p}' is not one of: random, lattice, file"),
-                ));
+                )
+                .into());
             }
         };
 
@@ -524,7 +531,8 @@ impl Scenario {
                 return Err(ParamError::new(
                     key,
                     format!("{key} / run.dt = {steps:e} steps is too many (at most 2^50)"),
-                ));
+                )
+                .into());
             }
         }
         let equilibrate_steps = (self.run.equilibrate / self.run.dt).round() as u64;
@@ -539,7 +547,7 @@ impl Scenario {
                     format!(
                         "{e} steps between samples, but the run samples only {sampled_steps} steps (run.time / run.dt): no density, contact density or cluster sample would be taken"
                     ),
-                ));
+                ).into());
             }
         }
         if let Some(t) = &o.trajectory
@@ -552,7 +560,7 @@ impl Scenario {
                     t.every,
                     equilibrate_steps + sampled_steps
                 ),
-            ));
+            ).into());
         }
         if let Some(d) = &o.density {
             param::at_least("observe.density.bins", d.bins, 1)?;
@@ -614,6 +622,8 @@ impl Scenario {
             equilibrate_steps,
             sampled_steps,
             period,
+            every: r.count(&OBSERVE_EVERY)?,
+            msd_max_lag: r.number(&OBSERVE_MSD_MAX_LAG)?,
             warnings,
         })
     }
@@ -698,7 +708,7 @@ impl Scenario {
         Ok(())
     }
 
-    fn field(&self, base: &Path) -> Result<ExternalField, ParamError> {
+    fn field(&self, r: &Reader, base: &Path) -> Result<ExternalField, ParamError> {
         let p = &self.potential;
         let mut terms = Vec::new();
         if let Some(c) = &p.cosine {
@@ -711,7 +721,9 @@ impl Scenario {
         }
         if let Some(h) = &p.harmonic {
             param::non_negative("potential.harmonic.stiffness", h.stiffness)?;
-            let centre = h.centre.unwrap_or(0.5 * self.system.length);
+            let centre = r
+                .number(&POTENTIAL_HARMONIC_CENTRE)
+                .map_err(|e| ParamError::new(POTENTIAL_HARMONIC_CENTRE.path, format!("{e:#}")))?;
             param::finite("potential.harmonic.centre", centre)?;
             terms.push(FieldTerm::Harmonic {
                 stiffness: h.stiffness,
@@ -769,20 +781,7 @@ impl Scenario {
             }
             None => None,
         };
-        let range = [
-            sticky.as_ref().map(|s| s.range()),
-            yukawa.as_ref().map(|y| y.range()),
-            table.as_ref().map(|t| t.range()),
-        ]
-        .into_iter()
-        .flatten()
-        .fold(0.0, f64::max);
-        Ok(Pair {
-            sticky,
-            yukawa,
-            table,
-            range,
-        })
+        Ok(Pair::new(sticky, yukawa, table))
     }
 }
 
@@ -824,17 +823,111 @@ fn read_pair(
     ))
 }
 
+/// A scenario's table checked against [`KEYS`], read, and resolved (with `seed` replacing the
+/// scenario's); relative file names are taken from `base`.
+pub fn read(
+    table: &toml::Table,
+    base: &Path,
+    seed: Option<u64>,
+) -> anyhow::Result<(Scenario, Resolved)> {
+    let r = Reader::new(table, KEYS)?;
+    let sc = Scenario::read(&r)?;
+    let resolved = sc.resolve(&r, base, seed)?;
+    Ok((sc, resolved))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn scenario(run_extra: &str) -> Result<Resolved, ParamError> {
-        let text = format!(
+    fn scenario_text(run_extra: &str) -> String {
+        format!(
             "method = \"bcd\"\n[system]\nlength = 20.0\nparticles = 10\ndiameter = 0.5\n\
              [run]\ndt = 1e-3\ntime = 1.0\n{run_extra}\n"
+        )
+    }
+
+    fn scenario(run_extra: &str) -> anyhow::Result<Resolved> {
+        let text = scenario_text(run_extra);
+        read(
+            &toml::from_str(&text).expect("scenario syntax"),
+            Path::new("."),
+            None,
+        )
+        .map(|(_, r)| r)
+    }
+
+    /// A scenario with every table, so that every key is read.
+    const FULL: &str = r#"
+method = "bcd"
+seed = 1
+[system]
+length = 20.0
+particles = 10
+diameter = 0.5
+[potential]
+cosine = { amplitude = 1.0, wavelength = 1.0 }
+harmonic = { stiffness = 0.1 }
+fourier = { wavelength = 2.0, cos = [0.1] }
+[interaction]
+sticky = { gamma = 1.0 }
+yukawa = { strength = 1.0, screening = 0.5, cutoff = 2.0 }
+[run]
+dt = 1e-5
+time = 0.01
+[observe]
+density = { bins = 10 }
+contact_density = { bins = 10, window = 0.1 }
+msd = { points = 40 }
+trajectory = { every = 10 }
+"#;
+
+    #[test]
+    fn every_declared_key_is_read() {
+        let table: toml::Table = toml::from_str(FULL).unwrap();
+        let r = Reader::new(&table, KEYS).unwrap();
+        let sc = Scenario::read(&r).unwrap();
+        sc.resolve(&r, Path::new("."), None).unwrap();
+        assert_eq!(r.unread(), Vec::<&str>::new());
+        // Without the optional tables their keys are not read (the check can fail).
+        let bare: toml::Table = toml::from_str(&scenario_text("")).unwrap();
+        let r = Reader::new(&bare, KEYS).unwrap();
+        Scenario::read(&r).unwrap();
+        assert!(r.unread().contains(&"potential.cosine.amplitude"));
+    }
+
+    #[test]
+    fn derived_defaults_are_computed_from_the_keys_they_name() {
+        let table: toml::Table = toml::from_str(FULL).unwrap();
+        let (sc, resolved) = read(&table, Path::new("."), None).unwrap();
+        // observe.msd.max_lag: run.time / 2.
+        assert_eq!(resolved.msd_max_lag, 0.5 * sc.run.time);
+        // potential.harmonic.centre: L/2.
+        let r = Reader::new(&table, KEYS).unwrap();
+        assert_eq!(
+            r.number(&POTENTIAL_HARMONIC_CENTRE).unwrap(),
+            0.5 * sc.system.length
         );
-        let sc: Scenario = toml::from_str(&text).expect("scenario syntax");
-        sc.resolve(Path::new("."), None)
+    }
+
+    #[test]
+    fn the_engine_s_checks_name_the_scenario_key() {
+        let refused = |text: &str| {
+            let e = read(&toml::from_str(text).unwrap(), Path::new("."), None).unwrap_err();
+            format!("{e:#}")
+        };
+        let crowded = "method = \"bcd\"\n[system]\nlength = 5.0\nparticles = 10\n\
+                       diameter = 0.5\n[run]\ndt = 1e-3\ntime = 1.0\n";
+        let e = refused(crowded);
+        assert!(e.contains("system.particles: 10 rods"), "{e}");
+        let wide = "method = \"bcd\"\n[system]\nlength = 20.0\nparticles = 10\n\
+                    diameter = 0.5\n[interaction]\nsticky = { gamma = 1.0, range = 0.6 }\n\
+                    [run]\ndt = 1e-6\ntime = 1.0\n";
+        let e = refused(wide);
+        assert!(
+            e.contains("interaction.sticky.range: must be much smaller"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -869,8 +962,14 @@ mod tests {
                  [interaction]\nsticky = {{ gamma = 1.0 }}\n\
                  [run]\ndt = 1e-5\ntime = 1.0\nintegrator = \"{integrator}\"\n"
             );
-            let sc: Scenario = toml::from_str(&text).expect("scenario syntax");
-            sc.resolve(Path::new("."), None).unwrap().warnings
+            read(
+                &toml::from_str(&text).expect("scenario syntax"),
+                Path::new("."),
+                None,
+            )
+            .unwrap()
+            .1
+            .warnings
         };
         assert!(sticky("lm").iter().any(|w| w.contains("sticky")));
         assert!(!sticky("euler").iter().any(|w| w.contains("run.integrator")));
@@ -882,8 +981,14 @@ mod tests {
                  [run]\ndt = 5e-7\ntime = 1.0\nintegrator = \"{integrator}\"\n\
                  [observe]\ncontact_density = {{ bins = 10, window = 0.02 }}\n"
             );
-            let sc: Scenario = toml::from_str(&text).expect("scenario syntax");
-            sc.resolve(Path::new("."), None).unwrap().warnings
+            read(
+                &toml::from_str(&text).expect("scenario syntax"),
+                Path::new("."),
+                None,
+            )
+            .unwrap()
+            .1
+            .warnings
         };
         assert!(contact_at("euler").is_empty());
         assert!(
