@@ -39,7 +39,6 @@
 //! # Ok::<(), RadialError>(())
 //! ```
 
-mod anderson;
 pub mod bulk;
 pub mod ddft;
 pub mod droplet;

@@ -11,7 +11,6 @@
 //! Units: lengths in the scenario's length unit, energies in kT (the potential is passed as
 //! `beta U`), time in the unit of `length^2 / D`. Equations and numerics: `docs/theory-rods.md`.
 
-mod anderson;
 pub mod bulk;
 pub mod ddft;
 pub mod equilibrium;

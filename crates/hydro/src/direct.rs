@@ -347,24 +347,9 @@ impl Mobility for DirectRpy {
         Ok(rep)
     }
 
-    fn displacement(
-        &mut self,
-        f: &[[f64; 3]],
-        dt: f64,
-        kt: f64,
-        key: NoiseKey,
-        out: &mut [[f64; 3]],
-    ) -> Result<SqrtReport, HydroError> {
-        let rep = self.brownian(key, (2.0 * kt * dt).sqrt(), out)?;
-        let mut u = std::mem::take(&mut self.scratch);
-        self.apply(f, &mut u);
-        for (o, u) in out.iter_mut().zip(&u) {
-            for k in 0..3 {
-                o[k] += dt * u[k];
-            }
-        }
-        self.scratch = u;
-        Ok(rep)
+    // `displacement`: the trait's provided method (Lanczos noise, then the product).
+    fn displacement_scratch(&mut self) -> Option<&mut Vec<[f64; 3]>> {
+        Some(&mut self.scratch)
     }
 
     fn stokes_mobility(&self, i: usize) -> f64 {
@@ -446,6 +431,9 @@ impl Mobility for FreeDraining {
         })
     }
 
+    /// Kept rather than the provided method: this adds `(dt m_i) f`, the provided one would add
+    /// `dt (f m_i)` (through [`Mobility::apply`]), which rounds differently; and it needs no
+    /// buffer.
     fn displacement(
         &mut self,
         f: &[[f64; 3]],
@@ -605,5 +593,62 @@ mod tests {
                 })
         };
         assert_eq!(run(1), run(3));
+    }
+
+    #[test]
+    fn displacements_keep_their_bits() {
+        // Expected bits from DirectRpy's and FreeDraining's own displacement() at commit 705c480,
+        // before DirectRpy moved to the trait's provided method.
+        let (pos, f) = (config(4, 3.0, 1), config(4, 2.0, 5));
+        let key = NoiseKey {
+            seed: 3,
+            step: 11,
+            key0: 0,
+        };
+        let bits = |m: &mut dyn Mobility| {
+            m.set_positions(&pos).unwrap();
+            let mut u = vec![[0.0; 3]; 4];
+            m.displacement(&f, 0.02, 1.1, key, &mut u).unwrap();
+            u.as_flattened()
+                .iter()
+                .map(|v| v.to_bits())
+                .collect::<Vec<_>>()
+        };
+        let mut direct = DirectRpy::new(4, 0.5, 0.9, LanczosParams::default(), 100).unwrap();
+        assert_eq!(
+            bits(&mut direct),
+            [
+                0xbf93011d99953ced,
+                0x3f9d1c19c12f304f,
+                0xbf907a7f26c66782,
+                0x3f67ec7b8c6b3404,
+                0xbfa0638a91260782,
+                0xbfb2b6cdf4b942f7,
+                0xbfa8e48cfe81adec,
+                0x3f950b774509dcdb,
+                0xbfb1f0ce5511064d,
+                0x3fab79c2f0220ff8,
+                0xbfb120d497369254,
+                0xbfaf3b4eff97686d,
+            ]
+        );
+        let mut free = FreeDraining::new(&[0.3, 0.4, 0.5, 0.6], 0.9).unwrap();
+        assert_eq!(
+            bits(&mut free),
+            [
+                0xbf9041eca1ba224b,
+                0x3fa81d5bba60bd7a,
+                0x3f824313be7b4870,
+                0xbf54207bb8573e53,
+                0xbf9bea14434fb22b,
+                0xbfb304aeebfc5c27,
+                0xbfa9f03de468bf95,
+                0x3f96ad8326887614,
+                0xbfaecffa8382ee20,
+                0x3fad570a7038aaab,
+                0xbfb076089f5f7a33,
+                0xbfa5e5f029f35d6e,
+            ]
+        );
     }
 }

@@ -100,7 +100,12 @@ pub trait Mobility: Send + Sync {
         out: &mut [[f64; 3]],
     ) -> Result<SqrtReport, HydroError>;
 
-    /// One Brownian-dynamics displacement `out = dt M f + sqrt(2 kT dt) M^(1/2) z(key)`.
+    /// One Brownian-dynamics displacement `out = dt M f + sqrt(2 kT dt) M^(1/2) z(key)`
+    /// (Ermak & McCammon 1978, without the `kT div M dt` term: see the crate docs).
+    ///
+    /// Provided: `out = sqrt(2 kT dt) M^(1/2) z` by [`Mobility::brownian`], `u = M f` by
+    /// [`Mobility::apply`] into [`Mobility::displacement_scratch`], then `out += dt u` per
+    /// component. Operators that fuse the two products override it.
     fn displacement(
         &mut self,
         f: &[[f64; 3]],
@@ -108,7 +113,30 @@ pub trait Mobility: Send + Sync {
         kt: f64,
         key: NoiseKey,
         out: &mut [[f64; 3]],
-    ) -> Result<SqrtReport, HydroError>;
+    ) -> Result<SqrtReport, HydroError> {
+        let rep = self.brownian(key, (2.0 * kt * dt).sqrt(), out)?;
+        let mut u = self
+            .displacement_scratch()
+            .map(std::mem::take)
+            .unwrap_or_default();
+        u.resize(out.len(), [0.0; 3]);
+        self.apply(f, &mut u);
+        for (o, u) in out.iter_mut().zip(&u) {
+            for k in 0..3 {
+                o[k] += dt * u[k];
+            }
+        }
+        if let Some(s) = self.displacement_scratch() {
+            *s = u;
+        }
+        Ok(rep)
+    }
+
+    /// The buffer of `M f` that the provided [`Mobility::displacement`] reuses from step to
+    /// step; `None` (the default) makes it allocate one per call.
+    fn displacement_scratch(&mut self) -> Option<&mut Vec<[f64; 3]>> {
+        None
+    }
 
     /// Self-mobility of an isolated particle `i` in an unbounded fluid, `1 / (6 pi eta a_i)`.
     fn stokes_mobility(&self, i: usize) -> f64;
@@ -181,6 +209,7 @@ impl Mobility for AnyMobility {
     ) -> Result<SqrtReport, HydroError> {
         self.inner().brownian(key, scale, out)
     }
+    // Forwarded, not the provided method: each operator's own (possibly fused) displacement.
     fn displacement(
         &mut self,
         f: &[[f64; 3]],

@@ -1503,6 +1503,10 @@ impl Mobility for Pse {
         Ok(rep)
     }
 
+    /// Fused, not the provided method: the wave-space parts of `dt M f` and of the noise share
+    /// one pass (one set of inverse FFTs and one interpolation instead of two, `dt` applied in
+    /// wave space), then `dt M^r f` is added. The provided method sums in another order, so it
+    /// would change the bits as well as cost more.
     fn displacement(
         &mut self,
         f: &[[f64; 3]],

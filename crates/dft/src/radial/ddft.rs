@@ -15,9 +15,9 @@
 
 use colloidsim_core::param;
 
-use super::anderson::Anderson;
 use super::rpy::{PairCorrelation, PairTable, RpyKernel};
 use super::{DryingSchedule, HarmonicInterface, RadialError, RadialGrid, Rosenfeld};
+use crate::anderson::{Anderson, Convention};
 
 /// Hydrodynamic approximation of the flux.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -259,7 +259,7 @@ impl Ddft {
             diag: vec![0.0; n],
             upper: vec![0.0; n],
             cp: vec![0.0; n],
-            acc: Anderson::new(n, opts.depth, 1.0),
+            acc: Anderson::new(n, opts.depth, 1.0, Convention::RADIAL),
             grid,
         };
         let r = s.schedule.radius(0.0)?;
@@ -486,7 +486,7 @@ impl Ddft {
         for i in 0..m {
             self.x[i] = (self.rho[i] + f * (self.rho[i] - self.rho_prev[i])).max(0.0);
         }
-        self.acc.reset(m);
+        self.acc.reset();
         let mut res = f64::INFINITY;
         for it in 1..=self.opts.max_iterations {
             self.picard_image(dt)?;
@@ -504,7 +504,7 @@ impl Ddft {
             if res < self.opts.tolerance {
                 return Ok((it, res));
             }
-            self.acc.step(&mut self.x, &self.g);
+            self.acc.step_map(&mut self.x[..m], &self.g[..m]);
             for v in &mut self.x[..m] {
                 if *v < 0.0 {
                     *v = 0.0;

@@ -7,8 +7,8 @@
 
 use colloidsim_core::param;
 
-use super::anderson::Anderson;
 use super::{RadialError, RadialGrid, Rosenfeld};
+use crate::anderson::{Anderson, Convention};
 
 /// Settings of the equilibrium solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,7 +97,7 @@ pub fn solve_equilibrium(
             normalise(beta_v, &mut x);
         }
     }
-    let mut acc = Anderson::new(n, opts.depth, opts.mixing);
+    let mut acc = Anderson::new(n, opts.depth, opts.mixing, Convention::RADIAL);
     let mut residual = f64::INFINITY;
     let mut beta_mu = 0.0;
     let mut x_good = x.clone();
@@ -115,7 +115,7 @@ pub fn solve_equilibrium(
                 if damp < 1e-6 {
                     break;
                 }
-                acc.reset(n);
+                acc.reset();
                 for i in 0..n {
                     x[i] = x_good[i] + damp * (g_good[i] - x_good[i]);
                 }
@@ -129,7 +129,7 @@ pub fn solve_equilibrium(
         beta_mu = normalise(&w, &mut g);
         x_good.copy_from_slice(&x);
         g_good.copy_from_slice(&g);
-        residual = acc.step(&mut x, &g);
+        residual = acc.step_map(&mut x, &g);
         if !residual.is_finite() {
             break;
         }

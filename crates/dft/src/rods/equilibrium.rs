@@ -8,10 +8,10 @@
 //! reaching 1) are halved. Grid sequencing: the problem is first solved on grids coarser by powers
 //! of two and the solution interpolated as the starting guess.
 
-use super::anderson::Anderson;
 use super::functional::{self, Overlap, Work};
 use super::grid::Grid;
 use super::{BetaPotential, RodsError, RodsProblem};
+use crate::anderson::{Anderson, Convention};
 use colloidsim_core::param::{self, ParamError};
 
 /// The equilibrium profile and its diagnostics.
@@ -434,7 +434,12 @@ impl Solver {
         tol: f64,
         max_it: usize,
     ) -> Result<(usize, f64, f64), RodsError> {
-        let mut anderson = Anderson::new(self.grid.m, problem.anderson_memory, problem.mixing);
+        let mut anderson = Anderson::new(
+            self.grid.m,
+            problem.anderson_memory,
+            problem.mixing,
+            Convention::RODS,
+        );
         let mut best = f64::INFINITY;
         let mut have_ok = false;
         let mut tried_peaks = false;
