@@ -255,6 +255,7 @@ pub(crate) const SEED_KEY: Spec = key(
 /// Step counts and other integers a run can hold.
 pub(crate) const COUNT: i64 = 1 << 53;
 
+pub mod shared;
 mod tables;
 pub use tables::*;
 

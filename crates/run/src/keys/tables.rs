@@ -4,6 +4,7 @@
 
 use super::Allowed::*;
 use super::Omitted::*;
+use super::shared::{INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS};
 use super::{COUNT, SEED_KEY, Spec, key};
 
 /// Keys that `droplet-bd` and `bd` share (the same engines and units).
@@ -213,35 +214,10 @@ pub static DROPLET: &[Spec] = &[
         "run for this time",
     )
     .also("before R^2 would turn negative (t < 4 pi R0^2 / alpha)"),
-    key(
-        "interface",
-        "-",
-        Means("k = 50 kT/d^2, range d/2, offset -d/2"),
-        Table,
-        "harmonic interface V = k/2 s^2 for 0 <= s < range, linear beyond, s = r - (R(t) + offset)",
-    ),
-    key(
-        "interface.stiffness",
-        "energy / length^2",
-        Means("50 kT / d^2"),
-        Positive,
-        "spring constant k",
-    ),
-    key(
-        "interface.range",
-        "length",
-        Means("d / 2"),
-        Positive,
-        "range of the harmonic part Delta",
-    ),
-    key(
-        "interface.offset",
-        "length",
-        Means("-d / 2"),
-        Finite,
-        "wall position relative to R(t) (-d/2: the colloid surface at R(t))",
-    )
-    .also("in [-R0, R0] and R_end + offset > 0"),
+    INTERFACE,
+    INTERFACE_STIFFNESS,
+    INTERFACE_RANGE,
+    INTERFACE_OFFSET.also("in [-R0, R0] and R_end + offset > 0"),
     key("run", "-", Means("defaults"), Table, "time stepping"),
     RUN_DT,
     RUN_SKIN,
@@ -812,35 +788,10 @@ pub static MC: &[Spec] = &[
         "start from the last frame of this GSD file",
     )
     .also("N spheres, no overlap, centres inside the wall"),
-    key(
-        "interface",
-        "-",
-        Means("-"),
-        Table,
-        "the harmonic interface, as droplet-bd's (geometry = \"interface\" only)",
-    ),
-    key(
-        "interface.stiffness",
-        "energy / length^2",
-        Means("50 kT / d^2"),
-        Positive,
-        "spring constant k of V = k s^2 / 2, s = r - (R + offset)",
-    ),
-    key(
-        "interface.range",
-        "length",
-        Means("d / 2"),
-        Positive,
-        "range of the harmonic part (linear beyond)",
-    ),
-    key(
-        "interface.offset",
-        "length",
-        Means("-d / 2"),
-        Finite,
-        "wall position relative to R (-d/2: the surface touches R)",
-    )
-    .also("above -radius"),
+    INTERFACE,
+    INTERFACE_STIFFNESS,
+    INTERFACE_RANGE,
+    INTERFACE_OFFSET.also("above -radius"),
     key("mc", "-", Means("-"), Table, "sweeps, warm-up and tuning"),
     key(
         "mc.sweeps",
@@ -1254,36 +1205,10 @@ pub static DROPLET_MPCD: &[Spec] = &[
         "stop after this time",
     )
     .also("R must stay above two cells"),
-    key(
-        "interface",
-        "-",
-        Means("-"),
-        Table,
-        "the harmonic interface on the colloid centres, as droplet-bd's",
-    ),
-    key(
-        "interface.stiffness",
-        "energy / length^2",
-        Means("50 kT / d^2"),
-        Positive,
-        "spring constant k of V = k s^2 / 2, s = r - (R(t) + offset)",
-    ),
-    key(
-        "interface.range",
-        "length",
-        Means("d / 2"),
-        Positive,
-        "range of the harmonic part (linear beyond)",
-    )
-    .also("at most R0"),
-    key(
-        "interface.offset",
-        "length",
-        Means("-d / 2"),
-        Finite,
-        "offset of the wall from R(t) (-d/2: the surface touches R)",
-    )
-    .also("in [-R0, R0]"),
+    INTERFACE,
+    INTERFACE_STIFFNESS,
+    INTERFACE_RANGE.also("at most R0"),
+    INTERFACE_OFFSET.also("in [-R0, R0]"),
     COLLOID[0],
     COLLOID[1],
     COLLOID[2],
