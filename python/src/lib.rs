@@ -266,7 +266,7 @@ fn keys(method: &str) -> PyResult<String> {
 /// The registered methods as JSON: names, one line, docs.
 #[pyfunction]
 fn methods() -> String {
-    let m: Vec<serde_json::Value> = colloidsim_run::method::all()
+    let m: Vec<serde_json::Value> = colloidsim_run::registry::all()
         .iter()
         .map(|m| serde_json::json!({ "names": m.names(), "about": m.about(), "docs": m.docs() }))
         .collect();

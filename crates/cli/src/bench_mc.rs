@@ -40,7 +40,7 @@ pub struct BenchArgs {
 /// each repetition (A/B on a shared machine); trial moves per second of wall time and of CPU
 /// time, medians, and the speed-up over the first thread count.
 pub fn bench(a: &BenchArgs) -> Result<()> {
-    use colloidsim_mc::scenario::NSELECT_MAX;
+    use colloidsim_mc::params::NSELECT_MAX;
     if let Some(bad) = a.nselect.iter().find(|&&k| !(1..=NSELECT_MAX).contains(&k)) {
         anyhow::bail!("--nselect must be integers in [1, {NSELECT_MAX}], got {bad}");
     }

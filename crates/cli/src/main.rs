@@ -24,7 +24,7 @@ use std::time::Duration;
 /// The methods and where they are documented, for `--help`.
 fn methods_help() -> String {
     let mut s = String::from("Methods (the `method` key of a scenario):\n");
-    for m in colloidsim_run::method::all() {
+    for m in colloidsim_run::registry::all() {
         s.push_str(&format!(
             "  {:<28} {}\n  {:<28} keys: colloidsim keys {}; docs: {}\n",
             m.names().join(", "),

@@ -10,7 +10,7 @@ use std::process::Command;
 fn every_key_page_is_what_the_binary_prints() {
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/keys");
     let mut pages = 0;
-    for m in colloidsim_run::method::all() {
+    for m in colloidsim_run::registry::all() {
         let name = m.names()[0];
         let o = Command::new(env!("CARGO_BIN_EXE_colloidsim"))
             .args(["keys", name, "--format", "markdown"])

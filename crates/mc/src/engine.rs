@@ -502,24 +502,25 @@ const MAX_DELTA_PER_SIDE: f64 = 0.5;
 impl HardSphereMc {
     /// Spheres at `positions` (relative to the box centre, or the droplet centre). Errors:
     /// parameters out of range, overlaps, centres outside the container, a cell grid larger
-    /// than the memory (`key` names the configuration's scenario key in messages).
+    /// than the memory (`key` names where the positions came from in messages; other errors
+    /// name the parameter: `diameter`, `delta`, `radius`, `box`).
     pub fn new(params: &McParams, positions: &[[f64; 3]], key: &str) -> Result<Self, McError> {
-        let d = positive("system.diameter", params.diameter)?;
-        positive("mc.delta", params.delta)?;
+        let d = positive("diameter", params.diameter)?;
+        positive("delta", params.delta)?;
         let edge = params.geometry.box_edge(d);
-        positive("system.box", edge)?;
+        positive("box", edge)?;
         if let Geometry::HardWall { radius } = params.geometry
             && radius <= 0.5 * d
         {
             return Err(ParamError::new(
-                "system.radius",
+                "radius",
                 format!("must exceed d/2 = {} (no room for a centre)", show(0.5 * d)),
             )
             .into());
         }
         if edge < 2.0 * d {
             return Err(ParamError::new(
-                "system.box",
+                "box",
                 format!(
                     "the periodic box edge must be at least 2 d = {}, got {}",
                     show(2.0 * d),

@@ -30,14 +30,14 @@ pub struct RadialPotential {
 impl RadialPotential {
     /// Nodes `values[k] = beta U(k dr)`; beyond the last node the last value; centres beyond
     /// `cutoff` are refused; `radius` is the droplet radius of the mean volume fraction
-    /// `N d^3 / (8 R^3)`. Keys in errors: `potential.dr`, `potential.values`, `potential.cutoff`.
+    /// `N d^3 / (8 R^3)`. Errors name the parameter (`dr`, `values`, `cutoff`, `radius`).
     pub fn new(dr: f64, values: Vec<f64>, cutoff: f64, radius: f64) -> Result<Self, ParamError> {
-        positive("potential.dr", dr)?;
-        positive("potential.cutoff", cutoff)?;
-        positive("system.radius", radius)?;
+        positive("dr", dr)?;
+        positive("cutoff", cutoff)?;
+        positive("radius", radius)?;
         if values.len() < 2 || values.iter().any(|v| !v.is_finite()) {
             return Err(ParamError::new(
-                "potential.values",
+                "values",
                 format!("needs at least 2 finite values, got {}", values.len()),
             ));
         }
@@ -98,8 +98,8 @@ pub enum Geometry {
 
 impl Geometry {
     /// The BD droplet interface of radius `radius` (`V = k s^2 / 2` for `0 <= s < range`, linear
-    /// beyond, `s = |r| - (radius + offset)`), with the outer cut where `V = 40 kT`. Keys
-    /// `interface.stiffness`, `interface.range`, `interface.offset`, `system.radius`, `system.kT`.
+    /// beyond, `s = |r| - (radius + offset)`), with the outer cut where `V = 40 kT`. Errors name
+    /// the parameter: `stiffness`, `range`, `offset`, `radius`, `kt`.
     pub fn interface(
         radius: f64,
         stiffness: f64,
@@ -107,16 +107,16 @@ impl Geometry {
         offset: f64,
         kt: f64,
     ) -> Result<Self, ParamError> {
-        positive("system.radius", radius)?;
-        positive("interface.stiffness", stiffness)?;
-        positive("interface.range", range)?;
-        finite("interface.offset", offset)?;
-        positive("system.kT", kt)?;
+        positive("radius", radius)?;
+        positive("stiffness", stiffness)?;
+        positive("range", range)?;
+        finite("offset", offset)?;
+        positive("kt", kt)?;
         if radius + offset <= 0.0 {
             return Err(ParamError::new(
-                "interface.offset",
+                "offset",
                 format!(
-                    "must exceed -system.radius = {} (the wall would sit at or behind the centre)",
+                    "must exceed -radius = {} (the wall would sit at or behind the centre)",
                     -radius
                 ),
             ));
@@ -248,7 +248,7 @@ mod tests {
             delta: 0.05,
         };
         let start = init::fcc_in_sphere(10, 0.1, 0.95).unwrap();
-        let mut mc = HardSphereMc::new(&params, &start, "system.initial").unwrap();
+        let mut mc = HardSphereMc::new(&params, &start, "positions").unwrap();
         mc.warm_up(1000, 100, 0.4);
         let mut blocks = Vec::new();
         for _ in 0..20 {

@@ -17,14 +17,14 @@ const BASIS: [[f64; 3]; 4] = [
 
 /// `n` spheres of diameter `d` on FCC sites filling the periodic cube of edge `edge` (centred on
 /// the origin): `4 m^3` sites with `m = ceil((n/4)^(1/3))`, `n` of them taken evenly spread
-/// through the site list. Error (key `system.volume_fraction`) when the nearest-neighbour
+/// through the site list. Error (parameter `n`) when the nearest-neighbour
 /// distance `edge / (m sqrt 2)` is below `d`.
 pub fn fcc_in_box(n: usize, d: f64, edge: f64) -> Result<Vec<[f64; 3]>, McError> {
     let m = ((n as f64 / 4.0).cbrt().ceil() as usize).max(1);
     let a = edge / m as f64;
     if a / 2f64.sqrt() < d {
         return Err(ParamError::new(
-            "system.volume_fraction",
+            "n",
             format!(
                 "{n} spheres do not fit on an FCC lattice in a box of edge {} (neighbour distance {} < d = {})",
                 show(edge),
@@ -81,7 +81,7 @@ pub fn fcc_in_sphere(n: usize, d: f64, radius: f64) -> Result<Vec<[f64; 3]>, McE
     let tight = d * (1.0 + 1e-9);
     if count(tight) < n {
         return Err(ParamError::new(
-            "system.volume_fraction",
+            "n",
             format!(
                 "{n} spheres of diameter {} do not fit on an FCC lattice with centres within {}",
                 show(d),

@@ -11,7 +11,7 @@
 //!   block-average errors, the Carnahan–Starling reference.
 //! - [`radial_pairs`]: the droplet's two-body density in the `(r1, r2, s)` bins of the DDFT's RPY
 //!   flux kernel (issue #15 item 4).
-//! - [`scenario`]: the `method = "hs-mc"` scenario and its validation.
+//! - [`params`]: the parameters of a run ([`params::McRun`]) and the engine they start.
 //! - [`bench`]: trial moves per second (`colloidsim bench mc`).
 //!
 //! Conventions and validation numbers: docs/mc.md.
@@ -21,8 +21,8 @@ pub mod engine;
 pub mod geometry;
 pub mod init;
 pub mod observe;
+pub mod params;
 pub mod radial_pairs;
-pub mod scenario;
 
 pub use engine::{HardSphereMc, McError, McParams, SweepStats};
 pub use geometry::{Geometry, RadialPotential};

@@ -44,17 +44,17 @@ impl RadialPairs {
         s_bins: usize,
         fine: usize,
     ) -> Result<Self, ParamError> {
-        positive("pairs.r_bin", r_bin)?;
-        positive("pairs.s_bin", s_bin)?;
+        positive("r_bin", r_bin)?;
+        positive("s_bin", s_bin)?;
         if r_bins == 0 || s_bins == 0 || fine == 0 {
             return Err(ParamError::new(
-                "pairs.bins",
+                "bins",
                 format!("need at least one bin each, got {r_bins} radial, {s_bins} s, {fine} fine"),
             ));
         }
         let n = r_bins * r_bins * s_bins;
         colloidsim_core::resources::ensure_fits(
-            "pairs.bins",
+            "bins",
             &format!("{r_bins}^2 x {s_bins} pair bins"),
             (n * 8) as f64,
         )?;

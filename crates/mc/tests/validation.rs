@@ -280,8 +280,8 @@ fn no_overlaps_and_no_escape_after_any_sweep() {
             seed: 1,
             delta: 0.1,
         };
-        match HardSphereMc::new(&p, &pos, "system.initial") {
-            Err(McError::Overlap { key, .. }) => assert_eq!(key, "system.initial"),
+        match HardSphereMc::new(&p, &pos, "start.gsd") {
+            Err(McError::Overlap { key, .. }) => assert_eq!(key, "start.gsd"),
             Err(McError::OutsideWall { .. }) => {}
             other => panic!("{name}: overlap not refused: {other:?}"),
         }
@@ -362,21 +362,21 @@ fn bad_configurations_are_refused_naming_the_key() {
         seed: 1,
         delta: 0.1,
     };
-    let e = HardSphereMc::new(&p, &[[0.0; 3], [2.6, 0.0, 0.0]], "system.initial").unwrap_err();
+    let e = HardSphereMc::new(&p, &[[0.0; 3], [2.6, 0.0, 0.0]], "start.gsd").unwrap_err();
     assert!(
-        matches!(e, McError::OutsideWall { i: 1, .. }) && e.to_string().contains("system.initial"),
+        matches!(e, McError::OutsideWall { i: 1, .. }) && e.to_string().contains("start.gsd"),
         "{e}"
     );
-    let e = HardSphereMc::new(&p, &[[0.0; 3], [0.0, 0.99, 0.0]], "system.initial").unwrap_err();
+    let e = HardSphereMc::new(&p, &[[0.0; 3], [0.0, 0.99, 0.0]], "start.gsd").unwrap_err();
     assert!(matches!(e, McError::Overlap { i: 0, j: 1, .. }), "{e}");
     let bad = McParams {
         diameter: -1.0,
         ..p
     };
     let e = HardSphereMc::new(&bad, &[], "x").unwrap_err();
-    assert!(e.to_string().contains("system.diameter"), "{e}");
+    assert!(e.to_string().starts_with("diameter: "), "{e}");
     let e = Geometry::interface(5.0, 50.0, 0.5, -6.0, 1.0).unwrap_err();
-    assert_eq!(e.key, "interface.offset");
+    assert_eq!(e.key, "offset");
     assert!(fcc_in_box(1000, 1.0, 5.0).is_err());
 }
 

@@ -28,11 +28,11 @@ use crate::bd_replica::{
     Saved, read_replica_checkpoint,
 };
 use crate::checkpoint::Envelope;
-use crate::droplet::trim_trajectory;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
+use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;

@@ -3,12 +3,12 @@
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
-use crate::droplet::trim_trajectory;
 use crate::engine::flat;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
 use crate::trajectory::FrameDigest;
+use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,

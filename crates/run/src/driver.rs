@@ -3,7 +3,8 @@
 
 use crate::checkpoint::{self, CHECKPOINT, Envelope};
 use crate::control::Control;
-use crate::method::{self, Session};
+use crate::method::Session;
+use crate::registry;
 use crate::{Failed, Interrupted, Report, RunOptions, Scenario};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -83,7 +84,7 @@ fn run_with(
     ctl: &Control,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Report> {
-    let m = method::of(sc)?;
+    let m = registry::of(sc)?;
     if let Some(s) = opts.seed {
         crate::seed32(s)?;
     }
@@ -268,7 +269,7 @@ fn resume_with(
     if let Some(s) = seed {
         crate::seed32(s)?;
     }
-    let m = method::of(&sc)?;
+    let m = registry::of(&sc)?;
     let seed = seed.unwrap_or(envelope.seed);
     let mut session = m
         .restore(&sc, seed, &out, &envelope, comm)

@@ -16,6 +16,7 @@ pub mod keys;
 pub mod method;
 pub mod methods;
 pub mod plot;
+pub mod registry;
 pub mod scenario;
 pub mod trajectory;
 
@@ -23,7 +24,6 @@ mod bd_replica;
 mod bulk;
 mod dpd;
 mod droplet;
-mod hs_mc;
 mod mpcd;
 mod theory_droplet;
 pub mod two_body;
@@ -124,12 +124,12 @@ pub struct Failed {
 
 /// Validate a scenario (`colloidsim check`).
 pub fn check(sc: &Scenario) -> anyhow::Result<Checked> {
-    method::of(sc)?.check(sc)
+    registry::of(sc)?.check(sc)
 }
 
 /// The continuum counterpart of a scenario (`colloidsim theory`).
 pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Result<Report> {
-    let m = method::of(sc)?;
+    let m = registry::of(sc)?;
     if opts.hydrodynamics.is_some() && m.names()[0] != "droplet-bd" {
         anyhow::bail!("--hydrodynamics applies to droplet-bd scenarios only");
     }
@@ -141,7 +141,7 @@ pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Res
 
 /// Every key of a method's scenarios (`colloidsim keys METHOD`).
 pub fn keys(method: &str) -> anyhow::Result<Vec<keys::Key>> {
-    Ok(method::find(method)?
+    Ok(registry::find(method)?
         .keys()
         .iter()
         .map(keys::Key::from)
@@ -151,7 +151,7 @@ pub fn keys(method: &str) -> anyhow::Result<Vec<keys::Key>> {
 /// The reference page of a method's keys (`colloidsim keys METHOD --format markdown`, kept as
 /// `docs/keys/METHOD.md`; a test fails when the page differs from what the binary prints).
 pub fn keys_page(method: &str) -> anyhow::Result<String> {
-    let m = method::find(method)?;
+    let m = registry::find(method)?;
     let name = m.names()[0];
     let docs = m.docs().strip_prefix("docs/").unwrap_or(m.docs());
     let listed: Vec<keys::Key> = m.keys().iter().map(keys::Key::from).collect();
@@ -180,7 +180,7 @@ pub fn keys_page(method: &str) -> anyhow::Result<String> {
 
 /// An engine built from a scenario, to be stepped by hand.
 pub fn engine(sc: &Scenario, seed: Option<u64>) -> anyhow::Result<Box<dyn Engine>> {
-    method::of(sc)?.engine(sc, seed)
+    registry::of(sc)?.engine(sc, seed)
 }
 
 /// Validate a seed from the scenario or the caller: the counter-based streams take 32 bits.

@@ -1,4 +1,5 @@
-//! The interface every method implements once, and the one place methods are registered.
+//! The interface every method implements once ([`Method`], [`Session`]); the methods are listed
+//! in [`crate::registry`].
 //!
 //! A [`Method`] turns a scenario into a [`Session`] (a fresh one, or one restored from a
 //! checkpoint); the driver ([`crate::run`]) then owns everything every run shares: the output
@@ -222,43 +223,4 @@ fn not_decomposed(sc: &Scenario, method: &str) -> String {
          and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )
-}
-
-/// Every method, in the order `--help` lists them. New methods register here.
-static METHODS: &[&dyn Method] = &[
-    &crate::methods::bcd::BcdMethod,
-    &crate::droplet::DropletBd,
-    &crate::bulk::BulkBd,
-    &crate::dpd::DpdMethod,
-    &crate::hs_mc::HsMc,
-    &crate::mpcd::MpcdBulk,
-    &crate::mpcd::DropletMpcd,
-];
-
-/// Every registered method.
-pub fn all() -> &'static [&'static dyn Method] {
-    METHODS
-}
-
-/// Every `method` value a scenario may name.
-pub fn names() -> Vec<&'static str> {
-    METHODS
-        .iter()
-        .flat_map(|m| m.names().iter().copied())
-        .collect()
-}
-
-/// The method a scenario names.
-pub fn find(name: &str) -> Result<&'static dyn Method> {
-    METHODS
-        .iter()
-        .copied()
-        .find(|m| m.names().contains(&name))
-        .ok_or_else(|| anyhow::anyhow!("unknown method '{name}' (one of: {})", names().join(", ")))
-}
-
-/// The method of a scenario, with the scenario named in the error.
-pub fn of(sc: &Scenario) -> Result<&'static dyn Method> {
-    let name = sc.method()?;
-    find(&name).map_err(|e| anyhow::anyhow!("{}: {e}", sc.label()))
 }

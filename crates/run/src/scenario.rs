@@ -162,7 +162,7 @@ impl Scenario {
             None => bail!(
                 "{}: missing key 'method' (one of: {})",
                 self.label(),
-                crate::method::names().join(", ")
+                crate::registry::names().join(", ")
             ),
         }
     }

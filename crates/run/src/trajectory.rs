@@ -1,4 +1,8 @@
-//! What a checkpoint vouches for in `trajectory.gsd`: a CRC-32 over the frames written up to
+//! The trajectory every method writes, shared: what a checkpoint vouches for in
+//! `trajectory.gsd` ([`FrameDigest`]) and how a restart trims it to the checkpoint's frames
+//! ([`trim_trajectory`]).
+//!
+//! The digest is a CRC-32 over the frames written up to
 //! the checkpoint, so that a restart refuses a trajectory damaged or changed since (GSD files
 //! carry no checksum of their own), and keeps exactly the frames the checkpoint counted.
 //!
@@ -9,7 +13,7 @@
 //! reading each frame once.
 
 use anyhow::{Context, Result, anyhow, bail};
-use colloidsim_md::gsd::{open_checked, quietly};
+use colloidsim_md::gsd::{self, GsdWriter, open_checked, quietly};
 use hoomd_gsd::file_layer::{DataType, GsdFile, Mode};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -136,5 +140,70 @@ fn hash_frame(file: &GsdFile, k: u64, buf: &mut Vec<u8>, h: &mut crc32fast::Hash
         }
     }
     h.update(buf);
+    Ok(())
+}
+
+/// Keep the first `frames` frames of the trajectory (a run killed after its last checkpoint
+/// may have written more), so that the continuation appends exactly where the checkpoint stood.
+/// The frames are written again as [`GsdWriter`] wrote them, with the scalars `log/NAME` of
+/// `logs` and, with `velocities`, the velocities and masses: byte for byte the same file.
+pub(crate) fn trim_trajectory(
+    path: &Path,
+    frames: u64,
+    logs: &[&str],
+    velocities: bool,
+) -> Result<()> {
+    let have = gsd::frame_count(path)?;
+    if have == frames {
+        return Ok(());
+    }
+    if have < frames {
+        bail!(
+            "{}: holds {have} frames, the checkpoint expects {frames}; the trajectory was damaged",
+            path.display()
+        );
+    }
+    let tmp = path.with_extension("gsd.trim");
+    let _ = std::fs::remove_file(&tmp);
+    {
+        let file = gsd::open_checked(path, Mode::Read)?;
+        let mut w = GsdWriter::create_new(&tmp)?;
+        if velocities {
+            w = w.with_velocities();
+        }
+        for k in 0..frames {
+            let mut f = gsd::read_frame(path, Some(k))?;
+            let e = |e: hoomd_gsd::file_layer::ReadError| {
+                anyhow::anyhow!("{}: frame {k}: {e}", path.display())
+            };
+            if velocities {
+                f.particles.vel = file
+                    .iter_arrays::<f32, 3>(k, "particles/velocity")
+                    .map_err(e)?
+                    .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
+                    .collect();
+                if f.particles.vel.len() != f.particles.len() {
+                    bail!("{}: frame {k}: velocities missing", path.display());
+                }
+            }
+            let values = logs
+                .iter()
+                .map(|name| -> Result<(&str, Vec<f64>)> {
+                    let v: Vec<f64> = file
+                        .iter_scalars::<f64>(k, &format!("log/{name}"))
+                        .map_err(e)?
+                        .collect();
+                    if v.is_empty() {
+                        bail!("{}: frame {k}: no log/{name}", path.display());
+                    }
+                    Ok((*name, v))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let values: Vec<(&str, &[f64])> = values.iter().map(|(n, v)| (*n, &v[..])).collect();
+            w.write_frame_log(f.step, &f.sbox, &f.particles, &values)?;
+        }
+        w.sync()?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
     Ok(())
 }

@@ -174,7 +174,7 @@ fn method_of(text: &str) -> String {
 
 #[test]
 fn every_registered_method_has_a_base_scenario() {
-    for m in colloidsim_run::method::all() {
+    for m in colloidsim_run::registry::all() {
         assert!(
             BASES
                 .iter()
@@ -258,7 +258,7 @@ proptest! {
         picks in proptest::collection::vec((any::<prop::sample::Index>(), hostile()), 1..4),
     ) {
         let text = BASES[base];
-        let spec = colloidsim_run::method::find(&method_of(text)).unwrap().keys();
+        let spec = colloidsim_run::registry::find(&method_of(text)).unwrap().keys();
         let mut doc: toml::Table = toml::from_str(text).unwrap();
         for (k, v) in picks {
             set(&mut doc, k.get(spec).path, v);

@@ -5,12 +5,15 @@
 //! wall). Checkpoints hold the positions exactly: a restart continues bitwise.
 
 use crate::checkpoint::Envelope;
-use crate::droplet::trim_trajectory;
+pub mod keys;
+pub mod params;
+
 use crate::engine::flat;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
+use crate::trajectory::trim_trajectory;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -20,8 +23,8 @@ use colloidsim_mc::observe::{
     carnahan_starling, carnahan_starling_contact, compressibility, contact_pairs, mean_and_error,
     wall_contact_density,
 };
-use colloidsim_mc::scenario::{McRun, McScenario};
-use colloidsim_mc::{HardSphereMc, SweepStats};
+use colloidsim_mc::params::McRun;
+use colloidsim_mc::{HardSphereMc, McError, SweepStats};
 use colloidsim_md::gsd::{self, GsdWriter};
 use colloidsim_md::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
@@ -31,20 +34,13 @@ use std::f64::consts::PI;
 /// Hard-sphere Monte Carlo scenarios.
 pub struct HsMc;
 
-/// Parse and validate a scenario (`system.initial` relative to the scenario's folder).
+/// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
+/// replacing the scenario's.
 fn resolve(src: &Source, seed: Option<u64>) -> Result<McRun> {
-    crate::keys::validate(&src.table()?, crate::keys::MC).with_context(|| src.label())?;
-    let mut sc = McScenario::from_toml(src.text()).with_context(|| src.label())?;
     if let Some(s) = seed {
         seed32(s)?;
-        sc.seed = s;
     }
-    if let Some(init) = &sc.system.initial
-        && init.is_relative()
-    {
-        sc.system.initial = Some(src.base().join(init));
-    }
-    sc.validate().with_context(|| src.label())
+    params::read(&src.table()?, src.base(), seed).with_context(|| src.label())
 }
 
 /// The engine at the start: the last frame of `system.initial`, or an FCC lattice.
@@ -52,12 +48,16 @@ fn build(p: &McRun) -> Result<HardSphereMc> {
     let positions = match &p.initial {
         Some(path) => {
             let f = gsd::read_frame(path, None)
-                .with_context(|| format!("system.initial: {}", path.display()))?;
+                .with_context(|| format!("{}: {}", keys::SYSTEM_INITIAL.path, path.display()))?;
             Some(f.particles.pos)
         }
         None => None,
     };
-    Ok(p.engine(positions.as_deref(), "system.initial")?)
+    p.engine(positions.as_deref(), keys::SYSTEM_INITIAL.path)
+        .map_err(|e| match e {
+            McError::Param(e) => params::keyed(e).into(),
+            e => e.into(),
+        })
 }
 
 impl Method for HsMc {
@@ -126,7 +126,7 @@ impl Method for HsMc {
     }
 
     fn keys(&self) -> &'static [Spec] {
-        crate::keys::MC
+        keys::KEYS
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {

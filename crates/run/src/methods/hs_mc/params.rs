@@ -1,0 +1,292 @@
+//! An `hs-mc` scenario read through its key declarations ([`super::keys`]) into the run the
+//! engine takes ([`McRun`]), with every check that relates several keys, each error naming the
+//! key and the allowed range.
+
+use super::keys::*;
+use crate::keys::shared::{
+    self, INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
+};
+use crate::keys::{Reader, SEED_KEY, rekey};
+use anyhow::{Result, bail};
+use colloidsim_core::ParamError;
+use colloidsim_core::param::show;
+use colloidsim_core::resources::ensure_fits;
+use colloidsim_mc::geometry::Geometry;
+use colloidsim_mc::params::{MAX_PHI, McRun};
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// The engine's names of its parameters, and the keys that set them.
+const ENGINE_NAMES: &[(&str, &crate::keys::Spec)] = &[
+    ("diameter", &SYSTEM_DIAMETER),
+    ("delta", &MC_DELTA),
+    ("radius", &SYSTEM_RADIUS),
+    ("stiffness", &INTERFACE_STIFFNESS),
+    ("range", &INTERFACE_RANGE),
+    ("offset", &INTERFACE_OFFSET),
+    ("n", &SYSTEM_VOLUME_FRACTION),
+];
+
+/// An engine's error about one of its parameters, naming the scenario key instead.
+pub(super) fn keyed(e: ParamError) -> ParamError {
+    rekey(e, ENGINE_NAMES)
+}
+
+/// A scenario's table checked against [`KEYS`] and resolved (with `seed` replacing the
+/// scenario's); `system.initial` is taken relative to `base`.
+pub fn read(table: &toml::Table, base: &Path, seed: Option<u64>) -> Result<McRun> {
+    let r = Reader::new(table, KEYS)?;
+    resolve(&r, base, seed)
+}
+
+/// Every key read and checked against the others.
+fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
+    let seed = colloidsim_core::param::seed(SEED_KEY.path, seed.unwrap_or(r.count(&SEED_KEY)?))?;
+    let d = r.number(&SYSTEM_DIAMETER)?;
+    let kt = r.number(&SYSTEM_KT)?;
+    let geometry = r.word(&SYSTEM_GEOMETRY)?;
+    let bulk = geometry == "bulk";
+    let (size_key, other_key) = if bulk {
+        (&SYSTEM_BOX, &SYSTEM_RADIUS)
+    } else {
+        (&SYSTEM_RADIUS, &SYSTEM_BOX)
+    };
+    let size = r.opt_number(size_key)?;
+    if r.has(other_key) {
+        bail!(ParamError::new(
+            other_key.path,
+            format!(
+                "does not apply to system.geometry = \"{geometry}\" (give {})",
+                size_key.path
+            ),
+        ));
+    }
+    let particles = r.opt_count(&SYSTEM_PARTICLES)?.map(|n| n as usize);
+    if bulk && particles == Some(1) {
+        bail!(ParamError::new(
+            SYSTEM_PARTICLES.path,
+            "must be at least 2 in bulk, got 1"
+        ));
+    }
+    let volume_fraction = r.opt_number(&SYSTEM_VOLUME_FRACTION)?;
+    // phi of N spheres in a size, and its inverses.
+    let unit = if bulk { PI / 6.0 } else { 1.0 / 8.0 };
+    let (particles, size) = match (particles, volume_fraction, size) {
+        (Some(n), None, Some(l)) => (n, l),
+        (Some(n), Some(phi), None) => (n, (n as f64 * unit * d.powi(3) / phi).cbrt()),
+        (None, Some(phi), Some(l)) => {
+            let n = (phi * l.powi(3) / (unit * d.powi(3))).round();
+            if !(1.0..=1e8).contains(&n) {
+                bail!(ParamError::new(
+                    SYSTEM_VOLUME_FRACTION.path,
+                    format!(
+                        "gives {} spheres in {} = {}; between 1 and 1e8 are allowed",
+                        show(n),
+                        size_key.path,
+                        show(l)
+                    ),
+                ));
+            }
+            (n as usize, l)
+        }
+        _ => bail!(ParamError::new(
+            SYSTEM.path,
+            format!(
+                "give exactly two of system.particles, system.volume_fraction and {}",
+                size_key.path
+            ),
+        )),
+    };
+    let phi = particles as f64 * unit * d.powi(3) / size.powi(3);
+    if phi > MAX_PHI {
+        bail!(ParamError::new(
+            SYSTEM_VOLUME_FRACTION.path,
+            format!(
+                "{particles} spheres in {} = {} pack to {:.4}, above random close packing {MAX_PHI}",
+                size_key.path,
+                show(size),
+                phi
+            ),
+        ));
+    }
+    let interface = if geometry == "interface" {
+        let i = shared::interface(r, d, kt)?;
+        Some([i.stiffness, i.range, i.offset])
+    } else {
+        if r.has(&INTERFACE) {
+            bail!(ParamError::new(
+                INTERFACE.path,
+                format!("applies to system.geometry = \"interface\" only, not \"{geometry}\""),
+            ));
+        }
+        None
+    };
+    let shape = if bulk {
+        Geometry::Bulk { edge: size }
+    } else if let Some([k, range, offset]) = interface {
+        Geometry::interface(size, k, range, offset, kt).map_err(keyed)?
+    } else {
+        if size <= 0.5 * d {
+            bail!(ParamError::new(
+                SYSTEM_RADIUS.path,
+                format!("must exceed d/2 = {}, got {}", show(0.5 * d), show(size)),
+            ));
+        }
+        Geometry::HardWall { radius: size }
+    };
+    let box_edge = shape.box_edge(d);
+    if bulk && box_edge < 2.0 * d {
+        bail!(ParamError::new(
+            SYSTEM_BOX.path,
+            format!(
+                "must be at least 2 d = {} (the cells need two per edge), got {}",
+                show(2.0 * d),
+                show(box_edge)
+            ),
+        ));
+    }
+    let sweeps = r.count(&MC_SWEEPS)?;
+    let target_acceptance = r.number(&MC_TARGET_ACCEPTANCE)?;
+    if !(target_acceptance > 0.0 && target_acceptance < 1.0) {
+        bail!(ParamError::new(
+            MC_TARGET_ACCEPTANCE.path,
+            format!(
+                "must lie strictly between 0 and 1, got {}",
+                show(target_acceptance)
+            ),
+        ));
+    }
+    let sample_every = r.count(&MC_SAMPLE_EVERY)?;
+    let blocks = r.count(&MC_BLOCKS)? as usize;
+    let samples = sweeps.div_ceil(sample_every);
+    if blocks as u64 > samples {
+        bail!(ParamError::new(
+            MC_BLOCKS.path,
+            format!(
+                "must be at most the number of samples, mc.sweeps / mc.sample_every = {samples}, got {blocks}"
+            ),
+        ));
+    }
+    let profile_bins = r.count(&OUTPUT_PROFILE_BINS)? as usize;
+    let gr_bins = r.count(&OUTPUT_GR_BINS)? as usize;
+    let half = 0.5 * box_edge;
+    // Just under half the box: freud's RDF (and any AABB query) refuses exactly L/2.
+    let gr_max = r.opt_number(&OUTPUT_GR_MAX)?.unwrap_or(0.98 * half);
+    if gr_max > half * (1.0 + 1e-12) {
+        bail!(ParamError::new(
+            OUTPUT_GR_MAX.path,
+            format!(
+                "must lie in (0, L/2 = {}], got {}",
+                show(half),
+                show(gr_max)
+            ),
+        ));
+    }
+    let rho2_r_bins = r.count(&OUTPUT_RHO2_R_BINS)? as usize;
+    let rho2_bins = (rho2_r_bins > 0)
+        .then(|| -> Result<_> { Ok((rho2_r_bins, r.count(&OUTPUT_RHO2_COS_BINS)? as usize)) })
+        .transpose()?;
+    r.count(&OUTPUT_RHO2_COS_BINS)?;
+    if bulk && rho2_bins.is_some() {
+        bail!(ParamError::new(
+            OUTPUT_RHO2_R_BINS.path,
+            "applies to the droplet geometries only (give 0 or leave it out in bulk)",
+        ));
+    }
+    let rho2_cells = rho2_bins.map_or(0.0, |(r, c)| (r * r * c) as f64);
+    // Positions (particle order, scratch and slots), histograms of every block.
+    let bytes = particles as f64 * 200.0
+        + blocks as f64 * 8.0 * ((profile_bins + gr_bins + 100) as f64 + rho2_cells);
+    ensure_fits(
+        SYSTEM_PARTICLES.path,
+        &format!("{particles} spheres"),
+        bytes,
+    )?;
+    Ok(McRun {
+        seed,
+        particles,
+        diameter: d,
+        geometry,
+        volume_fraction: phi,
+        radius: (!bulk).then_some(size),
+        box_edge,
+        kt,
+        interface,
+        sweeps,
+        nselect: r.count(&MC_NSELECT)? as usize,
+        warmup_sweeps: r.count(&MC_WARMUP_SWEEPS)?,
+        target_acceptance,
+        tune_every: r.count(&MC_TUNE_EVERY)?,
+        sample_every,
+        delta: r.number(&MC_DELTA)?,
+        blocks,
+        profile_bins,
+        gr_bins,
+        gr_max,
+        trajectory_every: r.count(&OUTPUT_TRAJECTORY_EVERY)?,
+        rho2_bins,
+        initial: r.file(&SYSTEM_INITIAL).map(|f| base.join(f)),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scenario with every table, so that every key is read.
+    const FULL: &str = r#"
+method = "hs-mc"
+[system]
+geometry = "interface"
+particles = 100
+radius = 5.0
+initial = "start.gsd"
+[interface]
+stiffness = 50.0
+[mc]
+sweeps = 1000
+[output]
+rho2_r_bins = 4
+"#;
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn every_declared_key_is_read() {
+        let t = table(FULL);
+        let r = Reader::new(&t, KEYS).unwrap();
+        resolve(&r, Path::new("."), None).unwrap();
+        assert_eq!(r.unread(), Vec::<&str>::new());
+    }
+
+    #[test]
+    fn derived_defaults_are_computed_from_the_keys_they_name() {
+        let run = read(&table(FULL), Path::new("."), None).unwrap();
+        assert_eq!(run.delta, 0.1 * run.diameter);
+        let [k, range, offset] = run.interface.unwrap();
+        assert_eq!((k, range, offset), (50.0, 0.5, -0.5));
+        let wide = FULL.replace("radius = 5.0", "radius = 5.0\ndiameter = 2.0\nkT = 3.0");
+        let wide = wide.replace("particles = 100", "particles = 10");
+        let run = read(&table(&wide), Path::new("."), None).unwrap();
+        assert_eq!(run.delta, 0.2);
+        assert_eq!(run.interface.unwrap()[1..], [1.0, -1.0]);
+    }
+
+    #[test]
+    fn the_engine_s_checks_name_the_scenario_key() {
+        let bad = FULL.replace("stiffness = 50.0", "stiffness = 50.0\noffset = -9.0");
+        let e = format!(
+            "{:#}",
+            read(&table(&bad), Path::new("."), None).unwrap_err()
+        );
+        assert!(e.starts_with("interface.offset:"), "{e}");
+        let both = FULL.replace("radius = 5.0", "radius = 5.0\nbox = 3.0");
+        let e = format!(
+            "{:#}",
+            read(&table(&both), Path::new("."), None).unwrap_err()
+        );
+        assert!(e.starts_with("system.box: does not apply"), "{e}");
+    }
+}
