@@ -379,6 +379,33 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// `read` of a key the scenario may leave out ([`Omitted::Means`]: the method decides what
+    /// its absence means), `None` when it does.
+    fn optional<T>(&self, k: &Spec, read: fn(&Self, &Spec) -> Result<T>) -> Result<Option<T>> {
+        match self.given(k) {
+            None if matches!(k.default, Means(_)) => Ok(None),
+            _ => read(self, k).map(Some),
+        }
+    }
+
+    /// `read` of a key only where the scenario gives it (a record of what was written; the
+    /// value used, with its default, comes from `read` itself).
+    pub fn if_given<T>(&self, k: &Spec, read: fn(&Self, &Spec) -> Result<T>) -> Result<Option<T>> {
+        match self.given(k) {
+            Some(_) => read(self, k).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// `read` of an optional table's keys when the scenario has the table `k`.
+    pub fn section<T>(&self, k: &Spec, read: impl FnOnce() -> Result<T>) -> Result<Option<T>> {
+        if self.has(k) {
+            read().map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
     /// A number: as given, its literal default, or its derived default.
     pub fn number(&self, k: &Spec) -> Result<f64> {
         if let (None, Derived(_, f)) = (self.given(k), k.default) {
@@ -393,10 +420,7 @@ impl<'a> Reader<'a> {
 
     /// A number the scenario may leave out ([`Omitted::Means`]: the method decides).
     pub fn opt_number(&self, k: &Spec) -> Result<Option<f64>> {
-        match self.given(k) {
-            None if matches!(k.default, Means(_)) => Ok(None),
-            _ => self.number(k).map(Some),
-        }
+        self.optional(k, Self::number)
     }
 
     /// A whole number (checked as an integer of its declared range).
@@ -409,10 +433,7 @@ impl<'a> Reader<'a> {
 
     /// A whole number the scenario may leave out ([`Omitted::Means`]).
     pub fn opt_integer(&self, k: &Spec) -> Result<Option<i64>> {
-        match self.given(k) {
-            None if matches!(k.default, Means(_)) => Ok(None),
-            _ => self.integer(k).map(Some),
-        }
+        self.optional(k, Self::integer)
     }
 
     /// A count (an integer declared >= 0).
@@ -423,10 +444,7 @@ impl<'a> Reader<'a> {
 
     /// A count the scenario may leave out ([`Omitted::Means`]).
     pub fn opt_count(&self, k: &Spec) -> Result<Option<u64>> {
-        match self.given(k) {
-            None if matches!(k.default, Means(_)) => Ok(None),
-            _ => self.count(k).map(Some),
-        }
+        self.optional(k, Self::count)
     }
 
     /// A word (one of the key's allowed words).
@@ -439,10 +457,7 @@ impl<'a> Reader<'a> {
 
     /// A word the scenario may leave out ([`Omitted::Means`]).
     pub fn opt_word(&self, k: &Spec) -> Result<Option<String>> {
-        match self.given(k) {
-            None if matches!(k.default, Means(_)) => Ok(None),
-            _ => self.word(k).map(Some),
-        }
+        self.optional(k, Self::word)
     }
 
     /// `true` or `false`.

@@ -218,7 +218,6 @@ impl Scenario {
     /// checked every key's type and range).
     pub fn read(r: &Reader) -> anyhow::Result<Self> {
         let count = |k| -> anyhow::Result<usize> { Ok(r.count(k)? as usize) };
-        let section = |k| r.has(k);
         Ok(Self {
             method: r.word(&METHOD)?,
             seed: r.count(&SEED)?,
@@ -234,55 +233,43 @@ impl Scenario {
                 },
             },
             potential: Potential {
-                cosine: section(&POTENTIAL_COSINE)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(Cosine {
-                            amplitude: r.number(&POTENTIAL_COSINE_AMPLITUDE)?,
-                            wavelength: r.number(&POTENTIAL_COSINE_WAVELENGTH)?,
-                        })
+                cosine: r.section(&POTENTIAL_COSINE, || {
+                    Ok(Cosine {
+                        amplitude: r.number(&POTENTIAL_COSINE_AMPLITUDE)?,
+                        wavelength: r.number(&POTENTIAL_COSINE_WAVELENGTH)?,
                     })
-                    .transpose()?,
+                })?,
                 drive: r.number(&POTENTIAL_DRIVE)?,
-                harmonic: section(&POTENTIAL_HARMONIC)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(Harmonic {
-                            stiffness: r.number(&POTENTIAL_HARMONIC_STIFFNESS)?,
-                            centre: r
-                                .given(&POTENTIAL_HARMONIC_CENTRE)
-                                .and(Some(r.number(&POTENTIAL_HARMONIC_CENTRE)?)),
-                        })
+                harmonic: r.section(&POTENTIAL_HARMONIC, || {
+                    Ok(Harmonic {
+                        stiffness: r.number(&POTENTIAL_HARMONIC_STIFFNESS)?,
+                        centre: r.if_given(&POTENTIAL_HARMONIC_CENTRE, Reader::number)?,
                     })
-                    .transpose()?,
-                fourier: section(&POTENTIAL_FOURIER)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(Fourier {
-                            wavelength: r.number(&POTENTIAL_FOURIER_WAVELENGTH)?,
-                            cos: r.numbers(&POTENTIAL_FOURIER_COS)?,
-                            sin: r.numbers(&POTENTIAL_FOURIER_SIN)?,
-                        })
+                })?,
+                fourier: r.section(&POTENTIAL_FOURIER, || {
+                    Ok(Fourier {
+                        wavelength: r.number(&POTENTIAL_FOURIER_WAVELENGTH)?,
+                        cos: r.numbers(&POTENTIAL_FOURIER_COS)?,
+                        sin: r.numbers(&POTENTIAL_FOURIER_SIN)?,
                     })
-                    .transpose()?,
+                })?,
                 table: r.file(&POTENTIAL_TABLE),
             },
             interaction: Interaction {
-                sticky: section(&INTERACTION_STICKY)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(StickySpec {
-                            gamma: r.number(&INTERACTION_STICKY_GAMMA)?,
-                            range: r.number(&INTERACTION_STICKY_RANGE)?,
-                            order: r.number(&INTERACTION_STICKY_ORDER)?,
-                        })
+                sticky: r.section(&INTERACTION_STICKY, || {
+                    Ok(StickySpec {
+                        gamma: r.number(&INTERACTION_STICKY_GAMMA)?,
+                        range: r.number(&INTERACTION_STICKY_RANGE)?,
+                        order: r.number(&INTERACTION_STICKY_ORDER)?,
                     })
-                    .transpose()?,
-                yukawa: section(&INTERACTION_YUKAWA)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(YukawaSpec {
-                            strength: r.number(&INTERACTION_YUKAWA_STRENGTH)?,
-                            screening: r.number(&INTERACTION_YUKAWA_SCREENING)?,
-                            cutoff: r.number(&INTERACTION_YUKAWA_CUTOFF)?,
-                        })
+                })?,
+                yukawa: r.section(&INTERACTION_YUKAWA, || {
+                    Ok(YukawaSpec {
+                        strength: r.number(&INTERACTION_YUKAWA_STRENGTH)?,
+                        screening: r.number(&INTERACTION_YUKAWA_SCREENING)?,
+                        cutoff: r.number(&INTERACTION_YUKAWA_CUTOFF)?,
                     })
-                    .transpose()?,
+                })?,
                 table: r.file(&INTERACTION_TABLE),
             },
             initial: Initial {
@@ -294,45 +281,35 @@ impl Scenario {
                 equilibrate: r.number(&RUN_EQUILIBRATE)?,
                 time: r.number(&RUN_TIME)?,
                 checkpoint_every: r.opt_count(&RUN_CHECKPOINT_EVERY)?,
-                integrator: r.given(&RUN_INTEGRATOR).and(Some(r.word(&RUN_INTEGRATOR)?)),
+                integrator: r.if_given(&RUN_INTEGRATOR, Reader::word)?,
             },
             observe: Observe {
-                every: r.given(&OBSERVE_EVERY).and(Some(r.count(&OBSERVE_EVERY)?)),
-                density: section(&OBSERVE_DENSITY)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(Bins {
-                            bins: count(&OBSERVE_DENSITY_BINS)?,
-                        })
+                every: r.if_given(&OBSERVE_EVERY, Reader::count)?,
+                density: r.section(&OBSERVE_DENSITY, || {
+                    Ok(Bins {
+                        bins: count(&OBSERVE_DENSITY_BINS)?,
                     })
-                    .transpose()?,
-                contact_density: section(&OBSERVE_CONTACT_DENSITY)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(ContactSpec {
-                            bins: count(&OBSERVE_CONTACT_DENSITY_BINS)?,
-                            window: r.number(&OBSERVE_CONTACT_DENSITY_WINDOW)?,
-                        })
+                })?,
+                contact_density: r.section(&OBSERVE_CONTACT_DENSITY, || {
+                    Ok(ContactSpec {
+                        bins: count(&OBSERVE_CONTACT_DENSITY_BINS)?,
+                        window: r.number(&OBSERVE_CONTACT_DENSITY_WINDOW)?,
                     })
-                    .transpose()?,
-                msd: section(&OBSERVE_MSD)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(MsdSpec {
-                            points: count(&OBSERVE_MSD_POINTS)?,
-                            max_lag: r
-                                .given(&OBSERVE_MSD_MAX_LAG)
-                                .and(Some(r.number(&OBSERVE_MSD_MAX_LAG)?)),
-                        })
+                })?,
+                msd: r.section(&OBSERVE_MSD, || {
+                    Ok(MsdSpec {
+                        points: count(&OBSERVE_MSD_POINTS)?,
+                        max_lag: r.if_given(&OBSERVE_MSD_MAX_LAG, Reader::number)?,
                     })
-                    .transpose()?,
+                })?,
                 current: r.flag(&OBSERVE_CURRENT)?,
                 clusters: r.flag(&OBSERVE_CLUSTERS)?,
-                trajectory: section(&OBSERVE_TRAJECTORY)
-                    .then(|| -> anyhow::Result<_> {
-                        Ok(Trajectory {
-                            every: r.count(&OBSERVE_TRAJECTORY_EVERY)?,
-                            equilibration: r.flag(&OBSERVE_TRAJECTORY_EQUILIBRATION)?,
-                        })
+                trajectory: r.section(&OBSERVE_TRAJECTORY, || {
+                    Ok(Trajectory {
+                        every: r.count(&OBSERVE_TRAJECTORY_EVERY)?,
+                        equilibration: r.flag(&OBSERVE_TRAJECTORY_EQUILIBRATION)?,
                     })
-                    .transpose()?,
+                })?,
             },
         })
     }
@@ -343,7 +320,7 @@ impl Scenario {
 pub struct Resolved {
     /// Engine configuration.
     pub config: BcdConfig,
-    /// Integrator of the free motion (`run.integrator`), for [`crate::Bcd::with_integrator`].
+    /// Integrator of the free motion (`run.integrator`), for [`colloidsim_bcd::Bcd::with_integrator`].
     pub integrator: Integrator,
     /// The external field (potential and drive).
     pub field: ExternalField,
