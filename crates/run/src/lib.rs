@@ -21,7 +21,6 @@ pub mod trajectory;
 
 mod bd_replica;
 mod bulk;
-mod dpd;
 mod droplet;
 mod hs_mc;
 mod mpcd;

@@ -2,3 +2,4 @@
 //! parameters, its session and its outputs. The registry in [`crate::method`] lists them.
 
 pub mod bcd;
+pub mod dpd;
