@@ -7,8 +7,8 @@ mod common;
 
 use colloidsim_md::Particles;
 use colloidsim_md::dpd::setup::DpdSetup;
-use colloidsim_run::methods::dpd::params;
 use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};
+use colloidsim_run::methods::dpd::params;
 use common::on_ranks;
 
 fn scenario(text: &str) -> DpdSetup {

@@ -2,10 +2,10 @@
 //! conservation, fluctuation–dissipation with lubrication, thread independence, bad input.
 
 use colloidsim_md::dpd::setup::DpdSetup;
-use colloidsim_run::methods::dpd::monitor::TemperatureMonitor;
-use colloidsim_run::methods::dpd::params;
 use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
+use colloidsim_run::methods::dpd::monitor::TemperatureMonitor;
+use colloidsim_run::methods::dpd::params;
 
 #[path = "../../md/tests/common/mod.rs"]
 mod common;

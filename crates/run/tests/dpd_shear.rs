@@ -6,8 +6,8 @@
 
 use colloidsim_md::Particles;
 use colloidsim_md::dpd::setup::DpdSetup;
-use colloidsim_run::methods::dpd::params;
 use colloidsim_md::dpd::{Dpd, NeighborMode};
+use colloidsim_run::methods::dpd::params;
 
 #[path = "../../md/tests/common/mod.rs"]
 mod common;

@@ -3,9 +3,9 @@
 //! Backx & Ernst and against the long run recorded in docs/dpd.md.
 
 use colloidsim_md::dpd::setup::DpdSetup;
-use colloidsim_run::methods::dpd::params;
 use colloidsim_md::dpd::viscosity::Estimate;
 use colloidsim_md::dpd::{Dpd, StressAcf};
+use colloidsim_run::methods::dpd::params;
 use std::f64::consts::PI;
 
 fn scenario(text: &str) -> DpdSetup {

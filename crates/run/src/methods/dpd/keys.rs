@@ -342,14 +342,14 @@ pub const OBSERVE_GR_MAX: Spec = key(
     Positive,
     "range of g(r)",
 )
-.also(
-    "at most half the shortest box edge (the default stays under it: freud's RDF refuses L/2)",
-);
+.also("at most half the shortest box edge (the default stays under it: freud's RDF refuses L/2)");
 
 pub const OBSERVE_CONTACT_GAP: Spec = key(
     "observe.contact_gap",
     "rc",
-    Derived("3 / morse_kappa", |r| Ok(3.0 / r.number(&COLLOIDS_MORSE_KAPPA)?)),
+    Derived("3 / morse_kappa", |r| {
+        Ok(3.0 / r.number(&COLLOIDS_MORSE_KAPPA)?)
+    }),
     Positive,
     "a contact is a surface gap below this",
 );

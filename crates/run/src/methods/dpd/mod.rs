@@ -22,11 +22,11 @@ use colloidsim_analysis::{
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_md::dpd::setup::DpdSetup;
-use monitor::TemperatureMonitor;
-use params::Resolved;
 use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::{Particles, SimBox};
+use monitor::TemperatureMonitor;
+use params::Resolved;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
@@ -88,7 +88,9 @@ impl Method for DpdMethod {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let s = resolve(src, seed)?;
-        Ok(Box::new(DpdEngine { sim: s.setup.build()? }))
+        Ok(Box::new(DpdEngine {
+            sim: s.setup.build()?,
+        }))
     }
 }
 
@@ -215,8 +217,11 @@ impl DpdSession {
                 s.setup.params.kt,
             ));
         }
-        let mut monitor =
-            TemperatureMonitor::new(s.setup.params.kt, s.max_temperature_drift, s.temperature_window);
+        let mut monitor = TemperatureMonitor::new(
+            s.setup.params.kt,
+            s.max_temperature_drift,
+            s.temperature_window,
+        );
         for &(step, t) in &obs.monitor {
             monitor
                 .push(step, t)
@@ -392,8 +397,13 @@ impl DpdSession {
         if let Some(log) = self.thermo_log.as_mut()
             && let Some((time, th)) = self.obs.thermo.last().filter(|(_, th)| th.step == next)
         {
-            log.append(&thermo_row(*time, th, self.sim.sbox.volume(), self.s.setup.tau))
-                .map_err(|e| fail_alone(&self.sim, e.into()))?;
+            log.append(&thermo_row(
+                *time,
+                th,
+                self.sim.sbox.volume(),
+                self.s.setup.tau,
+            ))
+            .map_err(|e| fail_alone(&self.sim, e.into()))?;
         }
         let check_every = if o.thermo_every > 0 {
             o.thermo_every
@@ -1118,7 +1128,10 @@ fn write_outputs(
                 &out.join("msd.png"),
                 &format!(
                     "MSD, DPD colloids (phi = {:.3}, {} colloids)",
-                    s.setup.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.setup.radius.powi(3) / vol,
+                    s.setup.colloids as f64 * 4.0 / 3.0
+                        * std::f64::consts::PI
+                        * s.setup.radius.powi(3)
+                        / vol,
                     s.setup.colloids
                 ),
                 "t / tau_D",
@@ -1173,7 +1186,9 @@ fn write_outputs(
         files.push("sq.csv".into());
         // The hard-sphere reference: Percus–Yevick at the colloids' volume fraction (the
         // contact force is hard to 1e-3 diameters; docs/dpd.md).
-        let phi = s.setup.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.setup.radius.powi(3) / vol;
+        let phi =
+            s.setup.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.setup.radius.powi(3)
+                / vol;
         let py = (phi > 0.0 && phi < 0.6).then(|| percus_yevick_g(phi, &r_over_d));
         let mut series = vec![Series {
             label: "colloids (bars: standard error)",
@@ -1419,7 +1434,9 @@ fn diffusion_note(s: &Resolved, obs: &Observed, diffusion: Option<f64>) -> Strin
         .msd_steps
         .last()
         .zip(obs.msd_steps.first())
-        .map_or(0.0, |(b, a)| (b - a) as f64 * s.setup.params.dt / s.setup.tau);
+        .map_or(0.0, |(b, a)| {
+            (b - a) as f64 * s.setup.params.dt / s.setup.tau
+        });
     match diffusion {
         Some(_) => format!(
             "slope of the colloid MSD / 6 over the second half of its {lags} lags (up to {longest:.3} tau_D)"

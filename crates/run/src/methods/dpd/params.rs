@@ -252,7 +252,8 @@ impl Scenario {
     }
 
     fn resolve_seeded(&self, r: &Reader, seed: u32) -> anyhow::Result<Resolved> {
-        let key = |k: &crate::keys::Spec, m: String| anyhow::Error::from(ParamError::new(k.path, m));
+        let key =
+            |k: &crate::keys::Spec, m: String| anyhow::Error::from(ParamError::new(k.path, m));
         let mut warnings = Vec::new();
         let s = &self.system;
         let l = match (s.box_length, &s.box_edges) {
@@ -578,7 +579,11 @@ profile_bins = 8
         // observe.gr_max: 0.49 L of the shortest edge; observe.contact_gap: 3 / morse_kappa.
         assert_eq!(r.gr_max, 0.49 * 8.0);
         assert_eq!(r.contact_gap, 3.0 / 20.0);
-        let (_, cube) = read(&table("method = \"dpd\"\n[system]\nbox_length = 7.0\n"), None).unwrap();
+        let (_, cube) = read(
+            &table("method = \"dpd\"\n[system]\nbox_length = 7.0\n"),
+            None,
+        )
+        .unwrap();
         assert_eq!(cube.gr_max, 0.49 * 7.0);
         // Literal defaults come from the declarations.
         assert_eq!(cube.setup.params.kt, 0.1);
@@ -590,8 +595,14 @@ profile_bins = 8
         let base = "method = \"dpd\"\n[system]\nbox_length = 10.0\nphi = 0.1\n";
         for (extra, says) in [
             ("", "system.box_length: give the box"),
-            ("box_edges = [10.0, 10.0, 10.0]\n", "system.box_edges: give either"),
-            ("radius_spread = 0.1\n", "system.radius_spread: a spread needs"),
+            (
+                "box_edges = [10.0, 10.0, 10.0]\n",
+                "system.box_edges: give either",
+            ),
+            (
+                "radius_spread = 0.1\n",
+                "system.radius_spread: a spread needs",
+            ),
             (
                 "[colloids]\nlubrication_gap = 2.0\n",
                 "colloids.lubrication_gap: must be smaller than colloids.cutoff",
@@ -615,7 +626,10 @@ profile_bins = 8
             assert!(e.contains(says), "{extra}: {e}");
         }
         let e = refused("method = \"dpd\"\n[system]\nbox_length = 3.0\nphi = 0.1\n");
-        assert!(e.contains("system.box_length: the shortest box edge 3"), "{e}");
+        assert!(
+            e.contains("system.box_length: the shortest box edge 3"),
+            "{e}"
+        );
         let e = refused("method = \"dpd\"\n[system]\nbox_edges = [10.0, 0.0, 10.0]\n");
         assert!(e.contains("system.box_edges: must be"), "{e}");
     }
