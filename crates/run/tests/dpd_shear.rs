@@ -441,7 +441,7 @@ fn bad_shear_rates_are_refused_with_the_key() {
             "shear_rate = 0.5\nrank_grid = [2, 1]",
             "sheared run is cut along z only",
         ),
-        ("rank_grid = [0, 2]", "2 numbers in [1, 1000000]"),
+        ("rank_grid = [0, 2]", "in [1, 1000000], got [0, 2]"),
     ] {
         let e = params::setup(&format!("{base}{bad}\n"))
             .unwrap_err()
