@@ -11,7 +11,7 @@
 use crate::common::{load_average, median, write_lammps_data};
 use crate::dpd_bench::BenchArgs;
 use anyhow::{Context, Result, bail};
-use colloidsim_md::dpd::scenario::DpdSetup;
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdParams};
 use colloidsim_md::{Particles, SimBox};
 use std::path::{Path, PathBuf};

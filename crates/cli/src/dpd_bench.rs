@@ -131,12 +131,12 @@ fn load() -> String {
 }
 
 /// The notes' standard colloid system in a cube of edge `--l` (seed `--seed`).
-pub fn colloid_setup(a: &BenchArgs) -> Result<colloidsim_md::dpd::scenario::DpdSetup> {
+pub fn colloid_setup(a: &BenchArgs) -> Result<colloidsim_md::dpd::setup::DpdSetup> {
     let text = format!(
         "method = \"dpd\"\nseed = {}\n[system]\nbox_length = {}\nphi = 0.2\n[run]\ndt = 0.001\n",
         a.seed, a.l
     );
-    Ok(colloidsim_md::dpd::scenario::DpdScenario::from_toml(&text)?.validate()?)
+    colloidsim_run::methods::dpd::params::setup(&text)
 }
 
 /// `colloidsim bench dpd --colloids`: the standard colloid system on each thread count, timed

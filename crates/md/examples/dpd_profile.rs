@@ -1,6 +1,8 @@
 //! Profile the DPD engine on DPD water: `cargo run --release -p colloidsim-md --example
 //! dpd_profile -- L STEPS SKIN` (density 3, kT = 1, dt = 0.04, a lattice start relaxed for 100 steps).
-use colloidsim_md::dpd::scenario::DpdScenario;
+use colloidsim_md::SimBox;
+use colloidsim_md::dpd::DpdParams;
+use colloidsim_md::dpd::setup::{DpdSetup, RadiusDistribution};
 use std::time::Instant;
 
 fn main() {
@@ -8,12 +10,22 @@ fn main() {
     let l: f64 = a.get(1).map_or(20.0, |s| s.parse().unwrap());
     let steps: u64 = a.get(2).map_or(200, |s| s.parse().unwrap());
     let skin: f64 = a.get(3).map_or(0.4, |s| s.parse().unwrap());
-    let setup = DpdScenario::from_toml(&format!(
-        "method = \"dpd\"\n[system]\nbox_length = {l}\nkT = 1.0\n[run]\ndt = 0.04\nskin = {skin}\n"
-    ))
-    .unwrap()
-    .validate()
-    .unwrap();
+    let params = DpdParams {
+        skin,
+        ..DpdParams::water(0.04, 1)
+    };
+    let setup = DpdSetup {
+        params,
+        sbox: SimBox::new([l; 3]),
+        colloids: 0,
+        solvent: (3.0 * l * l * l).round() as usize,
+        radius: 1.0,
+        distribution: RadiusDistribution::Monodisperse,
+        density: 3.0,
+        solvent_mass: 1.0,
+        d0: f64::NAN,
+        tau: f64::NAN,
+    };
     let mut sim = setup.build().unwrap();
     sim.run(100).unwrap();
     let b0 = sim.neighbor_builds();

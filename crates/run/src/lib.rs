@@ -22,7 +22,6 @@ pub mod trajectory;
 
 mod bd_replica;
 mod bulk;
-mod dpd;
 mod droplet;
 mod mpcd;
 mod theory_droplet;

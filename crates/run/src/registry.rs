@@ -9,7 +9,7 @@ static METHODS: &[&dyn Method] = &[
     &crate::methods::bcd::BcdMethod,
     &crate::droplet::DropletBd,
     &crate::bulk::BulkBd,
-    &crate::dpd::DpdMethod,
+    &crate::methods::dpd::DpdMethod,
     &crate::methods::hs_mc::HsMc,
     &crate::mpcd::MpcdBulk,
     &crate::mpcd::DropletMpcd,

@@ -290,15 +290,7 @@ fn methods() -> Vec<(&'static str, &'static [Spec], Parse)> {
                     .map_err(|e| e.to_string())
             }),
         ),
-        (
-            DPD,
-            spec("dpd"),
-            Some(|t| {
-                colloidsim_md::dpd::scenario::DpdScenario::from_toml(t)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
-        ),
+        (DPD, spec("dpd"), None),
         (MC, spec("hs-mc"), None),
         (
             MPCD,

@@ -46,7 +46,7 @@
 
 mod domain;
 pub mod forces;
-pub mod scenario;
+pub mod setup;
 pub mod viscosity;
 
 use crate::cells::{CellSort, permute, scan_layer_sheared};

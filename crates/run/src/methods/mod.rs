@@ -1,5 +1,6 @@
 //! One folder per method: its key declarations, how it reads them into the engine's
-//! parameters, its session and its outputs. The registry in [`crate::method`] lists them.
+//! parameters, its session and its outputs. The registry in [`crate::registry`] lists them.
 
 pub mod bcd;
+pub mod dpd;
 pub mod hs_mc;

@@ -2,13 +2,14 @@
 //! (a = 25 kT/rc, gamma = 4.5, density 3, kT = 1, rc = 1) against the kinetic theory of Marsh,
 //! Backx & Ernst and against the long run recorded in docs/dpd.md.
 
-use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::viscosity::Estimate;
 use colloidsim_md::dpd::{Dpd, StressAcf};
+use colloidsim_run::methods::dpd::params;
 use std::f64::consts::PI;
 
 fn scenario(text: &str) -> DpdSetup {
-    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+    params::setup(text).unwrap()
 }
 
 /// The DPD solvent with the engine's defaults (repulsion 25 kT/rc, gamma = 4.5, density 3,

@@ -1,5 +1,10 @@
 //! DPD colloids in explicit solvent (`method = "dpd"`): velocity Verlet with DPD pair forces
 //! as the thermostat; thermodynamics, MSD, g(r), S(q), coordination and clusters, GSD frames.
+//! Its keys are declared in [`keys`] and read in [`params`].
+
+pub mod keys;
+pub mod monitor;
+pub mod params;
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
@@ -16,26 +21,22 @@ use colloidsim_analysis::{
 };
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
-use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
 use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::{Particles, SimBox};
+use monitor::TemperatureMonitor;
+use params::Resolved;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 /// The DPD family of scenarios.
 pub struct DpdMethod;
 
-/// Parse and validate a scenario, with the seed given if any.
-fn resolve(src: &Source, seed: Option<u64>) -> Result<(DpdScenario, DpdSetup)> {
-    crate::keys::validate(&src.table()?, crate::keys::DPD).with_context(|| src.label())?;
-    let mut sc = DpdScenario::from_toml(src.text()).with_context(|| src.label())?;
-    if let Some(s) = seed {
-        crate::seed32(s)?;
-        sc.seed = s;
-    }
-    let setup = sc.validate().with_context(|| src.label())?;
-    Ok((sc, setup))
+/// The scenario read and resolved, with the seed given if any.
+fn resolve(src: &Source, seed: Option<u64>) -> Result<Resolved> {
+    let (_, r) = params::read(&src.table()?, seed).with_context(|| src.label())?;
+    Ok(r)
 }
 
 impl Method for DpdMethod {
@@ -52,9 +53,9 @@ impl Method for DpdMethod {
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
-        let (_, s) = resolve(src, None)?;
+        let s = resolve(src, None)?;
         // What `run` does before it starts: build the system.
-        s.build().with_context(|| src.label())?;
+        s.setup.build().with_context(|| src.label())?;
         Ok(Checked {
             resolved: describe(&s),
             warnings: s.warnings.clone(),
@@ -82,12 +83,14 @@ impl Method for DpdMethod {
     }
 
     fn keys(&self) -> &'static [Spec] {
-        crate::keys::DPD
+        keys::KEYS
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
-        let (_, s) = resolve(src, seed)?;
-        Ok(Box::new(DpdEngine { sim: s.build()? }))
+        let s = resolve(src, seed)?;
+        Ok(Box::new(DpdEngine {
+            sim: s.setup.build()?,
+        }))
     }
 }
 
@@ -97,11 +100,11 @@ fn start(
     seed: Option<u64>,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let (_, s) = resolve(src, seed)?;
+    let s = resolve(src, seed)?;
     let (sync_every, _) = periods(s.steps);
     let mut sim = match comm {
-        None => s.build()?,
-        Some(c) => s.build_decomposed(c)?,
+        None => s.setup.build()?,
+        Some(c) => s.setup.build_decomposed(c)?,
     };
     sim.set_sync_every(sync_every);
     DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
@@ -115,7 +118,7 @@ fn restore(
     envelope: &Envelope,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let (_, s) = resolve(src, Some(seed))?;
+    let s = resolve(src, Some(seed))?;
     let ck: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
     if ck.sync_every != periods(s.steps).0 {
         bail!(
@@ -126,7 +129,7 @@ fn restore(
     }
     let (sbox, types) = (SimBox::new(ck.box_l), DpdSetup::colloid_types());
     let (p, f, step, sync) = (ck.particles, &ck.forces, ck.step, ck.sync_every);
-    let sim = Dpd::restart_on(p, f, sbox, s.params, types, step, sync, comm)?;
+    let sim = Dpd::restart_on(p, f, sbox, s.setup.params, types, step, sync, comm)?;
     // Only the writer touches the folder.
     if sim.rank().0 == 0 {
         ck.obs
@@ -169,7 +172,7 @@ type Saved = Checkpoint<Observed>;
 
 /// A DPD run: the engine, its observations, the trajectory and the temperature monitor.
 struct DpdSession {
-    s: DpdSetup,
+    s: Resolved,
     sim: Dpd,
     obs: Observed,
     builds0: u64,
@@ -187,7 +190,7 @@ struct DpdSession {
 }
 
 impl DpdSession {
-    fn new(s: DpdSetup, sim: Dpd, obs: Observed, builds0: u64) -> Result<Self> {
+    fn new(s: Resolved, sim: Dpd, obs: Observed, builds0: u64) -> Result<Self> {
         let (sync_every, checkpoint_every) = periods(s.steps);
         let p = sim.snapshot();
         let colloid_tags: Vec<u32> = (0..p.len() as u32)
@@ -202,20 +205,23 @@ impl DpdSession {
             .map(|&t| 0.5 * p.diameter[t as usize])
             .collect();
         let mut obs = obs;
-        if s.params.shear_rate != 0.0 && obs.shear.is_none() {
+        if s.setup.params.shear_rate != 0.0 && obs.shear.is_none() {
             obs.shear = Some(ShearObserved::new(s.steps, s.observe.profile_bins));
         }
         if s.viscosity_lags > 0 && obs.stress_acf.is_none() {
             obs.stress_acf = Some(StressAcf::new(
                 s.observe.viscosity_every,
                 s.viscosity_lags,
-                s.params.dt,
+                s.setup.params.dt,
                 sim.sbox.volume(),
-                s.params.kt,
+                s.setup.params.kt,
             ));
         }
-        let mut monitor =
-            TemperatureMonitor::new(s.params.kt, s.max_temperature_drift, s.temperature_window);
+        let mut monitor = TemperatureMonitor::new(
+            s.setup.params.kt,
+            s.max_temperature_drift,
+            s.temperature_window,
+        );
         for &(step, t) in &obs.monitor {
             monitor
                 .push(step, t)
@@ -241,7 +247,7 @@ impl DpdSession {
     /// Record what is due at the engine's current step.
     fn record(&mut self) -> Result<()> {
         let (s, sim, obs, o) = (&self.s, &self.sim, &mut self.obs, &self.s.observe);
-        let (dt, tau) = (s.params.dt, s.tau);
+        let (dt, tau) = (s.setup.params.dt, s.setup.tau);
         let step = sim.step;
         if o.msd_every > 0 && step.is_multiple_of(o.msd_every) {
             let mut a = Vec::new();
@@ -332,7 +338,7 @@ impl DpdSession {
     /// cannot go on.
     fn step(&mut self) -> Result<Option<String>> {
         let o = &self.s.observe;
-        let dt = self.s.params.dt;
+        let dt = self.s.setup.params.dt;
         let next = self.sim.step + 1;
         let thermo_due = o.thermo_every > 0 && next.is_multiple_of(o.thermo_every);
         let frame_due = o.trajectory_every > 0 && next.is_multiple_of(o.trajectory_every);
@@ -391,8 +397,13 @@ impl DpdSession {
         if let Some(log) = self.thermo_log.as_mut()
             && let Some((time, th)) = self.obs.thermo.last().filter(|(_, th)| th.step == next)
         {
-            log.append(&thermo_row(*time, th, self.sim.sbox.volume(), self.s.tau))
-                .map_err(|e| fail_alone(&self.sim, e.into()))?;
+            log.append(&thermo_row(
+                *time,
+                th,
+                self.sim.sbox.volume(),
+                self.s.setup.tau,
+            ))
+            .map_err(|e| fail_alone(&self.sim, e.into()))?;
         }
         let check_every = if o.thermo_every > 0 {
             o.thermo_every
@@ -431,11 +442,11 @@ impl Session for DpdSession {
     }
 
     fn seed(&self) -> u64 {
-        self.s.params.seed as u64
+        self.s.setup.params.seed as u64
     }
 
     fn status(&self) -> String {
-        let t = self.sim.step as f64 * self.s.params.dt / self.s.tau;
+        let t = self.sim.step as f64 * self.s.setup.params.dt / self.s.setup.tau;
         let mut s = format!("t = {} tau_D", crate::driver::significant(t));
         if let Some((_, th)) = self.obs.thermo.last() {
             s.push_str(&format!(", T = {:.4}", th.temperature));
@@ -478,7 +489,7 @@ impl Session for DpdSession {
             return Ok(());
         }
         if self.s.observe.thermo_every > 0 {
-            let (vol, tau) = (self.sim.sbox.volume(), self.s.tau);
+            let (vol, tau) = (self.sim.sbox.volume(), self.s.setup.tau);
             self.thermo_log = Some(CsvLog::start(
                 out.join("thermo.csv"),
                 &THERMO_COLUMNS,
@@ -575,11 +586,11 @@ impl Session for DpdSession {
         let summary = summary(
             &self.s, &self.sim, &self.obs, diffusion, builds, wall, &warnings,
         );
-        let (s, dt, tau) = (&self.s, self.s.params.dt, self.s.tau);
+        let (s, dt, tau) = (&self.s, self.s.setup.params.dt, self.s.setup.tau);
         let message = format!(
             "dpd: {} colloids + {} solvent beads, {} steps ({:.3} tau_D) in {:.1} s -> {}\nwrote {}",
-            s.colloids,
-            s.solvent,
+            s.setup.colloids,
+            s.setup.solvent,
             self.sim.step,
             self.sim.step as f64 * dt / tau,
             wall,
@@ -642,24 +653,24 @@ impl crate::Engine for DpdEngine {
     }
 }
 
-fn describe(s: &DpdSetup) -> serde_json::Value {
-    let p = &s.params;
+fn describe(s: &Resolved) -> serde_json::Value {
+    let p = &s.setup.params;
     let c = &p.colloid;
     json!({
-        "box": s.sbox.l,
-        "colloids": s.colloids,
-        "solvent_beads": s.solvent,
-        "colloid_radius": s.radius,
-        "radius_distribution": format!("{:?}", s.distribution),
-        "density": s.density,
-        "solvent_mass": s.solvent_mass,
+        "box": s.setup.sbox.l,
+        "colloids": s.setup.colloids,
+        "solvent_beads": s.setup.solvent,
+        "colloid_radius": s.setup.radius,
+        "radius_distribution": format!("{:?}", s.setup.distribution),
+        "density": s.setup.density,
+        "solvent_mass": s.setup.solvent_mass,
         "kT": p.kt,
         "gamma": p.gamma,
         "rc": p.rc,
         "repulsion_solvent_solvent": p.repulsion * p.kt / p.rc,
-        "colloid_solvent_surface_cutoff": colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
-        "colloid_solvent_centre_cutoff": s.radius + colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
-        "repulsion_colloid_solvent": p.repulsion_cs * p.kt / colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.radius),
+        "colloid_solvent_surface_cutoff": colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.setup.radius),
+        "colloid_solvent_centre_cutoff": s.setup.radius + colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.setup.radius),
+        "repulsion_colloid_solvent": p.repulsion_cs * p.kt / colloidsim_md::dpd::colloid_solvent_cutoff(p.rc, s.setup.radius),
         "colloid_colloid_surface_cutoff": p.colloid_cutoff,
         "contact_modulus": c.contact,
         "contact_range": c.contact_range,
@@ -672,9 +683,9 @@ fn describe(s: &DpdSetup) -> serde_json::Value {
         "dt": p.dt,
         "skin": p.skin,
         "steps": s.steps,
-        "stokes_einstein_diffusion_D0": s.d0,
-        "diffusion_time_tau": s.tau,
-        "steps_per_tau": s.tau / p.dt,
+        "stokes_einstein_diffusion_D0": s.setup.d0,
+        "diffusion_time_tau": s.setup.tau,
+        "steps_per_tau": s.setup.tau / p.dt,
         "contact_gap": s.contact_gap,
         "solvent_viscosity_kinetic_theory": solvent_viscosity_kinetic_theory(s),
         "shear_rate": p.shear_rate,
@@ -1044,13 +1055,13 @@ fn thermo_rows_of(obs: &Observed, vol: f64, tau: f64) -> Vec<Vec<f64>> {
 /// long-time colloid diffusion coefficient.
 fn write_outputs(
     out: &OutputDir,
-    s: &DpdSetup,
+    s: &Resolved,
     sim: &Dpd,
     obs: &Observed,
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<String>, Option<f64>)> {
-    let dt = s.params.dt;
-    let tau = s.tau;
+    let dt = s.setup.params.dt;
+    let tau = s.setup.tau;
     let mut files = Vec::new();
     let vol = sim.sbox.volume();
     // thermo.csv (also written row by row as the run goes: `DpdSession::step`)
@@ -1085,7 +1096,7 @@ fn write_outputs(
         // colloid diffusion time tau_D = R^2 / D0 (before it the slope is the short-time
         // motion, not the long-time self-diffusion).
         let n = mc.len();
-        if s.colloids > 0 && n >= 4 && time_tau[n / 2] >= 1.0 {
+        if s.setup.colloids > 0 && n >= 4 && time_tau[n / 2] >= 1.0 {
             let (a, b) = (n / 2, n);
             let xs = &time[a..b];
             let ys = &mc[a..b];
@@ -1111,14 +1122,17 @@ fn write_outputs(
                 points: false,
             },
         ];
-        let n_series = if s.colloids > 0 { 2 } else { 1 };
+        let n_series = if s.setup.colloids > 0 { 2 } else { 1 };
         picture(
             line_plot(
                 &out.join("msd.png"),
                 &format!(
                     "MSD, DPD colloids (phi = {:.3}, {} colloids)",
-                    s.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3) / vol,
-                    s.colloids
+                    s.setup.colloids as f64 * 4.0 / 3.0
+                        * std::f64::consts::PI
+                        * s.setup.radius.powi(3)
+                        / vol,
+                    s.setup.colloids
                 ),
                 "t / tau_D",
                 "mean-squared displacement [rc^2]",
@@ -1138,7 +1152,7 @@ fn write_outputs(
             .map(|x| x / obs.gr_samples as f64)
             .collect();
         let r = &obs.gr_r;
-        let r_over_d: Vec<f64> = r.iter().map(|x| x / (2.0 * s.radius)).collect();
+        let r_over_d: Vec<f64> = r.iter().map(|x| x / (2.0 * s.setup.radius)).collect();
         // Standard error of the mean over the structure samples (their scatter; samples closer
         // than the structural relaxation time are correlated, so this is a lower bound then).
         let m = obs.gr_samples as f64;
@@ -1164,15 +1178,17 @@ fn write_outputs(
             ],
         )?;
         files.push("gr.csv".into());
-        let rho = s.colloids as f64 / vol;
+        let rho = s.setup.colloids as f64 / vol;
         let q = default_q_grid(s.gr_max, g.len());
         let sq = structure_factor_windowed(r, &g, rho, &q, Window::Lorch);
-        let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.radius).collect();
+        let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.setup.radius).collect();
         out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;
         files.push("sq.csv".into());
         // The hard-sphere reference: Percus–Yevick at the colloids' volume fraction (the
         // contact force is hard to 1e-3 diameters; docs/dpd.md).
-        let phi = s.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3) / vol;
+        let phi =
+            s.setup.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.setup.radius.powi(3)
+                / vol;
         let py = (phi > 0.0 && phi < 0.6).then(|| percus_yevick_g(phi, &r_over_d));
         let mut series = vec![Series {
             label: "colloids (bars: standard error)",
@@ -1286,7 +1302,7 @@ fn write_outputs(
         && sh.profile_samples > 0
     {
         let (y, v, _) = sh.profile(sim.sbox.l[1]);
-        let imposed: Vec<f64> = y.iter().map(|y| s.params.shear_rate * y).collect();
+        let imposed: Vec<f64> = y.iter().map(|y| s.setup.params.shear_rate * y).collect();
         let samples = vec![sh.profile_samples as f64; y.len()];
         out.write_table(
             "velocity_profile.csv",
@@ -1308,7 +1324,7 @@ fn write_outputs(
 
 /// The method's summary fields.
 fn summary(
-    s: &DpdSetup,
+    s: &Resolved,
     sim: &Dpd,
     obs: &Observed,
     diffusion: Option<f64>,
@@ -1316,9 +1332,9 @@ fn summary(
     wall: f64,
     warnings: &[String],
 ) -> serde_json::Value {
-    let (dt, tau) = (s.params.dt, s.tau);
+    let (dt, tau) = (s.setup.params.dt, s.setup.tau);
     let last = obs.thermo.last().map(|(_, t)| t.clone());
-    let n = (s.colloids + s.solvent) as f64;
+    let n = (s.setup.colloids + s.setup.solvent) as f64;
     let eta = obs.stress_acf.as_ref().map(|a| a.viscosity());
     let value = |e: Option<colloidsim_md::dpd::viscosity::Estimate>| e.map(|e| e.value);
     let error = |e: Option<colloidsim_md::dpd::viscosity::Estimate>| e.map(|e| e.error);
@@ -1329,7 +1345,7 @@ fn summary(
         |e| e.note.clone(),
     );
     // Lees–Edwards: <-P_xy> over the second half, eta = <-P_xy> / gamma_dot.
-    let rate = s.params.shear_rate;
+    let rate = s.setup.params.shear_rate;
     let (stress, shear_note) = match &obs.shear {
         None => (None, "no shear (run.shear_rate = 0)".to_string()),
         Some(sh) => match sh.mean_stress(s.steps) {
@@ -1376,7 +1392,7 @@ fn summary(
     json!({
         "software": crate::software(),
         "method": "dpd",
-        "seed": s.params.seed,
+        "seed": s.setup.params.seed,
         "parameters": describe(s),
         "steps": sim.step,
         "time": sim.step as f64 * dt,
@@ -1392,7 +1408,7 @@ fn summary(
         "mean_colloid_temperature_second_half": mean_second_half(&obs.thermo, |t| t.temperature_by_type.get(1).copied().unwrap_or(f64::NAN)),
         "mean_pressure_second_half": mean_second_half(&obs.thermo, |t| (t.pressure[0] + t.pressure[1] + t.pressure[2]) / 3.0),
         "colloid_diffusion_long_time": diffusion,
-        "colloid_diffusion_over_stokes_einstein": diffusion.map(|d| d / s.d0),
+        "colloid_diffusion_over_stokes_einstein": diffusion.map(|d| d / s.setup.d0),
         "colloid_diffusion_note": diffusion_note(s, obs, diffusion),
         "viscosity": value(all),
         "viscosity_error": error(all),
@@ -1412,18 +1428,20 @@ fn summary(
 }
 
 /// Why `colloid_diffusion_long_time` is null, or how it was measured.
-fn diffusion_note(s: &DpdSetup, obs: &Observed, diffusion: Option<f64>) -> String {
+fn diffusion_note(s: &Resolved, obs: &Observed, diffusion: Option<f64>) -> String {
     let lags = obs.msd_steps.len().saturating_sub(1);
     let longest = obs
         .msd_steps
         .last()
         .zip(obs.msd_steps.first())
-        .map_or(0.0, |(b, a)| (b - a) as f64 * s.params.dt / s.tau);
+        .map_or(0.0, |(b, a)| {
+            (b - a) as f64 * s.setup.params.dt / s.setup.tau
+        });
     match diffusion {
         Some(_) => format!(
             "slope of the colloid MSD / 6 over the second half of its {lags} lags (up to {longest:.3} tau_D)"
         ),
-        None if s.colloids == 0 => "no colloids".into(),
+        None if s.setup.colloids == 0 => "no colloids".into(),
         None => format!(
             "not measured: the MSD's lags reach {longest:.3} tau_D; the long-time diffusion \
              needs the second half of the lags to start at 1 tau_D or later (a run of at least \
@@ -1446,9 +1464,9 @@ fn mean_second_half(rows: &[(f64, Thermo)], f: impl Fn(&Thermo) -> f64) -> Optio
 /// `w_D(r) = (1 - r/rc)^2`, `eta_K = d m kT / (2 gamma int w_D d^3r) = 45 m kT / (4 pi gamma
 /// rc^3)` (velocities relax at `2 zeta / m`, `zeta = gamma rho int w_D d^3r / d`) and `eta_D =
 /// gamma rho^2 / (2 d (d + 2)) int r^2 w_D d^3r = 2 pi gamma rho^2 rc^5 / 1575`.
-fn solvent_viscosity_kinetic_theory(s: &DpdSetup) -> f64 {
-    let p = &s.params;
-    let (m, rho) = (s.solvent_mass, s.density);
+fn solvent_viscosity_kinetic_theory(s: &Resolved) -> f64 {
+    let p = &s.setup.params;
+    let (m, rho) = (s.setup.solvent_mass, s.setup.density);
     let pi = std::f64::consts::PI;
     45.0 * m * p.kt / (4.0 * pi * p.gamma * p.rc.powi(3))
         + 2.0 * pi * p.gamma * rho * rho * p.rc.powi(5) / 1575.0

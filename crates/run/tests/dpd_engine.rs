@@ -1,10 +1,13 @@
 //! Validation of the DPD colloid engine (issue 5): thermostat temperature, momentum
 //! conservation, fluctuation–dissipation with lubrication, thread independence, bad input.
 
-use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup, TemperatureMonitor};
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode};
 use colloidsim_md::{Particles, SimBox};
+use colloidsim_run::methods::dpd::monitor::TemperatureMonitor;
+use colloidsim_run::methods::dpd::params;
 
+#[path = "../../md/tests/common/mod.rs"]
 mod common;
 
 /// Mean and standard error from `blocks` block averages of `x`.
@@ -19,7 +22,7 @@ fn mean_and_error(x: &[f64], blocks: usize) -> (f64, f64) {
 }
 
 fn scenario(text: &str) -> DpdSetup {
-    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+    params::setup(text).unwrap()
 }
 
 /// Pure DPD water (a = 25, gamma = 4.5, density 3, kT = 1) in a cube of side `l`.
@@ -202,9 +205,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
 fn bad_input_is_refused_with_the_key() {
     let base = "method = \"dpd\"\n[system]\nbox_length = 10.0\nphi = 0.1\n";
     let err = |extra: &str| {
-        DpdScenario::from_toml(&format!("{base}{extra}"))
-            .unwrap()
-            .validate()
+        params::setup(&format!("{base}{extra}"))
             .unwrap_err()
             .to_string()
     };
@@ -212,9 +213,10 @@ fn bad_input_is_refused_with_the_key() {
     assert!(err("[dpd]\ngamma = 250.0\n").contains("(0, 200]"));
     assert!(err("[colloids]\ncutoff = 0.0005\n").contains("colloids.cutoff"));
     assert!(err("[run]\ndt = -1.0\n").contains("run.dt"));
-    let e = DpdScenario::from_toml(&format!("{base}[system2]\n"));
+    let e = params::setup(&format!("{base}[system2]\n"));
     assert!(e.is_err());
-    let ok = scenario(&format!("{base}[dpd]\ngamma = 2.0\n"));
+    let text = format!("{base}[dpd]\ngamma = 2.0\n");
+    let (_, ok) = params::read(&toml::from_str(&text).unwrap(), None).unwrap();
     assert!(ok.warnings.iter().any(|w| w.contains("gamma")));
     // Overlapping colloids at the start.
     let setup = scenario(base);

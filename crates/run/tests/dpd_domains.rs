@@ -2,15 +2,17 @@
 //! ([`LocalRanks`]); the MPI ranks of the CLI run the same code. A decomposed run must be
 //! bitwise the single-rank run, for any number of ranks, with lists or cells, with colloids.
 
+#[path = "../../md/tests/common/mod.rs"]
 mod common;
 
 use colloidsim_md::Particles;
-use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};
+use colloidsim_run::methods::dpd::params;
 use common::on_ranks;
 
 fn scenario(text: &str) -> DpdSetup {
-    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+    params::setup(text).unwrap()
 }
 
 /// A small polydisperse suspension with Morse attraction (as the thread test).

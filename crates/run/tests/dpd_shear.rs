@@ -5,9 +5,11 @@
 //! depend on the threads; restarts continue bitwise; bad input is refused with the key.
 
 use colloidsim_md::Particles;
-use colloidsim_md::dpd::scenario::{DpdScenario, DpdSetup};
+use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, NeighborMode};
+use colloidsim_run::methods::dpd::params;
 
+#[path = "../../md/tests/common/mod.rs"]
 mod common;
 use common::{brute_force, on_ranks};
 
@@ -24,20 +26,16 @@ fn fnv(h: &mut u64, x: f64) {
 /// lists and with cells, and of DPD water at dt = 0.04 (cells), all without shear.
 fn fingerprints() -> Vec<(u64, Vec<f64>)> {
     let sus = |mode: NeighborMode| {
-        let mut s = DpdScenario::from_toml(
+        let mut s = params::setup(
             "method = \"dpd\"\nseed = 9\n[system]\nbox_length = 8.0\nphi = 0.15\nradius_distribution = \"uniform\"\nradius_spread = 0.2\n[colloids]\nmorse_depth = 12.0\n",
         )
-        .unwrap()
-        .validate()
         .unwrap();
         s.params.neighbors = mode;
         s
     };
-    let water = DpdScenario::from_toml(
+    let water = params::setup(
         "method = \"dpd\"\nseed = 4\n[system]\nbox_length = 8.0\nkT = 1.0\n[run]\ndt = 0.04\n",
     )
-    .unwrap()
-    .validate()
     .unwrap();
     [sus(NeighborMode::Verlet), sus(NeighborMode::Cells), water]
         .iter()
@@ -142,7 +140,7 @@ fn zero_shear_is_the_engine_of_before_bitwise() {
 }
 
 fn scenario(text: &str) -> DpdSetup {
-    DpdScenario::from_toml(text).unwrap().validate().unwrap()
+    params::setup(text).unwrap()
 }
 
 /// The colloid suspension of the thread tests (Morse attraction, polydisperse) under shear.
@@ -431,9 +429,7 @@ fn shear_viscosity_table() {
 fn bad_shear_rates_are_refused_with_the_key() {
     let base = "method = \"dpd\"\n[system]\nbox_length = 8.0\n[run]\n";
     for bad in ["-0.1", "nan", "inf", "11.0"] {
-        let e = DpdScenario::from_toml(&format!("{base}shear_rate = {bad}\n"))
-            .unwrap()
-            .validate()
+        let e = params::setup(&format!("{base}shear_rate = {bad}\n"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("run.shear_rate"), "{bad}: {e}");
@@ -445,11 +441,9 @@ fn bad_shear_rates_are_refused_with_the_key() {
             "shear_rate = 0.5\nrank_grid = [2, 1]",
             "sheared run is cut along z only",
         ),
-        ("rank_grid = [0, 2]", "each at least 1"),
+        ("rank_grid = [0, 2]", "in [1, 1000000], got [0, 2]"),
     ] {
-        let e = DpdScenario::from_toml(&format!("{base}{bad}\n"))
-            .unwrap()
-            .validate()
+        let e = params::setup(&format!("{base}{bad}\n"))
             .unwrap_err()
             .to_string();
         assert!(
