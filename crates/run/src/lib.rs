@@ -24,7 +24,6 @@ mod bulk;
 mod dpd;
 mod droplet;
 mod hs_mc;
-mod mpcd;
 mod theory_droplet;
 pub mod two_body;
 

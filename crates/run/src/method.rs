@@ -231,8 +231,8 @@ static METHODS: &[&dyn Method] = &[
     &crate::bulk::BulkBd,
     &crate::dpd::DpdMethod,
     &crate::hs_mc::HsMc,
-    &crate::mpcd::MpcdBulk,
-    &crate::mpcd::DropletMpcd,
+    &crate::methods::mpcd::MpcdBulk,
+    &crate::methods::droplet_mpcd::DropletMpcd,
 ];
 
 /// Every registered method.
