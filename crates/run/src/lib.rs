@@ -23,7 +23,6 @@ pub mod trajectory;
 mod bd_replica;
 mod bulk;
 mod droplet;
-mod mpcd;
 mod theory_droplet;
 pub mod two_body;
 

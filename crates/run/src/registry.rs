@@ -11,8 +11,8 @@ static METHODS: &[&dyn Method] = &[
     &crate::bulk::BulkBd,
     &crate::methods::dpd::DpdMethod,
     &crate::methods::hs_mc::HsMc,
-    &crate::mpcd::MpcdBulk,
-    &crate::mpcd::DropletMpcd,
+    &crate::methods::mpcd::MpcdBulk,
+    &crate::methods::droplet_mpcd::DropletMpcd,
 ];
 
 /// Every registered method.

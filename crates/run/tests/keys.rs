@@ -292,24 +292,8 @@ fn methods() -> Vec<(&'static str, &'static [Spec], Parse)> {
         ),
         (DPD, spec("dpd"), None),
         (MC, spec("hs-mc"), None),
-        (
-            MPCD,
-            spec("mpcd"),
-            Some(|t| {
-                colloidsim_md::mpcd::scenario::BulkScenario::from_toml(t)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
-        ),
-        (
-            DROPLET_MPCD,
-            spec("droplet-mpcd"),
-            Some(|t| {
-                colloidsim_md::mpcd::scenario::DropletScenario::from_toml(t)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
-        ),
+        (MPCD, spec("mpcd"), None),
+        (DROPLET_MPCD, spec("droplet-mpcd"), None),
     ];
     assert_eq!(
         all.len(),

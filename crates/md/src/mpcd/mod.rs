@@ -13,7 +13,6 @@ pub mod colloid;
 pub mod drying;
 pub mod measure;
 pub mod ranks;
-pub mod scenario;
 pub mod srd;
 pub mod theory;
 

@@ -3,4 +3,6 @@
 
 pub mod bcd;
 pub mod dpd;
+pub mod droplet_mpcd;
 pub mod hs_mc;
+pub mod mpcd;
