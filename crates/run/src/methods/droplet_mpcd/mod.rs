@@ -4,7 +4,6 @@
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
-use crate::trajectory::trim_trajectory;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::methods::mpcd::common::*;
@@ -12,6 +11,7 @@ use crate::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
 };
 use crate::trajectory::FrameDigest;
+use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};

@@ -12,11 +12,11 @@
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
-use crate::trajectory::trim_trajectory;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
 use crate::trajectory::FrameDigest;
+use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
