@@ -23,10 +23,10 @@ pub mod trajectory;
 mod bd_replica;
 mod bulk;
 mod dpd;
-mod droplet;
 mod mpcd;
-mod theory_droplet;
 pub mod two_body;
+/// The droplet's profile file names, where droplet-mpcd (not yet in its folder) finds them.
+pub(crate) use methods::droplet_bd::theory as theory_droplet;
 
 pub use control::{Control, Progress, Silent};
 pub use driver::{resume, resume_decomposed, run, run_decomposed};

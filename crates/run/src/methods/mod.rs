@@ -2,4 +2,5 @@
 //! parameters, its session and its outputs. The registry in [`crate::method`] lists them.
 
 pub mod bcd;
+pub mod droplet_bd;
 pub mod hs_mc;
