@@ -48,7 +48,7 @@ use std::f64::consts::PI;
 /// Particles per parallel work item of the integration pass (a multiple of the noise block).
 const CHUNK: usize = 4 * BLOCK;
 
-/// How a step integrates the overdamped Langevin equation (`run.integrator`).
+/// How a step integrates the overdamped Langevin equation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Integrator {
@@ -66,31 +66,19 @@ pub enum Integrator {
     Lm,
 }
 impl Integrator {
-    /// The scenario's `run.integrator` (`"euler"`, the default, or `"lm"`); `rpy`: the run
-    /// has RPY hydrodynamics, for which Leimkuhler–Matthews is refused (the noise is correlated
-    /// through the mobility, which the scheme does not cover).
-    pub fn from_scenario(name: Option<&str>, rpy: bool) -> Result<Self, ParamError> {
-        let integrator = match name {
-            None | Some("euler") => Integrator::Euler,
-            Some("lm") => Integrator::Lm,
-            Some(other) => {
-                return Err(ParamError::new(
-                    "run.integrator",
-                    format!(
-                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
-                    ),
-                ));
-            }
-        };
-        if integrator == Integrator::Lm && rpy {
+    /// This integrator for a run with (`rpy`) or without RPY hydrodynamics: Leimkuhler–Matthews
+    /// is refused with RPY (the noise is correlated through the mobility, which the scheme does
+    /// not cover); the error names the parameter `integrator`.
+    pub fn check(self, rpy: bool) -> Result<Self, ParamError> {
+        if self == Integrator::Lm && rpy {
             return Err(ParamError::new(
-                "run.integrator",
+                "integrator",
                 "\"lm\" (Leimkuhler-Matthews) is for free draining only: with hydrodynamics.model = \
                  \"rpy\" the noise is correlated through the mobility, which the scheme does not \
                  cover; use run.integrator = \"euler\" or hydrodynamics.model = \"free-draining\"",
             ));
         }
-        Ok(integrator)
+        Ok(self)
     }
 }
 

@@ -387,7 +387,12 @@ impl BulkScenario {
         let rpy = hydrodynamics
             .as_ref()
             .is_some_and(|h| h.model == HydroModel::Rpy);
-        let integrator = Integrator::from_scenario(r.integrator.as_deref(), rpy)?;
+        let integrator = match r.integrator.as_deref() {
+            Some("lm") => Integrator::Lm,
+            _ => Integrator::Euler,
+        }
+        .check(rpy)
+        .map_err(|e| ParamError::new("run.integrator", e.message))?;
 
         let m = &self.observe.msd;
         let msd_points = in_range(

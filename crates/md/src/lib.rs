@@ -21,7 +21,7 @@ pub mod state;
 pub use brownian::{BdError, BdParams, Brownian, Integrator};
 pub use colloidsim_hydro as hydro;
 pub use dpd::{Dpd, DpdError, DpdParams};
-pub use droplet::{DropletParams, DropletScenario};
+pub use droplet::DropletParams;
 pub use hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 pub use neighbor::NeighborList;
 pub use potential::{

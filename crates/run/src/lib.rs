@@ -15,6 +15,7 @@ pub mod extrapolate;
 pub mod keys;
 pub mod method;
 pub mod methods;
+mod output;
 pub mod plot;
 pub mod registry;
 pub mod scenario;
@@ -22,8 +23,6 @@ pub mod trajectory;
 
 mod bd_replica;
 mod bulk;
-mod droplet;
-mod theory_droplet;
 pub mod two_body;
 
 pub use control::{Control, Progress, Silent};

@@ -7,7 +7,7 @@ use anyhow::Result;
 /// Every method, in the order `--help` lists them. New methods register here.
 static METHODS: &[&dyn Method] = &[
     &crate::methods::bcd::BcdMethod,
-    &crate::droplet::DropletBd,
+    &crate::methods::droplet_bd::DropletBd,
     &crate::bulk::BulkBd,
     &crate::methods::dpd::DpdMethod,
     &crate::methods::hs_mc::HsMc,

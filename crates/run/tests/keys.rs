@@ -272,15 +272,7 @@ fn methods() -> Vec<(&'static str, &'static [Spec], Parse)> {
     let spec = |name| colloidsim_run::registry::find(name).unwrap().keys();
     let all: Vec<(&str, &[Spec], Parse)> = vec![
         (BCD, spec("bcd"), None),
-        (
-            DROPLET,
-            spec("droplet-bd"),
-            Some(|t| {
-                colloidsim_md::DropletScenario::from_toml(t)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
-        ),
+        (DROPLET, spec("droplet-bd"), None),
         (
             BULK,
             spec("bd"),

@@ -4,8 +4,12 @@
 
 use super::Allowed::*;
 use super::Omitted::*;
-use super::{Reader, Spec, key};
-use anyhow::Result;
+use super::{COUNT, Reader, Spec, key, rekey};
+use anyhow::{Result, bail};
+use colloidsim_core::ParamError;
+use colloidsim_md::brownian::Integrator;
+use colloidsim_md::hydro::params::{DEFAULT_BOX_FACTOR, DEFAULT_DIRECT_MAX};
+use colloidsim_md::hydro::{HydroMethod, HydroModel, HydroParams};
 use colloidsim_md::mpcd::{ColloidParams, SrdParams};
 
 /// `[interface]`: the harmonic interface of a droplet (docs/droplet.md).
@@ -210,4 +214,236 @@ pub fn colloid(r: &Reader, d: f64) -> Result<ColloidParams> {
         md_steps: r.integer(&COLLOID_MD_STEPS)? as u32,
         wca_epsilon: r.number(&SOLVENT_KT)?,
     })
+}
+
+// The spheres, the solvent, the time stepping and the hydrodynamics of the Brownian-dynamics
+// methods (`droplet-bd`, `bd`): the same engines, units and defaults.
+
+/// `system.diameter`.
+pub const DIAMETER: Spec = key(
+    "system.diameter",
+    "length",
+    Value("1"),
+    Positive,
+    "colloid diameter d",
+);
+
+/// `system.kT`.
+pub const KT: Spec = key(
+    "system.kT",
+    "energy",
+    Value("1"),
+    Positive,
+    "thermal energy",
+);
+
+/// `system.viscosity`.
+pub const VISCOSITY: Spec = key(
+    "system.viscosity",
+    "energy time / length^3",
+    Value("1"),
+    Positive,
+    "solvent viscosity eta; friction 3 pi eta d, D0 = kT / (3 pi eta d)",
+);
+
+/// `run.dt`: by default `2e-4 d^2 / D0`.
+pub const RUN_DT: Spec = key(
+    "run.dt",
+    "time",
+    Derived("2e-4 d^2 / D0", |r| {
+        let s = spheres(r)?;
+        Ok(2e-4 * s.d * s.d / s.d0)
+    }),
+    Positive,
+    "time step (too large a step for the WCA core stops the run naming the step and particle)",
+)
+.also("at most 1e12 steps");
+
+/// `run.skin`: by default `0.6 d`.
+pub const RUN_SKIN: Spec = key(
+    "run.skin",
+    "length",
+    Derived("0.6 d", |r| Ok(0.6 * r.number(&DIAMETER)?)),
+    Positive,
+    "Verlet skin",
+)
+.also("in [0.001 d, 5 d]");
+
+/// `run.integrator`.
+pub const RUN_INTEGRATOR: Spec = key(
+        "run.integrator",
+        "-",
+        Word("euler"),
+        OneOf(&["euler", "lm"]),
+        "Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2: second order for the equilibrium profile, same cost; see docs/droplet.md)",
+    )
+    .also("lm needs free draining (not hydrodynamics.model = \"rpy\")");
+
+/// `[observe.trajectory]`.
+pub const TRAJECTORY: Spec = key(
+    "observe.trajectory",
+    "-",
+    Means("none"),
+    Table,
+    "GSD frames of replica 0: trajectory.gsd",
+);
+
+/// `observe.trajectory.every`.
+pub const TRAJECTORY_EVERY: Spec = key(
+    "observe.trajectory.every",
+    "steps",
+    Value("0"),
+    Integer(0, COUNT),
+    "steps between frames (0: none)",
+);
+
+/// `[hydrodynamics]` (each method declares its own `method`, and `box_factor` where it has one).
+pub const HYDRODYNAMICS: Spec = key(
+    "hydrodynamics",
+    "-",
+    Means("free draining"),
+    Table,
+    "hydrodynamic interactions; without this table the free-draining engine runs",
+);
+
+/// `hydrodynamics.model`.
+pub const HYDRO_MODEL: Spec = key(
+    "hydrodynamics.model",
+    "-",
+    Word("free-draining"),
+    OneOf(&["free-draining", "rpy"]),
+    "mobility: free draining (the free-draining engine) or Rotne-Prager-Yamakawa (no drift term: divergence-free)",
+);
+
+/// `hydrodynamics.tolerance`.
+pub const HYDRO_TOLERANCE: Spec = key(
+    "hydrodynamics.tolerance",
+    "-",
+    Value("1e-3"),
+    LeftOpen(0.0, 0.1),
+    "relative error of the PSE product and of each Lanczos square root",
+);
+
+/// `hydrodynamics.splitting`.
+pub const HYDRO_SPLITTING: Spec = key(
+    "hydrodynamics.splitting",
+    "1 / length",
+    Means("0.5 / a = 1 / d"),
+    Positive,
+    "PSE splitting parameter xi",
+)
+.also("method = \"pse\" only; real-space cut-off < half the box, grid <= 1024^3");
+
+/// `hydrodynamics.max_iterations`.
+pub const HYDRO_MAX_ITERATIONS: Spec = key(
+    "hydrodynamics.max_iterations",
+    "-",
+    Value("200"),
+    Integer(1, 1000),
+    "Lanczos iteration limit; reaching it stops the run naming the step",
+);
+
+/// The Brownian spheres and their solvent as read, with the Stokes friction and the free
+/// diffusivity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spheres {
+    /// Diameter d.
+    pub d: f64,
+    /// kT.
+    pub kt: f64,
+    /// Viscosity eta.
+    pub eta: f64,
+    /// Stokes friction `3 pi eta d`.
+    pub friction: f64,
+    /// `D0 = kT / (3 pi eta d)` (Stokes–Einstein).
+    pub d0: f64,
+}
+
+/// Read `system.diameter`, `system.kT` and `system.viscosity`.
+pub fn spheres(r: &Reader) -> Result<Spheres> {
+    let d = r.number(&DIAMETER)?;
+    let kt = r.number(&KT)?;
+    let eta = r.number(&VISCOSITY)?;
+    let friction = 3.0 * std::f64::consts::PI * eta * d;
+    Ok(Spheres {
+        d,
+        kt,
+        eta,
+        friction,
+        d0: kt / friction,
+    })
+}
+
+/// Read `run.integrator`; `rpy`: the run has RPY hydrodynamics (for which the engine refuses
+/// Leimkuhler–Matthews), the engine's error naming the key.
+pub fn integrator(r: &Reader, rpy: bool) -> Result<Integrator> {
+    let choice = match r.word(&RUN_INTEGRATOR)?.as_str() {
+        "lm" => Integrator::Lm,
+        _ => Integrator::Euler,
+    };
+    Ok(choice
+        .check(rpy)
+        .map_err(|e| rekey(e, &[("integrator", &RUN_INTEGRATOR)]))?)
+}
+
+/// Read `[hydrodynamics]` (`None` without the table) for `particles` spheres of radius
+/// `radius`; `method` is the method's `hydrodynamics.method` key and `box_factor` its
+/// `hydrodynamics.box_factor` (a droplet's periodic box), if it has one. `periodic`: the system
+/// is a periodic cube, so RPY needs PSE; otherwise both methods are allowed and the default is
+/// direct up to [`DEFAULT_DIRECT_MAX`] particles.
+pub fn hydrodynamics(
+    r: &Reader,
+    method: &Spec,
+    box_factor: Option<&Spec>,
+    particles: usize,
+    radius: f64,
+    periodic: bool,
+) -> Result<Option<HydroParams>> {
+    if !r.has(&HYDRODYNAMICS) {
+        return Ok(None);
+    }
+    let model = match r.word(&HYDRO_MODEL)?.as_str() {
+        "rpy" => HydroModel::Rpy,
+        _ => HydroModel::FreeDraining,
+    };
+    let chosen = r.opt_word(method)?.filter(|_| r.has(method));
+    let method_of = match (model, chosen.as_deref()) {
+        (HydroModel::FreeDraining, None) => None,
+        (HydroModel::FreeDraining, Some(m)) => bail!(ParamError::new(
+            method.path,
+            format!("\"{m}\" needs model = \"rpy\" (free draining has no method)"),
+        )),
+        (HydroModel::Rpy, None) => Some(if periodic || particles > DEFAULT_DIRECT_MAX {
+            HydroMethod::Pse
+        } else {
+            HydroMethod::Direct
+        }),
+        (HydroModel::Rpy, Some("direct")) if periodic => bail!(ParamError::new(
+            method.path,
+            "\"direct\" is the unbounded fluid; a periodic box needs \"pse\"",
+        )),
+        (HydroModel::Rpy, Some("direct")) => Some(HydroMethod::Direct),
+        (HydroModel::Rpy, _) => Some(HydroMethod::Pse),
+    };
+    let tolerance = r.number(&HYDRO_TOLERANCE)?;
+    let splitting = r.opt_number(&HYDRO_SPLITTING)?.unwrap_or(0.5 / radius);
+    let factor = match box_factor {
+        Some(k) => r.number(k)?,
+        None => DEFAULT_BOX_FACTOR,
+    };
+    let p = HydroParams {
+        model,
+        method: method_of,
+        tolerance,
+        splitting,
+        box_factor: factor,
+        max_iterations: r.count(&HYDRO_MAX_ITERATIONS)? as usize,
+    };
+    let pse_only = [Some(&HYDRO_SPLITTING), box_factor];
+    for k in pse_only.into_iter().flatten() {
+        if r.has(k) && method_of != Some(HydroMethod::Pse) {
+            bail!(ParamError::new(k.path, "applies only to method = \"pse\""));
+        }
+    }
+    Ok(Some(p))
 }

@@ -3,6 +3,7 @@
 
 pub mod bcd;
 pub mod dpd;
+pub mod droplet_bd;
 pub mod droplet_mpcd;
 pub mod hs_mc;
 pub mod mpcd;

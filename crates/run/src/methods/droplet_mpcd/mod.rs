@@ -569,7 +569,7 @@ impl Session for DropletSession {
             let mut xs = Vec::new();
             let mut drawn = Vec::new();
             for j in (0..cp.taken.len()).filter(|&j| cp.taken[j]) {
-                let name = crate::theory_droplet::profile_name(p.profile.fractions[j]);
+                let name = crate::output::profile_name(p.profile.fractions[j]);
                 out.write_table(&name, &[("r", &cp.r[j]), ("phi", &cp.phi[j])])?;
                 files.push(name);
                 labels.push(format!(

@@ -4,7 +4,7 @@
 //! pair energy per particle, as functions of dt (docs/validation.md, *Time-step error of the
 //! droplet BD*).
 //!
-//! `cargo run --release -p colloidsim-md --example droplet_dt_errors -- euler|lm R0 PHI TIME
+//! `cargo run --release -p colloidsim-run --example droplet_dt_errors -- euler|lm R0 PHI TIME
 //! REPLICAS MAX_DRIFT DT...` (dt in d^2/D0, TIME sampled per replica in d^2/D0 at the largest
 //! dt and scaled as dt^(1/2) below it, so that small steps cost less; MAX_DRIFT the blow-up
 //! guard in d, 0.2 in a scenario). Prints one CSV line per dt:

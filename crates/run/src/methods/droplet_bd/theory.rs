@@ -22,21 +22,12 @@ use colloidsim_dft::radial::{
     DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
     PairCorrelation, RadialError, RadialGrid, Snapshot, bin_average, equilibrium_at, run_droplet,
 };
-use colloidsim_md::droplet::{DropletParams, DropletScenario};
+use colloidsim_md::droplet::DropletParams;
 
 use crate::control::Control;
+use crate::output::profile_name;
 use crate::plot::{self, Scale, Series};
 use crate::{Report, Scenario as Source, TheoryOptions};
-
-/// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,
-/// more when the fraction needs them).
-pub fn profile_name(fraction: f64) -> String {
-    if ((fraction * 100.0).round() - fraction * 100.0).abs() < 1e-9 {
-        format!("profile_{fraction:.2}.csv")
-    } else {
-        format!("profile_{fraction}.csv")
-    }
-}
 
 /// Theory grid spacing: `--dx`, else `d / 100`.
 fn grid_spacing(p: &DropletParams, dx: Option<f64>) -> Result<f64> {
@@ -110,9 +101,7 @@ fn parse_pair(pair: Option<&str>, hydro: Hydrodynamics) -> Result<PairCorrelatio
 /// `colloidsim theory SCENARIO` for a drying droplet.
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
     let dx = topts.dx;
-    crate::keys::validate(&src.table()?, crate::keys::DROPLET).with_context(|| src.label())?;
-    let sc = DropletScenario::from_toml(src.text()).map_err(|e| anyhow!("{}: {e}", src.label()))?;
-    let p = sc.validate().map_err(|e| anyhow!("{}: {e}", src.label()))?;
+    let p = super::resolve(src, None)?;
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
     let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;
@@ -490,10 +479,12 @@ mod tests {
             [observe.profile]
             fractions = [0.0]
         "#;
-        let p = DropletScenario::from_toml(text)
-            .unwrap()
-            .validate()
-            .unwrap();
+        let p = super::super::params::read(
+            &toml::from_str(text).unwrap(),
+            std::path::Path::new("."),
+            None,
+        )
+        .unwrap();
         let tau = p.diameter * p.diameter / p.d0;
         let edge = p.r0 + p.offset;
         let cuts = [edge - 0.25 * p.diameter, edge - 1.0 * p.diameter];
@@ -567,10 +558,12 @@ mod tests {
             [observe.profile]
             fractions = [0.25, 0.5, 0.75]
         "#;
-        let p = DropletScenario::from_toml(text)
-            .unwrap()
-            .validate()
-            .unwrap();
+        let p = super::super::params::read(
+            &toml::from_str(text).unwrap(),
+            std::path::Path::new("."),
+            None,
+        )
+        .unwrap();
         let lambdas = [0.7, 0.85];
         let n = p.particles as f64;
         // BD: outer fractions per output time, averaged over replicas.
@@ -637,13 +630,5 @@ mod tests {
             worst(&wrong) > 1.0,
             "a 1.5 x Peclet theory is not distinguished: {wrong:?}"
         );
-    }
-
-    #[test]
-    fn profile_names_match_the_fractions() {
-        assert_eq!(profile_name(0.0), "profile_0.00.csv");
-        assert_eq!(profile_name(0.25), "profile_0.25.csv");
-        assert_eq!(profile_name(1.0), "profile_1.00.csv");
-        assert_eq!(profile_name(0.125), "profile_0.125.csv");
     }
 }

@@ -2,7 +2,7 @@
 //! shrinking (or, with `drying.peclet = 0`, static) harmonic interface, free draining by the
 //! free-draining engine or with RPY hydrodynamics (`[hydrodynamics]`: direct free-space sums or
 //! PSE in a periodic box), replicas one after the other, radial volume-fraction profiles at
-//! fractions of the drying time; `theory` is the radial FMT DDFT ([`crate::theory_droplet`]).
+//! fractions of the drying time; `theory` is the radial FMT DDFT ([`theory`]).
 
 use crate::bd_replica::{
     BdMethod, BdSession, Observe, ReplicaEngine, Replicas, Saved, read_replica_checkpoint,
@@ -11,11 +11,11 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
+use crate::output::profile_name;
 use crate::plot::{
     Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
     picture,
 };
-use crate::theory_droplet::profile_name;
 use crate::trajectory::FrameDigest;
 use crate::trajectory::trim_trajectory;
 use crate::{Report, Scenario as Source, TheoryOptions};
@@ -24,7 +24,7 @@ use colloidsim_analysis::radial_profile;
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::droplet::DropletSim;
-use colloidsim_md::{DropletParams, DropletScenario, HarmonicInterface, LennardJones, Particles};
+use colloidsim_md::{DropletParams, HarmonicInterface, LennardJones, Particles};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
@@ -32,21 +32,17 @@ use std::path::Path;
 /// The drying-droplet family of scenarios.
 pub struct DropletBd;
 
-/// Parse and validate a scenario; `system.initial` is taken relative to the scenario's folder.
-pub(crate) fn resolve(src: &Source, seed: Option<u64>) -> Result<(DropletScenario, DropletParams)> {
-    crate::keys::validate(&src.table()?, crate::keys::DROPLET).with_context(|| src.label())?;
-    let mut sc = DropletScenario::from_toml(src.text()).with_context(|| src.label())?;
+pub mod keys;
+pub mod params;
+pub mod theory;
+
+/// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
+/// replacing the scenario's.
+pub(crate) fn resolve(src: &Source, seed: Option<u64>) -> Result<DropletParams> {
     if let Some(s) = seed {
         crate::seed32(s)?;
-        sc.seed = s;
     }
-    if let Some(init) = &sc.system.initial
-        && init.is_relative()
-    {
-        sc.system.initial = Some(src.base().join(init));
-    }
-    let p = sc.validate().with_context(|| src.label())?;
-    Ok((sc, p))
+    params::read(&src.table()?, src.base(), seed).with_context(|| src.label())
 }
 
 impl Method for DropletBd {
@@ -63,7 +59,7 @@ impl Method for DropletBd {
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
-        let (_, p) = resolve(src, None)?;
+        let p = resolve(src, None)?;
         // What `run` does before it starts: set up replica 0 (reading system.initial).
         p.build_replica(0).with_context(|| src.label())?;
         Ok(Checked {
@@ -97,15 +93,15 @@ impl Method for DropletBd {
     }
 
     fn theory(&self, src: &Source, opts: &TheoryOptions, ctl: &Control) -> Result<Report> {
-        crate::theory_droplet::theory(src, opts, ctl)
+        theory::theory(src, opts, ctl)
     }
 
     fn keys(&self) -> &'static [Spec] {
-        crate::keys::DROPLET
+        keys::KEYS
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
-        let (_, p) = resolve(src, seed)?;
+        let p = resolve(src, seed)?;
         let sim = build_replica(&p, 0)?;
         Ok(Box::new(ReplicaEngine {
             method: "droplet-bd",
@@ -120,7 +116,7 @@ fn start(
     seed: Option<u64>,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let (_, p) = resolve(src, seed)?;
+    let p = resolve(src, seed)?;
     // Set up replica 0 before the output folder is created: bad input leaves nothing.
     let sim = build_replica(&p, 0)?;
     let acc = Accum::new(&p);
@@ -141,7 +137,7 @@ fn restore(
     envelope: &Envelope,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let (_, p) = resolve(src, Some(seed))?;
+    let p = resolve(src, Some(seed))?;
     let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
     if saved.replica >= p.replicas || saved.acc.sums.len() != p.fractions.len() {
         bail!(

@@ -1,6 +1,6 @@
 //! The drying droplet: conservation and confinement, bad input.
 
-use colloidsim_md::{BdError, DropletScenario, External};
+use colloidsim_md::{BdError, External};
 
 fn scenario(extra_run: &str) -> String {
     format!(
@@ -33,10 +33,7 @@ fn drying_keeps_every_particle_inside_the_interface_range() {
             "final_volume_fraction = 0.3",
         )
         .replace("[run]", "[interface]\nstiffness = 100.0\n[run]");
-    let p = DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap();
+    let p = droplet_params(&text);
     let mut sim = p.build_replica(0).unwrap();
     let slack = 10.0 * p.kt / (p.stiffness * p.range);
     let mut worst: f64 = f64::NEG_INFINITY;
@@ -82,29 +79,20 @@ fn too_large_a_time_step_is_reported_with_step_and_particle() {
     let text = scenario("dt = 0.05")
         .replace("phi0 = 0.1", "phi0 = 0.3")
         .replace("peclet = 10", "peclet = 0.1");
-    let p = DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap();
+    let p = droplet_params(&text);
     let mut sim = p.build_replica(0).unwrap();
     match sim.run(p.steps) {
         Err(e @ BdError::BlowUp { .. }) => assert!(e.to_string().contains("run.dt")),
         other => panic!("expected a blow-up, got {other:?}"),
     }
     // A drying too fast for the step is refused before it starts, naming the key.
-    let e = DropletScenario::from_toml(&scenario("dt = 0.5"))
-        .unwrap()
-        .validate()
-        .unwrap_err();
+    let e = droplet_error(&scenario("dt = 0.5"));
     assert_eq!(e.key, "drying.peclet", "{e}");
 }
 
 #[test]
 fn replicas_differ_and_initial_configuration_is_inside() {
-    let p = DropletScenario::from_toml(&scenario(""))
-        .unwrap()
-        .validate()
-        .unwrap();
+    let p = droplet_params(&scenario(""));
     let a = p.build_replica(0).unwrap().snapshot();
     let b = p.build_replica(1).unwrap().snapshot();
     assert!(a.pos != b.pos);
@@ -122,10 +110,7 @@ fn replicas_differ_and_initial_configuration_is_inside() {
         "phi0 = 0.1",
         &format!("phi0 = 0.1\ninitial = \"{}\"", bad.display()),
     );
-    let p = DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap();
+    let p = droplet_params(&text);
     let e = p
         .build_replica(0)
         .err()
@@ -141,23 +126,36 @@ fn replicas_differ_and_initial_configuration_is_inside() {
 fn an_interface_too_soft_to_hold_the_colloids_is_refused() {
     // 20 kT are reached 20.25 d beyond the wall at k = 2 kT/d^2 (range d/2), more than R0.
     let soft = scenario("").replace("[run]", "[interface]\nstiffness = 2.0\n[run]");
-    let e = DropletScenario::from_toml(&soft)
-        .unwrap()
-        .validate()
-        .unwrap_err();
+    let e = droplet_error(&soft);
     assert_eq!(e.key, "interface.stiffness", "{e}");
     assert!(e.to_string().contains("does not hold"), "{e}");
     // So stiff that one step overshoots its well (D0 k dt / kT >= 1): refused too.
     let stiff = scenario("dt = 1e-3").replace("[run]", "[interface]\nstiffness = 1e4\n[run]");
-    let e = DropletScenario::from_toml(&stiff)
-        .unwrap()
-        .validate()
-        .unwrap_err();
+    let e = droplet_error(&stiff);
     assert_eq!(e.key, "interface.stiffness", "{e}");
     assert!(e.to_string().contains("overshoots"), "{e}");
     // The default (50 kT/d^2) holds them within about a diameter.
-    DropletScenario::from_toml(&scenario(""))
-        .unwrap()
-        .validate()
-        .unwrap();
+    droplet_params(&scenario(""));
+}
+
+/// A `droplet-bd` scenario read by the run layer (its keys through their declarations).
+fn droplet_params(text: &str) -> colloidsim_md::DropletParams {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
+}
+
+/// The error naming a key that a `droplet-bd` scenario is refused with.
+fn droplet_error(text: &str) -> colloidsim_core::ParamError {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap_err()
+    .downcast()
+    .unwrap()
 }

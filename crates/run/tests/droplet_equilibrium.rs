@@ -4,8 +4,8 @@
 //! no drift term and samples the same Boltzmann distribution as free draining; a spurious drift
 //! (or noise that does not match the mobility) would change the profile.
 
-use colloidsim_md::hydro::HydrodynamicsSection;
-use colloidsim_md::{DropletParams, DropletScenario, HydroBdParams};
+use colloidsim_md::hydro::{HydroMethod, HydroModel, HydroParams};
+use colloidsim_md::{DropletParams, HydroBdParams};
 
 /// A static droplet of `N` WCA spheres at phi0 = 0.2 (R0 = 3.42 d) in the harmonic interface.
 const N: usize = 64;
@@ -14,10 +14,7 @@ fn static_droplet() -> DropletParams {
         "method = \"droplet-bd\"\nseed = 11\n[system]\nparticles = {N}\nphi0 = 0.2\n\
          [drying]\npeclet = 0\nduration = 1.0\n[run]\ndt = {DT}\n"
     );
-    DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap()
+    droplet_params(&text)
 }
 
 /// Time step: 2e-4 d^2 / D0 (as examples/droplet/drying-bd.toml; D0 = kT / (3 pi eta d) =
@@ -95,8 +92,15 @@ fn free_draining(p: &DropletParams) -> Profile {
 /// RPY in an unbounded fluid (direct sums), with the noise at `noise_kt` (kT of the scenario:
 /// the fluctuation-dissipation theorem holds).
 fn rpy(p: &DropletParams, noise_kt: f64) -> Profile {
-    let h: HydrodynamicsSection = toml::from_str("model = \"rpy\"\nmethod = \"direct\"").unwrap();
-    let h = h.validate(N, 0.5 * p.diameter, false).unwrap();
+    // `model = "rpy"`, `method = "direct"`, the other keys at their defaults.
+    let h = HydroParams {
+        model: HydroModel::Rpy,
+        method: Some(HydroMethod::Direct),
+        tolerance: 1e-3,
+        splitting: 1.0 / p.diameter,
+        box_factor: 2.0,
+        max_iterations: 200,
+    };
     let built = p.build_hydro_replica(0, &h).unwrap();
     let params = HydroBdParams {
         kt: noise_kt,
@@ -154,4 +158,14 @@ fn a_static_droplet_has_the_same_profile_with_rpy_as_free_draining() {
         hi.mean[o],
         fd.mean[o]
     );
+}
+
+/// A `droplet-bd` scenario read by the run layer (its keys through their declarations).
+fn droplet_params(text: &str) -> colloidsim_md::DropletParams {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
 }

@@ -8,8 +8,7 @@ use colloidsim_md::hydro::{
     Mobility, Pse, PseParams,
 };
 use colloidsim_md::{
-    DropletScenario, HydroBdError, HydroBdParams, HydroBrownian, NoExternal, NoPair, Particles,
-    SimBox,
+    HydroBdError, HydroBdParams, HydroBrownian, NoExternal, NoPair, Particles, SimBox,
 };
 use std::f64::consts::PI;
 
@@ -124,13 +123,10 @@ fn droplet(n: usize, hydro: &str) -> (colloidsim_md::DropletParams, HydroParams)
     let text = format!(
         "method = \"droplet-bd\"\nseed = 4\n[system]\nparticles = {n}\nphi0 = 0.1\n[drying]\npeclet = 5\n"
     );
-    let p = DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap();
-    let h: colloidsim_md::hydro::HydrodynamicsSection = toml::from_str(hydro).unwrap();
-    let h = h.validate(n, 0.5 * p.diameter, false).unwrap();
-    (p, h)
+    let p = droplet_params(&text);
+    // The same droplet with `[hydrodynamics]`: its resolved hydrodynamics.
+    let with = droplet_params(&format!("{text}[hydrodynamics]\n{hydro}\n"));
+    (p, with.hydrodynamics.unwrap())
 }
 
 #[test]
@@ -270,4 +266,14 @@ fn dilute_sedimentation_follows_k_1_minus_5_phi() {
         (mean - want).abs() < 3.5 * se + 0.004,
         "K = {mean} +- {se} vs {want}"
     );
+}
+
+/// A `droplet-bd` scenario read by the run layer (its keys through their declarations).
+fn droplet_params(text: &str) -> colloidsim_md::DropletParams {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
 }

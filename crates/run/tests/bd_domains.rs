@@ -7,9 +7,7 @@ mod common;
 
 use colloidsim_md::brownian::ListState;
 use colloidsim_md::potential::{ConstantForce, External};
-use colloidsim_md::{
-    BdError, BdParams, Brownian, DropletScenario, Integrator, LennardJones, Particles, SimBox,
-};
+use colloidsim_md::{BdError, BdParams, Brownian, Integrator, LennardJones, Particles, SimBox};
 use common::on_ranks;
 use std::f64::consts::PI;
 
@@ -183,10 +181,7 @@ phi0 = 0.1
 peclet = 10
 final_volume_fraction = 0.3
 "#;
-    let dp = DropletScenario::from_toml(text)
-        .unwrap()
-        .validate()
-        .unwrap();
+    let dp = droplet_params(text);
     let n_steps = 600;
     let mut one = dp.build_replica(0).unwrap();
     one.run(n_steps).unwrap();
@@ -290,4 +285,14 @@ fn leimkuhler_matthews_and_a_checkpoint_on_a_2_x_2_grid_are_the_single_rank_run(
     // Euler: a checkpoint (particles and list state) of a 2 x 2 grid continues on slabs and on
     // one process as the uninterrupted run.
     checkpoint_continues_on_3_and_on_1(4, Some([2, 2]));
+}
+
+/// A `droplet-bd` scenario read by the run layer (its keys through their declarations).
+fn droplet_params(text: &str) -> colloidsim_md::DropletParams {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
 }

@@ -2,7 +2,7 @@
 //! the contact layer at the interface, sampled in equilibrium (shared by the test
 //! `tests/droplet_dt_error.rs` and the sweep `examples/droplet_dt_errors.rs`).
 
-use colloidsim_md::droplet::{DropletParams, DropletScenario};
+use colloidsim_md::droplet::DropletParams;
 use colloidsim_md::{Brownian, Integrator, LennardJones, Pair};
 
 /// A static droplet (`drying.peclet = 0`) of radius `r0` (in d) at mean volume fraction `phi`,
@@ -14,10 +14,7 @@ pub fn static_droplet(r0: f64, phi: f64, duration: f64) -> DropletParams {
         "method = \"droplet-bd\"\n[system]\nparticles = {n}\nradius = {r0}\n\
          [drying]\npeclet = 0\nduration = {duration}\n[observe.profile]\nfractions = [0.0]\n"
     );
-    DropletScenario::from_toml(&text)
-        .unwrap()
-        .validate()
-        .unwrap()
+    droplet_params(&text)
 }
 
 /// Radii beyond which the layer fractions are counted: `R + offset - d/4` (the contact peak),
@@ -131,4 +128,14 @@ pub fn layer_fractions(
         se,
         blocks: means.len(),
     }
+}
+
+/// A `droplet-bd` scenario read by the run layer (its keys through their declarations).
+pub fn droplet_params(text: &str) -> colloidsim_md::DropletParams {
+    colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
 }
