@@ -32,7 +32,7 @@ pub mod rpy;
 pub use direct::{DirectRpy, FreeDraining};
 pub use lanczos::{LanczosError, LanczosParams, SqrtReport};
 pub use noise::NoiseKey;
-pub use params::{HydroMethod, HydroModel, HydroParams, HydrodynamicsSection};
+pub use params::{HydroMethod, HydroModel, HydroParams};
 pub use pse::{Pse, PseGeometry, PseParams, PseTimes};
 
 use colloidsim_core::ParamError;

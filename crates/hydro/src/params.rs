@@ -1,20 +1,10 @@
-//! The `[hydrodynamics]` table of a scenario: typed, validated parameters.
-//!
-//! ```toml
-//! [hydrodynamics]
-//! model = "rpy"          # "free-draining" (default) | "rpy"
-//! method = "pse"         # "direct" | "pse"; default: direct up to `direct_max` particles
-//! tolerance = 1e-3       # relative error of the product and of the Lanczos square root, (0, 0.1]
-//! splitting = 1.0        # PSE splitting xi (1 / length), > 0; default 0.5 / a = 1 / d
-//! box_factor = 2.0       # droplet with PSE: box edge / droplet diameter, [1.2, 20]
-//! max_iterations = 200   # Lanczos iteration limit, [1, 1000]
-//! ```
+//! Resolved hydrodynamics parameters (model, method, PSE splitting, Lanczos tolerance and
+//! iteration limit): the run layer reads a scenario's `[hydrodynamics]` into [`HydroParams`].
 
 use crate::lanczos::LanczosParams;
 use crate::pse::PseParams;
 use colloidsim_core::ParamError;
-use colloidsim_core::param::in_range;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 /// Default tolerance (the drying-droplet paper's PSE setting).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
@@ -24,30 +14,6 @@ pub const MAX_TOLERANCE: f64 = 0.1;
 pub const DEFAULT_BOX_FACTOR: f64 = 2.0;
 /// Default: the direct method up to this many particles, PSE above.
 pub const DEFAULT_DIRECT_MAX: usize = 2000;
-
-/// `[hydrodynamics]` as written in a scenario file.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct HydrodynamicsSection {
-    /// `"free-draining"` (default) or `"rpy"`.
-    #[serde(default)]
-    pub model: Option<String>,
-    /// `"direct"` (unbounded fluid) or `"pse"` (periodic cube); default by N.
-    #[serde(default)]
-    pub method: Option<String>,
-    /// Relative tolerance, (0, 0.1] (default 1e-3).
-    #[serde(default)]
-    pub tolerance: Option<f64>,
-    /// PSE splitting parameter xi (1 / length), > 0 (default 0.5 / a).
-    #[serde(default)]
-    pub splitting: Option<f64>,
-    /// Droplet with PSE: box edge as a multiple of the initial droplet diameter (default 2).
-    #[serde(default)]
-    pub box_factor: Option<f64>,
-    /// Lanczos iteration limit (default 200).
-    #[serde(default)]
-    pub max_iterations: Option<usize>,
-}
 
 /// The mobility model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -130,175 +96,27 @@ impl HydroParams {
     }
 }
 
-/// Tolerance and iteration limit must be in range (`hydrodynamics.tolerance`,
-/// `hydrodynamics.max_iterations`).
+/// Tolerance and iteration limit must be in range (the errors name `tolerance` and
+/// `max_iterations`).
 pub fn check_lanczos(p: &LanczosParams) -> Result<(), ParamError> {
     check_tolerance(p.tolerance)?;
     if !(1..=1000).contains(&p.max_iterations) {
         return Err(ParamError::new(
-            "hydrodynamics.max_iterations",
+            "max_iterations",
             format!("must lie in [1, 1000], got {}", p.max_iterations),
         ));
     }
     Ok(())
 }
 
-/// `hydrodynamics.tolerance` must lie in (0, 0.1].
+/// The tolerance must lie in (0, 0.1] (the error names `tolerance`).
 pub fn check_tolerance(t: f64) -> Result<f64, ParamError> {
     if t.is_finite() && t > 0.0 && t <= MAX_TOLERANCE {
         Ok(t)
     } else {
         Err(ParamError::new(
-            "hydrodynamics.tolerance",
+            "tolerance",
             format!("must lie in (0, {MAX_TOLERANCE}], got {t}"),
         ))
-    }
-}
-
-impl HydrodynamicsSection {
-    /// Validate for `particles` spheres of radius `radius`. `periodic`: the system is a
-    /// periodic cube (bulk), so RPY needs PSE; otherwise (droplet) both methods are allowed and
-    /// the default is direct up to [`DEFAULT_DIRECT_MAX`] particles.
-    pub fn validate(
-        &self,
-        particles: usize,
-        radius: f64,
-        periodic: bool,
-    ) -> Result<HydroParams, ParamError> {
-        let model = match self.model.as_deref().unwrap_or("free-draining") {
-            "free-draining" => HydroModel::FreeDraining,
-            "rpy" => HydroModel::Rpy,
-            other => {
-                return Err(ParamError::new(
-                    "hydrodynamics.model",
-                    format!("must be \"free-draining\" or \"rpy\", got \"{other}\""),
-                ));
-            }
-        };
-        let method = match (model, self.method.as_deref()) {
-            (HydroModel::FreeDraining, None) => None,
-            (HydroModel::FreeDraining, Some(m)) => {
-                return Err(ParamError::new(
-                    "hydrodynamics.method",
-                    format!("\"{m}\" needs model = \"rpy\" (free draining has no method)"),
-                ));
-            }
-            (HydroModel::Rpy, None) => Some(if periodic || particles > DEFAULT_DIRECT_MAX {
-                HydroMethod::Pse
-            } else {
-                HydroMethod::Direct
-            }),
-            (HydroModel::Rpy, Some("direct")) if periodic => {
-                return Err(ParamError::new(
-                    "hydrodynamics.method",
-                    "\"direct\" is the unbounded fluid; a periodic box needs \"pse\"",
-                ));
-            }
-            (HydroModel::Rpy, Some("direct")) => Some(HydroMethod::Direct),
-            (HydroModel::Rpy, Some("pse")) => Some(HydroMethod::Pse),
-            (_, Some(other)) => {
-                return Err(ParamError::new(
-                    "hydrodynamics.method",
-                    format!("must be \"direct\" or \"pse\", got \"{other}\""),
-                ));
-            }
-        };
-        let tolerance = check_tolerance(self.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
-        let splitting = self.splitting.unwrap_or(0.5 / radius);
-        if !(splitting.is_finite() && splitting > 0.0) {
-            return Err(ParamError::new(
-                "hydrodynamics.splitting",
-                format!(
-                    "must be a finite number > 0 (1 / length; paper: 0.5 / a), got {splitting}"
-                ),
-            ));
-        }
-        let box_factor = in_range(
-            "hydrodynamics.box_factor",
-            self.box_factor.unwrap_or(DEFAULT_BOX_FACTOR),
-            1.2,
-            20.0,
-        )?;
-        let max_iterations = self.max_iterations.unwrap_or(200);
-        let p = HydroParams {
-            model,
-            method,
-            tolerance,
-            splitting,
-            box_factor,
-            max_iterations,
-        };
-        check_lanczos(&p.lanczos())?;
-        for (key, given) in [
-            ("hydrodynamics.splitting", self.splitting.is_some()),
-            ("hydrodynamics.box_factor", self.box_factor.is_some()),
-        ] {
-            if given && method != Some(HydroMethod::Pse) {
-                return Err(ParamError::new(key, "applies only to method = \"pse\""));
-            }
-        }
-        Ok(p)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parse(text: &str) -> HydrodynamicsSection {
-        toml::from_str(text).unwrap()
-    }
-
-    #[test]
-    fn defaults_and_errors_name_the_key() {
-        let p = parse("").validate(1000, 0.5, false).unwrap();
-        assert_eq!(p.model, HydroModel::FreeDraining);
-        assert_eq!(p.method, None);
-        let p = parse("model = \"rpy\"").validate(1000, 0.5, false).unwrap();
-        assert_eq!(p.method, Some(HydroMethod::Direct));
-        assert_eq!(p.splitting, 1.0);
-        let p = parse("model = \"rpy\"")
-            .validate(50_000, 0.5, false)
-            .unwrap();
-        assert_eq!(p.method, Some(HydroMethod::Pse));
-        let key = |t: &str, periodic| parse(t).validate(100, 0.5, periodic).unwrap_err().key;
-        assert_eq!(key("model = \"oseen\"", false), "hydrodynamics.model");
-        assert_eq!(
-            key("model = \"rpy\"\ntolerance = 0.2", false),
-            "hydrodynamics.tolerance"
-        );
-        assert_eq!(
-            key("model = \"rpy\"\ntolerance = 0.0", false),
-            "hydrodynamics.tolerance"
-        );
-        assert_eq!(
-            key("model = \"rpy\"\nmethod = \"pse\"\nsplitting = -1", false),
-            "hydrodynamics.splitting"
-        );
-        assert_eq!(
-            key("model = \"rpy\"\nmethod = \"direct\"", true),
-            "hydrodynamics.method"
-        );
-        assert_eq!(key("method = \"pse\"", false), "hydrodynamics.method");
-        assert_eq!(
-            key("model = \"rpy\"\nmethod = \"pse\"\nbox_factor = 1.0", false),
-            "hydrodynamics.box_factor"
-        );
-        assert_eq!(
-            key(
-                "model = \"rpy\"\nmethod = \"direct\"\nsplitting = 1.0",
-                false
-            ),
-            "hydrodynamics.splitting"
-        );
-        assert_eq!(
-            key("model = \"rpy\"\nmax_iterations = 0", false),
-            "hydrodynamics.max_iterations"
-        );
-        let e = parse("model = \"rpy\"\ntolerance = 0.5")
-            .validate(10, 0.5, false)
-            .unwrap_err();
-        assert!(e.to_string().contains("(0, 0.1]"), "{e}");
-        assert!(toml::from_str::<HydrodynamicsSection>("speed = 1").is_err());
     }
 }

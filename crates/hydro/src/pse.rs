@@ -459,12 +459,12 @@ impl PseGeometry {
     /// The geometry, the tabulated wave-space functions and the real-space self term.
     fn with_table(params: &PseParams) -> Result<(Self, WaveTable, f64), HydroError> {
         let p = *params;
-        colloidsim_core::param::positive("system.diameter", p.radius)?;
-        colloidsim_core::param::positive("system.viscosity", p.viscosity)?;
-        colloidsim_core::param::positive("system.box_length", p.box_length)?;
+        colloidsim_core::param::positive("radius", p.radius)?;
+        colloidsim_core::param::positive("viscosity", p.viscosity)?;
+        colloidsim_core::param::positive("box_length", p.box_length)?;
         if !(p.splitting.is_finite() && p.splitting > 0.0) {
             return Err(ParamError::new(
-                "hydrodynamics.splitting",
+                "splitting",
                 format!("must be a finite number > 0, got {}", p.splitting),
             )
             .into());
@@ -476,7 +476,7 @@ impl PseGeometry {
         let (a, xi, l, eps) = (p.radius, p.splitting, p.box_length, p.tolerance);
         if l < 4.0 * a {
             return Err(ParamError::new(
-                "system.box_length",
+                "box_length",
                 format!(
                     "the periodic box {l} must be at least 4 radii ({})",
                     4.0 * a
@@ -508,7 +508,7 @@ impl PseGeometry {
         }
         if pts > MAX_SUPPORT {
             return Err(ParamError::new(
-                "hydrodynamics.tolerance",
+                "tolerance",
                 format!(
                     "{eps:e} needs a Gaussian support of {pts} grid points per axis, more than \
                      {MAX_SUPPORT}; use a tolerance of 1e-13 or more"
@@ -520,7 +520,7 @@ impl PseGeometry {
         debug_assert!(frac <= 1.0 + 1e-12, "Gaussian fraction {frac}");
         if grid > 1024 {
             return Err(ParamError::new(
-                "hydrodynamics.splitting",
+                "splitting",
                 format!(
                     "xi = {xi} needs a {grid}^3 grid for a box of edge {l} ({:.1} GiB); \
                      lower the splitting",
@@ -534,7 +534,7 @@ impl PseGeometry {
         // below 2 / L is refused here, before a table of 416 / (a xi) points is built.
         if 1.0 / xi >= 0.5 * l {
             return Err(ParamError::new(
-                "hydrodynamics.splitting",
+                "splitting",
                 format!(
                     "xi = {xi} gives a real-space part reaching beyond half the box ({}); raise \
                      the splitting well above {:.4} or enlarge the box",
@@ -559,7 +559,7 @@ impl PseGeometry {
         }
         if r_cut >= 0.5 * l {
             return Err(ParamError::new(
-                "hydrodynamics.splitting",
+                "splitting",
                 format!(
                     "xi = {xi} gives a real-space cut-off {r_cut:.4} beyond half the box ({}); \
                      raise the splitting to at least {:.4} or enlarge the box",

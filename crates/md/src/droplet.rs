@@ -13,13 +13,12 @@ use crate::init::random_in_sphere;
 use crate::potential::{HarmonicInterface, LennardJones, SphereAreaLaw};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
-use colloidsim_core::param::positive;
 use colloidsim_hydro::direct::DEFAULT_MAX_DIRECT;
 use colloidsim_hydro::{
     AnyMobility, DirectRpy, FreeDraining, HydroMethod, HydroModel, HydroParams, Pse, PseGeometry,
     PseParams,
 };
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -34,114 +33,6 @@ pub const MIN_DRYING_STEPS: u64 = 100;
 pub const MAX_PHI0: f64 = 0.3;
 /// Highest final mean volume fraction accepted (random close packing).
 pub const MAX_PHI_FINAL: f64 = 0.64;
-
-// The serde sections below are what the scenarios still parsed by serde (`droplet-mpcd`, and
-// `bd` for `[observe.trajectory]`) take from the droplet; `droplet-bd` reads its keys through
-// its declarations in the run layer (issue 41). They go when those methods are converted.
-
-/// `[drying]`: `R(t) = sqrt(R0^2 - alpha t / (4 pi))`. `peclet = 0` with `duration`: a static
-/// droplet (fixed R = R0), for equilibrium profiles.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct DryingSection {
-    /// Peclet number `Pe = R |dR/dt| / D0` (default 10; 0: a static droplet); give this or
-    /// `alpha`.
-    #[serde(default)]
-    pub peclet: Option<f64>,
-    /// Rate of loss of surface area `alpha = -dA/dt` (length^2 / time); give this or `peclet`.
-    #[serde(default)]
-    pub alpha: Option<f64>,
-    /// Stop when the mean volume fraction `N d^3 / (8 R^3)` reaches this (default 0.55);
-    /// give this or `duration`.
-    #[serde(default)]
-    pub final_volume_fraction: Option<f64>,
-    /// Stop after this time instead (time units).
-    #[serde(default)]
-    pub duration: Option<f64>,
-}
-
-impl DryingSection {
-    /// The Peclet number and the rate of loss of surface area `(Pe, alpha)`,
-    /// `alpha = 8 pi Pe D0` (`Pe = R |dR/dt| / D0`), from `peclet` (default 10) or `alpha`.
-    pub fn rate(&self, d0: f64) -> Result<(f64, f64), ParamError> {
-        match (self.peclet, self.alpha) {
-            (Some(_), Some(_)) => Err(ParamError::new(
-                "drying.peclet",
-                "give either drying.peclet or drying.alpha, not both",
-            )),
-            (None, Some(a)) => {
-                let a = positive("drying.alpha", a)?;
-                Ok((a / (8.0 * PI * d0), a))
-            }
-            (pe, None) => {
-                let pe = pe.unwrap_or(10.0);
-                if !(pe.is_finite() && pe >= 0.0) {
-                    return Err(ParamError::new(
-                        "drying.peclet",
-                        format!(
-                            "must be a finite number >= 0 (0: a static droplet), got {}",
-                            colloidsim_core::param::show(pe)
-                        ),
-                    ));
-                }
-                Ok((pe, 8.0 * PI * pe * d0))
-            }
-        }
-    }
-}
-
-/// `[interface]`: harmonic wall `V = k/2 s^2` for `0 <= s < range`, linear beyond, with
-/// `s = r - (R(t) + offset)`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct InterfaceSection {
-    /// Spring constant k (energy / length^2; default 50 kT / d^2).
-    #[serde(default)]
-    pub stiffness: Option<f64>,
-    /// Range Delta of the harmonic part (length; default d / 2).
-    #[serde(default)]
-    pub range: Option<f64>,
-    /// Offset of the wall from R(t) (length; default -d / 2: the surface touches the interface).
-    #[serde(default)]
-    pub offset: Option<f64>,
-}
-
-/// `[observe.profile]`.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ProfileSection {
-    /// Number of radial bins between 0 and R(t).
-    #[serde(default = "default_bins")]
-    pub bins: usize,
-    /// Fractions of the drying time at which profiles are taken.
-    #[serde(default = "default_fractions")]
-    pub fractions: Vec<f64>,
-}
-
-fn default_bins() -> usize {
-    50
-}
-fn default_fractions() -> Vec<f64> {
-    vec![0.0, 0.25, 0.5, 0.75, 1.0]
-}
-
-impl Default for ProfileSection {
-    fn default() -> Self {
-        Self {
-            bins: default_bins(),
-            fractions: default_fractions(),
-        }
-    }
-}
-
-/// `[observe.trajectory]`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct TrajectorySection {
-    /// Write a GSD frame every this many steps (0: no trajectory).
-    #[serde(default)]
-    pub every: u64,
-}
 
 /// Resolved, validated parameters of a drying droplet.
 #[derive(Debug, Clone, Serialize, PartialEq)]

@@ -22,7 +22,6 @@ pub mod scenario;
 pub mod trajectory;
 
 mod bd_replica;
-mod bulk;
 pub mod two_body;
 
 pub use control::{Control, Progress, Silent};

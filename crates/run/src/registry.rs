@@ -8,7 +8,7 @@ use anyhow::Result;
 static METHODS: &[&dyn Method] = &[
     &crate::methods::bcd::BcdMethod,
     &crate::methods::droplet_bd::DropletBd,
-    &crate::bulk::BulkBd,
+    &crate::methods::bd::BulkBd,
     &crate::methods::dpd::DpdMethod,
     &crate::methods::hs_mc::HsMc,
     &crate::methods::mpcd::MpcdBulk,

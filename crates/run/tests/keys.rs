@@ -273,15 +273,7 @@ fn methods() -> Vec<(&'static str, &'static [Spec], Parse)> {
     let all: Vec<(&str, &[Spec], Parse)> = vec![
         (BCD, spec("bcd"), None),
         (DROPLET, spec("droplet-bd"), None),
-        (
-            BULK,
-            spec("bd"),
-            Some(|t| {
-                colloidsim_md::bulk::BulkScenario::from_toml(t)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
-        ),
+        (BULK, spec("bd"), None),
         (DPD, spec("dpd"), None),
         (MC, spec("hs-mc"), None),
         (MPCD, spec("mpcd"), None),

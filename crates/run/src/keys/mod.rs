@@ -256,8 +256,6 @@ pub(crate) const SEED_KEY: Spec = key(
 pub(crate) const COUNT: i64 = 1 << 53;
 
 pub mod shared;
-mod tables;
-pub use tables::*;
 
 /// Check a scenario's table against a method's keys: unknown keys (with the keys of that
 /// table), types and each key's own range. `prefix` is the path of `table` (empty at the top).

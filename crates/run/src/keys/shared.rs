@@ -447,3 +447,103 @@ pub fn hydrodynamics(
     }
     Ok(Some(p))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::droplet_bd::keys::{HYDRO_BOX_FACTOR, HYDRO_METHOD, KEYS};
+
+    /// `[hydrodynamics]` with `text` read for `particles` spheres of radius 0.5 (the droplet's
+    /// keys, which allow both methods and `box_factor`).
+    fn read(text: &str, particles: usize, periodic: bool) -> Result<Option<HydroParams>> {
+        let t: toml::Table = toml::from_str(&format!("[hydrodynamics]\n{text}")).unwrap();
+        let r = Reader::new(&t, KEYS)?;
+        hydrodynamics(
+            &r,
+            &HYDRO_METHOD,
+            Some(&HYDRO_BOX_FACTOR),
+            particles,
+            0.5,
+            periodic,
+        )
+    }
+
+    /// The key an error names (a [`ParamError`]'s, or the declaration check's).
+    fn key(text: &str, periodic: bool) -> String {
+        let e = read(text, 100, periodic).unwrap_err();
+        match e.downcast_ref::<ParamError>() {
+            Some(p) => p.key.clone(),
+            None => e.to_string().split(':').next().unwrap().to_string(),
+        }
+    }
+
+    #[test]
+    fn hydrodynamics_defaults_and_errors_name_the_key() {
+        let t = toml::Table::new();
+        let r = Reader::new(&t, KEYS).unwrap();
+        let none = hydrodynamics(&r, &HYDRO_METHOD, None, 10, 0.5, false).unwrap();
+        assert_eq!(none, None);
+        let p = read("", 1000, false).unwrap().unwrap();
+        assert_eq!((p.model, p.method), (HydroModel::FreeDraining, None));
+        let p = read("model = \"rpy\"", 1000, false).unwrap().unwrap();
+        assert_eq!(p.method, Some(HydroMethod::Direct));
+        assert_eq!(
+            (p.splitting, p.tolerance, p.max_iterations),
+            (1.0, 1e-3, 200)
+        );
+        assert_eq!(p.box_factor, DEFAULT_BOX_FACTOR);
+        let p = read("model = \"rpy\"", 50_000, false).unwrap().unwrap();
+        assert_eq!(p.method, Some(HydroMethod::Pse));
+        let p = read("model = \"rpy\"", 10, true).unwrap().unwrap();
+        assert_eq!(p.method, Some(HydroMethod::Pse));
+        for (text, periodic, k) in [
+            ("model = \"oseen\"", false, "hydrodynamics.model"),
+            (
+                "model = \"rpy\"\ntolerance = 0.2",
+                false,
+                "hydrodynamics.tolerance",
+            ),
+            (
+                "model = \"rpy\"\ntolerance = 0.0",
+                false,
+                "hydrodynamics.tolerance",
+            ),
+            (
+                "model = \"rpy\"\nmethod = \"pse\"\nsplitting = -1",
+                false,
+                "hydrodynamics.splitting",
+            ),
+            (
+                "model = \"rpy\"\nmethod = \"direct\"",
+                true,
+                "hydrodynamics.method",
+            ),
+            ("method = \"pse\"", false, "hydrodynamics.method"),
+            (
+                "model = \"rpy\"\nmethod = \"pse\"\nbox_factor = 1.0",
+                false,
+                "hydrodynamics.box_factor",
+            ),
+            (
+                "model = \"rpy\"\nmethod = \"direct\"\nbox_factor = 2.0",
+                false,
+                "hydrodynamics.box_factor",
+            ),
+            (
+                "model = \"rpy\"\nmethod = \"direct\"\nsplitting = 1.0",
+                false,
+                "hydrodynamics.splitting",
+            ),
+            (
+                "model = \"rpy\"\nmax_iterations = 0",
+                false,
+                "hydrodynamics.max_iterations",
+            ),
+            ("speed = 1", false, "hydrodynamics.speed"),
+        ] {
+            assert_eq!(key(text, periodic), k, "{text}");
+        }
+        let e = read("model = \"rpy\"\ntolerance = 0.5", 10, false).unwrap_err();
+        assert!(e.to_string().contains("(0, 0.1]"), "{e}");
+    }
+}

@@ -2,6 +2,7 @@
 //! parameters, its session and its outputs. The registry in [`crate::registry`] lists them.
 
 pub mod bcd;
+pub mod bd;
 pub mod dpd;
 pub mod droplet_bd;
 pub mod droplet_mpcd;

@@ -4,8 +4,8 @@
 
 use super::keys::*;
 use crate::keys::shared::{
-    self, HYDRO_SPLITTING, HYDRODYNAMICS, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
-    RUN_DT, RUN_SKIN, Spheres, TRAJECTORY_EVERY,
+    self, HYDRO_MAX_ITERATIONS, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS, INTERFACE_OFFSET,
+    INTERFACE_RANGE, INTERFACE_STIFFNESS, RUN_DT, RUN_SKIN, Spheres, TRAJECTORY_EVERY,
 };
 use crate::keys::{Reader, SEED_KEY, Spec, rekey};
 use anyhow::{Result, bail};
@@ -20,7 +20,10 @@ use std::path::Path;
 /// The engine's names of its parameters, and the keys that set them.
 const ENGINE_NAMES: &[(&str, &Spec)] = &[
     ("box_factor", &HYDRO_BOX_FACTOR),
+    ("box_length", &HYDRO_BOX_FACTOR),
     ("splitting", &HYDRO_SPLITTING),
+    ("tolerance", &HYDRO_TOLERANCE),
+    ("max_iterations", &HYDRO_MAX_ITERATIONS),
     ("method", &HYDRO_METHOD),
     ("hydrodynamics", &HYDRODYNAMICS),
 ];

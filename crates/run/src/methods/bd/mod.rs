@@ -38,7 +38,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::mean_and_error;
-use colloidsim_md::bulk::{BulkParams, BulkScenario};
+use colloidsim_md::bulk::BulkParams;
 use colloidsim_md::{Brownian, ConstantForce};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -50,9 +50,13 @@ pub const MIN_BLOCKS: usize = 8;
 /// The bulk family of scenarios.
 pub struct BulkBd;
 
+pub mod keys;
+pub mod params;
+
 type Replica = AnyReplica<ConstantForce>;
 
-/// Parse and validate a scenario; `system.initial` is taken relative to the scenario's folder.
+/// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
+/// replacing the scenario's.
 fn resolve(src: &Source, seed: Option<u64>) -> Result<BulkParams> {
     let table = src.table()?;
     if table
@@ -78,18 +82,10 @@ fn resolve(src: &Source, seed: Option<u64>) -> Result<BulkParams> {
             src.label()
         );
     }
-    crate::keys::validate(&table, crate::keys::BULK).with_context(|| src.label())?;
-    let mut sc = BulkScenario::from_toml(src.text()).with_context(|| src.label())?;
     if let Some(s) = seed {
         crate::seed32(s)?;
-        sc.seed = s;
     }
-    if let Some(init) = &sc.system.initial
-        && init.is_relative()
-    {
-        sc.system.initial = Some(src.base().join(init));
-    }
-    sc.validate().with_context(|| src.label())
+    params::read(&table, src.base(), seed).with_context(|| src.label())
 }
 
 /// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
@@ -147,7 +143,7 @@ impl Method for BulkBd {
     }
 
     fn keys(&self) -> &'static [Spec] {
-        crate::keys::BULK
+        keys::KEYS
     }
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
