@@ -112,14 +112,14 @@ pub fn dilute_sedimentation(phi: f64, n: usize, a: f64, l: f64) -> f64 {
     mu - 5.0 * phi_n - 8.0 * phi_n * (mu - 1.0)
 }
 
-/// Errors while setting up a replica.
+/// Errors while setting up a replica (the run layer names the scenario keys).
 #[derive(Debug, thiserror::Error)]
 pub enum BulkError {
-    /// Random insertion failed.
-    #[error("system.box_length: {0}")]
+    /// Random insertion failed: the box is too small for the spheres.
+    #[error("box_length: {0}")]
     Packing(#[from] PackingError),
     /// The initial GSD file could not be used.
-    #[error("system.initial: {0}")]
+    #[error("initial: {0}")]
     Initial(String),
     /// The free-draining engine refused the configuration.
     #[error(transparent)]

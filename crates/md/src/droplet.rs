@@ -136,14 +136,14 @@ pub fn particles_for(phi: f64, r0: f64, d: f64) -> f64 {
     8.0 * phi * r0.powi(3) / d.powi(3)
 }
 
-/// Errors while setting up a droplet replica.
+/// Errors while setting up a droplet replica (the run layer names the scenario keys).
 #[derive(Debug, thiserror::Error)]
 pub enum DropletError {
-    /// Random insertion failed.
-    #[error("system.phi0: {0}")]
+    /// Random insertion failed: the droplet is too dense.
+    #[error("phi0: {0}")]
     Packing(#[from] crate::init::PackingError),
     /// The initial GSD file could not be used.
-    #[error("system.initial: {0}")]
+    #[error("initial: {0}")]
     Initial(String),
     /// The engine refused the configuration.
     #[error(transparent)]

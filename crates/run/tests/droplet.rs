@@ -102,7 +102,8 @@ fn replicas_differ_and_initial_configuration_is_inside() {
             .iter()
             .all(|x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() <= wall + 1e-12)
     );
-    // An unreadable initial file is a clear error naming the key.
+    // An unreadable initial file is a clear error naming the engine's input (the run layer
+    // names the key, system.initial).
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("x.gsd");
     std::fs::write(&bad, "not gsd").unwrap();
@@ -116,10 +117,7 @@ fn replicas_differ_and_initial_configuration_is_inside() {
         .err()
         .expect("unreadable GSD accepted")
         .to_string();
-    assert!(
-        e.starts_with("system.initial") && e.contains("x.gsd"),
-        "{e}"
-    );
+    assert!(e.starts_with("initial: ") && e.contains("x.gsd"), "{e}");
 }
 
 #[test]

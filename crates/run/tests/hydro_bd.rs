@@ -205,15 +205,28 @@ fn a_lanczos_failure_stops_the_run_naming_the_step() {
 
 #[test]
 fn a_box_too_small_for_the_droplet_is_refused_naming_the_key() {
-    let (p, mut h) = droplet(100, "model = \"rpy\"\nmethod = \"pse\"\nbox_factor = 1.2");
+    // The run layer refuses it naming the key, with the least value.
+    let text = "method = \"droplet-bd\"\nseed = 4\n[system]\nparticles = 100\nphi0 = 0.1\n\
+                [drying]\npeclet = 5\n[hydrodynamics]\nmodel = \"rpy\"\nmethod = \"pse\"\nbox_factor = 1.2\n";
+    let e = colloidsim_run::methods::droplet_bd::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("hydrodynamics.box_factor") && e.contains("at least"),
+        "{e}"
+    );
+    // The engine refuses it too, naming its own parameter.
+    let (p, mut h) = droplet(100, "model = \"rpy\"\nmethod = \"pse\"\nbox_factor = 2.0");
+    h.box_factor = 1.2;
     let e = match p.build_hydro_replica(0, &h) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("a box of 1.2 droplet diameters was accepted"),
     };
-    assert!(
-        e.contains("hydrodynamics.box_factor") && e.contains("at least"),
-        "{e}"
-    );
+    assert!(e.starts_with("box_factor") && e.contains("at least"), "{e}");
     h.model = HydroModel::FreeDraining;
     h.method = None;
     let sim = p.build_hydro_replica(0, &h).unwrap();

@@ -38,7 +38,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::mean_and_error;
-use colloidsim_md::bulk::BulkParams;
+use colloidsim_md::bulk::{BulkError, BulkParams};
 use colloidsim_md::{Brownian, ConstantForce};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -91,10 +91,19 @@ fn resolve(src: &Source, seed: Option<u64>) -> Result<BulkParams> {
 /// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
 fn build_replica(p: &BulkParams, replica: u32) -> Result<Replica> {
     Ok(if p.has_hydrodynamics() {
-        Replica::Hydro(Box::new(p.build_hydro_replica(replica)?))
+        Replica::Hydro(Box::new(p.build_hydro_replica(replica).map_err(keyed)?))
     } else {
-        Replica::Free(Box::new(p.build_replica(replica)?))
+        Replica::Free(Box::new(p.build_replica(replica).map_err(keyed)?))
     })
+}
+
+/// A replica's set-up error, naming the scenario key of the input it refuses.
+fn keyed(e: BulkError) -> anyhow::Error {
+    match e {
+        BulkError::Packing(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_BOX_LENGTH.path),
+        BulkError::Initial(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_INITIAL.path),
+        other => other.into(),
+    }
 }
 
 impl Method for BulkBd {

@@ -23,7 +23,7 @@ use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::droplet::DropletSim;
+use colloidsim_md::droplet::{DropletError, DropletSim};
 use colloidsim_md::{DropletParams, HarmonicInterface, LennardJones, Particles};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -61,7 +61,9 @@ impl Method for DropletBd {
     fn check(&self, src: &Source) -> Result<Checked> {
         let p = resolve(src, None)?;
         // What `run` does before it starts: set up replica 0 (reading system.initial).
-        p.build_replica(0).with_context(|| src.label())?;
+        p.build_replica(0)
+            .map_err(keyed)
+            .with_context(|| src.label())?;
         Ok(Checked {
             resolved: serde_json::to_value(&p)?,
             warnings: Vec::new(),
@@ -261,10 +263,20 @@ type Replica = crate::bd_replica::Replica<HarmonicInterface>;
 fn build_replica(p: &DropletParams, replica: u32) -> Result<Replica> {
     Ok(match &p.hydrodynamics {
         Some(h) if p.has_hydrodynamics() => {
-            Replica::Hydro(Box::new(p.build_hydro_replica(replica, h)?))
+            Replica::Hydro(Box::new(p.build_hydro_replica(replica, h).map_err(keyed)?))
         }
-        _ => Replica::Free(Box::new(p.build_replica(replica)?)),
+        _ => Replica::Free(Box::new(p.build_replica(replica).map_err(keyed)?)),
     })
+}
+
+/// A replica's set-up error, naming the scenario key of the input it refuses.
+fn keyed(e: DropletError) -> anyhow::Error {
+    match e {
+        DropletError::Packing(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_PHI0.path),
+        DropletError::Initial(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_INITIAL.path),
+        DropletError::Param(e) => params::keyed(e).into(),
+        other => other.into(),
+    }
 }
 
 /// A droplet run: replicas one after the other.
