@@ -50,7 +50,7 @@ pub enum HydroError {
     },
     /// Too many particles for the direct method.
     #[error(
-        "hydrodynamics.method: {particles} particles exceed the direct method's limit of {max} \
+        "method: {particles} particles exceed the direct method's limit of {max} \
          ({pairs:.2e} pair tensors per product, each Lanczos step one product; a stored 3N x 3N \
          matrix would need {matrix_gib:.1} GiB); use method = \"pse\" (periodic, O(N log N))"
     )]

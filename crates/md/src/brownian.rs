@@ -73,9 +73,9 @@ impl Integrator {
         if self == Integrator::Lm && rpy {
             return Err(ParamError::new(
                 "integrator",
-                "\"lm\" (Leimkuhler-Matthews) is for free draining only: with hydrodynamics.model = \
-                 \"rpy\" the noise is correlated through the mobility, which the scheme does not \
-                 cover; use run.integrator = \"euler\" or hydrodynamics.model = \"free-draining\"",
+                "\"lm\" (Leimkuhler-Matthews) is for free draining only: with the RPY mobility \
+                 (model \"rpy\") the noise is correlated through the mobility, which the scheme \
+                 does not cover; use \"euler\" or free draining",
             ));
         }
         Ok(self)
