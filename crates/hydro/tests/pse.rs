@@ -200,7 +200,7 @@ fn pse_step_does_not_depend_on_the_thread_count_and_is_a_function_of_the_positio
 }
 
 #[test]
-fn bad_parameters_are_refused_naming_the_key() {
+fn bad_parameters_are_refused_naming_the_parameter() {
     let key = |p: PseParams| match Pse::new(10, p) {
         Err(HydroError::Param(e)) => e.key,
         other => panic!("{other:?}"),
@@ -211,14 +211,14 @@ fn bad_parameters_are_refused_naming_the_key() {
             splitting: 0.2,
             ..ok
         }),
-        "hydrodynamics.splitting"
+        "splitting"
     );
     assert_eq!(
         key(PseParams {
             splitting: -1.0,
             ..ok
         }),
-        "hydrodynamics.splitting"
+        "splitting"
     );
     // A splitting so small that its real-space table alone would take petabytes: refused
     // before anything is allocated (it aborted the process before).
@@ -227,21 +227,21 @@ fn bad_parameters_are_refused_naming_the_key() {
             splitting: 1e-15,
             ..ok
         }),
-        "hydrodynamics.splitting"
+        "splitting"
     );
     assert_eq!(
         key(PseParams {
             tolerance: 0.5,
             ..ok
         }),
-        "hydrodynamics.tolerance"
+        "tolerance"
     );
     assert_eq!(
         key(PseParams {
             box_length: 1.5,
             ..ok
         }),
-        "system.box_length"
+        "box_length"
     );
     let e = Pse::new(
         10,
