@@ -2,6 +2,7 @@
 //! session (engine, observers on their triggers, GSD frames), its outputs beside the exact
 //! theory, and `theory`. Its keys are declared in [`keys`] and read in [`params`].
 
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 

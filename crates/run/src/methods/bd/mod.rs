@@ -50,6 +50,7 @@ pub const MIN_BLOCKS: usize = 8;
 /// The bulk family of scenarios.
 pub struct BulkBd;
 
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 

@@ -2,6 +2,7 @@
 //! as the thermostat; thermodynamics, MSD, g(r), S(q), coordination and clusters, GSD frames.
 //! Its keys are declared in [`keys`] and read in [`params`].
 
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod monitor;
 pub mod params;

@@ -14,173 +14,86 @@ use crate::keys::shared::{
 };
 use crate::keys::{SEED_KEY, Spec, key};
 
-pub const METHOD: Spec = key(
-    "method",
-    "-",
-    Required,
-    OneOf(&["droplet-bd"]),
-    "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics",
-);
+pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-bd"]),
+    "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics");
 
-pub const REPLICAS: Spec = key(
-    "replicas",
-    "-",
-    Value("1"),
-    Integer(1, 1_000_000),
-    "independent droplets whose profiles are averaged (replica r: initial stream r, noise keyed by (seed, step, r, block))",
-);
+pub const REPLICAS: Spec = key("replicas", "-", Value("1"), Integer(1, 1_000_000),
+    "independent droplets whose profiles are averaged (replica r: initial stream r, noise keyed by (seed, step, r, block))");
 
-pub const SYSTEM: Spec = key(
-    "system",
-    "-",
-    Required,
-    Table,
-    "particles, solvent and the initial droplet",
-);
+pub const SYSTEM: Spec = key("system", "-", Required, Table,
+    "particles, solvent and the initial droplet");
 
-pub const SYSTEM_PARTICLES: Spec = key(
-    "system.particles",
-    "-",
-    Required,
-    Integer(1, 100_000_000),
-    "number of colloids N",
-);
+pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-", Required, Integer(1, 100_000_000),
+    "number of colloids N");
 
-pub const SYSTEM_PHI0: Spec = key(
-    "system.phi0",
-    "-",
-    Means("give phi0 or radius"),
-    LeftOpen(0.0, 0.64),
-    "initial mean volume fraction N d^3 / (8 R0^3)",
-)
-.also("at most 0.3 for random insertion (0.64 with system.initial); give this or system.radius");
+pub const SYSTEM_PHI0: Spec = key("system.phi0", "-",
+    Means("give phi0 or radius"), LeftOpen(0.0, 0.64),
+    "initial mean volume fraction N d^3 / (8 R0^3)")
+    .also("at most 0.3 for random insertion (0.64 with system.initial); give this or system.radius");
 
-pub const SYSTEM_RADIUS: Spec = key(
-    "system.radius",
-    "length",
-    Means("give phi0 or radius"),
-    Positive,
-    "initial droplet radius R0",
-)
-.also("phi0 within the same limits");
+pub const SYSTEM_RADIUS: Spec = key("system.radius", "length",
+    Means("give phi0 or radius"), Positive,
+    "initial droplet radius R0")
+    .also("phi0 within the same limits");
 
-pub const SYSTEM_INITIAL: Spec = key(
-    "system.initial",
-    "-",
-    Means("random insertion"),
-    Path,
-    "start from the last frame of this GSD file (HOOMD schema) instead of random insertion",
-)
-.also("must hold system.particles particles within R0 + offset + range");
+pub const SYSTEM_INITIAL: Spec = key("system.initial", "-", Means("random insertion"), Path,
+    "start from the last frame of this GSD file (HOOMD schema) instead of random insertion")
+    .also("must hold system.particles particles within R0 + offset + range");
 
-pub const DRYING: Spec = key(
-    "drying",
-    "-",
-    Means("Pe = 10 to phi = 0.55"),
-    Table,
-    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi))",
-);
+pub const DRYING: Spec = key("drying", "-", Means("Pe = 10 to phi = 0.55"), Table,
+    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi))");
 
-pub const DRYING_PECLET: Spec = key(
-    "drying.peclet",
-    "-",
-    Value("10"),
-    NonNegative,
-    "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha. 0: a static droplet (R = R0), for equilibrium profiles",
-)
-.also("0 needs drying.duration");
+pub const DRYING_PECLET: Spec = key("drying.peclet", "-", Value("10"), NonNegative,
+    "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha. 0: a static droplet (R = R0), for equilibrium profiles")
+    .also("0 needs drying.duration");
 
-pub const DRYING_ALPHA: Spec = key(
-    "drying.alpha",
-    "length^2 / time",
-    Means("8 pi Pe D0"),
-    Positive,
-    "rate of loss of surface area",
-);
+pub const DRYING_ALPHA: Spec = key("drying.alpha", "length^2 / time", Means("8 pi Pe D0"), Positive,
+    "rate of loss of surface area");
 
-pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key(
-    "drying.final_volume_fraction",
-    "-",
-    Value("0.55"),
-    LeftOpen(0.0, 0.64),
-    "run until the mean volume fraction reaches this; or give drying.duration",
-)
-.also("> phi0");
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key("drying.final_volume_fraction", "-",
+    Value("0.55"), LeftOpen(0.0, 0.64),
+    "run until the mean volume fraction reaches this; or give drying.duration")
+    .also("> phi0");
 
-pub const DRYING_DURATION: Spec = key(
-    "drying.duration",
-    "time",
-    Means("until final_volume_fraction"),
-    Positive,
-    "run for this time",
-)
-.also("before R^2 would turn negative (t < 4 pi R0^2 / alpha)");
+pub const DRYING_DURATION: Spec = key("drying.duration", "time",
+    Means("until final_volume_fraction"), Positive,
+    "run for this time")
+    .also("before R^2 would turn negative (t < 4 pi R0^2 / alpha)");
 
 pub const RUN: Spec = key("run", "-", Means("defaults"), Table, "time stepping");
 
 pub const OBSERVE: Spec = key("observe", "-", Means("profiles"), Table, "what to measure");
 
-pub const OBSERVE_PROFILE: Spec = key(
-    "observe.profile",
-    "-",
-    Means("50 bins at 0, 25, 50, 75, 100 %"),
-    Table,
-    "radial volume-fraction profiles: profile_<f>.csv",
-);
+pub const OBSERVE_PROFILE: Spec = key("observe.profile", "-",
+    Means("50 bins at 0, 25, 50, 75, 100 %"), Table,
+    "radial volume-fraction profiles: profile_<f>.csv");
 
-pub const OBSERVE_PROFILE_BINS: Spec = key(
-    "observe.profile.bins",
-    "-",
-    Value("50"),
-    Integer(1, 10_000_000),
-    "radial bins of equal width between 0 and R(t)",
-);
+pub const OBSERVE_PROFILE_BINS: Spec = key("observe.profile.bins", "-",
+    Value("50"), Integer(1, 10_000_000),
+    "radial bins of equal width between 0 and R(t)");
 
-pub const OBSERVE_PROFILE_FRACTIONS: Spec = key(
-    "observe.profile.fractions",
-    "-",
-    Value("[0, 0.25, 0.5, 0.75, 1.0]"),
-    Numbers(0.0, 1.0, None),
-    "fractions of the drying time at which profiles are written",
-)
-.also("at least one");
+pub const OBSERVE_PROFILE_FRACTIONS: Spec = key("observe.profile.fractions", "-",
+    Value("[0, 0.25, 0.5, 0.75, 1.0]"), Numbers(0.0, 1.0, None),
+    "fractions of the drying time at which profiles are written")
+    .also("at least one");
 
-pub const OBSERVE_CROSS_SECTION: Spec = key(
-    "observe.cross_section",
-    "-",
-    Means("none"),
-    Table,
-    "a slab through the centre of replica 0's last frame: cross_section.csv (x,y,z,r) and cross_section.png",
-);
+pub const OBSERVE_CROSS_SECTION: Spec = key("observe.cross_section", "-", Means("none"), Table,
+    "a slab through the centre of replica 0's last frame: cross_section.csv (x,y,z,r) and cross_section.png");
 
-pub const OBSERVE_CROSS_SECTION_WIDTH: Spec = key(
-    "observe.cross_section.width",
-    "length",
-    Means("d"),
-    Positive,
-    "slab thickness: centres with |z| < width / 2",
-)
-.also("in [0.001 d, 2 R0]");
+pub const OBSERVE_CROSS_SECTION_WIDTH: Spec = key("observe.cross_section.width", "length",
+    Means("d"), Positive,
+    "slab thickness: centres with |z| < width / 2")
+    .also("in [0.001 d, 2 R0]");
 
-pub const HYDRO_METHOD: Spec = key(
-    "hydrodynamics.method",
-    "-",
-    Means("direct up to 2000 particles, pse above"),
-    OneOf(&["direct", "pse"]),
-    "RPY in an unbounded fluid by direct O(N^2) sums, or periodic by positively split Ewald",
-)
-.also("model = \"rpy\" only; direct: at most 20000 particles");
+pub const HYDRO_METHOD: Spec = key("hydrodynamics.method", "-",
+    Means("direct up to 2000 particles, pse above"), OneOf(&["direct", "pse"]),
+    "RPY in an unbounded fluid by direct O(N^2) sums, or periodic by positively split Ewald")
+    .also("model = \"rpy\" only; direct: at most 20000 particles");
 
-pub const HYDRO_BOX_FACTOR: Spec = key(
-    "hydrodynamics.box_factor",
-    "droplet diameters",
-    Value("2"),
-    Closed(1.2, 20.0),
-    "PSE: edge of the periodic box / initial droplet diameter 2 R0 (the paper: 2)",
-)
-.also(
-    "method = \"pse\" only; the box must hold the droplet, its interface and two neighbour ranges",
-);
+pub const HYDRO_BOX_FACTOR: Spec = key("hydrodynamics.box_factor", "droplet diameters",
+    Value("2"), Closed(1.2, 20.0),
+    "PSE: edge of the periodic box / initial droplet diameter 2 R0 (the paper: 2)")
+    .also("method = \"pse\" only; the box must hold the droplet, its interface and two neighbour ranges");
 
 /// The keys of `droplet-bd` scenarios, in the order `colloidsim keys droplet-bd` lists them.
 pub static KEYS: &[Spec] = &[

@@ -32,6 +32,7 @@ use std::path::Path;
 /// The drying-droplet family of scenarios.
 pub struct DropletBd;
 
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 pub mod theory;

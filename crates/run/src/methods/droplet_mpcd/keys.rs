@@ -6,125 +6,70 @@ use crate::keys::shared::{self, *};
 use crate::keys::{COUNT, SEED_KEY, Spec, key};
 
 /// `method`.
-pub const METHOD: Spec = key(
-    "method",
-    "-",
-    Required,
-    OneOf(&["droplet-mpcd"]),
-    "drying droplet of SRD solvent (docs/mpcd.md)",
-);
+pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-mpcd"]),
+    "drying droplet of SRD solvent (docs/mpcd.md)");
 
 /// `seed`.
 pub const SEED: Spec = SEED_KEY;
 
 /// `boundary`.
-pub const BOUNDARY: Spec = key(
-    "boundary",
-    "-",
-    Means("\"slip\""),
-    OneOf(&["none", "slip", "no-slip"]),
-    "the solvent at the moving sphere: none (fills the box, ignores it), slip or no-slip bounce-back",
-);
+pub const BOUNDARY: Spec = key("boundary", "-",
+    Means("\"slip\""), OneOf(&["none", "slip", "no-slip"]),
+    "the solvent at the moving sphere: none (fills the box, ignores it), slip or no-slip bounce-back");
 
 /// `system`.
 pub const SYSTEM: Spec = key("system", "-", Required, Table, "colloids, droplet and box");
 
 /// `system.particles`.
-pub const SYSTEM_PARTICLES: Spec = key(
-    "system.particles",
-    "-",
-    Value("0"),
-    Integer(0, 10_000_000),
-    "colloids N (0: a pure-solvent droplet), placed at random with centres within R0 - d/2",
-)
-.also("they must fit: random sequential addition, at most phi0 = 0.3");
+pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-", Value("0"), Integer(0, 10_000_000),
+    "colloids N (0: a pure-solvent droplet), placed at random with centres within R0 - d/2")
+    .also("they must fit: random sequential addition, at most phi0 = 0.3");
 
 /// `system.diameter`.
-pub const SYSTEM_DIAMETER: Spec = key(
-    "system.diameter",
-    "length",
-    Derived("4 solvent.cell", |r| Ok(4.0 * r.number(&SOLVENT_CELL)?)),
-    Positive,
-    "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe",
-);
+pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length",
+    Derived("4 solvent.cell", |r| Ok(4.0 * r.number(&SOLVENT_CELL)?)), Positive,
+    "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe");
 
 /// `system.radius`.
-pub const SYSTEM_RADIUS: Spec = key(
-    "system.radius",
-    "length",
-    Required,
-    Positive,
-    "initial droplet radius R0",
-)
-.also("at least 2 cells");
+pub const SYSTEM_RADIUS: Spec = key("system.radius", "length", Required, Positive,
+    "initial droplet radius R0")
+    .also("at least 2 cells");
 
 /// `system.phi0`.
-pub const SYSTEM_PHI0: Spec = key(
-    "system.phi0",
-    "-",
-    Means("from radius"),
-    LeftOpen(0.0, 0.3),
-    "initial colloid volume fraction N d^3 / (8 R0^3)",
-)
-.also("with colloids; not with system.radius");
+pub const SYSTEM_PHI0: Spec = key("system.phi0", "-", Means("from radius"), LeftOpen(0.0, 0.3),
+    "initial colloid volume fraction N d^3 / (8 R0^3)")
+    .also("with colloids; not with system.radius");
 
 /// `system.box`.
-pub const SYSTEM_BOX: Spec = key(
-    "system.box",
-    "length",
-    Means("smallest whole number of cells >= 2 R0 + 4"),
-    Positive,
-    "edge of the periodic box",
-)
-.also("at least 2 R0 + 4 cells, a whole number of cells");
+pub const SYSTEM_BOX: Spec = key("system.box", "length",
+    Means("smallest whole number of cells >= 2 R0 + 4"), Positive,
+    "edge of the periodic box")
+    .also("at least 2 R0 + 4 cells, a whole number of cells");
 
 /// `drying`.
-pub const DRYING: Spec = key(
-    "drying",
-    "-",
-    Means("-"),
-    Table,
-    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi)), as droplet-bd's",
-);
+pub const DRYING: Spec = key("drying", "-", Means("-"), Table,
+    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi)), as droplet-bd's");
 
 /// `drying.peclet`.
-pub const DRYING_PECLET: Spec = key(
-    "drying.peclet",
-    "-",
-    Value("10"),
-    NonNegative,
-    "Pe = R |dR/dt| / D0 (0: a static droplet)",
-)
-.also("not with drying.alpha");
+pub const DRYING_PECLET: Spec = key("drying.peclet", "-", Value("10"), NonNegative,
+    "Pe = R |dR/dt| / D0 (0: a static droplet)")
+    .also("not with drying.alpha");
 
 /// `drying.alpha`.
-pub const DRYING_ALPHA: Spec = key(
-    "drying.alpha",
-    "length^2 / time",
-    Means("8 pi Pe D0"),
-    Positive,
-    "rate of loss of surface area",
-);
+pub const DRYING_ALPHA: Spec = key("drying.alpha", "length^2 / time", Means("8 pi Pe D0"), Positive,
+    "rate of loss of surface area");
 
 /// `drying.final_volume_fraction`.
-pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key(
-    "drying.final_volume_fraction",
-    "-",
-    Means("0.55 with colloids"),
-    LeftOpen(0.0, 0.64),
-    "stop at this mean colloid volume fraction",
-)
-.also("with colloids; not with drying.duration");
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key("drying.final_volume_fraction", "-",
+    Means("0.55 with colloids"), LeftOpen(0.0, 0.64),
+    "stop at this mean colloid volume fraction")
+    .also("with colloids; not with drying.duration");
 
 /// `drying.duration`.
-pub const DRYING_DURATION: Spec = key(
-    "drying.duration",
-    "time",
-    Means("required without colloids"),
-    Positive,
-    "stop after this time",
-)
-.also("R must stay above two cells");
+pub const DRYING_DURATION: Spec = key("drying.duration", "time",
+    Means("required without colloids"), Positive,
+    "stop after this time")
+    .also("R must stay above two cells");
 
 /// `interface.range` (with its condition here).
 pub const INTERFACE_RANGE: Spec = shared::INTERFACE_RANGE.also("at most R0");
@@ -136,96 +81,53 @@ pub const INTERFACE_OFFSET: Spec = shared::INTERFACE_OFFSET.also("in [-R0, R0]")
 pub const OBSERVE: Spec = key("observe", "-", Means("-"), Table, "observables");
 
 /// `observe.every`.
-pub const OBSERVE_EVERY: Spec = key(
-    "observe.every",
-    "collisions",
-    Means("collisions / 200"),
-    Integer(1, COUNT),
-    "rows of thermo.csv (radius, solvent count, expected count, removed, bounced, temperature)",
-);
+pub const OBSERVE_EVERY: Spec = key("observe.every", "collisions",
+    Means("collisions / 200"), Integer(1, COUNT),
+    "rows of thermo.csv (radius, solvent count, expected count, removed, bounced, temperature)");
 
 /// `observe.profile`.
-pub const OBSERVE_PROFILE: Spec = key(
-    "observe.profile",
-    "-",
-    Means("-"),
-    Table,
-    "times of the profiles",
-);
+pub const OBSERVE_PROFILE: Spec = key("observe.profile", "-", Means("-"), Table,
+    "times of the profiles");
 
 /// `observe.profile.bins`.
-pub const OBSERVE_PROFILE_BINS: Spec = key(
-    "observe.profile.bins",
-    "-",
-    Value("50"),
-    Integer(1, 100_000),
-    "bins of the colloid volume-fraction profiles (with colloids)",
-);
+pub const OBSERVE_PROFILE_BINS: Spec = key("observe.profile.bins", "-",
+    Value("50"), Integer(1, 100_000),
+    "bins of the colloid volume-fraction profiles (with colloids)");
 
 /// `observe.profile.fractions`.
-pub const OBSERVE_PROFILE_FRACTIONS: Spec = key(
-    "observe.profile.fractions",
-    "-",
-    Value("[0.0, 0.25, 0.5, 0.75, 1.0]"),
-    Numbers(0.0, 1.0, None),
-    "fractions of the drying time at which profiles are taken",
-)
-.also("increasing, distinct collisions");
+pub const OBSERVE_PROFILE_FRACTIONS: Spec = key("observe.profile.fractions", "-",
+    Value("[0.0, 0.25, 0.5, 0.75, 1.0]"), Numbers(0.0, 1.0, None),
+    "fractions of the drying time at which profiles are taken")
+    .also("increasing, distinct collisions");
 
 /// `observe.solvent`.
-pub const OBSERVE_SOLVENT: Spec = key(
-    "observe.solvent",
-    "-",
-    Means("-"),
-    Table,
-    "solvent density and radial velocity against r / R(t)",
-);
+pub const OBSERVE_SOLVENT: Spec = key("observe.solvent", "-", Means("-"), Table,
+    "solvent density and radial velocity against r / R(t)");
 
 /// `observe.solvent.bins`.
-pub const OBSERVE_SOLVENT_BINS: Spec = key(
-    "observe.solvent.bins",
-    "-",
-    Value("20"),
-    Integer(1, 10_000),
-    "bins over [0, R(t)]",
-);
+pub const OBSERVE_SOLVENT_BINS: Spec = key("observe.solvent.bins", "-",
+    Value("20"), Integer(1, 10_000),
+    "bins over [0, R(t)]");
 
 /// `observe.solvent.window`.
-pub const OBSERVE_SOLVENT_WINDOW: Spec = key(
-    "observe.solvent.window",
-    "collisions",
-    Means("collisions / 10"),
-    Integer(1, COUNT),
-    "each solvent profile averages this many collisions ending at its time (10 blocks for the errors)",
-);
+pub const OBSERVE_SOLVENT_WINDOW: Spec = key("observe.solvent.window", "collisions",
+    Means("collisions / 10"), Integer(1, COUNT),
+    "each solvent profile averages this many collisions ending at its time (10 blocks for the errors)");
 
 /// `observe.trajectory`.
-pub const OBSERVE_TRAJECTORY: Spec = key(
-    "observe.trajectory",
-    "-",
-    Means("-"),
-    Table,
-    "GSD trajectory",
-);
+pub const OBSERVE_TRAJECTORY: Spec = key("observe.trajectory", "-", Means("-"), Table,
+    "GSD trajectory");
 
 /// `observe.trajectory.every`.
-pub const OBSERVE_TRAJECTORY_EVERY: Spec = key(
-    "observe.trajectory.every",
-    "collisions",
-    Value("0"),
-    Integer(0, COUNT),
-    "collisions between frames (0: none)",
-);
+pub const OBSERVE_TRAJECTORY_EVERY: Spec = key("observe.trajectory.every", "collisions",
+    Value("0"), Integer(0, COUNT),
+    "collisions between frames (0: none)");
 
 /// `observe.trajectory.solvent`.
-pub const OBSERVE_TRAJECTORY_SOLVENT: Spec = key(
-    "observe.trajectory.solvent",
-    "-",
-    Value("false"),
-    Bool,
-    "frames hold the solvent (type S, with velocities; log/radius)",
-)
-.also("true when frames are written without colloids");
+pub const OBSERVE_TRAJECTORY_SOLVENT: Spec = key("observe.trajectory.solvent", "-",
+    Value("false"), Bool,
+    "frames hold the solvent (type S, with velocities; log/radius)")
+    .also("true when frames are written without colloids");
 
 /// Every key of `droplet-mpcd` scenarios, in the order `colloidsim keys` lists them.
 pub static KEYS: &[Spec] = &[

@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::f64::consts::PI;
 
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 

@@ -9,203 +9,99 @@ use crate::keys::Omitted::*;
 use crate::keys::shared::{INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS};
 use crate::keys::{COUNT, SEED_KEY, Spec, key};
 
-pub const METHOD: Spec = key(
-    "method",
-    "-",
-    Required,
-    OneOf(&["hs-mc"]),
-    "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)",
-);
+pub const METHOD: Spec = key("method", "-", Required, OneOf(&["hs-mc"]),
+    "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)");
 
 pub const SYSTEM: Spec = key("system", "-", Required, Table, "spheres and container");
 
-pub const SYSTEM_GEOMETRY: Spec = key(
-    "system.geometry",
-    "-",
-    Required,
-    OneOf(&["bulk", "hard-wall", "interface"]),
-    "periodic cube; hard spherical wall (centres within radius - d/2); the BD droplet's harmonic interface ([interface])",
-);
+pub const SYSTEM_GEOMETRY: Spec = key("system.geometry", "-",
+    Required, OneOf(&["bulk", "hard-wall", "interface"]),
+    "periodic cube; hard spherical wall (centres within radius - d/2); the BD droplet's harmonic interface ([interface])");
 
-pub const SYSTEM_PARTICLES: Spec = key(
-    "system.particles",
-    "-",
-    Means("from the other two"),
-    Integer(1, 100_000_000),
-    "number of spheres N",
-)
-.also("give exactly two of particles, volume_fraction and box (bulk) or radius (droplet); at least 2 in bulk");
+pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-",
+    Means("from the other two"), Integer(1, 100_000_000),
+    "number of spheres N")
+    .also("give exactly two of particles, volume_fraction and box (bulk) or radius (droplet); at least 2 in bulk");
 
-pub const SYSTEM_VOLUME_FRACTION: Spec = key(
-    "system.volume_fraction",
-    "-",
-    Means("from the other two"),
-    LeftOpen(0.0, colloidsim_mc::params::MAX_PHI),
-    "N pi d^3 / (6 L^3) in bulk, N d^3 / (8 R^3) in a droplet; at most random close packing",
-);
+pub const SYSTEM_VOLUME_FRACTION: Spec = key("system.volume_fraction", "-",
+    Means("from the other two"), LeftOpen(0.0, colloidsim_mc::params::MAX_PHI),
+    "N pi d^3 / (6 L^3) in bulk, N d^3 / (8 R^3) in a droplet; at most random close packing");
 
-pub const SYSTEM_DIAMETER: Spec = key(
-    "system.diameter",
-    "length",
-    Value("1"),
-    Positive,
-    "sphere diameter d",
-);
+pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length", Value("1"), Positive,
+    "sphere diameter d");
 
-pub const SYSTEM_RADIUS: Spec = key(
-    "system.radius",
-    "length",
-    Means("from the other two"),
-    Positive,
-    "droplet radius R (hard-wall, interface)",
-)
-.also("above d/2; not with geometry = \"bulk\"");
+pub const SYSTEM_RADIUS: Spec = key("system.radius", "length",
+    Means("from the other two"), Positive,
+    "droplet radius R (hard-wall, interface)")
+    .also("above d/2; not with geometry = \"bulk\"");
 
-pub const SYSTEM_BOX: Spec = key(
-    "system.box",
-    "length",
-    Means("from the other two"),
-    Positive,
-    "edge L of the periodic cube (bulk)",
-)
-.also("at least 2 d; bulk only");
+pub const SYSTEM_BOX: Spec = key("system.box", "length", Means("from the other two"), Positive,
+    "edge L of the periodic cube (bulk)")
+    .also("at least 2 d; bulk only");
 
-pub const SYSTEM_KT: Spec = key(
-    "system.kT",
-    "energy",
-    Value("1"),
-    Positive,
-    "thermal energy (the interface's stiffness is in energy / length^2)",
-);
+pub const SYSTEM_KT: Spec = key("system.kT", "energy", Value("1"), Positive,
+    "thermal energy (the interface's stiffness is in energy / length^2)");
 
-pub const SYSTEM_INITIAL: Spec = key(
-    "system.initial",
-    "-",
-    Means("FCC lattice"),
-    Path,
-    "start from the last frame of this GSD file",
-)
-.also("N spheres, no overlap, centres inside the wall");
+pub const SYSTEM_INITIAL: Spec = key("system.initial", "-", Means("FCC lattice"), Path,
+    "start from the last frame of this GSD file")
+    .also("N spheres, no overlap, centres inside the wall");
 
 pub const MC: Spec = key("mc", "-", Means("-"), Table, "sweeps, warm-up and tuning");
 
-pub const MC_SWEEPS: Spec = key(
-    "mc.sweeps",
-    "sweeps",
-    Value("10000"),
-    Integer(1, COUNT),
-    "sampling sweeps (nselect N trial moves each) after the warm-up",
-);
+pub const MC_SWEEPS: Spec = key("mc.sweeps", "sweeps", Value("10000"), Integer(1, COUNT),
+    "sampling sweeps (nselect N trial moves each) after the warm-up");
 
-pub const MC_NSELECT: Spec = key(
-    "mc.nselect",
-    "-",
-    Value("1"),
-    Integer(1, colloidsim_mc::params::NSELECT_MAX as i64),
-    "trial moves per sphere per sweep, all on one binning of the cells (HOOMD-blue's nselect; docs/mc.md)",
-);
+pub const MC_NSELECT: Spec = key("mc.nselect", "-",
+    Value("1"), Integer(1, colloidsim_mc::params::NSELECT_MAX as i64),
+    "trial moves per sphere per sweep, all on one binning of the cells (HOOMD-blue's nselect; docs/mc.md)");
 
-pub const MC_WARMUP_SWEEPS: Spec = key(
-    "mc.warmup_sweeps",
-    "sweeps",
-    Value("2000"),
-    Integer(0, COUNT),
-    "warm-up sweeps, delta tuned every tune_every, then frozen",
-);
+pub const MC_WARMUP_SWEEPS: Spec = key("mc.warmup_sweeps", "sweeps",
+    Value("2000"), Integer(0, COUNT),
+    "warm-up sweeps, delta tuned every tune_every, then frozen");
 
-pub const MC_TARGET_ACCEPTANCE: Spec = key(
-    "mc.target_acceptance",
-    "-",
-    Value("0.3"),
-    LeftOpen(0.0, 1.0),
-    "acceptance the warm-up tunes delta towards",
-)
-.also("below 1");
+pub const MC_TARGET_ACCEPTANCE: Spec = key("mc.target_acceptance", "-",
+    Value("0.3"), LeftOpen(0.0, 1.0),
+    "acceptance the warm-up tunes delta towards")
+    .also("below 1");
 
-pub const MC_TUNE_EVERY: Spec = key(
-    "mc.tune_every",
-    "sweeps",
-    Value("100"),
-    Integer(1, COUNT),
-    "sweeps between tunings: delta *= acceptance / target (factor in [1/2, 2])",
-);
+pub const MC_TUNE_EVERY: Spec = key("mc.tune_every", "sweeps", Value("100"), Integer(1, COUNT),
+    "sweeps between tunings: delta *= acceptance / target (factor in [1/2, 2])");
 
-pub const MC_SAMPLE_EVERY: Spec = key(
-    "mc.sample_every",
-    "sweeps",
-    Value("10"),
-    Integer(1, COUNT),
-    "sweeps between samples of the observables",
-);
+pub const MC_SAMPLE_EVERY: Spec = key("mc.sample_every", "sweeps", Value("10"), Integer(1, COUNT),
+    "sweeps between samples of the observables");
 
-pub const MC_DELTA: Spec = key(
-    "mc.delta",
-    "length",
-    Derived("d / 10", |r| Ok(0.1 * r.number(&SYSTEM_DIAMETER)?)),
-    Positive,
-    "initial half-width of the displacement cube (at most half a cell side)",
-);
+pub const MC_DELTA: Spec = key("mc.delta", "length",
+    Derived("d / 10", |r| Ok(0.1 * r.number(&SYSTEM_DIAMETER)?)), Positive,
+    "initial half-width of the displacement cube (at most half a cell side)");
 
-pub const MC_BLOCKS: Spec = key(
-    "mc.blocks",
-    "-",
-    Value("20"),
-    Integer(2, 100_000),
-    "blocks of the sampling sweeps whose scatter gives the standard errors",
-)
-.also("at most sweeps / sample_every");
+pub const MC_BLOCKS: Spec = key("mc.blocks", "-", Value("20"), Integer(2, 100_000),
+    "blocks of the sampling sweeps whose scatter gives the standard errors")
+    .also("at most sweeps / sample_every");
 
 pub const OUTPUT: Spec = key("output", "-", Means("-"), Table, "observables and files");
 
-pub const OUTPUT_PROFILE_BINS: Spec = key(
-    "output.profile_bins",
-    "-",
-    Value("50"),
-    Integer(1, 1_000_000),
-    "radial bins between 0 and R (droplets: profile_mean.csv)",
-);
+pub const OUTPUT_PROFILE_BINS: Spec = key("output.profile_bins", "-",
+    Value("50"), Integer(1, 1_000_000),
+    "radial bins between 0 and R (droplets: profile_mean.csv)");
 
-pub const OUTPUT_GR_BINS: Spec = key(
-    "output.gr_bins",
-    "-",
-    Value("200"),
-    Integer(1, 1_000_000),
-    "bins of g(r) between 0 and gr_max (bulk: g_r.csv)",
-);
+pub const OUTPUT_GR_BINS: Spec = key("output.gr_bins", "-", Value("200"), Integer(1, 1_000_000),
+    "bins of g(r) between 0 and gr_max (bulk: g_r.csv)");
 
-pub const OUTPUT_GR_MAX: Spec = key(
-    "output.gr_max",
-    "length",
-    Means("0.49 L"),
-    Positive,
-    "range of g(r)",
-)
-.also("at most L/2 (the default stays under it: freud's RDF refuses L/2)");
+pub const OUTPUT_GR_MAX: Spec = key("output.gr_max", "length", Means("0.49 L"), Positive,
+    "range of g(r)")
+    .also("at most L/2 (the default stays under it: freud's RDF refuses L/2)");
 
-pub const OUTPUT_TRAJECTORY_EVERY: Spec = key(
-    "output.trajectory_every",
-    "sweeps",
-    Value("0"),
-    Integer(0, COUNT),
-    "sweeps between frames of trajectory.gsd (0: none)",
-);
+pub const OUTPUT_TRAJECTORY_EVERY: Spec = key("output.trajectory_every", "sweeps",
+    Value("0"), Integer(0, COUNT),
+    "sweeps between frames of trajectory.gsd (0: none)");
 
-pub const OUTPUT_RHO2_R_BINS: Spec = key(
-    "output.rho2_r_bins",
-    "-",
-    Value("0"),
-    Integer(0, 10_000),
-    "radial bins over [0, R] of the two-body density rho2(r1, r2, cos theta) and g2 (g2.csv; all pairs, O(N^2) per sample; 0: none)",
-)
-.also("droplets only");
+pub const OUTPUT_RHO2_R_BINS: Spec = key("output.rho2_r_bins", "-", Value("0"), Integer(0, 10_000),
+    "radial bins over [0, R] of the two-body density rho2(r1, r2, cos theta) and g2 (g2.csv; all pairs, O(N^2) per sample; 0: none)")
+    .also("droplets only");
 
-pub const OUTPUT_RHO2_COS_BINS: Spec = key(
-    "output.rho2_cos_bins",
-    "-",
-    Value("20"),
-    Integer(1, 10_000),
-    "bins of cos theta over [-1, 1] of the two-body density",
-);
+pub const OUTPUT_RHO2_COS_BINS: Spec = key("output.rho2_cos_bins", "-",
+    Value("20"), Integer(1, 10_000),
+    "bins of cos theta over [-1, 1] of the two-body density");
 
 /// The keys of `hs-mc` scenarios, in the order `colloidsim keys hs-mc` lists them.
 pub static KEYS: &[Spec] = &[

@@ -5,6 +5,7 @@
 //! wall). Checkpoints hold the positions exactly: a restart continues bitwise.
 
 use crate::checkpoint::Envelope;
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 

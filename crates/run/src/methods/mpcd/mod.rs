@@ -30,6 +30,7 @@ use serde_json::json;
 use std::f64::consts::PI;
 
 pub mod common;
+#[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
 
