@@ -227,12 +227,10 @@ impl DropletParams {
         })
     }
 
-    /// Set up replica `replica` (0-based) at step 0: random insertion (stream index
-    /// `replica`) or the last frame of `system.initial`, noise keyed by the replica.
-    pub fn build_replica(&self, replica: u32) -> Result<DropletSim, DropletError> {
-        let sbox = SimBox::cube(self.box_edge());
-        let particles = self.initial_particles(replica)?;
-        let params = BdParams {
+    /// The free-draining engine's parameters of replica `replica` (a fresh start and a
+    /// restart take them from here alike).
+    pub fn bd_params(&self, replica: u32) -> BdParams {
+        BdParams {
             kt: self.kt,
             viscosity: self.viscosity,
             dt: self.dt,
@@ -242,13 +240,32 @@ impl DropletParams {
             sort_every: 500,
             max_drift: 0.2,
             integrator: self.integrator,
-        };
+        }
+    }
+
+    /// The hydrodynamic engine's parameters of replica `replica`.
+    pub fn hydro_bd_params(&self, replica: u32) -> HydroBdParams {
+        HydroBdParams {
+            kt: self.kt,
+            dt: self.dt,
+            seed: self.seed,
+            replica,
+            skin: self.skin,
+            max_drift: 0.2,
+        }
+    }
+
+    /// Set up replica `replica` (0-based) at step 0: random insertion (stream index
+    /// `replica`) or the last frame of `system.initial`, noise keyed by the replica.
+    pub fn build_replica(&self, replica: u32) -> Result<DropletSim, DropletError> {
+        let sbox = SimBox::cube(self.box_edge());
+        let particles = self.initial_particles(replica)?;
         Ok(Brownian::new(
             particles,
             sbox,
             LennardJones::wca(self.kt, self.diameter),
             self.interface(),
-            params,
+            self.bd_params(replica),
             0,
         )?)
     }
@@ -349,15 +366,12 @@ impl DropletParams {
         replica: u32,
         hydro: &HydroParams,
     ) -> Result<HydroDropletSim, DropletError> {
-        let params = HydroBdParams {
-            kt: self.kt,
-            dt: self.dt,
-            seed: self.seed,
-            replica,
-            skin: self.skin,
-            max_drift: 0.2,
-        };
-        self.restart_hydro_replica(self.initial_particles(replica)?, hydro, params, 0)
+        self.restart_hydro_replica(
+            self.initial_particles(replica)?,
+            hydro,
+            self.hydro_bd_params(replica),
+            0,
+        )
     }
 
     /// A replica with hydrodynamics at `step` from its particles (positions and image counts,

@@ -10,12 +10,9 @@ use crate::trajectory::FrameDigest;
 use anyhow::{Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::brownian::Integrator;
 use colloidsim_md::gsd::{self, GsdFrame, GsdWriter};
 use colloidsim_md::hydro::AnyMobility;
-use colloidsim_md::{
-    BdParams, Brownian, External, HydroBdParams, HydroBrownian, LennardJones, Particles, SimBox,
-};
+use colloidsim_md::{Brownian, External, HydroBrownian, LennardJones, Particles, SimBox};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -168,89 +165,17 @@ impl<E: External> Replica<E> {
     }
 }
 
-/// The integrator parameters of the running replica (`BdParams`), so that it continues with
-/// exactly the parameters it started with (part of the method's checkpoint state).
+/// What the checkpoint keeps of the running replica beyond its GSD file. Its engine parameters
+/// are not here: a restart takes every parameter from the scenario saved with the run (the
+/// driver refuses one that resolves to other parameters), as a fresh start does.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub(crate) struct EngineState {
-    kt: f64,
-    viscosity: f64,
-    dt: f64,
-    seed: u32,
-    replica: u32,
-    skin: f64,
-    sort_every: u64,
-    max_drift: f64,
     /// Neighbour-list builds of this replica so far.
     pub(crate) builds: u64,
 }
 
-impl EngineState {
-    pub(crate) fn of<E: External>(s: &Replica<E>, builds: u64) -> Self {
-        match s {
-            Replica::Free(s) => {
-                let b = s.params();
-                Self {
-                    kt: b.kt,
-                    viscosity: b.viscosity,
-                    dt: b.dt,
-                    seed: b.seed,
-                    replica: b.replica,
-                    skin: b.skin,
-                    sort_every: b.sort_every,
-                    max_drift: b.max_drift,
-                    builds,
-                }
-            }
-            Replica::Hydro(s) => {
-                let b = s.params();
-                Self {
-                    kt: b.kt,
-                    viscosity: 0.0,
-                    dt: b.dt,
-                    seed: b.seed,
-                    replica: b.replica,
-                    skin: b.skin,
-                    sort_every: 0,
-                    max_drift: b.max_drift,
-                    builds,
-                }
-            }
-        }
-    }
-
-    /// The hydrodynamic engine's parameters.
-    pub(crate) fn hydro_params(&self) -> HydroBdParams {
-        HydroBdParams {
-            kt: self.kt,
-            dt: self.dt,
-            seed: self.seed,
-            replica: self.replica,
-            skin: self.skin,
-            max_drift: self.max_drift,
-        }
-    }
-
-    /// The free-draining engine's parameters with `integrator` (the scenario's
-    /// `run.integrator`: a restart runs the scenario it started with, so the checkpoint need not
-    /// hold it; nor the Leimkuhler–Matthews deviates, which the engine draws again from (seed,
-    /// step, particle)).
-    pub(crate) fn params(&self, integrator: Integrator) -> BdParams {
-        BdParams {
-            kt: self.kt,
-            viscosity: self.viscosity,
-            dt: self.dt,
-            seed: self.seed,
-            replica: self.replica,
-            skin: self.skin,
-            sort_every: self.sort_every,
-            max_drift: self.max_drift,
-            integrator,
-        }
-    }
-}
-
 /// A replica's GSD checkpoint as `checkpoint.bin` names it: file name, its CRC-32 and the
-/// engine's parameters.
+/// replica's list builds.
 pub(crate) type ReplicaState = (String, u32, EngineState);
 
 /// Checkpoint `sim` (the running replica and its list builds before this session), if any,
@@ -279,7 +204,13 @@ fn save_replica<E: External>(
                 s.write_checkpoint(None)?;
                 0
             };
-            Some((name, crc, EngineState::of(s, builds + s.neighbor_builds())))
+            Some((
+                name,
+                crc,
+                EngineState {
+                    builds: builds + s.neighbor_builds(),
+                },
+            ))
         }
         None => {
             stale.push(name);
@@ -304,7 +235,7 @@ pub(crate) fn read_replica_checkpoint(
     hydro: bool,
     diameter: f64,
 ) -> Result<GsdFrame> {
-    let (name, crc, engine) = state;
+    let (name, crc, _) = state;
     let path = out.join(name);
     let found = file_crc(&path)?;
     if found != *crc {
@@ -314,8 +245,7 @@ pub(crate) fn read_replica_checkpoint(
         );
     }
     let mut f = gsd::read_frame(&path, None)?;
-    if f.step != step || !f.exact || f.list.is_none() != hydro || engine.replica as usize != replica
-    {
+    if f.step != step || !f.exact || f.list.is_none() != hydro {
         bail!(
             "{}: not the checkpoint of replica {replica} at step {step} that checkpoint.bin names",
             path.display(),

@@ -17,8 +17,10 @@ pub const CHECKPOINT: &str = "checkpoint.bin";
 /// continuation draws, change, so that a restart across such a change is refused instead of
 /// silently continuing a different run. 2: the 1024-strip ziggurat; 3: the run path's
 /// envelope with a checksum; 4: the CRC-32 of the trajectory frames written so far; 5: the BCD
-/// density and contact density keep their block counts (for the standard errors).
-pub const FORMAT: u32 = 5;
+/// density and contact density keep their block counts (for the standard errors); 6: a BD
+/// replica's checkpoint no longer copies its engine parameters (a restart takes them from the
+/// scenario, as every method's does).
+pub const FORMAT: u32 = 6;
 
 /// The version string that leads every checkpoint: the package version and the format.
 pub fn version() -> String {

@@ -236,7 +236,7 @@ fn restore_replica(
     let engine = &state.2;
     let sim = if hydro {
         Replica::Hydro(Box::new(
-            p.restart_hydro_replica(f.particles, engine.hydro_params(), f.step)
+            p.restart_hydro_replica(f.particles, p.hydro_bd_params(saved.replica as u32), f.step)
                 .with_context(|| format!("restart from {}", path.display()))?,
         ))
     } else {
@@ -246,7 +246,7 @@ fn restore_replica(
                 f.sbox,
                 p.pair(),
                 p.body(),
-                engine.params(p.integrator),
+                p.bd_params(saved.replica as u32),
                 f.step,
                 f.list.as_ref(),
             )

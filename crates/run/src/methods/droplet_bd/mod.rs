@@ -241,15 +241,20 @@ fn restore_replica(
                 f.sbox,
                 LennardJones::wca(p.kt, p.diameter),
                 p.interface(),
-                engine.params(p.integrator),
+                p.bd_params(saved.replica as u32),
                 f.step,
                 f.list.as_ref(),
             )
             .with_context(|| format!("restart from {}", path.display()))?,
         )),
         Some(h) => Replica::Hydro(Box::new(
-            p.restart_hydro_replica(f.particles, h, engine.hydro_params(), f.step)
-                .with_context(|| format!("restart from {}", path.display()))?,
+            p.restart_hydro_replica(
+                f.particles,
+                h,
+                p.hydro_bd_params(saved.replica as u32),
+                f.step,
+            )
+            .with_context(|| format!("restart from {}", path.display()))?,
         )),
     };
     // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
