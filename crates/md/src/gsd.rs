@@ -15,6 +15,9 @@ use crate::state::{Particles, SimBox};
 use hoomd_gsd::file_layer::{GsdFile, Mode};
 use std::path::{Path, PathBuf};
 
+mod layer;
+pub use layer::{Entry, GsdFileWriter, GsdIndex, Layout, Value, restore_layout};
+
 const NAME_LEN: usize = 64;
 const POS64: &str = "log/particles/position_f64";
 const BOX64: &str = "log/configuration/box_f64";
@@ -63,9 +66,9 @@ fn chain(e: &dyn std::error::Error) -> String {
     s
 }
 
-/// Appends frames to a new GSD file.
+/// Appends frames to a GSD file ([`GsdFileWriter`]: its bytes depend on the frames alone).
 pub struct GsdWriter {
-    file: GsdFile,
+    file: GsdFileWriter,
     path: PathBuf,
     dynamics: bool,
 }
@@ -74,12 +77,7 @@ impl GsdWriter {
     /// Create a new file; an existing file is an error (nothing is overwritten).
     pub fn create_new(path: &Path) -> Result<Self, GsdError> {
         let application = format!("colloidsim {}", env!("CARGO_PKG_VERSION"));
-        let file = GsdFile::create_new(path, &application, "hoomd", (1, 4)).map_err(|e| {
-            GsdError::Open {
-                path: path.to_path_buf(),
-                message: chain(&e),
-            }
-        })?;
+        let file = GsdFileWriter::create_new(path, &application, "hoomd", (1, 4))?;
         Ok(Self {
             file,
             path: path.to_path_buf(),
@@ -89,7 +87,7 @@ impl GsdWriter {
 
     /// Open an existing file to append frames (restarts).
     pub fn append(path: &Path) -> Result<Self, GsdError> {
-        let file = open_checked(path, Mode::Write)?;
+        let file = GsdFileWriter::append(path)?;
         Ok(Self {
             file,
             path: path.to_path_buf(),
@@ -171,7 +169,10 @@ impl GsdWriter {
         log: &[(&str, &[f64])],
     ) -> Result<(), String> {
         let f = &mut self.file;
-        let e = |e: hoomd_gsd::file_layer::WriteError| chain(&e);
+        let e = |e: GsdError| match e {
+            GsdError::Write { message, .. } => message,
+            other => other.to_string(),
+        };
         f.write_scalars("configuration/step", [step]).map_err(e)?;
         f.write_scalars("configuration/dimensions", [3u8])
             .map_err(e)?;
@@ -243,16 +244,13 @@ impl GsdWriter {
             f.write_scalars(&format!("log/{name}"), v.iter().copied())
                 .map_err(e)?;
         }
-        f.end_frame().map_err(|x| chain(&x))?;
+        f.end_frame().map_err(e)?;
         Ok(())
     }
 
     /// Flush buffered frames to the file system.
     pub fn sync(&mut self) -> Result<(), GsdError> {
-        self.file.sync_all().map_err(|e| GsdError::Write {
-            path: self.path.clone(),
-            message: chain(&e),
-        })
+        self.file.sync_all()
     }
 }
 

@@ -431,7 +431,7 @@ impl<E: External> Replicas<E> {
             && self.trajectory_every > 0
             && let Some(traj) = &self.traj
         {
-            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            // On a restart the file holds exactly the checkpoint's frames (FrameDigest::restore).
             self.gsd = Some(if traj.exists() {
                 GsdWriter::append(traj)?
             } else {

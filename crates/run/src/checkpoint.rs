@@ -19,8 +19,9 @@ pub const CHECKPOINT: &str = "checkpoint.bin";
 /// envelope with a checksum; 4: the CRC-32 of the trajectory frames written so far; 5: the BCD
 /// density and contact density keep their block counts (for the standard errors); 6: a BD
 /// replica's checkpoint no longer copies its engine parameters (a restart takes them from the
-/// scenario, as every method's does).
-pub const FORMAT: u32 = 6;
+/// scenario, as every method's does); 7: the trajectory digest covers every chunk of every
+/// frame and keeps the file's layout (a restart cuts the file back to it, byte for byte).
+pub const FORMAT: u32 = 7;
 
 /// The version string that leads every checkpoint: the package version and the format.
 pub fn version() -> String {

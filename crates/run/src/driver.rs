@@ -96,16 +96,30 @@ fn run_with(
         ctl.progress().warning(w);
     }
     let out_path = opts.out.clone().unwrap_or_else(|| PathBuf::from(sc.name()));
+    let mut kept = Vec::new();
     let out = if session.is_writer() {
         let created = (|| -> Result<OutputDir> {
+            let input_copy = input_in_folder(sc, &out_path)?;
             let out = OutputDir::create(&out_path, opts.force)?;
             if opts.force {
-                for w in clear_earlier_outputs(&out, &*session)? {
+                let keep = input_copy.then_some("scenario.toml");
+                let (w, k) = clear_earlier_outputs(&out, &*session, keep)?;
+                for w in w {
                     ctl.progress().warning(&w);
                     warnings.push(w);
                 }
+                kept = k;
             }
-            out.write_bytes("scenario.toml", sc.text().as_bytes())?;
+            if input_copy {
+                // The user's file, which is the scenario as run: left as it is, never recorded
+                // as this run's (a later --force keeps it).
+                if !kept.iter().any(|k| k == "scenario.toml") {
+                    kept.push("scenario.toml".into());
+                }
+            } else {
+                out.write_bytes("scenario.toml", sc.text().as_bytes())?;
+            }
+            record_files(&out, &*session, &kept)?;
             Ok(out)
         })();
         created.map_err(|e| session.fail_alone(e))?
@@ -125,7 +139,10 @@ fn run_with(
     if let Err(e) = session.begin(&out, true) {
         return Err(session.fail_alone(e));
     }
-    drive(session, out, envelope, ctl, warnings)
+    if let Err(e) = record_files(&out, &*session, &kept) {
+        return Err(session.fail_alone(e));
+    }
+    drive(session, out, envelope, ctl, warnings, kept)
 }
 
 /// The scenario as a run with `seed` runs it: with its `seed` key set when `--seed` (or an
@@ -139,11 +156,72 @@ fn as_run(sc: &Scenario, seed: Option<u64>) -> Result<Scenario> {
     }
 }
 
-/// `--force`: remove the files an earlier run of this method left (so that none mixes with the
-/// new run); keep any other file. Returns what to tell the user.
-fn clear_earlier_outputs(out: &OutputDir, s: &dyn Session) -> Result<Vec<String>> {
+/// The file in which a run records, from its start and at each checkpoint, the files it has
+/// written in its folder (with those it found there and kept), so that a later `--force`
+/// removes those and nothing else; removed once `summary.json`, which lists them, is written.
+pub const MANIFEST: &str = "manifest.json";
+
+/// Files the driver itself writes in every run folder.
+const DRIVER_FILES: [&str; 4] = ["scenario.toml", "summary.json", CHECKPOINT, MANIFEST];
+
+/// Is the scenario file the run reads the `scenario.toml` of its output folder `out`? Then
+/// the run leaves it as it is when it is the scenario as run, byte for byte (`true`), and is
+/// refused otherwise: its as-run copy would overwrite the user's file.
+fn input_in_folder(sc: &Scenario, out: &Path) -> Result<bool> {
+    let (Some(origin), copy) = (sc.origin(), out.join("scenario.toml")) else {
+        return Ok(false);
+    };
+    let same = match (std::fs::canonicalize(origin), std::fs::canonicalize(&copy)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if !same {
+        return Ok(false);
+    }
+    if std::fs::read(&copy).is_ok_and(|b| b == sc.text().as_bytes()) {
+        return Ok(true);
+    }
+    bail!(
+        "{} is the scenario this run reads, and it lies in the output folder {}, where the run \
+         writes the scenario as run (with its seed and any --set) as {}: that would overwrite \
+         your file. Keep the scenario outside the output folder (move or copy it elsewhere and \
+         run that), or choose another --out",
+        origin.display(),
+        out.display(),
+        copy.display()
+    )
+}
+
+/// The files an earlier run in `out` recorded as its own: the `files` of its summary.json (a
+/// finished or failed run) and of its manifest (an interrupted or killed one), with those two.
+fn recorded_files(out: &OutputDir) -> std::collections::BTreeSet<String> {
+    let mut r = std::collections::BTreeSet::new();
+    for name in ["summary.json", MANIFEST] {
+        let v = std::fs::read(out.join(name))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok());
+        if let Some(files) = v.as_ref().and_then(|v| v["files"].as_array()) {
+            r.insert(name.to_string());
+            r.extend(files.iter().filter_map(|f| f.as_str().map(String::from)));
+        }
+    }
+    r
+}
+
+/// `--force`: remove the files that an earlier run in `out` recorded as its own
+/// ([`recorded_files`]), keep every other (and `keep`, the scenario the run reads). A kept file
+/// this run would overwrite is refused before anything is removed. Returns what to tell the
+/// user and the names kept.
+fn clear_earlier_outputs(
+    out: &OutputDir,
+    s: &dyn Session,
+    keep: Option<&str>,
+) -> Result<(Vec<String>, Vec<String>)> {
+    let recorded = recorded_files(out);
+    let stem = |n: &str| Path::new(n).file_stem().map(|x| x.to_os_string());
     let mut removed = Vec::new();
     let mut kept = Vec::new();
+    let mut clash = Vec::new();
     let entries =
         std::fs::read_dir(out.path()).with_context(|| out.path().display().to_string())?;
     for e in entries {
@@ -153,22 +231,45 @@ fn clear_earlier_outputs(out: &OutputDir, s: &dyn Session) -> Result<Vec<String>
             kept.push(name);
             continue;
         }
-        let ours = s.writes(&name)
-            || ["summary.json", "scenario.toml", CHECKPOINT].contains(&name.as_str())
-            || name.ends_with(".partial");
-        if ours {
-            std::fs::remove_file(e.path()).with_context(|| e.path().display().to_string())?;
+        // A temporary file of an atomic write (`NAME.partial`) of a recorded file.
+        let partial = name.ends_with(".partial")
+            && recorded
+                .iter()
+                .map(String::as_str)
+                .chain(DRIVER_FILES)
+                .any(|r| stem(r) == stem(&name))
+            && !recorded.is_empty();
+        if Some(name.as_str()) != keep && (recorded.contains(&name) || partial) {
             removed.push(name);
         } else {
+            if Some(name.as_str()) != keep
+                && (s.writes(&name) || DRIVER_FILES.contains(&name.as_str()))
+            {
+                clash.push(name.clone());
+            }
             kept.push(name);
         }
     }
     removed.sort();
     kept.sort();
+    clash.sort();
+    if !clash.is_empty() {
+        bail!(
+            "--force: {} holds {}, which this run would overwrite, but no earlier colloidsim run \
+             there recorded as its own (in summary.json or {MANIFEST}); nothing was removed. \
+             Move them out of the folder, or choose another --out",
+            out.path().display(),
+            clash.join(", ")
+        );
+    }
+    for name in &removed {
+        let path = out.join(name);
+        std::fs::remove_file(&path).with_context(|| path.display().to_string())?;
+    }
     let mut w = Vec::new();
     if !removed.is_empty() {
         w.push(format!(
-            "--force: removed {} file(s) of an earlier run in {}: {}",
+            "--force: removed {} file(s) an earlier run recorded as its own in {}: {}",
             removed.len(),
             out.path().display(),
             removed.join(", ")
@@ -176,12 +277,108 @@ fn clear_earlier_outputs(out: &OutputDir, s: &dyn Session) -> Result<Vec<String>
     }
     if !kept.is_empty() {
         w.push(format!(
-            "--force: kept what this run does not write in {}: {}",
+            "--force: kept what no earlier run recorded as its own in {}: {}",
             out.path().display(),
             kept.join(", ")
         ));
     }
-    Ok(w)
+    Ok((w, kept))
+}
+
+/// Record in [`MANIFEST`] the files of the run in `out` so far: those there now that the run
+/// writes, but not the `kept` ones it found there (the writer; atomically).
+fn record_files(out: &OutputDir, s: &dyn Session, kept: &[String]) -> Result<()> {
+    if !s.is_writer() {
+        return Ok(());
+    }
+    let mut files = Vec::new();
+    for e in std::fs::read_dir(out.path()).with_context(|| out.path().display().to_string())? {
+        let e = e?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        let ours = s.writes(&name) || DRIVER_FILES.contains(&name.as_str());
+        if e.file_type()?.is_file() && ours && name != MANIFEST && !kept.contains(&name) {
+            files.push(name);
+        }
+    }
+    write_manifest(out, files, kept)
+}
+
+/// Write [`MANIFEST`]: `files` (with those it already lists) and `kept`.
+fn write_manifest(out: &OutputDir, files: Vec<String>, kept: &[String]) -> Result<()> {
+    let mut all: std::collections::BTreeSet<String> = files.into_iter().collect();
+    if let Some(old) = std::fs::read(out.join(MANIFEST))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        && let Some(f) = old["files"].as_array()
+    {
+        all.extend(f.iter().filter_map(|x| x.as_str().map(String::from)));
+    }
+    out.write_json(
+        MANIFEST,
+        &json!({ "software": crate::software(), "files": all, "kept": kept }),
+    )?;
+    Ok(())
+}
+
+/// The names a run found in its folder and kept (from its manifest).
+fn kept_files(out: &OutputDir) -> Vec<String> {
+    std::fs::read(out.join(MANIFEST))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| {
+            v["kept"].as_array().map(|k| {
+                k.iter()
+                    .filter_map(|x| x.as_str().map(String::from))
+                    .collect()
+            })
+        })
+        .unwrap_or_default()
+}
+
+/// A restart puts back `scenario.toml` as the run started with it (the checkpoint's
+/// `scenario`) when it was deleted or edited; an edited copy is kept as
+/// `scenario.toml.edited` (or `.edited.2`, ... : never over another file). Returns the
+/// warning to give.
+fn restore_scenario(out: &OutputDir, text: &str) -> Result<Option<String>> {
+    let path = out.join("scenario.toml");
+    match std::fs::read(&path) {
+        Ok(b) if b == text.as_bytes() => Ok(None),
+        Ok(_) => {
+            let mut k = 1;
+            let kept = loop {
+                let name = if k == 1 {
+                    "scenario.toml.edited".to_string()
+                } else {
+                    format!("scenario.toml.edited.{k}")
+                };
+                match std::fs::hard_link(&path, out.join(&name)) {
+                    Ok(()) => break name,
+                    Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && k < 1000 => k += 1,
+                    Err(e) => {
+                        return Err(anyhow::anyhow!(
+                            "{}: edited since the run started, and it cannot be kept as {name} \
+                             ({e}); move it away and restart",
+                            path.display()
+                        ));
+                    }
+                }
+            };
+            out.write_bytes("scenario.toml", text.as_bytes())?;
+            Ok(Some(format!(
+                "{} was edited: restored the one the run started with; the edited copy kept \
+                 as {kept}",
+                path.display()
+            )))
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            out.write_bytes("scenario.toml", text.as_bytes())?;
+            Ok(Some(format!(
+                "{} was missing: restored the one the run started with",
+                path.display()
+            )))
+        }
+        Err(e) => Err(anyhow::anyhow!("{}: {e}", path.display())),
+    }
 }
 
 /// Continue the interrupted run in `dir` from its checkpoint, bitwise as if it had never
@@ -290,25 +487,40 @@ fn resume_with(
             envelope.position
         );
     }
-    let warnings = session.warnings();
+    let mut warnings = session.warnings();
+    let kept = kept_files(&out);
+    if session.is_writer() {
+        let restored = restore_scenario(&out, &envelope.scenario);
+        if let Some(w) = restored.map_err(|e| session.fail_alone(e))? {
+            warnings.push(w);
+        }
+    }
     for w in &warnings {
         ctl.progress().warning(w);
     }
     if let Err(e) = session.begin(&out, false) {
         return Err(session.fail_alone(e));
     }
-    drive(session, out, envelope, ctl, warnings)
+    drive(session, out, envelope, ctl, warnings, kept)
 }
 
 /// Write a checkpoint at the session's position (every rank of a decomposed run takes part;
 /// the writer writes).
-fn save(s: &mut dyn Session, out: &OutputDir, env: &mut Envelope, wall: f64) -> Result<()> {
+fn save(
+    s: &mut dyn Session,
+    out: &OutputDir,
+    env: &mut Envelope,
+    wall: f64,
+    kept: &[String],
+) -> Result<()> {
     s.flush().map_err(|e| s.fail_alone(e))?;
     env.payload = s.save(out)?;
     env.position = s.position();
     env.wall_seconds = wall;
     if s.is_writer() {
-        let written = checkpoint::encode(env).and_then(|b| Ok(out.write_bytes(CHECKPOINT, &b)?));
+        let written = checkpoint::encode(env)
+            .and_then(|b| Ok(out.write_bytes(CHECKPOINT, &b)?))
+            .and_then(|_| record_files(out, s, kept));
         written.map_err(|e| s.fail_alone(e))?;
     }
     env.payload = Vec::new();
@@ -352,6 +564,7 @@ fn drive(
     mut env: Envelope,
     ctl: &Control,
     mut warnings: Vec<String>,
+    kept: Vec<String>,
 ) -> Result<Report> {
     let total = s.total();
     let hooks = Hooks::from_env();
@@ -398,8 +611,9 @@ fn drive(
                             return Ok(Some(why));
                         }
                     }
-                    save(&mut *s, &out, &mut env, wall())?;
+                    save(&mut *s, &out, &mut env, wall(), &kept)?;
                     let outputs = s.interim_outputs(&out)?;
+                    record_files(&out, &*s, &kept)?;
                     ctl.progress().end();
                     return Err(Interrupted {
                         at: pos,
@@ -431,7 +645,7 @@ fn drive(
                 chunk = (chunk / 2).max(1);
             }
             if due == Some(s.position()) {
-                save(&mut *s, &out, &mut env, wall())?;
+                save(&mut *s, &out, &mut env, wall(), &kept)?;
             }
             ctl.progress().advance(s.position());
             ctl.progress()
@@ -452,7 +666,11 @@ fn drive(
     }
     warnings.extend(fin.warnings);
     let mut summary = fin.summary;
-    let mut files = vec!["scenario.toml".to_string()];
+    // The scenario.toml the run was given, in its folder, is the user's, not the run's.
+    let mut files = Vec::new();
+    if !kept.iter().any(|k| k == "scenario.toml") {
+        files.push("scenario.toml".to_string());
+    }
     files.extend(fin.files.into_iter().filter(|f| f != "scenario.toml"));
     if let Some(m) = summary.as_object_mut() {
         m.insert("completed".into(), json!(failure.is_none()));
@@ -460,9 +678,12 @@ fn drive(
         m.insert("files".into(), json!(files));
     }
     if s_is_writer {
+        write_manifest(&out, files.clone(), &kept)?;
         out.write_json("summary.json", &summary)?;
-        // The run is over: its checkpoint is no longer needed (a restart now refuses).
+        // The run is over: its checkpoint is no longer needed (a restart now refuses), and
+        // summary.json lists its files.
         let _ = std::fs::remove_file(out.join(CHECKPOINT));
+        let _ = std::fs::remove_file(out.join(MANIFEST));
     }
     if let Some(message) = failure {
         return Err(Failed {

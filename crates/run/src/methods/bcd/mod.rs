@@ -25,7 +25,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem, bulk};
-use hoomd_gsd::file_layer::{GsdFile, Mode};
+use colloidsim_md::gsd::GsdFileWriter as GsdFile;
 use params::{Resolved, Scenario};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -86,12 +86,7 @@ impl Method for BcdMethod {
         let (sc, r) = read(src, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
         if sc.observe.trajectory.is_some() {
-            let b = RodBox::of(&r.config);
-            saved
-                .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &b)
-                })?;
+            saved.digest.restore(&out.join("trajectory.gsd"))?;
         }
         session(sc, r, Some(saved))
     }
@@ -577,15 +572,19 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
 fn open_trajectory(out: &OutputDir, append: bool) -> Result<GsdFile> {
     let path = out.join("trajectory.gsd");
     Ok(if append && path.exists() {
-        colloidsim_md::gsd::open_checked(&path, Mode::Write)?
+        GsdFile::append(&path)?
     } else {
         create_trajectory(&path)?
     })
 }
 
 fn create_trajectory(path: &std::path::Path) -> Result<GsdFile> {
-    GsdFile::create(path, &crate::software(), "hoomd", (1, 4))
-        .with_context(|| path.display().to_string())
+    Ok(GsdFile::create_new(
+        path,
+        &crate::software(),
+        "hoomd",
+        (1, 4),
+    )?)
 }
 
 /// What the frames of a BCD trajectory look like in the HOOMD schema (`docs/bcd.md`).
@@ -666,51 +665,6 @@ fn write_frame(g: &mut GsdFile, step: u64, b: &RodBox, x: &[f32], image: &[i32])
         g.write_scalars("log/bcd/walls", [-h, h])?;
     }
     g.end_frame()?;
-    Ok(())
-}
-
-/// Keep the first `frames` frames of a BCD trajectory (a run killed after its last checkpoint
-/// may have written more), rewritten from their steps, positions and images exactly as
-/// [`write_frame`] wrote them, so that the continuation appends where the checkpoint stood.
-fn trim_trajectory(path: &std::path::Path, frames: u64, b: &RodBox) -> Result<()> {
-    let file = colloidsim_md::gsd::open_checked(path, Mode::Read)?;
-    if file.n_frames() == frames {
-        return Ok(());
-    }
-    if frames > 0 && file.find_chunk(0, "particles/image").is_none() {
-        bail!(
-            "{}: its frames have no particles/image chunk (written by a colloidsim from before the HOOMD-style BCD trajectory, which kept unwrapped positions in a log chunk), and the run stopped after its last checkpoint, so the file would have to be cut back to {frames} frames, which this build does not do for that layout. Start the run again in a new folder, or continue it with the build that wrote it",
-            path.display()
-        );
-    }
-    let tmp = path.with_extension("gsd.trim");
-    let _ = std::fs::remove_file(&tmp);
-    {
-        let mut g = create_trajectory(&tmp)?;
-        for k in 0..frames {
-            let e = |e: hoomd_gsd::file_layer::ReadError| {
-                anyhow::anyhow!("{}: frame {k}: {e}", path.display())
-            };
-            let step = file
-                .iter_scalars::<u64>(k, "configuration/step")
-                .map_err(e)?
-                .next()
-                .with_context(|| format!("{}: frame {k}: no step", path.display()))?;
-            let x: Vec<f32> = file
-                .iter_arrays::<f32, 3>(k, "particles/position")
-                .map_err(e)?
-                .map(|p| p[0])
-                .collect();
-            let image: Vec<i32> = file
-                .iter_arrays::<i32, 3>(k, "particles/image")
-                .map_err(e)?
-                .map(|i| i[0])
-                .collect();
-            write_frame(&mut g, step, b, &x, &image)?;
-        }
-        g.sync_all()?;
-    }
-    std::fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
     Ok(())
 }
 
@@ -1546,41 +1500,6 @@ mod tests {
     use super::*;
     use colloidsim_bcd::forces::NoField;
     use colloidsim_bcd::{BcdConfig, Update, init};
-
-    /// A trajectory of the layout before the image chunk (positions only, unwrapped x in a
-    /// log chunk) that would need trimming is refused with the file's name and what to do,
-    /// and left as it was.
-    #[test]
-    fn trimming_a_trajectory_without_images_is_refused_by_name() {
-        let tmp = tempfile::tempdir().unwrap();
-        let path = tmp.path().join("trajectory.gsd");
-        {
-            let mut g = GsdFile::create(&path, "hoomd-rs 1.4.0", "hoomd", (1, 4)).unwrap();
-            for step in [0u64, 100, 200] {
-                g.write_scalars("configuration/step", [step]).unwrap();
-                g.write_scalars("particles/N", [2u32]).unwrap();
-                g.write_arrays("particles/position", [[0.5f32, 0.0, 0.0], [1.5, 0.0, 0.0]])
-                    .unwrap();
-                g.write_scalars("log/particles/x_unwrapped", [0.5f64, 1.5])
-                    .unwrap();
-                g.end_frame().unwrap();
-            }
-            g.sync_all().unwrap();
-        }
-        let before = std::fs::read(&path).unwrap();
-        let b = RodBox {
-            length: 10.0,
-            walls: false,
-            sigma: 1.0,
-        };
-        // Nothing to trim: accepted as it is.
-        trim_trajectory(&path, 3, &b).unwrap();
-        let e = format!("{:#}", trim_trajectory(&path, 2, &b).unwrap_err());
-        assert!(e.contains("trajectory.gsd"), "{e}");
-        assert!(e.contains("particles/image"), "{e}");
-        assert!(e.contains("Start the run again"), "{e}");
-        assert_eq!(std::fs::read(&path).unwrap(), before);
-    }
 
     /// Engine states round-trip through the checkpoint encoding bit for bit, with and without
     /// the ring update's reduced coordinates (bincode is not self-describing, so every field

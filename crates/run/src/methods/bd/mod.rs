@@ -32,7 +32,6 @@ use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;
@@ -206,9 +205,7 @@ fn restore(
         saved
             .acc
             .digest
-            .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &[TIME_LOG], false)
-            })
+            .restore(&out.join("trajectory.gsd"))
             .map_err(|e| fail_alone_over(comm.as_deref(), e))?;
     }
     Ok(Box::new(BulkObs::session(

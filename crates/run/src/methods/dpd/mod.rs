@@ -14,7 +14,6 @@ use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
@@ -135,9 +134,7 @@ fn restore(
     if sim.rank().0 == 0 {
         ck.obs
             .digest
-            .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &FRAME_LOGS, true)
-            })
+            .restore(&out.join("trajectory.gsd"))
             .map_err(|e| fail_alone(&sim, e))?;
     }
     // Restoring builds the lists the interrupted run built at this step: count them once.
@@ -500,7 +497,7 @@ impl Session for DpdSession {
         }
         if self.s.observe.trajectory_every > 0 {
             let traj = out.join("trajectory.gsd");
-            // On a restart the file holds exactly the checkpoint's frames (trim_trajectory).
+            // On a restart the file holds exactly the checkpoint's frames (FrameDigest::restore).
             self.gsd = Some(if traj.exists() {
                 GsdWriter::append(&traj)?.with_velocities()
             } else {

@@ -17,7 +17,6 @@ use crate::plot::{
     picture,
 };
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
@@ -156,9 +155,7 @@ fn restore(
         saved
             .acc
             .digest
-            .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &["droplet/radius", "droplet/time"], false)
-            })
+            .restore(&out.join("trajectory.gsd"))
             .map_err(|e| fail_alone_over(comm.as_deref(), e))?;
     }
     Ok(Box::new(DropletObs::session(

@@ -11,7 +11,6 @@ use crate::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
 };
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
@@ -137,9 +136,7 @@ impl Method for DropletMpcd {
             saved
                 .acc
                 .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &["radius"], true)
-                })
+                .restore(&out.join("trajectory.gsd"))
                 .map_err(|e| crate::method::fail_alone_over(srd.exchange(), e))?;
         }
         Ok(Box::new(DropletSession {

@@ -14,7 +14,6 @@ use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -116,12 +115,7 @@ impl Method for HsMc {
         let mut mc = p.engine(Some(&rows), "checkpoint.bin")?;
         mc.restore(saved.pos, saved.sweeps, saved.delta);
         if p.trajectory_every > 0 {
-            saved
-                .acc
-                .digest
-                .restore(&out.join("trajectory.gsd"), |path, frames| {
-                    trim_trajectory(path, frames, &[], false)
-                })?;
+            saved.acc.digest.restore(&out.join("trajectory.gsd"))?;
         }
         Ok(Box::new(McSession::new(p, mc, saved.acc)))
     }

@@ -16,7 +16,6 @@ use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, line_plot, picture};
 use crate::trajectory::FrameDigest;
-use crate::trajectory::trim_trajectory;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
@@ -253,9 +252,7 @@ fn restore_bulk(
         saved
             .acc
             .digest
-            .restore(&out.join("trajectory.gsd"), |path, frames| {
-                trim_trajectory(path, frames, &[], true)
-            })
+            .restore(&out.join("trajectory.gsd"))
             .map_err(|e| crate::method::fail_alone_over(srd.exchange(), e))?;
     }
     Ok(Box::new(BulkSession {
