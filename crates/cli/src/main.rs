@@ -876,7 +876,8 @@ fn ensemble_member(plan: impl FnOnce() -> Result<Ensemble>, k: usize, how: &Laun
     }
     let dir = plan.out().join(&plan.members()[k].folder);
     let out = shell_word(&plan.out().display().to_string());
-    let collect = format!("when every member is: colloidsim ensemble --collect {out}");
+    let collect =
+        format!("once every member is, average them: colloidsim ensemble --collect {out}");
     if plan.member_state(k) == MemberState::Complete {
         if !how.quiet {
             println!("member {k} is complete in {}; {collect}", dir.display());
