@@ -1,5 +1,6 @@
 //! `colloidsim`: run a scenario, compute its theory, check it, list its keys, or benchmark an
-//! engine. Argument parsing, a progress bar and Ctrl-C; the run path is `colloidsim-run`.
+//! engine. Argument parsing, a progress bar, signals (Ctrl-C, SIGTERM, SIGUSR1), the wall-time
+//! budget and the exit statuses; the run path is `colloidsim-run`.
 
 mod bench_bcd;
 mod bench_bd;
@@ -13,13 +14,13 @@ mod rpy_bench;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use colloidsim_run::ensemble::{Ensemble, parse_vary};
-use colloidsim_run::{Control, Progress, RunOptions, Scenario, TheoryOptions};
+use colloidsim_run::ensemble::{Ensemble, MemberState, parse_vary};
+use colloidsim_run::{Control, Progress, RunOptions, Scenario, Stop, TheoryOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The methods and where they are documented, for `--help`.
 fn methods_help() -> String {
@@ -89,6 +90,11 @@ enum Command {
         /// Continue an interrupted run from the checkpoint in this output folder.
         #[arg(long, conflicts_with_all = ["out", "force"])]
         restart: Option<PathBuf>,
+        /// Wall-time budget, HH:MM:SS (or D-HH:MM:SS, or seconds), counted from the program's
+        /// start: the run stops at the last checkpoint that fits, with a safety margin, and
+        /// exits with status 83 (docs/cluster.md).
+        #[arg(long, value_name = "HH:MM:SS", value_parser = parse_walltime)]
+        walltime: Option<WallTime>,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -146,8 +152,8 @@ enum Command {
     /// member in its own folder, and write their averages with errors; spreads the members over
     /// MPI ranks under `mpirun` (built with `--features mpi`).
     Ensemble {
-        /// Scenario file (TOML); not with --restart.
-        #[arg(required_unless_present = "restart")]
+        /// Scenario file (TOML); not with --restart or --collect.
+        #[arg(required_unless_present_any = ["restart", "collect"])]
         scenario: Option<PathBuf>,
         /// Output folder (default: the scenario's name followed by `-ensemble`).
         #[arg(long)]
@@ -172,6 +178,25 @@ enum Command {
         /// members are kept, interrupted ones continue from their checkpoints.
         #[arg(long, conflicts_with_all = ["scenario", "out", "force", "vary", "replicas"])]
         restart: Option<PathBuf>,
+        /// Run only member K (0-based; the folder and seed a whole ensemble gives it), e.g.
+        /// one job of a job array; the ensemble's folder and plan are created by the first
+        /// member to start, checked by the others. Then `--collect DIR` averages.
+        #[arg(long, value_name = "K", conflicts_with = "force")]
+        member: Option<usize>,
+        /// Average the members of the ensemble in this folder that were run with --member, as
+        /// a whole ensemble run does; refused while members are unfinished.
+        #[arg(long, value_name = "DIR", conflicts_with_all = [
+            "scenario", "out", "force", "vary", "replicas", "restart", "member", "walltime",
+            "threads", "set",
+        ])]
+        collect: Option<PathBuf>,
+        /// With --collect: average the members that finished, leaving out (and naming in
+        /// summary.json) those that did not.
+        #[arg(long, requires = "collect")]
+        finished_only: bool,
+        /// Wall-time budget, as for `colloidsim run --walltime` (for all the members run).
+        #[arg(long, value_name = "HH:MM:SS", value_parser = parse_walltime)]
+        walltime: Option<WallTime>,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -314,19 +339,173 @@ impl Bar {
     }
 }
 
-/// A control whose interrupt flag Ctrl-C sets; a second Ctrl-C stops at once.
-fn control(quiet: bool) -> Control {
-    let ctl = Control::new(Arc::new(Bar::new(quiet)));
-    let flag = ctl.interrupt_flag();
+/// Which signals ask a command to stop at its next checkpoint.
+#[derive(Clone, Copy, PartialEq)]
+enum Signals {
+    /// Ctrl-C only (commands that do not write checkpoints: SIGTERM still ends them at once).
+    CtrlC,
+    /// Ctrl-C, SIGTERM and SIGUSR1 (runs and ensembles).
+    All,
+}
+
+/// A control that the first Ctrl-C (and, with [`Signals::All`], SIGTERM or SIGUSR1) stops at
+/// the next checkpoint, with the signal as its cause; a second signal ends the program at
+/// once, without a checkpoint, with status 128 + the signal's number (130 for Ctrl-C). With a
+/// budget, the run stops by itself at the last checkpoint that fits in it.
+fn control(quiet: bool, signals: Signals, walltime: Option<&WallTime>) -> Control {
+    let mut ctl = Control::new(Arc::new(Bar::new(quiet)));
+    if let Some(w) = walltime {
+        ctl = ctl.with_walltime(w.seconds, started());
+    }
+    watch_signals(&ctl, signals);
+    ctl
+}
+
+#[cfg(unix)]
+fn watch_signals(ctl: &Control, which: Signals) {
+    use signal_hook::consts::{SIGINT, SIGTERM, SIGUSR1};
+    let list: &[i32] = match which {
+        Signals::CtrlC => &[SIGINT],
+        Signals::All => &[SIGINT, SIGTERM, SIGUSR1],
+    };
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(list) else {
+        return;
+    };
+    let ctl = ctl.clone();
+    std::thread::spawn(move || {
+        let mut seen = false;
+        for sig in signals.forever() {
+            let (cause, name) = match sig {
+                SIGTERM => (Stop::Terminate, "SIGTERM"),
+                SIGUSR1 => (Stop::User1, "SIGUSR1"),
+                _ => (Stop::Interrupt, "Ctrl-C"),
+            };
+            if seen {
+                eprintln!(
+                    "\nsecond {name}: stopping at once, without a checkpoint (the last one written remains)"
+                );
+                std::process::exit(128 + sig);
+            }
+            seen = true;
+            ctl.stop(cause);
+        }
+    });
+}
+
+#[cfg(not(unix))]
+fn watch_signals(ctl: &Control, _which: Signals) {
+    let ctl = ctl.clone();
+    let seen = std::sync::atomic::AtomicBool::new(false);
     let _ = ctrlc::set_handler(move || {
-        if flag.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        if seen.swap(true, std::sync::atomic::Ordering::SeqCst) {
             eprintln!(
-                "\nsecond Ctrl-C: stopping without a checkpoint (the last regular one remains)"
+                "\nsecond Ctrl-C: stopping at once, without a checkpoint (the last one written remains)"
             );
             std::process::exit(130);
         }
+        ctl.stop(Stop::Interrupt);
     });
-    ctl
+}
+
+/// When the program started (the wall-time budget counts from it).
+fn started() -> Instant {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    *START.get_or_init(Instant::now)
+}
+
+/// `--walltime`: the budget as given (repeated in the command that continues) and in seconds.
+#[derive(Clone, Debug)]
+struct WallTime {
+    text: String,
+    seconds: f64,
+}
+
+/// Parse `--walltime`: `HH:MM:SS` (hours may exceed 23), `D-HH:MM:SS` (Slurm's form), or
+/// seconds; more than 0 s and at most 366 days.
+fn parse_walltime(text: &str) -> std::result::Result<WallTime, String> {
+    let t = text.trim();
+    let form = "expected HH:MM:SS (e.g. 23:50:00), D-HH:MM:SS or a number of seconds";
+    let number = |s: &str| -> std::result::Result<f64, String> {
+        if s.is_empty() || !s.chars().all(|c| c.is_ascii_digit() || c == '.') {
+            return Err(format!("{form}, got '{text}'"));
+        }
+        s.parse::<f64>()
+            .map_err(|_| format!("{form}, got '{text}'"))
+    };
+    let (days, clock) = match t.split_once('-') {
+        Some((d, rest)) => (number(d)?, rest),
+        None => (0.0, t),
+    };
+    let parts: Vec<&str> = clock.split(':').collect();
+    let seconds = match parts[..] {
+        [s] if days == 0.0 && !t.contains('-') => number(s)?,
+        [h, m, s] => {
+            let (h, m, s) = (number(h)?, number(m)?, number(s)?);
+            if m >= 60.0 || s >= 60.0 {
+                return Err(format!(
+                    "minutes and seconds must be below 60, got '{text}'"
+                ));
+            }
+            ((days * 24.0 + h) * 60.0 + m) * 60.0 + s
+        }
+        _ => return Err(format!("{form}, got '{text}'")),
+    };
+    if !(seconds > 0.0 && seconds <= 366.0 * 86400.0) {
+        return Err(format!(
+            "must be more than 0 s and at most 366 days, got '{text}'"
+        ));
+    }
+    Ok(WallTime {
+        text: t.to_string(),
+        seconds,
+    })
+}
+
+/// The exit status of a run stopped with its checkpoint written, per cause (docs/cluster.md).
+fn stop_status(cause: Stop) -> u8 {
+    match cause {
+        Stop::Interrupt => 80,
+        Stop::Terminate => 81,
+        Stop::User1 => 82,
+        Stop::WallTime => 83,
+    }
+}
+
+/// A command stopped on request, its checkpoints written: the program exits with `status`
+/// after printing `message` (none when another rank printed it already).
+#[derive(Debug)]
+struct Stopped {
+    status: u8,
+    message: Option<String>,
+}
+
+impl std::fmt::Display for Stopped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(
+            self.message
+                .as_deref()
+                .unwrap_or("stopped (see the message above)"),
+        )
+    }
+}
+
+impl std::error::Error for Stopped {}
+
+/// [`parallel::Ranks::agree`] that keeps a stop's exit status on every rank.
+fn agree_stopped<T>(ranks: &parallel::Ranks, local: Result<T>) -> Result<T> {
+    let status = local
+        .as_ref()
+        .err()
+        .and_then(|e| e.downcast_ref::<Stopped>())
+        .map(|s| s.status);
+    ranks.agree(local).map_err(|e| match status {
+        Some(status) if e.downcast_ref::<parallel::Reported>().is_some() => Stopped {
+            status,
+            message: None,
+        }
+        .into(),
+        _ => e,
+    })
 }
 
 fn scenario(path: &Path, overrides: &Overrides) -> Result<Scenario> {
@@ -334,10 +513,17 @@ fn scenario(path: &Path, overrides: &Overrides) -> Result<Scenario> {
 }
 
 fn main() -> std::process::ExitCode {
+    started();
     quiet_on_closed_pipe();
     match run_cli() {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
+            if let Some(s) = e.downcast_ref::<Stopped>() {
+                if let Some(m) = &s.message {
+                    eprintln!("error: {m}");
+                }
+                return std::process::ExitCode::from(s.status);
+            }
             if e.downcast_ref::<parallel::Reported>().is_none() {
                 report(&e);
             }
@@ -400,15 +586,33 @@ fn quiet_on_closed_pipe() {
     }));
 }
 
-/// The error of an interrupted run, with the command that continues it.
-fn continue_hint(e: anyhow::Error, launcher: &str) -> anyhow::Error {
-    match e.downcast_ref::<colloidsim_run::Interrupted>() {
-        Some(i) => anyhow::anyhow!(
-            "{i}. Continue with: {launcher}colloidsim run --restart {}",
+/// The error of an interrupted run, with the command that continues it (`--walltime` again
+/// when one was given) and the exit status of its cause. A budget that ran out before a step
+/// could be made is an error (status 1), so that a loop of restarts does not go on forever.
+fn continue_hint(e: anyhow::Error, launcher: &str, walltime: Option<&WallTime>) -> anyhow::Error {
+    let Some(i) = e.downcast_ref::<colloidsim_run::Interrupted>() else {
+        return e;
+    };
+    let again = walltime.map_or(String::new(), |w| {
+        format!(" --walltime {}", shell_word(&w.text))
+    });
+    let command = format!(
+        "{launcher}colloidsim run --restart {}{again}",
+        shell_word(&i.out.display().to_string())
+    );
+    if i.cause == Stop::WallTime && i.checkpoint == i.started {
+        return anyhow::anyhow!(
+            "{i}: the wall-time budget (--walltime {}) ran out before a step could be made; \
+             continue with a longer one: {launcher}colloidsim run --restart {} --walltime ...",
+            walltime.map_or("?", |w| &w.text),
             shell_word(&i.out.display().to_string())
-        ),
-        None => e,
+        );
     }
+    Stopped {
+        status: stop_status(i.cause),
+        message: Some(format!("{i}. Continue with: {command}")),
+    }
+    .into()
 }
 
 /// `s` quoted for a POSIX shell when it needs it.
@@ -434,13 +638,14 @@ fn run_cli() -> Result<()> {
             quiet,
             force,
             restart,
+            walltime,
             overrides,
         } => {
             let ranks = parallel::Ranks::init()?;
             if ranks.size() > 1 {
                 let opts = RunOptions { out, seed, force };
                 let sc = path.as_deref().map(|p| (p, &overrides));
-                return run_on_ranks(&ranks, sc, opts, restart, threads, quiet);
+                return run_on_ranks(&ranks, sc, opts, restart, threads, quiet, walltime);
             }
             thread_pool(threads)?;
             let sc = path
@@ -452,13 +657,13 @@ fn run_cli() -> Result<()> {
                     "--set needs the scenario file: colloidsim run SCENARIO --set ... --restart DIR"
                 );
             }
-            let ctl = control(quiet);
+            let ctl = control(quiet, Signals::All, walltime.as_ref());
             let report = match (&restart, &sc) {
                 (Some(dir), _) => colloidsim_run::resume(dir, sc.as_ref(), seed, &ctl),
                 (None, Some(sc)) => colloidsim_run::run(sc, &RunOptions { out, seed, force }, &ctl),
                 (None, None) => unreachable!("clap requires a scenario without --restart"),
             }
-            .map_err(|e| continue_hint(e, ""))?;
+            .map_err(|e| continue_hint(e, "", walltime.as_ref()))?;
             if !quiet {
                 println!("{}", report.message);
             }
@@ -483,7 +688,7 @@ fn run_cli() -> Result<()> {
                     hydrodynamics,
                     pair,
                 },
-                &control(false),
+                &control(false, Signals::CtrlC, None),
             )?;
             println!("{}", report.message);
             Ok(())
@@ -505,7 +710,8 @@ fn run_cli() -> Result<()> {
                 order,
                 force,
             };
-            let report = colloidsim_run::extrapolate(&sc, &opts, &control(true))?;
+            let report =
+                colloidsim_run::extrapolate(&sc, &opts, &control(true, Signals::CtrlC, None))?;
             println!("{}", report.message);
             Ok(())
         }
@@ -518,8 +724,15 @@ fn run_cli() -> Result<()> {
             quiet,
             force,
             restart,
+            member,
+            collect,
+            finished_only,
+            walltime,
             overrides,
         } => {
+            if let Some(dir) = collect {
+                return collect_ensemble(&dir, finished_only);
+            }
             let create = restart.is_none();
             let plan = move || match (&restart, &path) {
                 (Some(dir), _) if overrides.set.is_empty() => Ensemble::reopen(dir),
@@ -535,7 +748,16 @@ fn run_cli() -> Result<()> {
                 ),
                 (None, None) => unreachable!("clap requires a scenario without --restart"),
             };
-            ensemble(plan, create, threads, quiet)
+            let how = Launch {
+                create,
+                threads,
+                quiet,
+                walltime,
+            };
+            match member {
+                Some(k) => ensemble_member(plan, k, &how),
+                None => ensemble(plan, &how),
+            }
         }
         Command::Check {
             scenario: path,
@@ -586,6 +808,7 @@ fn run_on_ranks(
     restart: Option<PathBuf>,
     threads: Option<usize>,
     quiet: bool,
+    walltime: Option<WallTime>,
 ) -> Result<()> {
     let (rank, size) = (ranks.rank(), ranks.size());
     ranks.agree(thread_pool(threads.or(ranks.default_threads())))?;
@@ -596,7 +819,7 @@ fn run_on_ranks(
         )),
         _ => Ok(()),
     })?;
-    let ctl = control(quiet || rank != 0);
+    let ctl = control(quiet || rank != 0, Signals::All, walltime.as_ref());
     let comm = ranks.agree(ranks.exchange())?;
     let report = match (&restart, &sc) {
         (Some(dir), _) => {
@@ -605,48 +828,141 @@ fn run_on_ranks(
         (None, Some(sc)) => colloidsim_run::run_decomposed(sc, &opts, &ctl, comm),
         (None, None) => unreachable!("clap requires a scenario without --restart"),
     }
-    .map_err(|e| continue_hint(e, "mpirun -n N "));
-    let report = ranks.agree(report)?;
+    .map_err(|e| continue_hint(e, "mpirun -n N ", walltime.as_ref()));
+    let report = agree_stopped(ranks, report)?;
     if rank == 0 && !quiet {
         println!("{} ({size} MPI ranks)", report.message);
     }
     Ok(())
 }
 
-/// `colloidsim ensemble`: every rank plans the same ensemble (and stops alike on bad input),
-/// rank 0 creates the folder (unless the ensemble is continued), member `k` runs on rank
-/// `k mod size`, and rank 0 combines.
-fn ensemble(
-    plan: impl FnOnce() -> Result<Ensemble>,
+/// How `colloidsim ensemble` runs: whether it creates the folder (not when continued), the
+/// threads, quiet, the wall-time budget.
+struct Launch {
     create: bool,
     threads: Option<usize>,
     quiet: bool,
-) -> Result<()> {
+    walltime: Option<WallTime>,
+}
+
+/// `--walltime X` as repeated in a command that continues, or nothing.
+fn walltime_again(w: Option<&WallTime>) -> String {
+    w.map_or(String::new(), |w| {
+        format!(" --walltime {}", shell_word(&w.text))
+    })
+}
+
+/// `colloidsim ensemble ... --member K`: member `k` alone, in one process, into the folder a
+/// whole ensemble gives it (the folder and its plan created if absent, checked otherwise).
+fn ensemble_member(plan: impl FnOnce() -> Result<Ensemble>, k: usize, how: &Launch) -> Result<()> {
+    let ranks = parallel::Ranks::init()?;
+    if ranks.size() > 1 {
+        bail!(
+            "--member runs one member in one process; under mpirun, leave it out (the ranks share \
+             the members) or start one process per member"
+        );
+    }
+    thread_pool(how.threads)?;
+    let plan = plan()?;
+    let n = plan.members().len();
+    if k >= n {
+        bail!(
+            "--member: must lie in 0 ..= {} (this ensemble has {n} member(s)), got {k}",
+            n - 1
+        );
+    }
+    if how.create {
+        plan.join()?;
+    }
+    let dir = plan.out().join(&plan.members()[k].folder);
+    let out = shell_word(&plan.out().display().to_string());
+    let collect =
+        format!("once every member is, average them: colloidsim ensemble --collect {out}");
+    if plan.member_state(k) == MemberState::Complete {
+        if !how.quiet {
+            println!("member {k} is complete in {}; {collect}", dir.display());
+        }
+        return Ok(());
+    }
+    let ctl = control(how.quiet, Signals::All, how.walltime.as_ref());
+    if let Err(e) = plan.run_member(k, &ctl) {
+        if let Some(i) = e.downcast_ref::<colloidsim_run::Interrupted>() {
+            return Err(Stopped {
+                status: stop_status(i.cause),
+                message: Some(format!(
+                    "member {k}: {i}. Continue with: colloidsim ensemble --restart {out} --member {k}{}",
+                    walltime_again(how.walltime.as_ref())
+                )),
+            }
+            .into());
+        }
+        return Err(e);
+    }
+    if !how.quiet {
+        println!("member {k} completed in {}; {collect}", dir.display());
+    }
+    Ok(())
+}
+
+/// `colloidsim ensemble --collect DIR`: average the members run with --member.
+fn collect_ensemble(dir: &Path, finished_only: bool) -> Result<()> {
+    let ranks = parallel::Ranks::init()?;
+    if ranks.size() > 1 {
+        bail!("--collect runs in one process, not under mpirun");
+    }
+    let report = Ensemble::load(dir, "--collect")?.collect(finished_only)?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    println!("{}", report.message);
+    Ok(())
+}
+
+/// `colloidsim ensemble`: every rank plans the same ensemble (and stops alike on bad input),
+/// rank 0 creates the folder (unless the ensemble is continued), member `k` runs on rank
+/// `k mod size`, and rank 0 combines. A stop (a signal, the budget) on any rank stops every
+/// rank after its running member, with the status of the largest cause seen.
+fn ensemble(plan: impl FnOnce() -> Result<Ensemble>, how: &Launch) -> Result<()> {
     let start = std::time::Instant::now();
     let ranks = parallel::Ranks::init()?;
     let (rank, size) = (ranks.rank(), ranks.size());
-    ranks.agree(thread_pool(threads.or(ranks.default_threads())))?;
+    ranks.agree(thread_pool(how.threads.or(ranks.default_threads())))?;
     let plan = ranks.agree(plan())?;
-    ranks.agree(if rank == 0 && create {
+    ranks.agree(if rank == 0 && how.create {
         plan.create()
     } else {
         Ok(())
     })?;
-    let ctl = control(quiet || rank != 0);
+    let quiet = how.quiet;
+    let ctl = control(quiet || rank != 0, Signals::All, how.walltime.as_ref());
     let mine: serde_json::Map<String, serde_json::Value> = plan
         .run_share(rank, size, &ctl)
         .into_iter()
         .map(|(k, e)| (k.to_string(), e.into()))
         .collect();
-    ranks.agree(if ctl.interrupted() {
-        Err(anyhow::anyhow!(
-            "interrupted; continue with: {}colloidsim ensemble --restart {}",
-            if size > 1 { "mpirun -n N " } else { "" },
-            shell_word(&plan.out().display().to_string())
-        ))
-    } else {
-        Ok(())
-    })?;
+    let code = ranks
+        .all_gather(&ctl.stop_cause().map_or(0, Stop::code).to_string())
+        .iter()
+        .filter_map(|c| c.parse::<u8>().ok())
+        .max()
+        .and_then(Stop::from_code);
+    agree_stopped(
+        &ranks,
+        match code {
+            Some(cause) => Err(Stopped {
+                status: stop_status(cause),
+                message: Some(format!(
+                    "{}; continue with: {}colloidsim ensemble --restart {}{}",
+                    cause.what(),
+                    if size > 1 { "mpirun -n N " } else { "" },
+                    shell_word(&plan.out().display().to_string()),
+                    walltime_again(how.walltime.as_ref())
+                )),
+            }
+            .into()),
+            None => Ok(()),
+        },
+    )?;
     let mut errors = vec![None; plan.members().len()];
     for text in ranks.all_gather(&serde_json::Value::Object(mine).to_string()) {
         let failed: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text)?;

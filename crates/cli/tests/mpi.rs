@@ -650,3 +650,83 @@ fn an_mpcd_droplet_on_2_and_3_ranks_writes_the_single_process_folder() {
     let droplet = format!("{}solvent = true\n", common::MPCD_DROPLET_COLLOIDS);
     writes_the_single_process_folder("droplet-mpcd", &droplet, &[2, 3], "170", 1);
 }
+
+#[test]
+fn a_dpd_run_on_2_ranks_stops_within_its_budget_with_one_status_and_continues_on_1() {
+    // On the fake clock (1/8 s a step, docs/cluster.md): 30 s less the 10 s margin hold at
+    // most 160 steps; both ranks stop at the same synchronised step, exit with 83, and one
+    // message names the command that continues.
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "dpd", TINY_DPD);
+    let out = tmp.path().join("budget");
+    let o = mpirun_env(
+        2,
+        &[
+            "run",
+            &s,
+            "--out",
+            out.to_str().unwrap(),
+            "--walltime",
+            "30",
+            "--quiet",
+        ],
+        &[("COLLOIDSIM_FAKE_STEP_SECONDS", "0.125")],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(83), "{t}");
+    assert_eq!(t.matches("error:").count(), 1, "{t}");
+    assert!(
+        t.contains(&format!(
+            "mpirun -n N colloidsim run --restart {} --walltime 30",
+            out.display()
+        )),
+        "{t}"
+    );
+    assert!(out.join("checkpoint.bin").exists());
+    let r = common::cli(&["run", "--restart", out.to_str().unwrap(), "--quiet"], &[]);
+    assert!(r.status.success());
+    assert_same_tree(&reference, &out);
+}
+
+#[test]
+fn sigusr1_to_mpirun_stops_every_rank_of_a_dpd_run_at_one_checkpoint() {
+    // mpirun passes SIGUSR1 on to every rank (Open MPI; srun does too): the ranks, waiting at
+    // step 100 (test hook), agree on the stop and exit with 82.
+    use std::io::{BufRead, BufReader, Read};
+    let tmp = tempfile::tempdir().unwrap();
+    let (s, reference) = reference(tmp.path(), "dpd", TINY_DPD);
+    let out = tmp.path().join("signalled");
+    let mut child = Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-n", "2"])
+        .arg(env!("CARGO_BIN_EXE_colloidsim"))
+        .args(["run", &s, "--out", out.to_str().unwrap(), "--quiet"])
+        .env("COLLOIDSIM_PAUSE_AT_STEP", "100")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    while seen.matches("paused at step 100").count() < 2 {
+        let mut line = String::new();
+        assert!(err.read_line(&mut line).unwrap() > 0, "{seen}");
+        seen.push_str(&line);
+    }
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-s", "USR1", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    err.read_to_string(&mut seen).unwrap();
+    let status = child.wait().unwrap();
+    eprintln!("{seen}");
+    assert_eq!(status.code(), Some(82), "{seen}");
+    assert!(seen.contains("stopped by SIGUSR1 at step 100"), "{seen}");
+    assert!(out.join("checkpoint.bin").exists());
+    let r = common::cli(&["run", "--restart", out.to_str().unwrap(), "--quiet"], &[]);
+    assert!(r.status.success());
+    assert_same_tree(&reference, &out);
+}

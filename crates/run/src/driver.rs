@@ -2,7 +2,7 @@
 //! checkpoints, verified restarts, test hooks, progress and `summary.json`.
 
 use crate::checkpoint::{self, CHECKPOINT, Envelope};
-use crate::control::Control;
+use crate::control::{Control, Stop};
 use crate::method::Session;
 use crate::registry;
 use crate::{Failed, Interrupted, Report, RunOptions, Scenario};
@@ -15,19 +15,125 @@ use std::time::Instant;
 
 /// Test hooks read from the environment: behave as if Ctrl-C arrived at this position
 /// (`COLLOIDSIM_INTERRUPT_AT_STEP`), or as if the process were killed there, without a
-/// checkpoint, after the trajectory reached the disk (`COLLOIDSIM_KILL_AT_STEP`).
+/// checkpoint, after the trajectory reached the disk (`COLLOIDSIM_KILL_AT_STEP`); wait there
+/// (`COLLOIDSIM_PAUSE_AT_STEP`, after printing `paused at step N (test hook)` on stderr) until
+/// the run is asked to stop or the wall-time budget runs out (at most a minute), so that a
+/// test can send a signal to a run it knows is running, or let a real budget run out at a
+/// known step; and a fake
+/// clock for the wall-time budget, on which each position advanced takes
+/// `COLLOIDSIM_FAKE_STEP_SECONDS` and each checkpoint `COLLOIDSIM_FAKE_CHECKPOINT_SECONDS`
+/// (default 0) and nothing else takes time, so that where a budget stops a run does not
+/// depend on the machine.
 struct Hooks {
     interrupt: Option<u64>,
     kill: Option<u64>,
+    pause: Option<u64>,
+    fake_step: Option<f64>,
+    fake_checkpoint: f64,
 }
 
 impl Hooks {
     fn from_env() -> Self {
-        let read = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
+        fn read<T: std::str::FromStr>(name: &str) -> Option<T> {
+            std::env::var(name).ok().and_then(|v| v.parse().ok())
+        }
         Self {
             interrupt: read("COLLOIDSIM_INTERRUPT_AT_STEP"),
             kill: read("COLLOIDSIM_KILL_AT_STEP"),
+            pause: read("COLLOIDSIM_PAUSE_AT_STEP"),
+            fake_step: read::<f64>("COLLOIDSIM_FAKE_STEP_SECONDS").filter(|x| *x >= 0.0),
+            fake_checkpoint: read::<f64>("COLLOIDSIM_FAKE_CHECKPOINT_SECONDS")
+                .filter(|x| *x >= 0.0)
+                .unwrap_or(0.0),
         }
+    }
+}
+
+/// The wall-time budget's clock and what the driver has measured against it: the seconds per
+/// position and per checkpoint, and how far ahead the next point a checkpoint can be written
+/// at has been seen to lie.
+struct Timer<'a> {
+    ctl: &'a Control,
+    fake_step: Option<f64>,
+    fake_checkpoint: f64,
+    /// Seconds per position of the last chunk and of everything this process ran.
+    last_rate: Option<f64>,
+    positions: u64,
+    stepping: f64,
+    /// The longest checkpoint written by this process, in seconds.
+    checkpoint: f64,
+    /// The most positions seen from a position to its stop point.
+    reach: u64,
+}
+
+/// The safety margin of the wall-time budget: 1 % of it, at least 10 s, at most half of it.
+pub(crate) fn walltime_margin(budget: f64) -> f64 {
+    (0.01 * budget).max(10.0).min(0.5 * budget)
+}
+
+impl<'a> Timer<'a> {
+    fn new(ctl: &'a Control, hooks: &Hooks) -> Self {
+        Self {
+            ctl,
+            fake_step: hooks.fake_step,
+            fake_checkpoint: hooks.fake_checkpoint,
+            last_rate: None,
+            positions: 0,
+            stepping: 0.0,
+            checkpoint: 0.0,
+            reach: 0,
+        }
+    }
+
+    /// Seconds of the budget spent so far.
+    fn now(&self) -> f64 {
+        self.ctl.spent(self.fake_step.is_some())
+    }
+
+    /// `n` positions were run in `real` seconds; returns the seconds they took on the
+    /// budget's clock.
+    fn stepped(&mut self, n: u64, real: f64) -> f64 {
+        let secs = match self.fake_step {
+            Some(x) => {
+                self.ctl.spend_fake(x * n as f64);
+                x * n as f64
+            }
+            None => real,
+        };
+        if n > 0 {
+            self.last_rate = Some(secs / n as f64);
+            self.positions += n;
+            self.stepping += secs;
+        }
+        secs
+    }
+
+    /// A checkpoint was written in `real` seconds.
+    fn saved(&mut self, real: f64) {
+        let secs = match self.fake_step {
+            Some(_) => {
+                self.ctl.spend_fake(self.fake_checkpoint);
+                self.fake_checkpoint
+            }
+            None => real,
+        };
+        self.checkpoint = self.checkpoint.max(secs);
+    }
+
+    /// With a budget: would running `n` more positions from `pos` still leave the time to go
+    /// on to the next point a checkpoint can be written at and write it, within the budget
+    /// less its margin? The time per position is the larger of the last chunk's and the mean.
+    fn must_stop(&mut self, pos: u64, stop_point: u64, n: u64) -> bool {
+        let Some(budget) = self.ctl.walltime() else {
+            return false;
+        };
+        self.reach = self.reach.max(stop_point.saturating_sub(pos));
+        let rate = match self.last_rate {
+            Some(r) => r.max(self.stepping / self.positions.max(1) as f64),
+            None => 0.0,
+        };
+        let need = (n + self.reach) as f64 * rate + self.checkpoint + walltime_margin(budget);
+        self.now() + need > budget
     }
 }
 
@@ -573,6 +679,7 @@ fn drive(
     let pos0 = s.position();
     let wall0 = env.wall_seconds;
     let wall = || wall0 + start.elapsed().as_secs_f64();
+    let mut timer = Timer::new(ctl, &hooks);
     // The steps run on a worker of the thread pool, so that each step's parallel passes start
     // without a hand-over from this thread.
     let failure = rayon::scope(|_| -> Result<Option<String>> {
@@ -592,30 +699,66 @@ fn drive(
             if hooks.interrupt == Some(pos) {
                 ctl.interrupt();
             }
-            // The ranks of a decomposed run go on alike: the same chunk, the same interrupt.
-            let interrupted;
-            (chunk, interrupted) = s.agree(chunk, ctl.interrupted());
-            if interrupted && !ctl.interrupted() {
-                ctl.interrupt();
+            if hooks.pause == Some(pos) {
+                eprintln!("paused at step {pos} (test hook)");
+                let waited = Instant::now();
+                while !ctl.interrupted()
+                    && !timer.must_stop(pos, s.stop_point(), 0)
+                    && waited.elapsed().as_secs() < 60
+                {
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
             }
-            if !draining && interrupted {
+            // The next chunk ends at a due checkpoint or a test hook's position, if sooner.
+            let due = s.next_checkpoint().filter(|&c| c > pos && c < total);
+            let end_of = |chunk: u64| {
+                let mut next = pos.saturating_add(chunk).min(total);
+                for c in [due, hooks.interrupt, hooks.kill, hooks.pause]
+                    .into_iter()
+                    .flatten()
+                {
+                    if c > pos {
+                        next = next.min(c);
+                    }
+                }
+                next
+            };
+            if !draining && timer.must_stop(pos, s.stop_point(), end_of(chunk) - pos) {
+                ctl.stop(Stop::WallTime);
+            }
+            // The ranks of a decomposed run go on alike: the same chunk, the same stop.
+            let code;
+            (chunk, code) = s.agree(chunk, ctl.stop_cause().map_or(0, Stop::code));
+            let agreed = Stop::from_code(code);
+            if let Some(cause) = agreed
+                && !ctl.interrupted()
+            {
+                ctl.stop(cause);
+            }
+            if let Some(cause) = agreed.filter(|_| !draining) {
                 let stop = s.stop_point();
                 if stop >= total {
                     draining = true;
                 } else {
                     if stop > pos {
                         ctl.progress().message(&format!(
-                            "interrupted at step {pos}: running on to step {stop} to write a checkpoint (Ctrl-C again stops at once)"
+                            "{} at step {pos}: running on to step {stop} to write a checkpoint ({})",
+                            cause.what(),
+                            cause.again()
                         ));
+                        let t = Instant::now();
                         if let Some(why) = s.advance(stop)? {
                             return Ok(Some(why));
                         }
+                        timer.stepped(stop - pos, t.elapsed().as_secs_f64());
                     }
                     save(&mut *s, &out, &mut env, wall(), &kept)?;
                     let outputs = s.interim_outputs(&out)?;
                     record_files(&out, &*s, &kept)?;
                     ctl.progress().end();
                     return Err(Interrupted {
+                        cause,
+                        started: pos0,
                         at: pos,
                         checkpoint: s.position(),
                         out: out.path().to_path_buf(),
@@ -624,28 +767,21 @@ fn drive(
                     .into());
                 }
             }
-            let due = s.next_checkpoint().filter(|&c| c > pos && c < total);
-            let mut next = pos.saturating_add(chunk).min(total);
-            if let Some(c) = due {
-                next = next.min(c);
-            }
-            for h in [hooks.interrupt, hooks.kill].into_iter().flatten() {
-                if h > pos {
-                    next = next.min(h);
-                }
-            }
+            let next = end_of(chunk);
             let t = Instant::now();
             if let Some(why) = s.advance(next)? {
                 return Ok(Some(why));
             }
-            let secs = t.elapsed().as_secs_f64();
+            let secs = timer.stepped(next - pos, t.elapsed().as_secs_f64());
             if secs < 0.5 * CHUNK_SECONDS && next - pos == chunk {
                 chunk = (chunk * 2).min(1 << 20);
             } else if secs > 2.0 * CHUNK_SECONDS {
                 chunk = (chunk / 2).max(1);
             }
             if due == Some(s.position()) {
+                let t = Instant::now();
                 save(&mut *s, &out, &mut env, wall(), &kept)?;
+                timer.saved(t.elapsed().as_secs_f64());
             }
             ctl.progress().advance(s.position());
             ctl.progress()

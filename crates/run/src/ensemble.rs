@@ -60,6 +60,19 @@ pub struct Member {
     scenario: Scenario,
 }
 
+/// Where a member stands, from its folder ([`Ensemble::member_state`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum MemberState {
+    /// Its `summary.json` says `completed = true`.
+    Complete,
+    /// Its `summary.json` says `completed = false`, with this error.
+    Failed(String),
+    /// Interrupted: a checkpoint and no summary.
+    Checkpointed,
+    /// Nothing to continue from (never started, or stopped before its first checkpoint).
+    NotStarted,
+}
+
 /// A planned ensemble: every member validated, nothing written yet.
 #[derive(Debug, Clone)]
 pub struct Ensemble {
@@ -205,30 +218,131 @@ impl Ensemble {
         &self.out
     }
 
-    /// Create the ensemble's folder (refused when it holds files, unless `force`) and write
-    /// the plan into it (`ensemble.json`: the scenario, its folder, the replicas and the sweep),
-    /// from which [`Ensemble::reopen`] continues an interrupted ensemble.
-    pub fn create(&self) -> Result<()> {
-        let dir = OutputDir::create(&self.out, self.force)?;
-        let plan = json!({
+    /// The plan as `ensemble.json` keeps it: the scenario, its folder, the replicas and the
+    /// sweep.
+    fn plan_json(&self) -> Value {
+        json!({
             "format": PLAN_FORMAT,
             "scenario": self.scenario.text(),
             "base": self.scenario.base(),
             "name": self.scenario.name(),
             "replicas": self.replicas,
             "vary": self.vary.iter().map(|(k, v)| json!([k, v])).collect::<Vec<_>>(),
-        });
-        dir.write_json(PLAN, &plan)?;
+        })
+    }
+
+    /// Create the ensemble's folder (refused when it holds files, unless `force`) and write
+    /// the plan into it (`ensemble.json`), from which [`Ensemble::reopen`] continues an
+    /// interrupted ensemble.
+    pub fn create(&self) -> Result<()> {
+        let dir = OutputDir::create(&self.out, self.force)?;
+        dir.write_json(PLAN, &self.plan_json())?;
+        Ok(())
+    }
+
+    /// For one member run on its own (`colloidsim ensemble --member K`, a job of a job
+    /// array): create the ensemble's folder and its plan if they are not there yet, or else
+    /// check that the plan there is this one. Safe when many processes start at once, on one
+    /// machine or on several sharing a file system: the plan is written under a name of this
+    /// process's own and linked into place only if no plan is there (a hard link does not
+    /// replace a file), so the first one wins and every other compares.
+    pub fn join(&self) -> Result<()> {
+        let path = self.out.join(PLAN);
+        let mine = self.plan_json();
+        if !path.exists() {
+            if self.out.exists() {
+                self.refuse_foreign_files()?;
+            }
+            std::fs::create_dir_all(&self.out)
+                .with_context(|| format!("cannot create {}", self.out.display()))?;
+            let mut bytes = serde_json::to_vec_pretty(&mine)?;
+            bytes.push(b'\n');
+            let unique = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos());
+            let tmp = self
+                .out
+                .join(format!("{PLAN}.{}-{unique}.partial", std::process::id()));
+            let linked = (|| -> std::io::Result<()> {
+                use std::io::Write;
+                let mut f = std::fs::File::create_new(&tmp)?;
+                f.write_all(&bytes)?;
+                f.sync_all()?;
+                std::fs::hard_link(&tmp, &path)
+            })();
+            let _ = std::fs::remove_file(&tmp);
+            match linked {
+                Ok(()) => return Ok(()),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot write {}", path.display()));
+                }
+            }
+        }
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let theirs: Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+        let differ: Vec<&str> = ["format", "scenario", "base", "name", "replicas", "vary"]
+            .into_iter()
+            .filter(|k| theirs[*k] != mine[*k])
+            .collect();
+        if !differ.is_empty() {
+            bail!(
+                "{}: the ensemble planned in this folder is not this one (its {} differ): give \
+                 every member the same scenario, --set, --replicas and --vary, or another --out",
+                path.display(),
+                differ.join(", ")
+            );
+        }
+        Ok(())
+    }
+
+    /// A folder without a plan may hold only what members being started write into it.
+    fn refuse_foreign_files(&self) -> Result<()> {
+        let mut foreign: Vec<String> = std::fs::read_dir(&self.out)
+            .with_context(|| format!("cannot read {}", self.out.display()))?
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| {
+                !(n.starts_with(PLAN) && n.ends_with(".partial")
+                    || n.starts_with("replica-")
+                    || n.starts_with("point-"))
+            })
+            .collect();
+        foreign.sort();
+        if !foreign.is_empty() {
+            bail!(
+                "output folder {} holds files that are not an ensemble's ({}) and no {PLAN}; \
+                 choose another --out",
+                self.out.display(),
+                foreign.join(", ")
+            );
+        }
         Ok(())
     }
 
     /// The ensemble planned in folder `dir` by an earlier [`Ensemble::create`], to be
     /// continued: refused when the folder has no plan or the ensemble completed.
     pub fn reopen(dir: &Path) -> Result<Self> {
+        let plan = Self::load(dir, "--restart")?;
+        let summary = read_summary(dir).ok();
+        if summary.as_ref().is_some_and(|s| s["completed"] == true) {
+            bail!(
+                "--restart {}: this ensemble is complete (summary.json); nothing to continue",
+                dir.display()
+            );
+        }
+        Ok(plan)
+    }
+
+    /// The ensemble planned in folder `dir` (`flag` names the option that gave it, for the
+    /// messages), whether or not it completed (`--collect`).
+    pub fn load(dir: &Path, flag: &str) -> Result<Self> {
         let path = dir.join(PLAN);
         let text = std::fs::read_to_string(&path).with_context(|| {
             format!(
-                "--restart {}: no {PLAN} (not the folder of `colloidsim ensemble`)",
+                "{flag} {}: no {PLAN} (not the folder of `colloidsim ensemble`)",
                 dir.display()
             )
         })?;
@@ -239,13 +353,6 @@ impl Ensemble {
                 "{}: format {} is not {PLAN_FORMAT}",
                 path.display(),
                 v["format"]
-            );
-        }
-        let summary = read_summary(dir).ok();
-        if summary.as_ref().is_some_and(|s| s["completed"] == true) {
-            bail!(
-                "--restart {}: this ensemble is complete (summary.json); nothing to continue",
-                dir.display()
             );
         }
         let field = |k: &str| {
@@ -298,6 +405,124 @@ impl Ensemble {
     /// the averages and `summary.json`; with a failed member, the summary says `completed =
     /// false`, names the failures and no averages are written, and the result is an error.
     pub fn finish(&self, errors: &[Option<String>], wall_seconds: f64) -> Result<Report> {
+        self.combine(errors, &[], wall_seconds)
+    }
+
+    /// Where member `k` stands, from its folder.
+    pub fn member_state(&self, k: usize) -> MemberState {
+        let dir = self.out.join(&self.members[k].folder);
+        if dir.join("summary.json").exists() {
+            return match read_summary(&dir) {
+                Ok(s) if s["completed"] == true => MemberState::Complete,
+                Ok(s) => MemberState::Failed(s["error"].as_str().unwrap_or("?").to_string()),
+                Err(e) => MemberState::Failed(format!("{e:#}")),
+            };
+        }
+        if dir.join(crate::checkpoint::CHECKPOINT).exists() {
+            MemberState::Checkpointed
+        } else {
+            MemberState::NotStarted
+        }
+    }
+
+    /// `colloidsim ensemble --collect DIR`: average the members that were run on their own
+    /// (`--member K`) exactly as a whole ensemble's [`Ensemble::finish`] does. Refused, naming
+    /// them, while members are unfinished (interrupted or not started), unless
+    /// `finished_only`: then the members that completed are averaged, the others left out
+    /// and named in `summary.json` (`left_out`; `completed = false`, `partial = true`). A
+    /// member that failed is reported as a whole ensemble reports it (or left out).
+    pub fn collect(&self, finished_only: bool) -> Result<Report> {
+        let states: Vec<MemberState> = (0..self.members.len())
+            .map(|k| self.member_state(k))
+            .collect();
+        let name = |k: usize| format!("{k} ({})", self.members[k].folder);
+        let unfinished: Vec<String> = states
+            .iter()
+            .enumerate()
+            .filter_map(|(k, st)| match st {
+                MemberState::Checkpointed => Some(format!("{} interrupted", name(k))),
+                MemberState::NotStarted => Some(format!("{} not run", name(k))),
+                _ => None,
+            })
+            .collect();
+        if !unfinished.is_empty() && !finished_only {
+            bail!(
+                "--collect {}: {} of {} members are not finished: {}; run them (`colloidsim \
+                 ensemble --restart {} --member K`), or average the finished ones only with \
+                 --finished-only",
+                self.out.display(),
+                unfinished.len(),
+                self.members.len(),
+                unfinished.join(", "),
+                self.out.display()
+            );
+        }
+        let wall_seconds: f64 = states
+            .iter()
+            .enumerate()
+            .filter(|(_, st)| **st == MemberState::Complete)
+            .filter_map(|(k, _)| {
+                read_summary(&self.out.join(&self.members[k].folder)).ok()?["wall_seconds"].as_f64()
+            })
+            .sum();
+        if finished_only {
+            let left_out: Vec<(usize, String)> = states
+                .iter()
+                .enumerate()
+                .filter_map(|(k, st)| match st {
+                    MemberState::Complete => None,
+                    MemberState::Failed(e) => Some((k, format!("failed: {e}"))),
+                    MemberState::Checkpointed => Some((k, "interrupted".to_string())),
+                    MemberState::NotStarted => Some((k, "not run".to_string())),
+                })
+                .collect();
+            if left_out.len() == self.members.len() {
+                bail!(
+                    "--collect {}: no member has finished; nothing to average",
+                    self.out.display()
+                );
+            }
+            let errors = vec![None; self.members.len()];
+            let mut r = self.combine(&errors, &left_out, wall_seconds)?;
+            r.message = format!(
+                "averaged {} of {} members (left out: {}) into {}",
+                self.members.len() - left_out.len(),
+                self.members.len(),
+                left_out
+                    .iter()
+                    .map(|(k, why)| format!("{}, {why}", name(*k)))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+                self.out.display()
+            );
+            return Ok(r);
+        }
+        let errors: Vec<Option<String>> = states
+            .iter()
+            .enumerate()
+            .map(|(k, st)| match st {
+                MemberState::Failed(e) => Some(format!("member {}: {e}", name(k))),
+                _ => None,
+            })
+            .collect();
+        let mut r = self.combine(&errors, &[], wall_seconds)?;
+        r.message = format!(
+            "averaged the {} members ({} point(s) x {} replica(s)) into {}",
+            self.members.len(),
+            self.points.len(),
+            self.replicas,
+            self.out.display()
+        );
+        Ok(r)
+    }
+
+    /// [`Ensemble::finish`], leaving out the members `left_out` (with why) from the averages.
+    fn combine(
+        &self,
+        errors: &[Option<String>],
+        left_out: &[(usize, String)],
+        wall_seconds: f64,
+    ) -> Result<Report> {
         let out = OutputDir::reopen(&self.out)?;
         let failed: Vec<Value> = errors
             .iter()
@@ -351,8 +576,9 @@ impl Ensemble {
             let folders: Vec<PathBuf> = self
                 .members
                 .iter()
-                .filter(|m| m.point == p)
-                .map(|m| self.out.join(&m.folder))
+                .enumerate()
+                .filter(|(k, m)| m.point == p && !left_out.iter().any(|(l, _)| l == k))
+                .map(|(_, m)| self.out.join(&m.folder))
                 .collect();
             let prefix = if self.vary.is_empty() {
                 String::new()
@@ -366,7 +592,12 @@ impl Ensemble {
                     files.push(format!("{prefix}{name}"));
                 }
             }
-            let obs = pool_summaries(&folders)?;
+            let obs = if folders.is_empty() {
+                warnings.push(format!("point {p}: no finished member, no averages"));
+                BTreeMap::new()
+            } else {
+                pool_summaries(&folders)?
+            };
             observables.push(json!({
                 "point": p,
                 "set": values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
@@ -383,13 +614,33 @@ impl Ensemble {
         files.push("observables.csv".into());
         summary["completed"] = json!(true);
         summary["error"] = Value::Null;
+        if !left_out.is_empty() {
+            let named: Vec<String> = left_out
+                .iter()
+                .map(|(k, why)| format!("{k} ({}, {why})", self.members[*k].folder))
+                .collect();
+            let error = format!(
+                "averages of {} of {} members; left out: {}",
+                self.members.len() - left_out.len(),
+                self.members.len(),
+                named.join(", ")
+            );
+            warnings.push(error.clone());
+            summary["completed"] = json!(false);
+            summary["partial"] = json!(true);
+            summary["error"] = json!(error);
+            summary["left_out"] = left_out
+                .iter()
+                .map(|(k, why)| json!({"member": k, "folder": self.members[*k].folder, "state": why}))
+                .collect();
+        }
         summary["points"] = Value::Array(observables);
         summary["files"] = json!(files);
         summary["warnings"] = json!(warnings);
         out.write_json("summary.json", &summary)?;
         let message = format!(
             "ran {} member(s) ({} point(s) x {} replica(s)) and wrote their averages into {}",
-            self.members.len(),
+            self.members.len() - left_out.len(),
             self.points.len(),
             self.replicas,
             self.out.display()

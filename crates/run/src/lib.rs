@@ -24,7 +24,7 @@ pub mod trajectory;
 mod bd_replica;
 pub mod two_body;
 
-pub use control::{Control, Progress, Silent};
+pub use control::{Control, Progress, Silent, Stop};
 pub use driver::{resume, resume_decomposed, run, run_decomposed};
 pub use engine::Engine;
 pub use ensemble::{EnsembleOptions, ensemble, resume_ensemble};
@@ -82,16 +82,22 @@ pub struct Report {
     pub message: String,
 }
 
-/// A run stopped on request (Ctrl-C, or the caller's interrupt) after writing a checkpoint.
+/// A run stopped on request (Ctrl-C, a signal, the caller's interrupt, the wall-time budget)
+/// after writing a checkpoint.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error(
-    "interrupted at step {at}; checkpoint written at step {checkpoint} in {}{}",
+    "{} at step {at}; checkpoint written at step {checkpoint} in {}{}",
+    cause.what(),
     out.display(),
     if outputs.is_empty() { String::new() } else {
         format!(" with the outputs so far ({}; summary.json is written when the run completes)", outputs.join(", "))
     }
 )]
 pub struct Interrupted {
+    /// Why it stopped.
+    pub cause: Stop,
+    /// Position this process took the run up at (0, or a restart's checkpoint).
+    pub started: u64,
     /// Position at which the interrupt was seen.
     pub at: u64,
     /// Position of the checkpoint written.

@@ -158,10 +158,13 @@ pub trait Session: Send {
     fn is_writer(&self) -> bool {
         self.exchange().is_none_or(|c| c.rank() == 0)
     }
-    /// Decomposed runs: every rank's chunk of positions and whether it saw an interrupt,
-    /// combined so that all ranks go on alike (rank 0's chunk; interrupted if any rank was).
-    fn agree(&mut self, chunk: u64, interrupted: bool) -> (u64, bool) {
-        agree_over(self.exchange(), chunk, interrupted)
+    /// Decomposed runs: every rank's chunk of positions and the stop it saw ([`Stop::code`],
+    /// 0 for none), combined so that all ranks go on alike (rank 0's chunk; the largest code,
+    /// so that every rank stops, for the same cause, if any rank was asked to).
+    ///
+    /// [`Stop::code`]: crate::Stop::code
+    fn agree(&mut self, chunk: u64, stop: u8) -> (u64, u8) {
+        agree_over(self.exchange(), chunk, stop)
     }
     /// An error on this rank alone (a file the writer could not write): returned as it is on
     /// one rank; in a decomposed run, where the other ranks cannot learn of it, printed and the
@@ -181,17 +184,14 @@ pub trait Session: Send {
 pub use crate::scenario::Scenario;
 
 /// [`Session::agree`] over the ranks of `comm` (unchanged on one process).
-pub(crate) fn agree_over(
-    comm: Option<&dyn Exchange>,
-    chunk: u64,
-    interrupted: bool,
-) -> (u64, bool) {
+pub(crate) fn agree_over(comm: Option<&dyn Exchange>, chunk: u64, stop: u8) -> (u64, u8) {
     let Some(c) = comm else {
-        return (chunk, interrupted);
+        return (chunk, stop);
     };
     let mut all = Vec::new();
-    c.all_gather(&[chunk as f64, interrupted as u8 as f64], &mut all);
-    (all[0] as u64, all.chunks_exact(2).any(|r| r[1] != 0.0))
+    c.all_gather(&[chunk as f64, stop as f64], &mut all);
+    let code = all.chunks_exact(2).map(|r| r[1] as u8).max().unwrap_or(0);
+    (all[0] as u64, code)
 }
 
 /// [`Session::fail_alone`] over the ranks of `comm`: the error as it is on one process; the
