@@ -194,7 +194,7 @@ fn bad_input_is_refused_before_anything_is_written() {
         (
             "model = \"rpy\"",
             "model = \"rpy\"\ntolerance = 0.2",
-            "hydrodynamics.tolerance: must be a number in (0, 0.1]",
+            "hydrodynamics.tolerance: must be a number in (0, 0.01]",
         ),
         (
             "equilibrate = 0.1",

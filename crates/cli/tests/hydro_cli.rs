@@ -146,11 +146,11 @@ fn bad_hydrodynamics_are_refused_before_anything_is_written() {
     for (change, words) in [
         (
             "tolerance = 0.2",
-            "hydrodynamics.tolerance: must be a number in (0, 0.1]",
+            "hydrodynamics.tolerance: must be a number in (0, 0.01]",
         ),
         (
             "tolerance = 0",
-            "hydrodynamics.tolerance: must be a number in (0, 0.1]",
+            "hydrodynamics.tolerance: must be a number in (0, 0.01]",
         ),
         (
             "splitting = -1",

@@ -8,8 +8,10 @@ use serde::Serialize;
 
 /// Default tolerance (the drying-droplet paper's PSE setting).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
-/// Largest tolerance accepted.
-pub const MAX_TOLERANCE: f64 = 0.1;
+/// Largest tolerance accepted: PSE's error split (Fourier cut-off, Gaussian support) meets its
+/// tolerance up to 1e-2 (tests/pse.rs); at 0.1 the Gaussian came out wider than the splitting
+/// allows and the product missed the tolerance by a factor of two.
+pub const MAX_TOLERANCE: f64 = 1e-2;
 /// Default box edge of a periodic droplet, in droplet diameters (the paper's).
 pub const DEFAULT_BOX_FACTOR: f64 = 2.0;
 /// Default: the direct method up to this many particles, PSE above.
@@ -109,7 +111,7 @@ pub fn check_lanczos(p: &LanczosParams) -> Result<(), ParamError> {
     Ok(())
 }
 
-/// The tolerance must lie in (0, 0.1] (the error names `tolerance`).
+/// The tolerance must lie in (0, [`MAX_TOLERANCE`]] (the error names `tolerance`).
 pub fn check_tolerance(t: f64) -> Result<f64, ParamError> {
     if t.is_finite() && t > 0.0 && t <= MAX_TOLERANCE {
         Ok(t)

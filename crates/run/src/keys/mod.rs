@@ -81,7 +81,7 @@ impl Allowed {
         };
         let got = || match v {
             toml::Value::String(s) => format!("\"{s}\""),
-            other => other.to_string(),
+            other => shown(other),
         };
         let must = |what: String| Err(format!("must be {what}, got {}", got()));
         match *self {
@@ -516,6 +516,20 @@ pub fn text(keys: &[Key]) -> String {
     s
 }
 
+/// `v` as the scenario would write it, but a float far from 1 in exponent form (`1e-300`, not
+/// three hundred digits).
+fn shown(v: &toml::Value) -> String {
+    match v {
+        toml::Value::Float(x) if x.is_finite() && *x != 0.0 && !(1e-6..1e15).contains(&x.abs()) => {
+            format!("{x:e}")
+        }
+        toml::Value::Array(a) => {
+            format!("[{}]", a.iter().map(shown).collect::<Vec<_>>().join(", "))
+        }
+        other => other.to_string(),
+    }
+}
+
 /// A scenario's keys with their values and units, as `colloidsim check` prints them: every
 /// key the scenario sets, then beside them the defaults it leaves (marked `(default)`), in the
 /// order of the key table; keys inside an optional table the scenario leaves out, and
@@ -535,7 +549,7 @@ pub fn values(table: &toml::Table, keys: &[Key]) -> String {
     for k in keys.iter().filter(|k| !is_table(k)) {
         let unit = if k.unit == "-" { "" } else { &k.unit };
         match lookup(&k.path) {
-            Some(v) => rows.push((k.path.as_str(), v.to_string(), unit, "")),
+            Some(v) => rows.push((k.path.as_str(), shown(v), unit, "")),
             None => {
                 let inside_absent = tables.iter().any(|t| {
                     k.path.starts_with(&format!("{}.", t.path)) && lookup(&t.path).is_none()

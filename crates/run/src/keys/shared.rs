@@ -320,7 +320,7 @@ pub const HYDRO_TOLERANCE: Spec = key(
     "hydrodynamics.tolerance",
     "-",
     Value("1e-3"),
-    LeftOpen(0.0, 0.1),
+    LeftOpen(0.0, colloidsim_md::hydro::params::MAX_TOLERANCE),
     "relative error of the PSE product and of each Lanczos square root",
 );
 
@@ -544,6 +544,6 @@ mod tests {
             assert_eq!(key(text, periodic), k, "{text}");
         }
         let e = read("model = \"rpy\"\ntolerance = 0.5", 10, false).unwrap_err();
-        assert!(e.to_string().contains("(0, 0.1]"), "{e}");
+        assert!(e.to_string().contains("(0, 0.01]"), "{e}");
     }
 }

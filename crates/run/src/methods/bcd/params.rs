@@ -498,6 +498,16 @@ impl Scenario {
 
         param::non_negative("run.equilibrate", self.run.equilibrate)?;
         param::positive("run.time", self.run.time)?;
+        if self.run.time < self.run.dt {
+            return Err(ParamError::new(
+                "run.time",
+                format!(
+                    "{:e} is less than one step (run.dt = {:e}): nothing would be sampled",
+                    self.run.time, self.run.dt
+                ),
+            )
+            .into());
+        }
         // Step counts are checked as numbers before they become integers (a cast saturates).
         for (key, t) in [
             ("run.equilibrate", self.run.equilibrate),
@@ -905,6 +915,22 @@ trajectory = { every = 10 }
             e.contains("interaction.sticky.range: must be much smaller"),
             "{e}"
         );
+    }
+
+    /// A run shorter than one step samples nothing (it used to take one step and write NaN
+    /// error bars).
+    #[test]
+    fn a_run_shorter_than_one_step_is_refused() {
+        let run = |time: &str| {
+            let text = format!(
+                "method = \"bcd\"\n[system]\nlength = 20.0\nparticles = 10\ndiameter = 0.5\n\
+                 [run]\ndt = 1e-3\ntime = {time}\n"
+            );
+            read(&toml::from_str(&text).unwrap(), Path::new("."), None)
+        };
+        let e = format!("{:#}", run("1e-300").unwrap_err());
+        assert!(e.contains("run.time: 1e-300 is less than one step"), "{e}");
+        run("1e-3").unwrap();
     }
 
     #[test]
