@@ -42,6 +42,21 @@ pub enum GsdError {
         /// What went wrong.
         message: String,
     },
+    /// A frame's positions or velocities are not finite (or too large for the schema's f32):
+    /// nothing of the frame is written.
+    #[error(
+        "{path}: the state went non-finite at step {step}: particle {particle} has {what}; no frame is written"
+    )]
+    NonFinite {
+        /// File.
+        path: PathBuf,
+        /// Step of the frame.
+        step: u64,
+        /// Index of the first such particle.
+        particle: usize,
+        /// What is not finite, with its value.
+        what: String,
+    },
     /// The file is readable but does not hold what a configuration needs.
     #[error("{path}: {message}")]
     Content {
@@ -120,10 +135,6 @@ impl GsdWriter {
     ) -> Result<(), GsdError> {
         let log = scalars(log);
         self.write_inner(step, sbox, p, exact, None, &log)
-            .map_err(|message| GsdError::Write {
-                path: self.path.clone(),
-                message,
-            })
     }
 
     /// Append one frame whose logged quantities may be arrays (`log/NAME` with one value per
@@ -136,10 +147,6 @@ impl GsdWriter {
         log: &[(&str, &[f64])],
     ) -> Result<(), GsdError> {
         self.write_inner(step, sbox, p, false, None, log)
-            .map_err(|message| GsdError::Write {
-                path: self.path.clone(),
-                message,
-            })
     }
 
     /// Append a checkpoint frame: exact positions and box plus the engine's storage order and
@@ -155,13 +162,50 @@ impl GsdWriter {
     ) -> Result<(), GsdError> {
         let log = scalars(log);
         self.write_inner(step, sbox, p, true, Some(list), &log)
+    }
+
+    /// Refuse a frame whose positions (or, for dynamics, velocities) are not finite or do not
+    /// fit the schema's f32.
+    fn check_finite(&self, step: u64, p: &Particles) -> Result<(), GsdError> {
+        let bad = |v: &[f64; 3]| v.iter().any(|&x| !(x as f32).is_finite());
+        let found = match p.pos.iter().position(bad) {
+            Some(i) => Some((i, format!("position {:?}", p.pos[i]))),
+            None if self.dynamics => p
+                .vel
+                .iter()
+                .position(bad)
+                .map(|i| (i, format!("velocity {:?}", p.vel[i]))),
+            None => None,
+        };
+        match found {
+            Some((particle, what)) => Err(GsdError::NonFinite {
+                path: self.path.clone(),
+                step,
+                particle,
+                what,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn write_inner(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        exact: bool,
+        list: Option<&ListState>,
+        log: &[(&str, &[f64])],
+    ) -> Result<(), GsdError> {
+        self.check_finite(step, p)?;
+        self.write_frame_data(step, sbox, p, exact, list, log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
             })
     }
 
-    fn write_inner(
+    fn write_frame_data(
         &mut self,
         step: u64,
         sbox: &SimBox,

@@ -107,7 +107,8 @@ pub const INTERACTION_YUKAWA: Spec = key("interaction.yukawa", "-", Means("none"
 
 pub const INTERACTION_YUKAWA_STRENGTH: Spec = key("interaction.yukawa.strength", "energy",
     Required, Finite,
-    "A, the energy at contact");
+    "A, the energy at contact")
+    .also("mu |A| / l run.dt at most system.length");
 
 pub const INTERACTION_YUKAWA_SCREENING: Spec = key("interaction.yukawa.screening", "length",
     Required, Positive,
@@ -169,7 +170,8 @@ pub const OBSERVE_CONTACT_DENSITY_BINS: Spec = key("observe.contact_density.bins
 
 pub const OBSERVE_CONTACT_DENSITY_WINDOW: Spec = key("observe.contact_density.window", "length",
     Required, Positive,
-    "contact window Delta'");
+    "contact window Delta'")
+    .also("at least 1e-9 system.length");
 
 pub const OBSERVE_MSD: Spec = key("observe.msd", "-", Means("off"), Table,
     "mean-square displacement at log-spaced lags: msd.csv");

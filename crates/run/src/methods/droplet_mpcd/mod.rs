@@ -480,9 +480,13 @@ impl Session for DropletSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         if DropletSession::is_writer(self) {
+            if self.colloids.is_none() {
+                out.explain("thermo.csv", "colloid_temperature", "no colloids");
+            }
             self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
-            self.thermo_log = Some(CsvLog::start(
-                out.join("thermo.csv"),
+            self.thermo_log = Some(CsvLog::start_in(
+                out,
+                "thermo.csv",
                 &DROPLET_THERMO,
                 fresh,
                 || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
