@@ -85,7 +85,10 @@ pub struct NonFinite {
 
 /// The [`NonFinite`] entries of one output folder, shared by its clones and its logs.
 #[derive(Debug, Clone, Default)]
-pub struct NonFiniteRecord(Arc<Mutex<(Vec<NonFinite>, Vec<(String, String, String)>)>>);
+pub struct NonFiniteRecord(Arc<Mutex<(Vec<NonFinite>, Vec<Reason>)>>);
+
+/// The reason a method gave for a column's numbers that are not finite: file, column, reason.
+type Reason = (String, String, String);
 
 impl NonFiniteRecord {
     /// Replace what was recorded for `file` (a file written whole) by `found`.

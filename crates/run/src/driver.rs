@@ -88,10 +88,12 @@ fn run_with(
     if let Some(s) = opts.seed {
         crate::seed32(s)?;
     }
-    let mut session = m.start(sc, opts.seed, comm)?;
+    let units = crate::unit_warnings(sc, m)?;
+    let mut session = crate::first_the_units(m.start(sc, opts.seed, comm), &units)?;
     // Saved (scenario.toml, checkpoint) with the seed it ran with, so that it reruns this run.
     let sc = &as_run(sc, opts.seed)?;
-    let mut warnings = session.warnings();
+    let mut warnings = units;
+    warnings.extend(session.warnings());
     for w in &warnings {
         ctl.progress().warning(w);
     }

@@ -98,7 +98,8 @@ pub const SOLVENT_ANGLE: Spec = key(
     Value("130"),
     LeftOpen(0.0, 180.0),
     "SRD rotation angle about a random axis per cell",
-);
+)
+.suspicious(&[super::RADIANS]);
 
 /// `solvent.tau`.
 pub const SOLVENT_TAU: Spec = key(

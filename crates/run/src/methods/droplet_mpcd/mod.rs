@@ -692,6 +692,13 @@ impl Session for DropletSession {
                 .zip(cols.iter())
                 .map(|(n, c)| (*n, c.as_slice()))
                 .collect();
+            for c in ["radial_velocity", "radial_velocity_err", "density_err"] {
+                out.explain(
+                    "solvent_profiles.csv",
+                    c,
+                    "a shell that held no solvent in the window (no velocity to average) or one block (no error)",
+                );
+            }
             out.write_table("solvent_profiles.csv", &table)?;
             files.push("solvent_profiles.csv".into());
             for (name, ylabel, pick) in [
