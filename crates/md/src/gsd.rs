@@ -565,4 +565,32 @@ mod tests {
         );
         assert!(read_frame(&path, Some(5)).is_err());
     }
+
+    #[test]
+    fn a_state_that_is_not_finite_is_never_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gsd");
+        let sbox = SimBox::new([10.0, 10.0, 10.0]);
+        let mut p = Particles::monodisperse(vec![[0.1, 0.2, 0.3], [1.0, 2.0, 3.0]], 1.0);
+        let mut w = GsdWriter::create_new(&path).unwrap();
+        w.write_frame(1, &sbox, &p, false, &[]).unwrap();
+        // Finite in f64 but beyond the schema's f32, and NaN: refused naming step and particle.
+        for bad in [1e300, f64::NAN] {
+            p.pos[1][2] = bad;
+            let e = w.write_frame(2, &sbox, &p, true, &[]).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    GsdError::NonFinite {
+                        step: 2,
+                        particle: 1,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        drop(w);
+        assert_eq!(frame_count(&path).unwrap(), 1);
+    }
 }
