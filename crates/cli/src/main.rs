@@ -136,7 +136,7 @@ enum Command {
         #[arg(long, default_value_t = 4)]
         seeds: u32,
         /// Order p of the time-step bias, A(dt) = A(0) + c dt^p: 1 for Euler's bias of
-        /// averages, 2 for Leimkuhler-Matthews' force bias, 0.5 for contact densities.
+        /// averages, 2 for Leimkuhler-Matthews' force bias, 0.5 for contact densities (0.25 to 4).
         #[arg(long, default_value_t = 1.0)]
         order: f64,
         /// Write into an output folder that already holds files.

@@ -3,10 +3,16 @@
 //! Files are written to a temporary name and renamed into place, so an interrupted write never
 //! leaves a truncated file that looks complete. An [`OutputDir`] refuses to write into a folder
 //! that already holds results unless asked to overwrite.
+//!
+//! Every number is written finite or not at all: a value that is not finite (NaN, ±inf) is
+//! written as an empty CSV field (JSON: `null`), never as `NaN` or `inf` text, and the writers
+//! of an [`OutputDir`] record where they met one ([`NonFinite`]: file, column, rows), so that
+//! the run's `summary.json` can say which quantities are missing and why.
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use thiserror::Error;
 
 /// Errors of the output layer.
@@ -62,10 +68,69 @@ fn io_err(path: &Path) -> impl FnOnce(io::Error) -> OutputError + '_ {
     }
 }
 
+/// Where a writer met numbers that are not finite: they are written as empty fields.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NonFinite {
+    /// File, relative to the output folder.
+    pub file: String,
+    /// Column.
+    pub column: String,
+    /// How many rows hold a non-finite value in that column.
+    pub rows: usize,
+    /// The first such data row (0-based).
+    pub first_row: usize,
+    /// Why, where the method said ([`OutputDir::explain`]); else `None`.
+    pub reason: Option<String>,
+}
+
+/// The [`NonFinite`] entries of one output folder, shared by its clones and its logs.
+#[derive(Debug, Clone, Default)]
+pub struct NonFiniteRecord(Arc<Mutex<(Vec<NonFinite>, Vec<Reason>)>>);
+
+/// The reason a method gave for a column's numbers that are not finite: file, column, reason.
+type Reason = (String, String, String);
+
+impl NonFiniteRecord {
+    /// Replace what was recorded for `file` (a file written whole) by `found`.
+    fn set_file(&self, file: &str, found: Vec<NonFinite>) {
+        let v = &mut self.0.lock().unwrap_or_else(|e| e.into_inner()).0;
+        v.retain(|n| n.file != file);
+        v.extend(found);
+    }
+
+    /// Add rows appended to `file` (a log).
+    fn add(&self, found: Vec<NonFinite>) {
+        let v = &mut self.0.lock().unwrap_or_else(|e| e.into_inner()).0;
+        for f in found {
+            match v
+                .iter_mut()
+                .find(|n| n.file == f.file && n.column == f.column)
+            {
+                Some(n) => n.rows += f.rows,
+                None => v.push(f),
+            }
+        }
+    }
+
+    /// Everything recorded, by file and column.
+    pub fn entries(&self) -> Vec<NonFinite> {
+        let (mut v, why) = self.0.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        v.sort_by(|a, b| (&a.file, &a.column).cmp(&(&b.file, &b.column)));
+        for n in &mut v {
+            n.reason = why
+                .iter()
+                .find(|(f, c, _)| *f == n.file && *c == n.column)
+                .map(|w| w.2.clone());
+        }
+        v
+    }
+}
+
 /// A folder that receives a run's outputs.
 #[derive(Debug, Clone)]
 pub struct OutputDir {
     root: PathBuf,
+    non_finite: NonFiniteRecord,
 }
 
 impl OutputDir {
@@ -80,20 +145,51 @@ impl OutputDir {
             }
         }
         fs::create_dir_all(&root).map_err(io_err(&root))?;
-        Ok(Self { root })
+        Ok(Self::at(root))
     }
 
     /// The folder another process writes (rank 0 of a run decomposed over MPI ranks): only its
     /// path, which nothing here touches.
     pub fn unwritten(root: impl Into<PathBuf>) -> Self {
-        Self { root: root.into() }
+        Self::at(root.into())
+    }
+
+    fn at(root: PathBuf) -> Self {
+        Self {
+            root,
+            non_finite: NonFiniteRecord::default(),
+        }
+    }
+
+    /// The numbers that were not finite in the tables written so far (written as empty
+    /// fields), by file and column.
+    pub fn non_finite(&self) -> Vec<NonFinite> {
+        self.non_finite.entries()
+    }
+
+    /// Say why `column` of `file` may hold numbers that are not finite (e.g. "no colloids"):
+    /// [`Self::non_finite`] gives the reason with the entry.
+    pub fn explain(&self, file: &str, column: &str, reason: &str) {
+        let w = &mut self
+            .non_finite
+            .0
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .1;
+        w.retain(|(f, c, _)| !(f == file && c == column));
+        w.push((file.into(), column.into(), reason.into()));
+    }
+
+    /// The record the folder's writers add to (for a [`CsvLog`] of this folder).
+    pub fn non_finite_record(&self) -> &NonFiniteRecord {
+        &self.non_finite
     }
 
     /// Open an existing folder to continue writing into it (restarts).
     pub fn reopen(root: impl Into<PathBuf>) -> Result<Self, OutputError> {
         let root = root.into();
         fs::metadata(&root).map_err(io_err(&root))?;
-        Ok(Self { root })
+        Ok(Self::at(root))
     }
 
     /// The folder's path.
@@ -119,8 +215,10 @@ impl OutputDir {
         name: &str,
         columns: &[(&str, &[f64])],
     ) -> Result<PathBuf, OutputError> {
-        let bytes = table_bytes(name, columns)?;
-        self.write_bytes(name, &bytes)
+        let (bytes, found) = table_bytes_counted(name, columns)?;
+        let path = self.write_bytes(name, &bytes)?;
+        self.non_finite.set_file(name, found);
+        Ok(path)
     }
 
     /// Write rows of `header.len()` numbers as a CSV table ([`rows_bytes`]).
@@ -130,11 +228,16 @@ impl OutputDir {
         header: &[&str],
         rows: &[Vec<f64>],
     ) -> Result<PathBuf, OutputError> {
-        let bytes = rows_bytes(name, header, rows)?;
-        self.write_bytes(name, &bytes)
+        check_row_lengths(name, header, rows)?;
+        let (bytes, found) = encode(name, Some(header), header.len(), rows.len(), |i, j| {
+            rows[i][j]
+        })?;
+        let path = self.write_bytes(name, &bytes)?;
+        self.non_finite.set_file(name, found);
+        Ok(path)
     }
 
-    /// Write `value` as pretty JSON.
+    /// Write `value` as pretty JSON (numbers that are not finite become `null`).
     pub fn write_json<T: serde::Serialize>(
         &self,
         name: &str,
@@ -166,8 +269,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     written
 }
 
-/// Encode columns as CSV with a header line. Numbers use Rust's shortest round-trip format.
+/// Encode columns as CSV with a header line. Numbers use Rust's shortest round-trip format;
+/// a number that is not finite is an empty field.
 pub fn table_bytes(name: &str, columns: &[(&str, &[f64])]) -> Result<Vec<u8>, OutputError> {
+    Ok(table_bytes_counted(name, columns)?.0)
+}
+
+fn table_bytes_counted(
+    name: &str,
+    columns: &[(&str, &[f64])],
+) -> Result<(Vec<u8>, Vec<NonFinite>), OutputError> {
     let rows = columns.first().map_or(0, |c| c.1.len());
     for (col, data) in columns {
         if data.len() != rows {
@@ -188,9 +299,12 @@ pub fn table_bytes(name: &str, columns: &[(&str, &[f64])]) -> Result<Vec<u8>, Ou
 /// The same CSV as [`table_bytes`], from rows of `header.len()` numbers.
 pub fn rows_bytes(name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<Vec<u8>, OutputError> {
     check_row_lengths(name, header, rows)?;
-    encode(name, Some(header), header.len(), rows.len(), |i, j| {
-        rows[i][j]
-    })
+    Ok(
+        encode(name, Some(header), header.len(), rows.len(), |i, j| {
+            rows[i][j]
+        })?
+        .0,
+    )
 }
 
 fn check_row_lengths(name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<(), OutputError> {
@@ -205,14 +319,24 @@ fn check_row_lengths(name: &str, header: &[&str], rows: &[Vec<f64>]) -> Result<(
     }
 }
 
-/// CSV records: the header (when given) and `rows` rows of `width` numbers `cell(row, column)`.
+/// The CSV field of a number: Rust's shortest round-trip form, or empty when not finite.
+pub fn field(x: f64) -> String {
+    if x.is_finite() {
+        x.to_string()
+    } else {
+        String::new()
+    }
+}
+
+/// CSV records: the header (when given) and `rows` rows of `width` numbers `cell(row, column)`,
+/// with the columns that held numbers that are not finite (named by the header, else by index).
 fn encode(
     name: &str,
     header: Option<&[&str]>,
     width: usize,
     rows: usize,
     cell: impl Fn(usize, usize) -> f64,
-) -> Result<Vec<u8>, OutputError> {
+) -> Result<(Vec<u8>, Vec<NonFinite>), OutputError> {
     let path = PathBuf::from(name);
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |source| OutputError::Csv {
@@ -223,15 +347,36 @@ fn encode(
         w.write_record(h).map_err(csv_err)?;
     }
     let mut rec = Vec::with_capacity(width);
+    let mut found: Vec<Option<NonFinite>> = vec![None; width];
     for i in 0..rows {
         rec.clear();
-        rec.extend((0..width).map(|j| cell(i, j).to_string()));
+        for (j, slot) in found.iter_mut().enumerate() {
+            let x = cell(i, j);
+            if !x.is_finite() {
+                match slot {
+                    Some(n) => n.rows += 1,
+                    None => {
+                        *slot = Some(NonFinite {
+                            file: name.to_string(),
+                            column: header
+                                .and_then(|h| h.get(j))
+                                .map_or_else(|| format!("column {j}"), |c| c.to_string()),
+                            rows: 1,
+                            first_row: i,
+                            reason: None,
+                        })
+                    }
+                }
+            }
+            rec.push(field(x));
+        }
         w.write_record(&rec).map_err(csv_err)?;
     }
-    w.into_inner().map_err(|e| OutputError::Io {
+    let bytes = w.into_inner().map_err(|e| OutputError::Io {
         path: path.clone(),
         source: e.into_error(),
-    })
+    })?;
+    Ok((bytes, found.into_iter().flatten().collect()))
 }
 
 /// A CSV table written row by row while a run goes on, so that a user can follow it
@@ -243,6 +388,10 @@ pub struct CsvLog {
     path: PathBuf,
     header: Vec<String>,
     file: Option<fs::File>,
+    /// The folder's record of numbers that are not finite, and the file's name in it.
+    record: Option<(NonFiniteRecord, String)>,
+    /// Data rows in the file.
+    rows: usize,
 }
 
 impl CsvLog {
@@ -253,7 +402,26 @@ impl CsvLog {
             path: path.into(),
             header: header.iter().map(|h| h.to_string()).collect(),
             file: None,
+            record: None,
+            rows: 0,
         }
+    }
+
+    /// The log `name` of the folder `out` ([`Self::start`]); the numbers that are not finite
+    /// in its rows are recorded with the folder's ([`OutputDir::non_finite`]).
+    pub fn start_in(
+        out: &OutputDir,
+        name: &str,
+        header: &[&str],
+        fresh: bool,
+        rows: impl FnOnce() -> Vec<Vec<f64>>,
+    ) -> Result<Self, OutputError> {
+        let mut log = Self::new(out.join(name), header);
+        log.record = Some((out.non_finite.clone(), name.to_string()));
+        if !fresh {
+            log.reset(&rows())?;
+        }
+        Ok(log)
     }
 
     /// The log of a run continued from a checkpoint that kept `rows`: the file is brought to
@@ -286,10 +454,21 @@ impl CsvLog {
         self.path.display().to_string()
     }
 
+    /// The file's name as the folder's record knows it.
+    fn record_name(&self) -> String {
+        self.record
+            .as_ref()
+            .map_or_else(|| self.name(), |(_, n)| n.clone())
+    }
+
     /// Bring the file to exactly `rows` (a restart: rows a killed run wrote after its
     /// checkpoint are dropped), atomically; without rows the file is removed.
     pub fn reset(&mut self, rows: &[Vec<f64>]) -> Result<(), OutputError> {
         self.file = None;
+        self.rows = 0;
+        if let Some((r, name)) = &self.record {
+            r.set_file(name, Vec::new());
+        }
         if rows.is_empty() {
             match fs::remove_file(&self.path) {
                 Err(e) if e.kind() != io::ErrorKind::NotFound => {
@@ -299,7 +478,19 @@ impl CsvLog {
             }
         }
         let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
-        write_atomic(&self.path, &rows_bytes(&self.name(), &header, rows)?)?;
+        check_row_lengths(&self.name(), &header, rows)?;
+        let (bytes, found) = encode(
+            &self.record_name(),
+            Some(&header),
+            header.len(),
+            rows.len(),
+            |i, j| rows[i][j],
+        )?;
+        write_atomic(&self.path, &bytes)?;
+        if let Some((r, name)) = &self.record {
+            r.set_file(name, found);
+        }
+        self.rows = rows.len();
         self.file = Some(
             fs::OpenOptions::new()
                 .append(true)
@@ -323,16 +514,36 @@ impl CsvLog {
         let mut bytes = Vec::new();
         if self.file.is_none() {
             let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
-            bytes = encode(&name, Some(&header), 0, 0, |_, _| 0.0)?;
+            bytes = encode(&name, Some(&header), 0, 0, |_, _| 0.0)?.0;
             self.file = Some(fs::File::create(&self.path).map_err(io_err(&self.path))?);
         }
-        bytes.extend(encode(&name, None, row.len(), 1, |_, j| row[j])?);
+        let (line, mut found) = encode(&name, None, row.len(), 1, |_, j| row[j])?;
+        bytes.extend(line);
+        if let Some((_, file)) = &self.record {
+            for n in &mut found {
+                n.file = file.clone();
+                n.first_row = self.rows;
+                let j = n
+                    .column
+                    .strip_prefix("column ")
+                    .and_then(|j| j.parse::<usize>().ok());
+                if let Some(name) = j.and_then(|j| self.header.get(j)) {
+                    n.column = name.clone();
+                }
+            }
+        }
         let f = self.file.as_mut().expect("opened above");
-        f.write_all(&bytes).map_err(io_err(&self.path))
+        f.write_all(&bytes).map_err(io_err(&self.path))?;
+        if let Some((r, _)) = &self.record {
+            r.add(found);
+        }
+        self.rows += 1;
+        Ok(())
     }
 }
 
-/// Read a numeric CSV table with a header line; returns the header and the columns.
+/// Read a numeric CSV table with a header line; returns the header and the columns. An empty
+/// field reads as NaN (what the writers write for a number that is not finite).
 pub fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     let mut r = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -349,6 +560,11 @@ pub fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     for (line, rec) in r.records().enumerate() {
         let rec = rec.map_err(|e| format!("{}: {e}", path.display()))?;
         for (j, field) in rec.iter().enumerate() {
+            // An empty field is a number that was not finite ([`field`]).
+            if field.is_empty() {
+                cols[j].push(f64::NAN);
+                continue;
+            }
             let v: f64 = field.parse().map_err(|_| {
                 format!(
                     "{}: data row {}, column '{}': '{field}' is not a number",
@@ -386,6 +602,53 @@ mod tests {
             dir.write_table("bad.csv", &[("x", &x), ("y", &y[..2])])
                 .is_err()
         );
+    }
+
+    #[test]
+    fn no_writer_lets_a_number_that_is_not_finite_through() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = OutputDir::create(tmp.path().join("out"), false).unwrap();
+        let x = [0.5, 1.0, 1.5];
+        let y = [f64::NAN, 2.0, f64::INFINITY];
+        let p = dir.write_table("t.csv", &[("x", &x), ("y", &y)]).unwrap();
+        let text = fs::read_to_string(&p).unwrap();
+        assert_eq!(text, "x,y\n0.5,\n1,2\n1.5,\n");
+        let rows = dir
+            .write_rows("r.csv", &["a", "b"], &[vec![f64::NEG_INFINITY, 1.0]])
+            .unwrap();
+        assert_eq!(fs::read_to_string(&rows).unwrap(), "a,b\n,1\n");
+        let mut log = CsvLog::start_in(&dir, "log.csv", &["s", "T"], true, Vec::new).unwrap();
+        log.append(&[1.0, f64::NAN]).unwrap();
+        log.append(&[2.0, 3.0]).unwrap();
+        log.append(&[3.0, f64::NAN]).unwrap();
+        assert_eq!(
+            fs::read_to_string(dir.join("log.csv")).unwrap(),
+            "s,T\n1,\n2,3\n3,\n"
+        );
+        let j = dir.write_json("s.json", &[f64::NAN, 1.0]).unwrap();
+        let json = fs::read_to_string(&j).unwrap();
+        assert!(!json.contains("NaN") && json.contains("null"), "{json}");
+        dir.explain("log.csv", "T", "nothing to average");
+        let entry = |file: &str, column: &str, rows, first_row| NonFinite {
+            file: file.into(),
+            column: column.into(),
+            rows,
+            first_row,
+            reason: (file == "log.csv").then(|| "nothing to average".to_string()),
+        };
+        assert_eq!(
+            dir.non_finite(),
+            vec![
+                entry("log.csv", "T", 2, 0),
+                entry("r.csv", "a", 1, 0),
+                entry("t.csv", "y", 2, 0),
+            ]
+        );
+        // A file written again replaces its entries; the empty fields read back as NaN.
+        dir.write_table("t.csv", &[("x", &x), ("y", &x)]).unwrap();
+        assert_eq!(dir.non_finite().len(), 2);
+        let (_, c) = read_table(&rows).unwrap();
+        assert!(c[0][0].is_nan());
     }
 
     #[test]

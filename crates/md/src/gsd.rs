@@ -45,6 +45,21 @@ pub enum GsdError {
         /// What went wrong.
         message: String,
     },
+    /// A frame's positions or velocities are not finite (or too large for the schema's f32):
+    /// nothing of the frame is written.
+    #[error(
+        "{path}: the state went non-finite at step {step}: particle {particle} has {what}; no frame is written"
+    )]
+    NonFinite {
+        /// File.
+        path: PathBuf,
+        /// Step of the frame.
+        step: u64,
+        /// Index of the first such particle.
+        particle: usize,
+        /// What is not finite, with its value.
+        what: String,
+    },
     /// The file is readable but does not hold what a configuration needs.
     #[error("{path}: {message}")]
     Content {
@@ -118,10 +133,6 @@ impl GsdWriter {
     ) -> Result<(), GsdError> {
         let log = scalars(log);
         self.write_inner(step, sbox, p, exact, None, &log)
-            .map_err(|message| GsdError::Write {
-                path: self.path.clone(),
-                message,
-            })
     }
 
     /// Append one frame whose logged quantities may be arrays (`log/NAME` with one value per
@@ -134,10 +145,6 @@ impl GsdWriter {
         log: &[(&str, &[f64])],
     ) -> Result<(), GsdError> {
         self.write_inner(step, sbox, p, false, None, log)
-            .map_err(|message| GsdError::Write {
-                path: self.path.clone(),
-                message,
-            })
     }
 
     /// Append a checkpoint frame: exact positions and box plus the engine's storage order and
@@ -153,13 +160,50 @@ impl GsdWriter {
     ) -> Result<(), GsdError> {
         let log = scalars(log);
         self.write_inner(step, sbox, p, true, Some(list), &log)
+    }
+
+    /// Refuse a frame whose positions (or, for dynamics, velocities) are not finite or do not
+    /// fit the schema's f32.
+    fn check_finite(&self, step: u64, p: &Particles) -> Result<(), GsdError> {
+        let bad = |v: &[f64; 3]| v.iter().any(|&x| !(x as f32).is_finite());
+        let found = match p.pos.iter().position(bad) {
+            Some(i) => Some((i, format!("position {:?}", p.pos[i]))),
+            None if self.dynamics => p
+                .vel
+                .iter()
+                .position(bad)
+                .map(|i| (i, format!("velocity {:?}", p.vel[i]))),
+            None => None,
+        };
+        match found {
+            Some((particle, what)) => Err(GsdError::NonFinite {
+                path: self.path.clone(),
+                step,
+                particle,
+                what,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn write_inner(
+        &mut self,
+        step: u64,
+        sbox: &SimBox,
+        p: &Particles,
+        exact: bool,
+        list: Option<&ListState>,
+        log: &[(&str, &[f64])],
+    ) -> Result<(), GsdError> {
+        self.check_finite(step, p)?;
+        self.write_frame_data(step, sbox, p, exact, list, log)
             .map_err(|message| GsdError::Write {
                 path: self.path.clone(),
                 message,
             })
     }
 
-    fn write_inner(
+    fn write_frame_data(
         &mut self,
         step: u64,
         sbox: &SimBox,
@@ -518,5 +562,33 @@ mod tests {
             "{e}"
         );
         assert!(read_frame(&path, Some(5)).is_err());
+    }
+
+    #[test]
+    fn a_state_that_is_not_finite_is_never_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.gsd");
+        let sbox = SimBox::new([10.0, 10.0, 10.0]);
+        let mut p = Particles::monodisperse(vec![[0.1, 0.2, 0.3], [1.0, 2.0, 3.0]], 1.0);
+        let mut w = GsdWriter::create_new(&path).unwrap();
+        w.write_frame(1, &sbox, &p, false, &[]).unwrap();
+        // Finite in f64 but beyond the schema's f32, and NaN: refused naming step and particle.
+        for bad in [1e300, f64::NAN] {
+            p.pos[1][2] = bad;
+            let e = w.write_frame(2, &sbox, &p, true, &[]).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    GsdError::NonFinite {
+                        step: 2,
+                        particle: 1,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        drop(w);
+        assert_eq!(frame_count(&path).unwrap(), 1);
     }
 }

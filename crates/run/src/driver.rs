@@ -194,10 +194,12 @@ fn run_with(
     if let Some(s) = opts.seed {
         crate::seed32(s)?;
     }
-    let mut session = m.start(sc, opts.seed, comm)?;
+    let units = crate::unit_warnings(sc, m)?;
+    let mut session = crate::first_the_units(m.start(sc, opts.seed, comm), &units)?;
     // Saved (scenario.toml, checkpoint) with the seed it ran with, so that it reruns this run.
     let sc = &as_run(sc, opts.seed)?;
-    let mut warnings = session.warnings();
+    let mut warnings = units;
+    warnings.extend(session.warnings());
     for w in &warnings {
         ctl.progress().warning(w);
     }
@@ -660,6 +662,25 @@ pub(crate) fn significant(x: f64) -> String {
     format!("{x:.digits$}")
 }
 
+/// [`Session::advance`], with a trajectory frame refused for a state that is not finite taken
+/// as the reason the run stops (completed = false, naming the step and the particle), as an
+/// engine's own non-finite check is.
+fn advance(s: &mut dyn Session, until: u64) -> Result<Option<String>> {
+    match s.advance(until) {
+        Err(e) => {
+            let non_finite = e.chain().find_map(|c| match c.downcast_ref() {
+                Some(g @ colloidsim_md::gsd::GsdError::NonFinite { .. }) => Some(g.to_string()),
+                _ => None,
+            });
+            match non_finite {
+                Some(why) => Ok(Some(why)),
+                None => Err(e),
+            }
+        }
+        other => other,
+    }
+}
+
 /// Work units per chunk are adapted so that a chunk takes about this long: interrupts are
 /// seen within it and the progress moves. Outputs never depend on the chunks.
 const CHUNK_SECONDS: f64 = 0.2;
@@ -747,7 +768,7 @@ fn drive(
                             cause.again()
                         ));
                         let t = Instant::now();
-                        if let Some(why) = s.advance(stop)? {
+                        if let Some(why) = advance(&mut *s, stop)? {
                             return Ok(Some(why));
                         }
                         timer.stepped(stop - pos, t.elapsed().as_secs_f64());
@@ -769,7 +790,7 @@ fn drive(
             }
             let next = end_of(chunk);
             let t = Instant::now();
-            if let Some(why) = s.advance(next)? {
+            if let Some(why) = advance(&mut *s, next)? {
                 return Ok(Some(why));
             }
             let secs = timer.stepped(next - pos, t.elapsed().as_secs_f64());
@@ -808,7 +829,20 @@ fn drive(
         files.push("scenario.toml".to_string());
     }
     files.extend(fin.files.into_iter().filter(|f| f != "scenario.toml"));
+    // Every number is written finite or as an empty field (JSON: null): say where and why.
+    let non_finite = out.non_finite();
+    for n in non_finite.iter().filter(|n| n.reason.is_none()) {
+        let w = format!(
+            "{}: column '{}' has {} row(s) that are not numbers (from data row {}), written as empty fields; see non_finite in summary.json",
+            n.file, n.column, n.rows, n.first_row
+        );
+        ctl.progress().warning(&w);
+        warnings.push(w);
+    }
     if let Some(m) = summary.as_object_mut() {
+        if !non_finite.is_empty() {
+            m.insert("non_finite".into(), json!(non_finite));
+        }
         m.insert("completed".into(), json!(failure.is_none()));
         m.insert("error".into(), json!(failure));
         m.insert("files".into(), json!(files));

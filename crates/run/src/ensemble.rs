@@ -677,8 +677,9 @@ impl Ensemble {
                 .collect();
             if let Some(obs) = point["observables"].as_object() {
                 for (name, v) in obs {
-                    let num =
-                        |x: &Value| x.as_f64().map_or("nan".to_string(), |x| format!("{x:e}"));
+                    // A number that is not finite (an error of one replica) is an empty
+                    // field, as in every table colloidsim writes.
+                    let num = |x: &Value| x.as_f64().map_or(String::new(), |x| format!("{x:e}"));
                     s.push_str(&format!("{p}"));
                     for c in &set {
                         s.push(',');

@@ -40,6 +40,47 @@ impl Default for ExtrapolateOptions {
     }
 }
 
+/// The range of `--order`: below it the extrapolation only amplifies noise.
+const MIN_ORDER: f64 = 0.25;
+const MAX_ORDER: f64 = 4.0;
+
+/// A warning for the columns whose means are >= 0 at both time steps (a density, a volume
+/// fraction, a probability) but negative somewhere once extrapolated: the extrapolation of
+/// noise, which a user must not take for a physical value.
+fn negative_where_runs_are_not(
+    name: &str,
+    coarse: &Pooled,
+    fine: &Pooled,
+    extrapolated: &Pooled,
+) -> Option<String> {
+    let mut found = Vec::new();
+    for (j, col) in extrapolated.means.iter().enumerate() {
+        let non_negative = |p: &Pooled| p.means[j].iter().all(|&v| v >= 0.0);
+        if !(non_negative(coarse) && non_negative(fine)) {
+            continue;
+        }
+        let below: Vec<usize> = (0..col.len()).filter(|&i| col[i] < 0.0).collect();
+        if let Some(&worst) = below.iter().min_by(|&&a, &&b| col[a].total_cmp(&col[b])) {
+            found.push(format!(
+                "{} ({} of {} rows, down to {:.3e} +- {:.1e} at {} = {})",
+                extrapolated.header[j + 1],
+                below.len(),
+                col.len(),
+                col[worst],
+                extrapolated.errors[j][worst],
+                extrapolated.header[0],
+                extrapolated.x[worst]
+            ));
+        }
+    }
+    (!found.is_empty()).then(|| {
+        format!(
+            "{name}: extrapolated values below 0 where both time steps give none: {}; the extrapolation amplifies the noise between seeds (use more --seeds, or the half-dt table)",
+            found.join("; ")
+        )
+    })
+}
+
 /// The scenario's time step, from its resolved parameters.
 fn time_step(sc: &Scenario) -> Result<f64> {
     let r = crate::check(sc)?.resolved;
@@ -60,8 +101,12 @@ pub fn extrapolate(sc: &Scenario, opts: &ExtrapolateOptions, ctl: &Control) -> R
             opts.seeds
         );
     }
-    if !(opts.order.is_finite() && opts.order > 0.0 && opts.order <= 4.0) {
-        bail!("--order: must lie in (0, 4], got {}", opts.order);
+    if !(opts.order.is_finite() && opts.order >= MIN_ORDER && opts.order <= MAX_ORDER) {
+        bail!(
+            "--order: must lie in [{MIN_ORDER}, {MAX_ORDER}], got {}: the extrapolation multiplies the difference between the two time steps by 2^p / (2^p - 1), {:.3} at p = {MIN_ORDER} and without bound as p goes to 0 (the usual orders: 0.5 contact densities, 1 Euler's averages, 2 Leimkuhler-Matthews' forces)",
+            opts.order,
+            2f64.powf(MIN_ORDER) / (2f64.powf(MIN_ORDER) - 1.0)
+        );
     }
     let dt = time_step(sc)?;
     let out_path = opts
@@ -132,6 +177,9 @@ pub fn extrapolate(sc: &Scenario, opts: &ExtrapolateOptions, ctl: &Control) -> R
                 })
                 .collect(),
         };
+        if let Some(w) = negative_where_runs_are_not(name, c, f, &extrapolated) {
+            warnings.push(w);
+        }
         write_pooled(&out, name, &extrapolated)?;
         files.push(name.clone());
         for (sub, p) in [("dt", c), ("half-dt", f)] {

@@ -126,7 +126,28 @@ pub struct Failed {
 
 /// Validate a scenario (`colloidsim check`).
 pub fn check(sc: &Scenario) -> anyhow::Result<Checked> {
-    registry::of(sc)?.check(sc)
+    let m = registry::of(sc)?;
+    let units = unit_warnings(sc, m)?;
+    let mut checked = first_the_units(m.check(sc), &units)?;
+    checked.warnings.splice(0..0, units);
+    Ok(checked)
+}
+
+/// Values of `sc` that almost surely mean a unit mistake ([`keys::suspicious`]).
+pub(crate) fn unit_warnings(sc: &Scenario, m: &dyn method::Method) -> anyhow::Result<Vec<String>> {
+    Ok(keys::suspicious(&sc.table()?, m.keys()))
+}
+
+/// A scenario refused where a value also looks like a unit mistake: the unit mistake is
+/// reported first (it is the likely cause of the refusal).
+pub(crate) fn first_the_units<T>(r: anyhow::Result<T>, units: &[String]) -> anyhow::Result<T> {
+    match r {
+        Err(e) if !units.is_empty() => Err(e.context(format!(
+            "{}\n(probably the cause of what follows)",
+            units.join("\n")
+        ))),
+        other => other,
+    }
 }
 
 /// The continuum counterpart of a scenario (`colloidsim theory`).

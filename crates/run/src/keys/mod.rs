@@ -183,6 +183,107 @@ pub struct Spec {
     pub also: &'static str,
     /// What it sets.
     pub doc: &'static str,
+    /// Values inside the range that almost surely mean a unit mistake ([`Spec::suspicions`]);
+    /// empty: those of the key's unit ([`by_unit`]).
+    pub suspicious: &'static [Suspicion],
+    /// No unit-mistake warning for this key (a length that is legitimately tiny).
+    pub plausible: bool,
+}
+
+/// Values of a key, inside its range, that almost surely mean a unit mistake: a warning names
+/// the key and the likely intent.
+#[derive(Debug, Clone, Copy)]
+pub struct Suspicion {
+    /// Lowest suspicious value.
+    pub lo: f64,
+    /// Highest suspicious value.
+    pub hi: f64,
+    /// The likely intent and what the key means instead.
+    pub hint: &'static str,
+}
+
+/// kT given in kelvin.
+pub const KELVIN: Suspicion = Suspicion {
+    lo: 250.0,
+    hi: 400.0,
+    hint: "kelvin? kT is an energy in the scenario's units (kT = 1: the thermal energy), not a temperature; room temperature is kT = 1",
+};
+/// kT given in joules.
+pub const JOULES: Suspicion = Suspicion {
+    lo: 1e-23,
+    hi: 1e-19,
+    hint: "joules? kT is an energy in the scenario's units (kT = 1: the thermal energy), not SI (4.1e-21 J is kT = 1 at room temperature)",
+};
+/// A length given in metres.
+pub const METRES: Suspicion = Suspicion {
+    lo: 1e-10,
+    hi: 1e-5,
+    hint: "metres? lengths are in the scenario's units (the diameter, the cut-off or the cell, e.g. 1), not SI",
+};
+/// A viscosity given in pascal seconds.
+pub const PASCAL_SECONDS: Suspicion = Suspicion {
+    lo: 5e-4,
+    hi: 2e-3,
+    hint: "Pa s (water: 1e-3)? the viscosity is in the scenario's reduced units (energy time / length^3, e.g. 1)",
+};
+/// An angle in degrees given in radians.
+pub const RADIANS: Suspicion = Suspicion {
+    lo: 0.0,
+    hi: 2.0 * std::f64::consts::PI,
+    hint: "radians? the key is in degrees (the usual 130 degrees is 2.27 rad)",
+};
+
+/// The unit mistakes a key's unit invites: kT in kelvin or joules, lengths in metres,
+/// viscosities in Pa s, degrees given in radians.
+pub fn by_unit(s: &Spec) -> &'static [Suspicion] {
+    match s.unit {
+        "energy" if s.path.ends_with("kT") => &[KELVIN, JOULES],
+        "length" | "rc" => &[METRES],
+        "energy time / length^3" => &[PASCAL_SECONDS],
+        "degrees" => &[RADIANS],
+        _ => &[],
+    }
+}
+
+impl Spec {
+    /// The values of this key that warn of a unit mistake.
+    pub fn suspicions(&self) -> &'static [Suspicion] {
+        if self.plausible {
+            &[]
+        } else if self.suspicious.is_empty() {
+            by_unit(self)
+        } else {
+            self.suspicious
+        }
+    }
+}
+
+/// Warnings for the values of `table` that almost surely mean a unit mistake (`check` and `run`
+/// print them; a scenario they make fail reports them first).
+pub fn suspicious(table: &toml::Table, spec: &[Spec]) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in spec {
+        let mut parts = s.path.split('.');
+        let mut v = parts.next().and_then(|p| table.get(p));
+        for p in parts {
+            v = v.and_then(|v| v.as_table()).and_then(|t| t.get(p));
+        }
+        let x = match v {
+            Some(toml::Value::Float(x)) => *x,
+            Some(toml::Value::Integer(i)) => *i as f64,
+            _ => continue,
+        };
+        if let Some(w) = s.suspicions().iter().find(|w| x > w.lo && x <= w.hi) {
+            out.push(format!(
+                "{} = {}: {} (unit: {})",
+                s.path,
+                colloidsim_core::param::show(x),
+                w.hint,
+                s.unit
+            ));
+        }
+    }
+    out
 }
 
 /// One scenario key as listed by `colloidsim keys`.
@@ -230,12 +331,26 @@ pub(crate) const fn key(
         allowed,
         also: "",
         doc,
+        suspicious: &[],
+        plausible: false,
     }
 }
 
 impl Spec {
     pub(crate) const fn also(mut self, also: &'static str) -> Self {
         self.also = also;
+        self
+    }
+
+    /// Warn of a unit mistake for these values (instead of those of the key's unit).
+    pub(crate) const fn suspicious(mut self, values: &'static [Suspicion]) -> Self {
+        self.suspicious = values;
+        self
+    }
+
+    /// No unit-mistake warning: tiny values of this length are meant.
+    pub(crate) const fn plausible(mut self) -> Self {
+        self.plausible = true;
         self
     }
 }

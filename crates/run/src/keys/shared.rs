@@ -7,6 +7,7 @@ use super::Omitted::*;
 use super::{COUNT, Reader, Spec, key, rekey};
 use anyhow::{Result, bail};
 use colloidsim_core::ParamError;
+use colloidsim_core::param::show;
 use colloidsim_md::brownian::Integrator;
 use colloidsim_md::hydro::params::{DEFAULT_BOX_FACTOR, DEFAULT_DIRECT_MAX};
 use colloidsim_md::hydro::{HydroMethod, HydroModel, HydroParams};
@@ -87,7 +88,8 @@ pub const SOLVENT_DENSITY: Spec = key(
     Value("5"),
     LeftOpen(0.0, 1000.0),
     "mean particles per cell M",
-);
+)
+.also("at least 3 (with fewer, most cells hold 0 or 1 particle and collide nothing)");
 
 /// `solvent.angle`.
 pub const SOLVENT_ANGLE: Spec = key(
@@ -96,7 +98,8 @@ pub const SOLVENT_ANGLE: Spec = key(
     Value("130"),
     LeftOpen(0.0, 180.0),
     "SRD rotation angle about a random axis per cell",
-);
+)
+.suspicious(&[super::RADIANS]);
 
 /// `solvent.tau`.
 pub const SOLVENT_TAU: Spec = key(
@@ -114,7 +117,8 @@ pub const SOLVENT_KT: Spec = key(
     Value("1"),
     Positive,
     "thermal energy",
-);
+)
+.also("mean free path tau sqrt(kT/m) in [1e-4, 10] cells");
 
 /// `solvent.mass`.
 pub const SOLVENT_MASS: Spec = key(
@@ -190,8 +194,47 @@ pub const COLLOID_MD_STEPS: Spec = key(
     "velocity Verlet steps per collision time",
 );
 
-/// Read `[solvent]` into the engine's parameters, with the run's `seed`.
+/// The fewest mean particles per collision cell an SRD solvent may have.
+pub const MIN_SOLVENT_DENSITY: f64 = 3.0;
+/// The range of the mean free path `tau sqrt(kT/m)`, in cells.
+pub const MEAN_FREE_PATH: (f64, f64) = (1e-4, 10.0);
+
+/// Read `[solvent]` into the engine's parameters, with the run's `seed`: refused where the
+/// solvent is too dilute to collide, or its particles stream absurdly far (or not at all)
+/// between collisions.
 pub fn solvent(r: &Reader, seed: u32) -> Result<SrdParams> {
+    let density = r.number(&SOLVENT_DENSITY)?;
+    if density < MIN_SOLVENT_DENSITY {
+        bail!(
+            "{}: {} particles per cell is below the minimum {MIN_SOLVENT_DENSITY}: with fewer, most collision cells hold 0 or 1 particle, which exchange no momentum, so the solvent has no SRD viscosity and its observables are not defined (use 3 to 10)",
+            SOLVENT_DENSITY.path,
+            show(density)
+        );
+    }
+    let (kt, mass, tau, cell) = (
+        r.number(&SOLVENT_KT)?,
+        r.number(&SOLVENT_MASS)?,
+        r.number(&SOLVENT_TAU)?,
+        r.number(&SOLVENT_CELL)?,
+    );
+    let free_path = tau * (kt / mass).sqrt() / cell;
+    if !(MEAN_FREE_PATH.0..=MEAN_FREE_PATH.1).contains(&free_path) {
+        bail!(
+            "{}: {} gives a mean free path tau sqrt(kT/m) = {free_path:.3e} cells (tau = {}, m = {}, cell = {}); it must be in [{}, {}] cells: {} (the usual SRD solvent: kT = 1, m = 1, tau = 0.1, a free path of 0.1 cells)",
+            SOLVENT_KT.path,
+            show(kt),
+            show(tau),
+            show(mass),
+            show(cell),
+            MEAN_FREE_PATH.0,
+            MEAN_FREE_PATH.1,
+            if free_path > MEAN_FREE_PATH.1 {
+                "a particle would cross that many cells in one streaming step, and thermal velocities that large lose the positions' precision"
+            } else {
+                "the particles would not move between collisions"
+            }
+        );
+    }
     Ok(SrdParams {
         cell: r.number(&SOLVENT_CELL)?,
         density: r.number(&SOLVENT_DENSITY)?,
@@ -359,12 +402,34 @@ pub struct Spheres {
     pub d0: f64,
 }
 
-/// Read `system.diameter`, `system.kT` and `system.viscosity`.
+/// How far from overflow and underflow the scales of [`spheres`] must stay.
+const SCALE_MARGIN: f64 = 1e30;
+
+/// Read `system.diameter`, `system.kT` and `system.viscosity` (refused where the volume, time
+/// and force scales they make are near overflow or underflow).
 pub fn spheres(r: &Reader) -> Result<Spheres> {
     let d = r.number(&DIAMETER)?;
     let kt = r.number(&KT)?;
     let eta = r.number(&VISCOSITY)?;
     let friction = 3.0 * std::f64::consts::PI * eta * d;
+    // Volumes (of many spheres: a droplet, a box), the time d^2/D0 and the force kT/d must
+    // stay numbers with room to spare, or every length written comes out inf or 0.
+    let volume = d.powi(3);
+    let time = d * d * friction / kt;
+    let force = kt / d;
+    let fine = |x: f64| (x * SCALE_MARGIN).is_finite() && (x / SCALE_MARGIN).is_normal();
+    if !(fine(volume) && fine(time) && fine(force)) {
+        bail!(
+            "{} = {}, {} = {}, {} = {}: the scales they make (the volume d^3 = {volume:e}, the time d^2/D0 = {time:e}, the force kT/d = {force:e}) must stay within 1e{} of the largest and smallest numbers; the Brownian methods work in units near the diameter (e.g. d = 1, kT = 1, viscosity = 1)",
+            DIAMETER.path,
+            show(d),
+            KT.path,
+            show(kt),
+            VISCOSITY.path,
+            show(eta),
+            SCALE_MARGIN.log10()
+        );
+    }
     Ok(Spheres {
         d,
         kt,

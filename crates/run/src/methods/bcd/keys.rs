@@ -96,7 +96,8 @@ pub const INTERACTION_STICKY_GAMMA: Spec = key("interaction.sticky.gamma", "-", 
 
 pub const INTERACTION_STICKY_RANGE: Spec = key("interaction.sticky.range", "length",
     Value("0.05"), Positive,
-    "virtual range eps");
+    "virtual range eps")
+    .plausible();
 
 pub const INTERACTION_STICKY_ORDER: Spec = key("interaction.sticky.order", "-",
     Value("3"), Closed(1.0, 100.0),
@@ -107,7 +108,8 @@ pub const INTERACTION_YUKAWA: Spec = key("interaction.yukawa", "-", Means("none"
 
 pub const INTERACTION_YUKAWA_STRENGTH: Spec = key("interaction.yukawa.strength", "energy",
     Required, Finite,
-    "A, the energy at contact");
+    "A, the energy at contact")
+    .also("mu |A| / l run.dt at most system.length");
 
 pub const INTERACTION_YUKAWA_SCREENING: Spec = key("interaction.yukawa.screening", "length",
     Required, Positive,
@@ -169,7 +171,9 @@ pub const OBSERVE_CONTACT_DENSITY_BINS: Spec = key("observe.contact_density.bins
 
 pub const OBSERVE_CONTACT_DENSITY_WINDOW: Spec = key("observe.contact_density.window", "length",
     Required, Positive,
-    "contact window Delta'");
+    "contact window Delta'")
+    .also("at least 1e-9 system.length")
+    .plausible();
 
 pub const OBSERVE_MSD: Spec = key("observe.msd", "-", Means("off"), Table,
     "mean-square displacement at log-spaced lags: msd.csv");

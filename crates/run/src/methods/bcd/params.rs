@@ -453,6 +453,24 @@ impl Scenario {
             }
         }
 
+        if let Some(y) = &self.interaction.yukawa {
+            // A rod at contact must not be thrown across the system in one step: beyond that the
+            // force only measures rounding (the ring's net force of 1e-16 of it drifts every rod).
+            let jump = s.mobility * (y.strength / y.screening).abs() * self.run.dt;
+            if jump > s.length {
+                return Err(ParamError::new(
+                    "interaction.yukawa.strength",
+                    format!(
+                        "{} moves a rod at contact by mu |A| / l dt = {jump:.3e} in one step, more than the system length {}; use |A| <= {:.3e} (or a smaller run.dt)",
+                        param::show(y.strength),
+                        s.length,
+                        s.length * y.screening / (s.mobility * self.run.dt)
+                    ),
+                )
+                .into());
+            }
+        }
+
         if integrator == Integrator::Lm && pair.sticky.is_some() {
             warnings.push(
                 "run.integrator = \"lm\" with interaction.sticky: the stiff contact force is outside \
@@ -555,6 +573,19 @@ impl Scenario {
         if let Some(c) = &o.contact_density {
             param::at_least("observe.contact_density.bins", c.bins, 1)?;
             param::positive("observe.contact_density.window", c.window)?;
+            // Gaps are resolved to the rounding of positions (1e-16 of the system length): a
+            // window near it counts rounding, and rho2 = count / window overflows.
+            if c.window < 1e-9 * s.length {
+                return Err(ParamError::new(
+                    "observe.contact_density.window",
+                    format!(
+                        "{} is below what the positions resolve: at least 1e-9 of the system length, {:e}",
+                        param::show(c.window),
+                        1e-9 * s.length
+                    ),
+                )
+                .into());
+            }
             // Colliding pairs end a BCD step at exactly zero gap. To leading order the gap is a
             // random walk stopped at contact, whose stationary law is the continuous one with the
             // wall moved out by delta = 0.5826 sqrt(2 D_rel dt), D_rel = 2D (Siegmund's

@@ -114,7 +114,8 @@ pub const COLLOIDS_LUBRICATION_NOISE: Spec = key("colloids.lubrication_noise", "
 
 pub const RUN: Spec = key("run", "-", Means("defaults"), Table, "time stepping");
 
-pub const RUN_DT: Spec = key("run.dt", "DPD time", Value("0.001"), Positive, "time step");
+pub const RUN_DT: Spec = key("run.dt", "DPD time", Value("0.001"), Positive, "time step")
+    .also("at least 1e-6");
 
 pub const RUN_STEPS: Spec = key("run.steps", "-", Value("10000"), Integer(0, COUNT), "steps");
 

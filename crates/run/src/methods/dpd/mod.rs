@@ -486,10 +486,14 @@ impl Session for DpdSession {
             }
             return Ok(());
         }
+        if self.s.setup.colloids == 0 {
+            out.explain("thermo.csv", "T_colloid", "no colloids");
+        }
         if self.s.observe.thermo_every > 0 {
             let (vol, tau) = (self.sim.sbox.volume(), self.s.setup.tau);
-            self.thermo_log = Some(CsvLog::start(
-                out.join("thermo.csv"),
+            self.thermo_log = Some(CsvLog::start_in(
+                out,
+                "thermo.csv",
                 &THERMO_COLUMNS,
                 fresh,
                 || thermo_rows_of(&self.obs, vol, tau),
@@ -1070,7 +1074,11 @@ fn write_outputs(
     }
     // msd.csv
     let mut diffusion = None;
-    if obs.msd_steps.len() >= 2 {
+    // A kind of particle that is not followed (no colloids, observe.msd_solvent_beads = 0)
+    // has no MSD: its column is left out rather than written as not a number.
+    let has_colloids = s.setup.colloids > 0;
+    let has_beads = obs.solvent_frames.first().is_some_and(|f| !f.is_empty());
+    if obs.msd_steps.len() >= 2 && (has_colloids || has_beads) {
         let mc = msd(&obs.colloid_frames);
         let ms = msd(&obs.solvent_frames);
         let lag_steps: Vec<f64> = (1..obs.msd_steps.len())
@@ -1078,16 +1086,18 @@ fn write_outputs(
             .collect();
         let time: Vec<f64> = lag_steps.iter().map(|l| l * dt).collect();
         let time_tau: Vec<f64> = time.iter().map(|t| t / tau).collect();
-        out.write_table(
-            "msd.csv",
-            &[
-                ("lag_steps", &lag_steps),
-                ("time", &time),
-                ("time_tau", &time_tau),
-                ("msd_colloid", &mc),
-                ("msd_solvent", &ms),
-            ],
-        )?;
+        let mut columns: Vec<(&str, &[f64])> = vec![
+            ("lag_steps", &lag_steps),
+            ("time", &time),
+            ("time_tau", &time_tau),
+        ];
+        if has_colloids {
+            columns.push(("msd_colloid", &mc));
+        }
+        if has_beads {
+            columns.push(("msd_solvent", &ms));
+        }
+        out.write_table("msd.csv", &columns)?;
         files.push("msd.csv".into());
         // Long-time colloid diffusion: slope of the MSD over the second half of the lags
         // (least squares), D = slope / 6; only when that half starts at a lag of at least one
@@ -1120,7 +1130,11 @@ fn write_outputs(
                 points: false,
             },
         ];
-        let n_series = if s.setup.colloids > 0 { 2 } else { 1 };
+        let shown: Vec<Series> = series
+            .into_iter()
+            .zip([has_colloids, has_beads])
+            .filter_map(|(series, followed)| followed.then_some(series))
+            .collect();
         picture(
             line_plot(
                 &out.join("msd.png"),
@@ -1134,7 +1148,7 @@ fn write_outputs(
                 ),
                 "t / tau_D",
                 "mean-squared displacement [rc^2]",
-                &series[2 - n_series..],
+                &shown,
                 Scale::LogLog,
             ),
             "msd.png",

@@ -15,6 +15,9 @@ use colloidsim_md::dpd::{
 };
 use std::f64::consts::PI;
 
+/// The shortest DPD time step (DPD times `rc sqrt(m / kT)`).
+const MIN_DT: f64 = 1e-6;
+
 /// Most sample intervals in the stress autocorrelation (`observe.viscosity_time`): each sample
 /// costs that many products of six components.
 pub const MAX_VISCOSITY_LAGS: usize = 100_000;
@@ -331,6 +334,17 @@ impl Scenario {
         }
         let run = &self.run;
         let (dt, skin, shear_rate) = (run.dt, run.skin, run.shear_rate);
+        if dt < MIN_DT {
+            // The random force's amplitude grows as 1 / sqrt(dt): its pressure and stress
+            // samples become noise that no run averages out.
+            return Err(key(
+                &RUN_DT,
+                format!(
+                    "{dt:e} is below {MIN_DT:e} DPD times: the random force scales as 1/sqrt(dt), so its pressure and stress samples would be {:.0e} times the thermal scale and the run would cover no time (the usual step: 0.01 to 0.04)",
+                    dt.sqrt().recip()
+                ),
+            ));
+        }
         let rank_grid = match run.rank_grid.as_deref() {
             Some(&[py, pz]) => {
                 if py.fract() != 0.0 || pz.fract() != 0.0 {
@@ -392,6 +406,27 @@ impl Scenario {
             600.0 * beads,
         )?;
         let colloids = (phi * sbox.volume() / vc).round() as usize;
+        if phi > 0.0 && vc > sbox.volume() {
+            return Err(key(
+                &SYSTEM_COLLOID_RADIUS,
+                format!(
+                    "one colloid of radius {radius} (volume {vc:.4}) does not fit in the box (volume {:.4}) at phi = {phi}; use a larger box or smaller colloids, or phi = 0 for the solvent alone",
+                    sbox.volume()
+                ),
+            ));
+        }
+        if phi > 0.0 && colloids == 0 {
+            // The requested volume fraction would be dropped without notice.
+            return Err(key(
+                &SYSTEM_PHI,
+                format!(
+                    "{phi} of a box of volume {:.4} is {:.3} colloids of radius {radius} (volume {vc:.4} each), which rounds to none; use a larger box or smaller colloids (at least half a colloid: phi >= {:.3}), or phi = 0 for the solvent alone",
+                    sbox.volume(),
+                    phi * sbox.volume() / vc,
+                    0.5 * vc / sbox.volume()
+                ),
+            ));
+        }
         let free = sbox.volume() * (1.0 - phi);
         let solvent = (density * free).round() as usize;
         if colloids + solvent < 2 {

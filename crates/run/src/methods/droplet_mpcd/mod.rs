@@ -477,9 +477,13 @@ impl Session for DropletSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         if DropletSession::is_writer(self) {
+            if self.colloids.is_none() {
+                out.explain("thermo.csv", "colloid_temperature", "no colloids");
+            }
             self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
-            self.thermo_log = Some(CsvLog::start(
-                out.join("thermo.csv"),
+            self.thermo_log = Some(CsvLog::start_in(
+                out,
+                "thermo.csv",
                 &DROPLET_THERMO,
                 fresh,
                 || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
@@ -685,6 +689,13 @@ impl Session for DropletSession {
                 .zip(cols.iter())
                 .map(|(n, c)| (*n, c.as_slice()))
                 .collect();
+            for c in ["radial_velocity", "radial_velocity_err", "density_err"] {
+                out.explain(
+                    "solvent_profiles.csv",
+                    c,
+                    "a shell that held no solvent in the window (no velocity to average) or one block (no error)",
+                );
+            }
             out.write_table("solvent_profiles.csv", &table)?;
             files.push("solvent_profiles.csv".into());
             for (name, ylabel, pick) in [

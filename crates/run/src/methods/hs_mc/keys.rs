@@ -89,7 +89,7 @@ pub const OUTPUT_GR_BINS: Spec = key("output.gr_bins", "-", Value("200"), Intege
 
 pub const OUTPUT_GR_MAX: Spec = key("output.gr_max", "length", Means("0.49 L"), Positive,
     "range of g(r)")
-    .also("at most L/2 (the default stays under it: freud's RDF refuses L/2)");
+    .also("above the diameter, at most L/2 (the default stays under it: freud's RDF refuses L/2)");
 
 pub const OUTPUT_TRAJECTORY_EVERY: Spec = key("output.trajectory_every", "sweeps",
     Value("0"), Integer(0, COUNT),

@@ -182,6 +182,16 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             ),
         ));
     }
+    if gr_max <= d {
+        bail!(ParamError::new(
+            OUTPUT_GR_MAX.path,
+            format!(
+                "{} is not beyond the diameter {}: hard spheres never come closer, so g(r) would hold no pair (and its shells' volumes underflow as gr_max goes to 0); use gr_max > d, e.g. 3 d to 5 d",
+                show(gr_max),
+                show(d)
+            ),
+        ));
+    }
     let rho2_r_bins = r.count(&OUTPUT_RHO2_R_BINS)? as usize;
     let rho2_bins = (rho2_r_bins > 0)
         .then(|| -> Result<_> { Ok((rho2_r_bins, r.count(&OUTPUT_RHO2_COS_BINS)? as usize)) })

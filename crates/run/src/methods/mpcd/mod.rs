@@ -533,9 +533,13 @@ impl Session for BulkSession {
 
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         if BulkSession::is_writer(self) {
+            if self.p.colloids == 0 {
+                out.explain("thermo.csv", "colloid_temperature", "no colloids");
+            }
             self.gsd = open_trajectory(out, self.p.trajectory_every, fresh)?;
-            self.thermo_log = Some(CsvLog::start(
-                out.join("thermo.csv"),
+            self.thermo_log = Some(CsvLog::start_in(
+                out,
+                "thermo.csv",
                 &BULK_THERMO,
                 fresh,
                 || thermo_rows(self.p.solvent.srd.tau, &self.acc.rows),
