@@ -253,6 +253,33 @@ fn bad_parameters_are_refused_naming_the_parameter() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("raise the splitting"), "{e}");
+    // A radius of 1e-300 beside a splitting of order one: a table of 1e302 points overflowed
+    // its count (a panic); refused naming the radius.
+    assert_eq!(
+        key(PseParams {
+            radius: 1e-300,
+            splitting: 1.0,
+            ..ok
+        }),
+        "radius"
+    );
+    // The paper's splitting 0.5 / a at a = 1e-300: a grid of 1e301 points per axis.
+    assert_eq!(key(PseParams::paper(1e-300, 1.0, 10.0)), "splitting");
+}
+
+/// At the loosest tolerance allowed (0.1) the grid k_cut asks for was too coarse for the
+/// Gaussians (4 xi^2 sigma^2 = 1.02 > 1, a debug assertion, and in release a wave-space kernel
+/// growing with k); the grid is now refined until it holds.
+#[test]
+fn the_gaussians_fit_the_splitting_at_loose_tolerances() {
+    for tol in [0.1, 0.05, 1e-2] {
+        let g = colloidsim_hydro::PseGeometry::new(&PseParams {
+            tolerance: tol,
+            ..PseParams::paper(0.5, 1.0, 20.0)
+        })
+        .unwrap();
+        assert!(g.gaussian_fraction <= 1.0, "{tol}: {g:?}");
+    }
 }
 
 #[test]
