@@ -169,10 +169,42 @@ fn fourier_series_beyond_the_term_bound_are_refused() {
 #[test]
 fn dpd_gr_bins_beyond_the_bound_are_refused() {
     let text =
-        "method = \"dpd\"\n[system]\nbox_length = 6.0\nphi = 0.1\n[observe]\ngr_bins = 100001\n";
+        "method = \"dpd\"\n[system]\nbox_length = 8.0\nphi = 0.1\n[observe]\ngr_bins = 100001\n";
     let e = refusal(text);
     assert!(
         e.contains("observe.gr_bins") && e.contains("[1, 100000]"),
+        "{e}"
+    );
+}
+
+/// DPD keeps every MSD sample to the end of the run: 1e15 steps sampled every step are refused
+/// by check, naming the sampling interval (they grew until the machine ran out of memory).
+#[test]
+fn dpd_msd_samples_beyond_the_memory_are_refused() {
+    let text = "method = \"dpd\"\n[system]\nbox_length = 8.0\nphi = 0.1\n\
+                [run]\nsteps = 1000000000000000\n[observe]\nmsd_every = 1\n";
+    let e = refusal(text);
+    assert!(
+        e.contains("observe.msd_every") && e.contains("MSD samples"),
+        "{e}"
+    );
+}
+
+/// BD with PSE hydrodynamics and a diameter of 1e-300: the real-space table of the wave-space
+/// functions (1e302 points) overflowed its count (a panic in check); refused naming the
+/// diameter.
+#[test]
+fn a_pse_table_beyond_the_bound_is_refused_naming_the_diameter() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/bd/hasimoto.toml"
+    );
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("[system]", "[system]\ndiameter = 1e-300");
+    let e = refusal(&text);
+    assert!(
+        e.contains("system.diameter") && e.contains("wave-space table"),
         "{e}"
     );
 }
