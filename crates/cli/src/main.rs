@@ -76,7 +76,7 @@ enum Command {
         /// Override the scenario's seed (0 ..= 4294967295).
         #[arg(long)]
         seed: Option<u64>,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores; at most 8 per core and 4096).
         #[arg(long)]
         threads: Option<usize>,
         /// No progress bar, no informational messages, no closing line (warnings and errors
@@ -142,7 +142,7 @@ enum Command {
         /// Write into an output folder that already holds files.
         #[arg(long)]
         force: bool,
-        /// Worker threads (default: all cores).
+        /// Worker threads (default: all cores; at most 8 per core and 4096).
         #[arg(long)]
         threads: Option<usize>,
         #[command(flatten)]
@@ -165,7 +165,8 @@ enum Command {
         /// (repeatable: the points are all combinations).
         #[arg(long, value_name = "KEY=[V1,V2,...]")]
         vary: Vec<String>,
-        /// Worker threads per rank (default: the node's cores shared among its ranks).
+        /// Worker threads per rank (default: the node's cores shared among its ranks; at most 8
+        /// per core and 4096).
         #[arg(long)]
         threads: Option<usize>,
         /// No progress bar, no informational messages, no closing line.
@@ -537,11 +538,28 @@ fn report(e: &anyhow::Error) {
     eprintln!("error: {}", error_chain(e));
 }
 
-/// `--threads N`: the global pool of N workers (default: all cores).
+/// The most worker threads `--threads` may ask for: 8 per core this process may use
+/// (`available_parallelism`, which follows CPU affinity and cgroup quotas), and never more than
+/// 4096. More threads than that only share the same cores, while each costs a stack and the
+/// per-thread buffers of the engines (a histogram or a force array per thread).
+fn max_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (8 * cores).min(4096)
+}
+
+/// `--threads N`: the global pool of N workers (default: all cores); refused above
+/// [`max_threads`] before any thread starts.
 fn thread_pool(threads: Option<usize>) -> Result<()> {
     if let Some(n) = threads {
         if n == 0 {
             bail!("--threads must be at least 1");
+        }
+        let limit = max_threads();
+        if n > limit {
+            bail!(
+                "--threads {n}: at most {limit} (8 per available core, {} here, and at most 4096): more threads only share the same cores",
+                std::thread::available_parallelism().map_or(1, |c| c.get())
+            );
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)

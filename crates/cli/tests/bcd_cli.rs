@@ -526,6 +526,32 @@ fn density_errors_are_the_same_on_one_and_two_threads() {
     }
 }
 
+/// `--threads 100000` started a pool of 100,000 OS threads (run, extrapolate, ensemble): now
+/// refused above 8 per core (and 4096) before any thread starts or any output is written.
+#[test]
+fn thread_counts_beyond_the_bound_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = write_scenario(tmp.path(), "small.toml", SMALL);
+    let out = tmp.path().join("out");
+    for cmd in ["run", "extrapolate", "ensemble"] {
+        let o = run(&[
+            cmd,
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            "100000",
+        ]);
+        assert!(!o.status.success());
+        let t = text(&o);
+        assert!(
+            t.contains("--threads 100000: at most") && t.contains("per available core"),
+            "{cmd}: {t}"
+        );
+        assert!(!out.exists(), "{cmd}");
+    }
+}
+
 /// `colloidsim check` prints the scenario's keys with their values and units, defaults
 /// marked, not the engine's names; `--json` the resolved parameters.
 #[test]

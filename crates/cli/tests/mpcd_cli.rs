@@ -310,6 +310,40 @@ fn bad_input_is_refused_naming_the_key_and_range() {
     }
 }
 
+/// Colloids are counted in the memory estimate beside the solvent (43 particles each): with a
+/// limit that holds the solvent of a box of 10 cells but not 1000 colloids, check and run
+/// refuse naming the colloid count, for both MPCD methods.
+#[test]
+fn colloids_beyond_the_memory_are_refused_naming_their_count() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (scenario, key) in [
+        (
+            "method = \"mpcd\"\n[system]\nbox = 10\ncolloids = 1000\ndiameter = 1\n[run]\ncollisions = 1000\n",
+            "system.colloids",
+        ),
+        (
+            "method = \"droplet-mpcd\"\n[system]\nradius = 8\nparticles = 1000\ndiameter = 0.1\n[drying]\nduration = 1\n",
+            "system.particles",
+        ),
+    ] {
+        std::fs::write(tmp.path().join("s.toml"), scenario).unwrap();
+        for cmd in ["check", "run"] {
+            let o = run(
+                tmp.path(),
+                &[cmd, "s.toml", "--out", "a"][..if cmd == "run" { 4 } else { 2 }],
+                &[("COLLOIDSIM_MEMORY_LIMIT", "2M")],
+            );
+            assert!(!o.status.success(), "{cmd} {scenario}");
+            let t = text(&o);
+            assert!(
+                t.contains(&format!("{key}: 1000 colloids of 43 particles")),
+                "{cmd} {scenario}\n{t}"
+            );
+            assert!(!tmp.path().join("a").exists());
+        }
+    }
+}
+
 #[test]
 fn the_examples_are_valid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");

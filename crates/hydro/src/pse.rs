@@ -488,7 +488,19 @@ impl PseGeometry {
         // Fourier side.
         let k_cut = 2.0 * xi * hasimoto_cut(FOURIER_SHARE * eps).sqrt();
         let ln = (1.0 / (SUPPORT_SHARE * eps)).ln();
-        let mut grid = fft_size((k_cut * l / PI).ceil() as usize);
+        let want = (k_cut * l / PI).ceil();
+        if want.is_nan() || want > 1024.0 {
+            // Before the count becomes an integer (1e300 would saturate it).
+            return Err(ParamError::new(
+                "splitting",
+                format!(
+                    "xi = {xi} needs a grid of {want:.3e} points per axis for a box of edge {l}, \
+                     more than 1024; lower the splitting"
+                ),
+            )
+            .into());
+        }
+        let mut grid = fft_size(want as usize);
         let support = |grid: usize| {
             let h = l / grid as f64;
             let sigma = h / PI * ln.sqrt();
@@ -545,6 +557,24 @@ impl PseGeometry {
             .into());
         }
         let r_max = (4.0 * a).max(6.5 / xi);
+        // The table's points (spacing min(a, 1 / xi) / 64 up to r_max), each a quadrature.
+        let points = r_max / (a.min(1.0 / xi) / 64.0);
+        if points.is_nan() || points > MAX_TABLE_POINTS {
+            let (key, what) = if a < 1.0 / xi {
+                ("radius", format!("a = {a:e}"))
+            } else {
+                ("splitting", format!("xi = {xi:e}"))
+            };
+            return Err(ParamError::new(
+                key,
+                format!(
+                    "{what} beside the real-space reach {r_max:.4e} needs a wave-space table of \
+                     {points:.2e} points, more than {MAX_TABLE_POINTS:e}: the radius and 1 / \
+                     splitting must be within a factor of about 25,000 of each other"
+                ),
+            )
+            .into());
+        }
         let table = WaveTable::build(a, p.viscosity, xi, r_max);
         let self_real = mu0 - table.a[0];
         let mut r_cut = 0.0;
@@ -1371,6 +1401,10 @@ fn for_row_chunks_collect<'a, T, U>(
 /// Largest Gaussian support (points per axis): tolerances down to about 1e-14 need fewer
 /// (1e-3: 8 points, 1e-6: 14); a smaller tolerance is refused.
 const MAX_SUPPORT: usize = 32;
+
+/// The most points of the real-space table of the wave-space functions (each costs a
+/// quadrature over some 1000 wave numbers): 1e7, a table 25,000 times finer than its reach.
+const MAX_TABLE_POINTS: f64 = 1e7;
 
 /// The `pts` grid columns from `bx` (periodic in `g`) as at most two contiguous runs: pairs of
 /// (columns of the grid row, offsets into the support); the second run is empty unless the

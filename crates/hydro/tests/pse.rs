@@ -274,6 +274,18 @@ fn bad_parameters_are_refused_naming_the_parameter() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("raise the splitting"), "{e}");
+    // A radius of 1e-300 beside a splitting of order one: a table of 1e302 points overflowed
+    // its count (a panic); refused naming the radius.
+    assert_eq!(
+        key(PseParams {
+            radius: 1e-300,
+            splitting: 1.0,
+            ..ok
+        }),
+        "radius"
+    );
+    // The paper's splitting 0.5 / a at a = 1e-300: a grid of 1e301 points per axis.
+    assert_eq!(key(PseParams::paper(1e-300, 1.0, 10.0)), "splitting");
 }
 
 #[test]

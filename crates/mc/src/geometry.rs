@@ -9,12 +9,16 @@
 //! limit of an infinitely stiff interface.
 
 use colloidsim_core::ParamError;
-use colloidsim_core::param::{finite, positive};
+use colloidsim_core::param::{finite, positive, show};
 use colloidsim_md::potential::{External, HarmonicInterface, SphereAreaLaw};
 
 /// Interface energy (in kT) beyond which the interface geometry places a hard outer wall: a
 /// Boltzmann factor of 4e-18, so no sampled configuration can tell.
 pub const INTERFACE_CUT_KT: f64 = 40.0;
+
+/// The smallest interface range per wall distance (radius + offset): `1e-9`, some 4.5 million
+/// f64 steps of a position at the wall.
+pub const MIN_RANGE_PER_RADIUS: f64 = 1e-9;
 
 /// A tabulated spherically symmetric external potential `beta U(r)` (in kT), linear between the
 /// nodes `r_k = k dr`, with a hard outer wall at `cutoff` (issue #15 item 4: the potential that
@@ -134,10 +138,36 @@ impl Geometry {
         // Bisect the md crate's own energy for the distance where it reaches the cut (the
         // energy grows monotonically beyond the wall).
         let wall = radius + offset;
+        // Positions near the wall are numbers of about `wall`, spaced `wall * 2^-52` apart: the
+        // harmonic range must span many of those steps (else `wall + range == wall`, and the
+        // search below would never leave the wall).
+        if range < MIN_RANGE_PER_RADIUS * wall {
+            return Err(ParamError::new(
+                "range",
+                format!(
+                    "{} is not resolved at the wall's distance radius + offset = {} (f64 positions there are {:.1e} apart): need range >= {MIN_RANGE_PER_RADIUS:e} (radius + offset) = {:.3e}, or a smaller radius or offset",
+                    show(range),
+                    show(wall),
+                    wall * f64::EPSILON,
+                    MIN_RANGE_PER_RADIUS * wall
+                ),
+            ));
+        }
         let energy = |r: f64| interface.energy([r, 0.0, 0.0], 0.0) / kt;
         let mut hi = wall + range;
-        while energy(hi) < INTERFACE_CUT_KT {
+        // Each doubling at least doubles the distance beyond the wall: at most some 2100 of
+        // them reach infinity, which a stiffness too weak to reach the cut ends at.
+        while energy(hi) < INTERFACE_CUT_KT && hi.is_finite() {
             hi = wall + 2.0 * (hi - wall);
+        }
+        if !hi.is_finite() {
+            return Err(ParamError::new(
+                "stiffness",
+                format!(
+                    "{} is too weak: the interface energy reaches {INTERFACE_CUT_KT} kT at no finite distance",
+                    show(stiffness)
+                ),
+            ));
         }
         let mut lo = wall;
         for _ in 0..200 {
@@ -271,5 +301,17 @@ mod tests {
         let p = cum(0.5) / cum(1.0);
         println!("fraction within r < 0.5: {f:.4} +- {se:.4} vs {p:.4}");
         assert!((f - p).abs() < 4.0 * se, "{f} +- {se} vs {p}");
+    }
+
+    /// The cut-off search never left the wall when `wall + range` rounded to `wall`.
+    #[test]
+    fn an_interface_range_unresolved_at_the_wall_is_refused() {
+        let big = 9_223_372_036_854_775_807.0;
+        for (radius, range, offset) in [(big, 0.5, -0.5), (5.0, 1e-300, -0.5), (5.0, 0.5, big)] {
+            let e = Geometry::interface(radius, 50.0, range, offset, 1.0).unwrap_err();
+            assert_eq!(e.key, "range", "{e}");
+            assert!(e.message.contains("not resolved at the wall"), "{e}");
+        }
+        assert!(Geometry::interface(5.0, 50.0, 1e-8, -0.5, 1.0).is_ok());
     }
 }

@@ -19,6 +19,7 @@ impl RadialGrid {
     pub fn new(dr: f64, n: usize) -> Result<Self, RadialError> {
         param::positive("theory.dr", dr)?;
         param::at_least("theory.cells", n, 2)?;
+        Self::ensure_fits(dr, n as f64)?;
         let faces: Vec<f64> = (0..=n).map(|i| i as f64 * dr).collect();
         let centres = (0..n).map(|i| (i as f64 + 0.5) * dr).collect();
         let volumes = (0..n)
@@ -41,7 +42,23 @@ impl RadialGrid {
     pub fn covering(dr: f64, r_max: f64) -> Result<Self, RadialError> {
         param::positive("theory.dr", dr)?;
         param::positive("theory.r_max", r_max)?;
-        Self::new(dr, (r_max / dr).ceil().max(2.0) as usize)
+        let cells = (r_max / dr).ceil().max(2.0);
+        // Before the count becomes an integer: 1e301 cells would saturate it.
+        Self::ensure_fits(dr, cells)?;
+        Self::new(dr, cells as usize)
+    }
+
+    /// Refuse a grid of `cells` cells whose four arrays (and as much again for a solver's
+    /// fields on it) the machine cannot hold, naming the spacing.
+    fn ensure_fits(dr: f64, cells: f64) -> Result<(), RadialError> {
+        colloidsim_core::resources::ensure_fits(
+            "theory.dr",
+            &format!(
+                "a radial grid of {cells:.3e} cells of width {dr:.3e} (a larger --dx makes it smaller)"
+            ),
+            64.0 * cells,
+        )?;
+        Ok(())
     }
 
     /// Cell width.
@@ -93,5 +110,13 @@ mod tests {
         assert!((v - 4.0 * std::f64::consts::PI / 3.0 * 125.0).abs() < 1e-9);
         assert!(RadialGrid::new(0.0, 5).is_err());
         assert!(RadialGrid::new(0.1, 1).is_err());
+    }
+
+    /// A spacing of 1e-300 over 15 diameters asked for 1.5e301 cells ("capacity overflow").
+    #[test]
+    fn grids_beyond_the_memory_are_refused_naming_the_spacing() {
+        let e = RadialGrid::covering(1e-300, 15.0).unwrap_err().to_string();
+        assert!(e.contains("theory.dr") && e.contains("radial grid"), "{e}");
+        assert!(RadialGrid::new(1e-3, usize::MAX).is_err());
     }
 }

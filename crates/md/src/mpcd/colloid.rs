@@ -232,6 +232,23 @@ struct Edge {
     r0: f64,
 }
 
+/// Cells per axis of a grid over a box of edges `l` for `n` centres, cells at least `width`
+/// wide (at least `min` per axis): as many as fit, but no more than about `max(8 n, 32^3)` in
+/// all (more cells would only be empty, and a tiny `width` would ask for an unbounded grid).
+fn grid_cells(l: [f64; 3], width: f64, n: usize, min: usize) -> [usize; 3] {
+    let cap = ((8.0 * n as f64).max(32768.0)).cbrt().floor() as usize;
+    std::array::from_fn(|k| {
+        let fit = l[k] / width;
+        // Non-finite (width 0 or a NaN) or beyond the cap: the cap.
+        let fit = if fit.is_finite() {
+            fit.floor().max(0.0)
+        } else {
+            f64::MAX
+        };
+        (fit.min(cap as f64) as usize).max(min)
+    })
+}
+
 /// `N` discrete-particle colloids in the periodic box of the solvent (see the module docs).
 #[derive(Debug, Clone)]
 pub struct DiscreteColloids {
@@ -364,8 +381,9 @@ impl DiscreteColloids {
                 "{n} colloids: at most 2^40 are supported"
             )));
         }
-        // A grid of cells at least d wide over the box for the overlap checks.
-        let nc: [usize; 3] = std::array::from_fn(|k| ((l[k] / d).floor() as usize).clamp(1, 1024));
+        // A grid of cells at least d wide over the box for the overlap checks (no more cells
+        // than the colloids need: a tiny d must not make a grid of 1024^3 empty cells).
+        let nc = grid_cells(l, d, n, 1);
         let cell = |x: [f64; 3]| -> [usize; 3] {
             std::array::from_fn(|k| {
                 (((x[k] / l[k] + 0.5) * nc[k] as f64).floor() as usize).min(nc[k] - 1)
@@ -496,7 +514,7 @@ impl DiscreteColloids {
             })
             .collect();
         // Cells at least the cut-off wide; fewer than 3 per axis: all pairs.
-        let nc: [usize; 3] = std::array::from_fn(|k| (sbox.l[k] / cut).floor() as usize);
+        let nc = grid_cells(sbox.l, cut, n, 0);
         let cells = if nc.iter().all(|&c| c >= 3) && n > 1 {
             nc
         } else {
@@ -1279,6 +1297,32 @@ mod tests {
 
     /// Random placement: no two centres closer than d (periodic), all inside the sphere,
     /// the same configuration for the same seed.
+    #[test]
+    fn grids_over_the_colloids_stay_small_for_any_diameter() {
+        let l = [10.0; 3];
+        // A tiny or vanishing width: no more cells than the cap, at least `min` per axis.
+        for width in [1e-300, 0.0, f64::NAN, 1e-6] {
+            let nc = grid_cells(l, width, 1, 1);
+            assert!(nc.iter().all(|&c| (1..=32).contains(&c)), "{width}: {nc:?}");
+        }
+        assert_eq!(grid_cells(l, 4.0, 1, 1), [2; 3]);
+        assert_eq!(grid_cells(l, 20.0, 1, 1), [1; 3]);
+        assert_eq!(grid_cells(l, 20.0, 1, 0), [0; 3]);
+        assert_eq!(grid_cells([1e6; 3], 1.0, 1_000_000, 0), [200; 3]);
+    }
+
+    /// One colloid of diameter 1e-300 in a box of 10: a placement grid of 1024^3 cells
+    /// (24 GiB, an abort) before the grid was bounded by the number of colloids.
+    #[test]
+    fn tiny_colloids_are_placed_without_a_huge_grid() {
+        let p = ColloidParams::standard(1e-300, 1.0);
+        for n in [1, 2] {
+            let c =
+                DiscreteColloids::random(p, SimBox::cube(10.0), n, Region::Box, 1.0, 3).unwrap();
+            assert_eq!(c.len(), n);
+        }
+    }
+
     #[test]
     fn random_placement_does_not_overlap_and_stays_in_the_region() {
         let (d, radius) = (2.0, 9.0);

@@ -75,11 +75,13 @@ pub const POTENTIAL_FOURIER_WAVELENGTH: Spec = key("potential.fourier.wavelength
 
 pub const POTENTIAL_FOURIER_COS: Spec = key("potential.fourier.cos", "energy",
     Value("[]"), Numbers(f64::MIN, f64::MAX, None),
-    "a_1, a_2, ...");
+    "a_1, a_2, ...")
+    .also("at most 256 terms (finer shapes: potential.table)");
 
 pub const POTENTIAL_FOURIER_SIN: Spec = key("potential.fourier.sin", "energy",
     Value("[]"), Numbers(f64::MIN, f64::MAX, None),
-    "b_1, b_2, ...");
+    "b_1, b_2, ...")
+    .also("at most 256 terms (finer shapes: potential.table)");
 
 pub const POTENTIAL_TABLE: Spec = key("potential.table", "-", Means("none"), Path,
     "CSV with columns x,U over exactly one period (last U equal to the first); periodic cubic spline");

@@ -19,6 +19,13 @@ use std::path::{Path, PathBuf};
 /// The most steps a run may have (2^50).
 const MAX_STEPS: f64 = 1_125_899_906_842_624.0;
 
+/// The most terms of each list of `potential.fourier`: the check of the time step samples the
+/// force at 4096 points of a period, 16 per wavelength of the 256th harmonic, and the force
+/// table a run uses (and `check` builds) resolves it with some 64,000 cells per period, built
+/// from 5 evaluations of every term per cell (a few seconds); the 2e5 terms this once allowed
+/// took hours. Finer shapes are a table (`potential.table`, a spline).
+pub const MAX_FOURIER_TERMS: usize = 256;
+
 /// A BCD scenario as given (the sections `summary.json` records as written; optional keys the
 /// scenario leaves out stay `None`, their defaults come from the declarations).
 #[derive(Debug, Clone, Serialize)]
@@ -751,6 +758,20 @@ impl Scenario {
         }
         if let Some(f) = &p.fourier {
             param::positive("potential.fourier.wavelength", f.wavelength)?;
+            for (key, terms) in [
+                (POTENTIAL_FOURIER_COS.path, &f.cos),
+                (POTENTIAL_FOURIER_SIN.path, &f.sin),
+            ] {
+                if terms.len() > MAX_FOURIER_TERMS {
+                    return Err(ParamError::new(
+                        key,
+                        format!(
+                            "{} terms: at most {MAX_FOURIER_TERMS} (every force evaluation sums them all, and the run tabulates the force on up to 2^22 points per period before it starts); give a finer shape as potential.table",
+                            terms.len()
+                        ),
+                    ));
+                }
+            }
             for v in f.cos.iter().chain(&f.sin) {
                 param::finite("potential.fourier", *v)?;
             }

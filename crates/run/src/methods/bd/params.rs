@@ -23,6 +23,8 @@ const ENGINE_NAMES: &[(&str, &Spec)] = &[
     ("tolerance", &HYDRO_TOLERANCE),
     ("max_iterations", &HYDRO_MAX_ITERATIONS),
     ("box_length", &SYSTEM_BOX_LENGTH),
+    // The PSE engine's sphere radius: half the diameter.
+    ("radius", &shared::DIAMETER),
     ("hydrodynamics", &HYDRODYNAMICS),
 ];
 

@@ -954,6 +954,9 @@ fn periods(steps: u64) -> (u64, u64) {
 /// Longest synchronisation period (steps).
 const SYNC_MAX: u64 = 1000;
 
+/// The most wave numbers of `sq.csv` (its transform costs wave numbers x g(r) bins).
+const MAX_Q_POINTS: usize = 1000;
+
 /// MSD at lags of whole frames, averaged over at most ~200 time origins per lag.
 fn msd(frames: &[Vec<[f64; 3]>]) -> Vec<f64> {
     let f = frames.len();
@@ -1191,7 +1194,9 @@ fn write_outputs(
         )?;
         files.push("gr.csv".into());
         let rho = s.setup.colloids as f64 / vol;
-        let q = default_q_grid(s.gr_max, g.len());
+        // S(q) costs wave numbers x bins: at most MAX_Q_POINTS wave numbers, q_k = k pi / r_max
+        // (q d up to 1000 pi d / r_max, far beyond the structure's first peaks).
+        let q = default_q_grid(s.gr_max, g.len().min(MAX_Q_POINTS));
         let sq = structure_factor_windowed(r, &g, rho, &q, Window::Lorch);
         let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.setup.radius).collect();
         out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;

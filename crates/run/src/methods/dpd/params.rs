@@ -435,6 +435,19 @@ impl Scenario {
                 "the box holds fewer than 2 particles".into(),
             ));
         }
+        // The MSD keeps every sample's unwrapped positions of the colloids and the followed
+        // solvent beads (24 B each) to the end of the run.
+        if let Some(samples) = run.steps.checked_div(self.observe.msd_every) {
+            let frames = samples as f64 + 1.0;
+            let followed = colloids + self.observe.msd_solvent_beads.min(solvent);
+            colloidsim_core::resources::ensure_fits(
+                OBSERVE_MSD_EVERY.path,
+                &format!(
+                    "{frames:.3e} MSD samples of {followed} particles (run.steps / observe.msd_every)"
+                ),
+                600.0 * beads + 24.0 * frames * followed as f64,
+            )?;
+        }
         // Box must hold 3 cells of the fluid range and twice the colloid range.
         let rmax = match distribution {
             RadiusDistribution::Monodisperse => radius,

@@ -22,6 +22,8 @@ const ENGINE_NAMES: &[(&str, &Spec)] = &[
     ("box_factor", &HYDRO_BOX_FACTOR),
     ("box_length", &HYDRO_BOX_FACTOR),
     ("splitting", &HYDRO_SPLITTING),
+    // The PSE engine's sphere radius: half the diameter.
+    ("radius", &shared::DIAMETER),
     ("tolerance", &HYDRO_TOLERANCE),
     ("max_iterations", &HYDRO_MAX_ITERATIONS),
     ("method", &HYDRO_METHOD),

@@ -6,7 +6,8 @@
 use super::keys::*;
 use crate::keys::{Reader, Spec, shared};
 use crate::methods::mpcd::common::{
-    SolventParams, box_edge, ensure_solvent_fits, run_seed, thermo_every,
+    SolventParams, box_edge, ensure_colloids_fit, ensure_solvent_fits, run_seed, solvent_bytes,
+    thermo_every,
 };
 use anyhow::Result;
 use colloidsim_core::ParamError;
@@ -336,6 +337,11 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         ));
     }
     ensure_solvent_fits(&SYSTEM_BOX, solvent_particles, (l / a).powi(3))?;
+    ensure_colloids_fit(
+        &SYSTEM_PARTICLES,
+        particles,
+        solvent_bytes(solvent_particles, (l / a).powi(3)),
+    )?;
     let profile = Profile {
         bins: r.count(&OBSERVE_PROFILE_BINS)? as usize,
         fractions: r.numbers(&OBSERVE_PROFILE_FRACTIONS)?,

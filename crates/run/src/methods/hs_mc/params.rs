@@ -145,6 +145,17 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             ),
         ));
     }
+    // The engine's cell grid over the box (cells of at least 2 d, as HardSphereMc::new makes
+    // it): a radius or box of 1e18 diameters is refused here, before check or run go on.
+    let cells = (box_edge / (2.0 * d)).floor().max(2.0).powi(3);
+    ensure_fits(
+        size_key.path,
+        &format!(
+            "a grid of {cells:.3e} Monte Carlo cells over a box of edge {}",
+            show(box_edge)
+        ),
+        cells * 228.0,
+    )?;
     let sweeps = r.count(&MC_SWEEPS)?;
     let target_acceptance = r.number(&MC_TARGET_ACCEPTANCE)?;
     if !(target_acceptance > 0.0 && target_acceptance < 1.0) {

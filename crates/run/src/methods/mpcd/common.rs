@@ -364,8 +364,35 @@ pub(crate) fn run_seed(r: &Reader, seed: Option<u64>) -> Result<u32> {
 /// Peak bytes of a solvent of `n` particles in `cells` cells: `Srd::new` holds the particles
 /// in `f64` before encoding them (about twice the 56 bytes per particle of a running engine).
 pub(crate) fn ensure_solvent_fits(key: &Spec, n: f64, cells: f64) -> Result<()> {
-    let bytes = 112.0 * n + 8.0 * cells;
-    colloidsim_core::resources::ensure_fits(key.path, &format!("{n:e} solvent particles"), bytes)?;
+    colloidsim_core::resources::ensure_fits(
+        key.path,
+        &format!("{n:e} solvent particles"),
+        solvent_bytes(n, cells),
+    )?;
+    Ok(())
+}
+
+/// Peak bytes of a solvent (see [`ensure_solvent_fits`]).
+pub(crate) fn solvent_bytes(n: f64, cells: f64) -> f64 {
+    112.0 * n + 8.0 * cells
+}
+
+/// Bytes of `n` discrete-particle colloids: 43 particles each with positions, velocities,
+/// forces and masses, their checkpoint copies and the placement grid (about 200 B a particle).
+pub(crate) fn colloid_bytes(n: f64) -> f64 {
+    n * (1 + VERTICES) as f64 * 200.0
+}
+
+/// Refuse `n` colloids (key `key`) beside a solvent of `solvent` bytes when both do not fit.
+pub(crate) fn ensure_colloids_fit(key: &Spec, n: usize, solvent: f64) -> Result<()> {
+    colloidsim_core::resources::ensure_fits(
+        key.path,
+        &format!(
+            "{n} colloids of {} particles beside the solvent",
+            1 + VERTICES
+        ),
+        solvent + colloid_bytes(n as f64),
+    )?;
     Ok(())
 }
 

@@ -2,7 +2,10 @@
 //! parameters, with every check that relates several keys. MPCD units: lengths in the cell
 //! edge `a`, masses in the solvent mass `m`, energies in `kT`, times in `a sqrt(m / kT)`.
 
-use super::common::{SolventParams, box_edge, ensure_solvent_fits, run_seed, thermo_every};
+use super::common::{
+    SolventParams, box_edge, colloid_bytes, ensure_colloids_fit, ensure_solvent_fits, run_seed,
+    solvent_bytes, thermo_every,
+};
 use super::keys::*;
 use crate::keys::{Reader, Spec, shared};
 use anyhow::Result;
@@ -185,6 +188,17 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<BulkRun> {
                 sampling / 2
             ),
         ));
+    }
+    if nc > 0 {
+        let solvent = solvent_bytes(particles, (l / srd.cell).powi(3));
+        ensure_colloids_fit(&SYSTEM_COLLOIDS, nc, solvent)?;
+        // The autocorrelation's ring of lags + 1 velocity sets and its sums per block.
+        let vacf = (vacf_lags as f64 + 1.0) * (24.0 * nc as f64 + 40.0 + 16.0 * blocks as f64);
+        colloidsim_core::resources::ensure_fits(
+            OBSERVE_VACF_LAGS.path,
+            &format!("the velocity autocorrelation of {nc} colloids over {vacf_lags} lags"),
+            solvent + colloid_bytes(nc as f64) + vacf,
+        )?;
     }
     let x = 0.5 * d / l;
     let stokes_einstein_hasimoto = srd.kt / (3.0 * PI * eta * d) * (1.0 - 2.837297 * x);
