@@ -1041,6 +1041,16 @@ impl Dpd {
         Ok(self.pressure_tensor())
     }
 
+    /// The thermodynamic state at the current step with its virial, where no step was taken
+    /// with it (the first frame of a run): the forces of this step are computed again with the
+    /// virial, the same forces (the pair noise is keyed by the step), so the trajectory does
+    /// not change. Collective.
+    pub fn thermo_with_virial(&mut self) -> Thermo {
+        self.compute_forces::<true>(self.step);
+        self.exchange_halo();
+        self.thermo()
+    }
+
     /// The pressure tensor from the current velocities and the virial of the last step taken
     /// with it ([`Self::thermo`]'s `pressure`, without the rest).
     pub fn pressure_tensor(&self) -> [f64; 6] {

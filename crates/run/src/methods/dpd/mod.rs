@@ -244,6 +244,21 @@ impl DpdSession {
 
     /// Record what is due at the engine's current step.
     fn record(&mut self) -> Result<()> {
+        let frame_due = self.s.observe.trajectory_every > 0
+            && self
+                .sim
+                .step
+                .is_multiple_of(self.s.observe.trajectory_every);
+        if frame_due
+            && self
+                .frame_thermo
+                .as_ref()
+                .is_none_or(|t| t.step != self.sim.step)
+        {
+            // No step was taken with the virial (the first frame): compute it here, so that
+            // every frame logs a pressure and a potential energy.
+            self.frame_thermo = Some(self.sim.thermo_with_virial());
+        }
         let (s, sim, obs, o) = (&self.s, &self.sim, &mut self.obs, &self.s.observe);
         let (dt, tau) = (s.setup.params.dt, s.setup.tau);
         let step = sim.step;
@@ -297,24 +312,21 @@ impl DpdSession {
         if o.trajectory_every > 0 && step.is_multiple_of(o.trajectory_every) {
             let snap = sim.snapshot();
             // What HOOMD-blue's ThermodynamicQuantities compute logs, under its names
-            // (FRAME_LOGS). The virial parts exist only for a step taken with them: at step 0
-            // the pressure and the potential energy are NaN (every frame carries every
-            // quantity, as the gsd package expects).
-            let th = self.frame_thermo.take().filter(|t| t.step == step);
-            let kinetic = th
-                .as_ref()
-                .map_or_else(|| sim.thermo().temperature, |t| t.temperature);
-            let (pressure, tensor, potential) = match &th {
-                Some(t) => {
-                    let q = &t.pressure;
-                    (
-                        (q[0] + q[1] + q[2]) / 3.0,
-                        [q[0], q[3], q[4], q[1], q[5], q[2]],
-                        t.potential_energy,
-                    )
-                }
-                None => (f64::NAN, [f64::NAN; 6], f64::NAN),
-            };
+            // (FRAME_LOGS), from the step's virial (taken above where no step carried it).
+            let t = self
+                .frame_thermo
+                .take()
+                .filter(|t| t.step == step)
+                .ok_or_else(|| {
+                    anyhow::anyhow!("no thermodynamic state for the frame of step {step}")
+                })?;
+            let q = &t.pressure;
+            let (kinetic, pressure, tensor, potential) = (
+                t.temperature,
+                (q[0] + q[1] + q[2]) / 3.0,
+                [q[0], q[3], q[4], q[1], q[5], q[2]],
+                t.potential_energy,
+            );
             let values: [&[f64]; 5] = [
                 &[step as f64 * dt / tau],
                 &[kinetic],
