@@ -15,10 +15,10 @@ pub struct RadialGrid {
 }
 
 impl RadialGrid {
-    /// `n` cells of width `dr` (key names used in errors: `theory.dr`, `theory.cells`).
+    /// `n` cells of width `dr` (errors name `dr` and `cells`).
     pub fn new(dr: f64, n: usize) -> Result<Self, RadialError> {
-        param::positive("theory.dr", dr)?;
-        param::at_least("theory.cells", n, 2)?;
+        param::positive("dr", dr)?;
+        param::at_least("cells", n, 2)?;
         let faces: Vec<f64> = (0..=n).map(|i| i as f64 * dr).collect();
         let centres = (0..n).map(|i| (i as f64 + 0.5) * dr).collect();
         let volumes = (0..n)
@@ -39,8 +39,8 @@ impl RadialGrid {
 
     /// The smallest grid of spacing `dr` that covers `[0, r_max]`.
     pub fn covering(dr: f64, r_max: f64) -> Result<Self, RadialError> {
-        param::positive("theory.dr", dr)?;
-        param::positive("theory.r_max", r_max)?;
+        param::positive("dr", dr)?;
+        param::positive("r_max", r_max)?;
         Self::new(dr, (r_max / dr).ceil().max(2.0) as usize)
     }
 
