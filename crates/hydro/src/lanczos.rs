@@ -56,7 +56,7 @@ pub enum LanczosError {
     /// The tolerance was not reached within the iteration limit.
     #[error(
         "the Lanczos square root did not converge: relative change {residual:.3e} after {iterations} \
-         iterations, tolerance {tolerance:.3e} (raise hydrodynamics.max_iterations or the tolerance)"
+         iterations, tolerance {tolerance:.3e} (raise `max_iterations` or the tolerance)"
     )]
     NotConverged {
         /// Iterations done.

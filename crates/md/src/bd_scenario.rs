@@ -11,7 +11,7 @@ pub(crate) fn read_initial(path: &Path, n: usize) -> Result<GsdFrame, String> {
     let f = read_frame(path, None).map_err(|e| e.to_string())?;
     if f.particles.len() != n {
         return Err(format!(
-            "{} holds {} particles, system.particles is {n}",
+            "{} holds {} particles, `particles` is {n}",
             path.display(),
             f.particles.len(),
         ));

@@ -132,7 +132,7 @@ pub enum BdError {
     /// The time step is too large for the forces.
     #[error(
         "blow-up at step {step} (t = {time}): particle {particle} at ({:.4}, {:.4}, {:.4}) would move {drift:.4} \
-         (diameter {diameter}) in one step under a force {force:.4e}; the time step is too large for the WCA core — reduce run.dt",
+         (diameter {diameter}) in one step under a force {force:.4e}; the time step is too large for the WCA core — reduce `dt`",
         position[0], position[1], position[2]
     )]
     BlowUp {

@@ -253,7 +253,7 @@ impl BulkParams {
                     .any(|e| (e / self.box_length - 1.0).abs() > 1e-6)
                 {
                     return Err(bad(format!(
-                        "its box {:?} is not the cube of system.box_length = {}",
+                        "its box {:?} is not the cube of `box_length` = {}",
                         f.sbox.l,
                         show(self.box_length)
                     )));

@@ -60,7 +60,7 @@ pub enum HydroBdError {
     /// The time step is too large for the forces.
     #[error(
         "blow-up at step {step} (t = {time}): particle {particle} would move {drift:.4} (diameter {diameter}) \
-         in one step under a force {force:.4e}; the time step is too large for the WCA core — reduce run.dt"
+         in one step under a force {force:.4e}; the time step is too large for the WCA core — reduce `dt`"
     )]
     BlowUp {
         /// Step.

@@ -301,7 +301,7 @@ fn blow_up_names_step_and_particle() {
                 msg.contains(&format!("step {step}"))
                     && msg.contains(&format!("particle {particle}"))
             );
-            assert!(msg.contains("run.dt"));
+            assert!(msg.contains("reduce `dt`"), "{msg}");
         }
         e => panic!("expected a blow-up, got {e}"),
     }

@@ -5,6 +5,8 @@
 
 use crate::checkpoint::file_crc;
 use crate::engine::flat;
+use crate::keys::shared::{HYDRO_MAX_ITERATIONS, RUN_DT};
+use crate::keys::{Spec, rekey_text};
 use crate::method::{Finished, Session};
 use crate::trajectory::FrameDigest;
 use anyhow::{Result, bail};
@@ -15,6 +17,11 @@ use colloidsim_md::hydro::AnyMobility;
 use colloidsim_md::{Brownian, External, HydroBrownian, LennardJones, Particles, SimBox};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// The Brownian engines' names of the parameters their run-time errors advise changing, and
+/// the keys (shared by `bd` and `droplet-bd`) that set them.
+const ENGINE_NAMES: &[(&str, &Spec)] =
+    &[("dt", &RUN_DT), ("max_iterations", &HYDRO_MAX_ITERATIONS)];
 
 /// A running replica: the free-draining engine (bitwise the engine of every free-draining run),
 /// or Brownian dynamics with a hydrodynamic mobility.
@@ -121,11 +128,13 @@ impl<E: External> Replica<E> {
         }
     }
 
-    /// Run `n` steps; the error says why the run cannot go on (and names the step).
+    /// Run `n` steps; the error says why the run cannot go on (and names the step), and the
+    /// keys (`run.dt`, `hydrodynamics.max_iterations`) where the engine names its parameters.
     pub(crate) fn run(&mut self, n: u64) -> Result<(), String> {
+        let rekeyed = |e: &dyn std::fmt::Display| rekey_text(&e.to_string(), ENGINE_NAMES);
         match self {
-            Self::Free(s) => s.run(n).map_err(|e| e.to_string()),
-            Self::Hydro(s) => s.run(n).map_err(|e| e.to_string()),
+            Self::Free(s) => s.run(n).map_err(|e| rekeyed(&e)),
+            Self::Hydro(s) => s.run(n).map_err(|e| rekeyed(&e)),
         }
     }
 

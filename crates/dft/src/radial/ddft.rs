@@ -82,20 +82,20 @@ impl DdftOptions {
     }
 
     fn validate(&self) -> Result<(), RadialError> {
-        param::positive("system.d0", self.d0)?;
-        param::positive("theory.dt", self.dt)?;
-        param::positive("theory.dt_max", self.dt_max)?;
-        param::positive("theory.dt_min", self.dt_min)?;
-        param::positive("theory.tolerance", self.tolerance)?;
-        param::at_least("theory.max_iterations", self.max_iterations, 2)?;
-        param::positive("theory.eject_potential", self.eject_potential)?;
-        param::positive("theory.eject_tolerance", self.eject_tolerance)?;
-        param::positive("theory.potential_cutoff", self.potential_cutoff)?;
+        param::positive("d0", self.d0)?;
+        param::positive("dt", self.dt)?;
+        param::positive("dt_max", self.dt_max)?;
+        param::positive("dt_min", self.dt_min)?;
+        param::positive("tolerance", self.tolerance)?;
+        param::at_least("max_iterations", self.max_iterations, 2)?;
+        param::positive("eject_potential", self.eject_potential)?;
+        param::positive("eject_tolerance", self.eject_tolerance)?;
+        param::positive("potential_cutoff", self.potential_cutoff)?;
         if self.potential_cutoff < self.eject_potential + 20.0 {
             return Err(colloidsim_core::ParamError::new(
-                "theory.potential_cutoff",
+                "potential_cutoff",
                 format!(
-                    "must exceed theory.eject_potential + 20 kT = {} so that ejected particles stay on the grid",
+                    "must exceed eject_potential + 20 kT = {} so that ejected particles stay on the grid",
                     self.eject_potential + 20.0
                 ),
             )
@@ -216,7 +216,7 @@ impl Ddft {
         let n = grid.len();
         if rho0.len() != n || rho0.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(colloidsim_core::ParamError::new(
-                "theory.initial",
+                "initial",
                 format!("initial density needs {n} finite values >= 0"),
             )
             .into());
@@ -301,7 +301,7 @@ impl Ddft {
     pub fn set_rpy_kernel(&mut self, kernel: RpyKernel) -> Result<(), RadialError> {
         if self.rpy.is_none() || kernel.faces() != self.grid.len() + 1 {
             return Err(colloidsim_core::ParamError::new(
-                "theory.hydrodynamics",
+                "hydrodynamics",
                 format!(
                     "an RPY kernel of {} faces needs RPY hydrodynamics on a grid of {} cells",
                     kernel.faces(),

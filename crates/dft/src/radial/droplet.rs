@@ -48,22 +48,22 @@ impl DropletSetup {
     /// Check the setup: positive sizes, mean volume fractions at most close packing at the start
     /// and the end, a schedule that does not pass `R = 0`, a grid that resolves the particle.
     pub fn validate(&self) -> Result<DryingSchedule, RadialError> {
-        param::positive("system.particles", self.particles)?;
-        param::positive("system.diameter", self.diameter)?;
-        param::positive("system.d0", self.d0)?;
-        param::non_negative("drying.duration", self.t_end)?;
+        param::positive("particles", self.particles)?;
+        param::positive("diameter", self.diameter)?;
+        param::positive("d0", self.d0)?;
+        param::non_negative("t_end", self.t_end)?;
         let schedule = DryingSchedule::new(self.r0, self.alpha)?;
         let phi0 = mean_volume_fraction(self.particles, self.diameter, self.r0);
         if phi0 > CLOSE_PACKING {
             return Err(ParamError::new(
-                "system.particles",
+                "particles",
                 format!("initial mean volume fraction {phi0:.4} is beyond close packing ({CLOSE_PACKING})"),
             )
             .into());
         }
         if self.t_end >= schedule.collapse_time() {
             return Err(ParamError::new(
-                "drying.duration",
+                "t_end",
                 format!(
                     "the drying schedule passes R = 0 at t = {:.6} before the end t = {}",
                     schedule.collapse_time(),
@@ -80,7 +80,7 @@ impl DropletSetup {
         // accepts. (The functional itself is regular there; it diverges at a local packing 1.)
         if phi_end > CLOSE_PACKING * 1.01 {
             return Err(ParamError::new(
-                "drying.final_volume_fraction",
+                "final_volume_fraction",
                 format!(
                     "the mean volume fraction reaches {phi_end:.4} at the end (R = {r_end:.4}), beyond close packing ({CLOSE_PACKING})"
                 ),
@@ -89,14 +89,14 @@ impl DropletSetup {
         }
         if r_end + self.interface.offset < 0.5 * self.diameter {
             return Err(ParamError::new(
-                "drying.duration",
+                "t_end",
                 format!("the droplet (R = {r_end:.4}) becomes smaller than one particle"),
             )
             .into());
         }
         if self.diameter / self.dr < super::fmt::MIN_CELLS_PER_DIAMETER {
             return Err(ParamError::new(
-                "theory.dr",
+                "dr",
                 format!(
                     "grid spacing {} does not resolve the particle: need dr <= diameter / {}",
                     self.dr,
@@ -169,7 +169,7 @@ pub fn run_droplet(
         || times.windows(2).any(|w| w[1] < w[0])
     {
         return Err(ParamError::new(
-            "observe.profile.fractions",
+            "times",
             format!("output times must ascend within [0, {}]", setup.t_end),
         )
         .into());

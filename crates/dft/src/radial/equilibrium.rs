@@ -61,9 +61,9 @@ pub fn solve_equilibrium(
     initial: Option<&[f64]>,
     opts: &EquilibriumOptions,
 ) -> Result<Equilibrium, RadialError> {
-    param::positive("system.particles", particles)?;
-    param::positive("theory.tolerance", opts.tolerance)?;
-    param::in_range("theory.mixing", opts.mixing, 1e-6, 1.0)?;
+    param::positive("particles", particles)?;
+    param::positive("tolerance", opts.tolerance)?;
+    param::in_range("mixing", opts.mixing, 1e-6, 1.0)?;
     let n = grid.len();
     assert_eq!(beta_v.len(), n, "potential must be given at every cell");
     let vol = grid.volumes();

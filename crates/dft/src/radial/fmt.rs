@@ -71,11 +71,11 @@ impl Rosenfeld {
     /// Errors if the grid does not resolve the particle (`diameter / dr < 10`) or the grid is
     /// shorter than one diameter.
     pub fn new(grid: &RadialGrid, diameter: f64) -> Result<Self, RadialError> {
-        colloidsim_core::param::positive("system.diameter", diameter)?;
+        colloidsim_core::param::positive("diameter", diameter)?;
         let dr = grid.dr();
         if diameter / dr < MIN_CELLS_PER_DIAMETER {
             return Err(colloidsim_core::ParamError::new(
-                "theory.dr",
+                "dr",
                 format!(
                     "grid spacing {dr} does not resolve the particle: need dr <= diameter / {MIN_CELLS_PER_DIAMETER} = {}",
                     diameter / MIN_CELLS_PER_DIAMETER
@@ -85,7 +85,7 @@ impl Rosenfeld {
         }
         if grid.r_max() < diameter {
             return Err(colloidsim_core::ParamError::new(
-                "theory.r_max",
+                "r_max",
                 format!(
                     "grid extent {} is shorter than the diameter {diameter}",
                     grid.r_max()
@@ -99,7 +99,7 @@ impl Rosenfeld {
         // Four weight bands of n x bw, and as much again for the DDFT's kernels and scratch:
         // refused before they are allocated when the machine cannot hold them.
         colloidsim_core::resources::ensure_fits(
-            "theory.dr",
+            "dr",
             &format!(
                 "the FMT weights of {n} cells x {bw} (grid spacing {dr:.3e}; a larger --dx makes them smaller)"
             ),
@@ -333,6 +333,6 @@ mod tests {
     fn coarse_grid_is_rejected() {
         let g = RadialGrid::new(0.2, 50).unwrap();
         let e = Rosenfeld::new(&g, 1.0).unwrap_err();
-        assert!(e.to_string().contains("theory.dr"));
+        assert!(e.to_string().starts_with("dr:"), "{e}");
     }
 }

@@ -65,7 +65,7 @@ impl TabulatedPair {
         s_bins: usize,
         h: Vec<f64>,
     ) -> Result<Self, ParamError> {
-        colloidsim_core::param::positive("system.diameter", diameter)?;
+        colloidsim_core::param::positive("diameter", diameter)?;
         colloidsim_core::param::positive("pair.r_bin", r_bin)?;
         colloidsim_core::param::positive("pair.s_bin", s_bin)?;
         let per = diameter / s_bin;
@@ -191,7 +191,7 @@ impl TabulatedPair {
         let reach = self.s_max().max(d);
         let bw = (2.0 * reach / dr).ceil() as usize + 3;
         colloidsim_core::resources::ensure_fits(
-            "theory.dr",
+            "dr",
             &format!("the RPY kernel of {nf} faces x {bw} cells"),
             (nf * bw * std::mem::size_of::<f64>()) as f64,
         )?;

@@ -15,10 +15,10 @@ pub struct RadialGrid {
 }
 
 impl RadialGrid {
-    /// `n` cells of width `dr` (key names used in errors: `theory.dr`, `theory.cells`).
+    /// `n` cells of width `dr` (errors name `dr` and `cells`).
     pub fn new(dr: f64, n: usize) -> Result<Self, RadialError> {
-        param::positive("theory.dr", dr)?;
-        param::at_least("theory.cells", n, 2)?;
+        param::positive("dr", dr)?;
+        param::at_least("cells", n, 2)?;
         Self::ensure_fits(dr, n as f64)?;
         let faces: Vec<f64> = (0..=n).map(|i| i as f64 * dr).collect();
         let centres = (0..n).map(|i| (i as f64 + 0.5) * dr).collect();
@@ -40,8 +40,8 @@ impl RadialGrid {
 
     /// The smallest grid of spacing `dr` that covers `[0, r_max]`.
     pub fn covering(dr: f64, r_max: f64) -> Result<Self, RadialError> {
-        param::positive("theory.dr", dr)?;
-        param::positive("theory.r_max", r_max)?;
+        param::positive("dr", dr)?;
+        param::positive("r_max", r_max)?;
         let cells = (r_max / dr).ceil().max(2.0);
         // Before the count becomes an integer: 1e301 cells would saturate it.
         Self::ensure_fits(dr, cells)?;
@@ -52,7 +52,7 @@ impl RadialGrid {
     /// fields on it) the machine cannot hold, naming the spacing.
     fn ensure_fits(dr: f64, cells: f64) -> Result<(), RadialError> {
         colloidsim_core::resources::ensure_fits(
-            "theory.dr",
+            "dr",
             &format!(
                 "a radial grid of {cells:.3e} cells of width {dr:.3e} (a larger --dx makes it smaller)"
             ),
@@ -116,7 +116,7 @@ mod tests {
     #[test]
     fn grids_beyond_the_memory_are_refused_naming_the_spacing() {
         let e = RadialGrid::covering(1e-300, 15.0).unwrap_err().to_string();
-        assert!(e.contains("theory.dr") && e.contains("radial grid"), "{e}");
+        assert!(e.contains("dr:") && e.contains("radial grid"), "{e}");
         assert!(RadialGrid::new(1e-3, usize::MAX).is_err());
     }
 }

@@ -21,11 +21,11 @@ pub struct HarmonicInterface {
 }
 
 impl HarmonicInterface {
-    /// Validated interface (keys `interface.stiffness`, `interface.range`, `interface.offset`).
+    /// Validated interface (errors name `stiffness`, `range`, `offset`).
     pub fn new(stiffness: f64, range: f64, offset: f64) -> Result<Self, RadialError> {
-        param::positive("interface.stiffness", stiffness)?;
-        param::positive("interface.range", range)?;
-        param::finite("interface.offset", offset)?;
+        param::positive("stiffness", stiffness)?;
+        param::positive("range", range)?;
+        param::finite("offset", offset)?;
         Ok(Self {
             stiffness,
             range,
@@ -75,17 +75,17 @@ pub struct DryingSchedule {
 }
 
 impl DryingSchedule {
-    /// Validated schedule (keys `system.radius`, `drying.alpha`).
+    /// Validated schedule (errors name `r0`, `alpha`).
     pub fn new(r0: f64, alpha: f64) -> Result<Self, RadialError> {
-        param::positive("system.radius", r0)?;
-        param::non_negative("drying.alpha", alpha)?;
+        param::positive("r0", r0)?;
+        param::non_negative("alpha", alpha)?;
         Ok(Self { r0, alpha })
     }
 
     /// Schedule of Peclet number `Pe = R |dR/dt| / D0`, i.e. `alpha = 8 pi Pe D0`.
     pub fn from_peclet(r0: f64, peclet: f64, d0: f64) -> Result<Self, RadialError> {
-        param::non_negative("drying.peclet", peclet)?;
-        param::positive("system.d0", d0)?;
+        param::non_negative("peclet", peclet)?;
+        param::positive("d0", d0)?;
         Self::new(r0, 8.0 * PI * peclet * d0)
     }
 
@@ -105,7 +105,7 @@ impl DryingSchedule {
             Ok(r2.sqrt())
         } else {
             Err(ParamError::new(
-                "drying.duration",
+                "t_end",
                 format!(
                     "the drying schedule passes R = 0 at t = {} (asked for t = {t})",
                     self.collapse_time()

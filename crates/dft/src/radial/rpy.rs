@@ -87,13 +87,13 @@ impl PairTable {
     fn validate(&self) -> Result<(), ParamError> {
         if !(self.range.is_finite() && (2.0..=30.0).contains(&self.range)) {
             return Err(ParamError::new(
-                "theory.pair_range",
+                "pair_range",
                 format!("must be in [2, 30] diameters, got {}", self.range),
             ));
         }
         if !(self.eta_max.is_finite() && (0.2..=super::pair::ETA_CLIP).contains(&self.eta_max)) {
             return Err(ParamError::new(
-                "theory.pair_eta_max",
+                "pair_eta_max",
                 format!(
                     "must be in [0.2, {}], got {}",
                     super::pair::ETA_CLIP,
@@ -294,7 +294,7 @@ impl RpyKernel {
         let d_eta = table.eta_max / (PAIR_NODES - 1) as f64;
         if nodes > 1 {
             colloidsim_core::resources::ensure_fits(
-                "theory.dr",
+                "dr",
                 &format!(
                     "the RPY kernel tables of {nf} faces x {bw} cells x {nodes} packing fractions (grid spacing {dr:.3e}; a larger --dx makes them smaller)"
                 ),

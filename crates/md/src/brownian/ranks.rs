@@ -236,7 +236,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.domain = Some(d);
         if let Some(tag) = lost {
             return Err(BdError::Invalid(format!(
-                "particle {tag} crossed more than one domain in a step at step {}; reduce run.dt \
+                "particle {tag} crossed more than one domain in a step at step {}; reduce `dt` \
                  or use fewer ranks",
                 self.step
             )));

@@ -138,7 +138,7 @@ pub enum DpdError {
     BoxTooSmall(#[from] BoxTooSmall),
     /// A position or velocity became NaN or infinite.
     #[error(
-        "the run went non-finite at step {step}: particle {tag} ({what}); reduce run.dt or check the forces"
+        "the run went non-finite at step {step}: particle {tag} ({what}); reduce `dt` or check the forces"
     )]
     NonFinite {
         /// Step at which it was detected.
@@ -152,7 +152,7 @@ pub enum DpdError {
     /// over a step and the integration is meaningless (the neighbour lists stay valid, as they are
     /// rebuilt after every drift that needs it).
     #[error(
-        "particle {tag} moved {distance:.3} in one step at step {step} (more than half the cut-off, {limit}): the time step is too large for these forces; reduce run.dt"
+        "particle {tag} moved {distance:.3} in one step at step {step} (more than half the cut-off, {limit}): the time step is too large for these forces; reduce `dt`"
     )]
     Unstable {
         /// Step.
@@ -738,7 +738,7 @@ impl Dpd {
             };
             let d = Domain::grid(comm, [nc[1], nc[2]], grid, cell_range).map_err(|e| {
                 let key = if p.rank_grid.is_some() {
-                    "run.rank_grid: "
+                    "`rank_grid`: "
                 } else {
                     ""
                 };
@@ -1291,7 +1291,7 @@ impl Dpd {
         };
         if lost != u32::MAX {
             return Err(DpdError::Invalid(format!(
-                "particle {lost} crossed more than one domain in a step at step {}; reduce run.dt",
+                "particle {lost} crossed more than one domain in a step at step {}; reduce `dt`",
                 self.step
             )));
         }

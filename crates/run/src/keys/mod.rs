@@ -618,6 +618,28 @@ pub fn rekey(
     }
 }
 
+/// An engine's message that names its parameters in backticks (``reduce `dt` ``), naming
+/// instead the scenario keys that set them (`reduce run.dt`); `names` pairs the engine's
+/// names with the keys. A name not listed is shown without its backticks.
+pub fn rekey_text(message: &str, names: &[(&str, &Spec)]) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(open) = rest.find('`') {
+        let Some(len) = rest[open + 1..].find('`') else {
+            break;
+        };
+        let name = &rest[open + 1..open + 1 + len];
+        out.push_str(&rest[..open]);
+        match names.iter().find(|(n, _)| *n == name) {
+            Some((_, k)) => out.push_str(k.path),
+            None => out.push_str(name),
+        }
+        rest = &rest[open + len + 2..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// The keys as aligned text columns.
 pub fn text(keys: &[Key]) -> String {
     let w = keys.iter().map(|k| k.path.len()).max().unwrap_or(4).max(4);
@@ -764,6 +786,23 @@ mod tests {
             let e = validate(&table(bad), BCD).unwrap_err().to_string();
             assert!(e.contains(words), "{bad}: {e}");
         }
+    }
+
+    #[test]
+    fn engine_names_in_backticks_become_keys() {
+        use crate::keys::shared::{HYDRO_MAX_ITERATIONS, RUN_DT};
+        let names: &[(&str, &Spec)] = &[("dt", &RUN_DT), ("max_iterations", &HYDRO_MAX_ITERATIONS)];
+        assert_eq!(
+            rekey_text(
+                "step 3: reduce `dt` (or raise `max_iterations`; `other`)",
+                names
+            ),
+            "step 3: reduce run.dt (or raise hydrodynamics.max_iterations; other)"
+        );
+        assert_eq!(
+            rekey_text("no names, one ` tick", names),
+            "no names, one ` tick"
+        );
     }
 
     #[test]

@@ -72,6 +72,68 @@ pub fn interface(r: &Reader, d: f64, kt: f64) -> Result<Interface> {
     })
 }
 
+/// `[drying]`: the radius law of both droplet methods (docs/droplet.md).
+pub const DRYING: Spec = key(
+    "drying",
+    "-",
+    Means("Pe = 10 to phi = 0.55"),
+    Table,
+    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi))",
+);
+
+/// `drying.peclet`.
+pub const DRYING_PECLET: Spec = key(
+    "drying.peclet",
+    "-",
+    Value("10"),
+    NonNegative,
+    "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha. 0: a static droplet (R = R0), for equilibrium profiles",
+)
+.also("0 needs drying.duration");
+
+/// `drying.alpha`.
+pub const DRYING_ALPHA: Spec = key(
+    "drying.alpha",
+    "length^2 / time",
+    Means("8 pi Pe D0"),
+    Positive,
+    "rate of loss of surface area",
+);
+
+/// `drying.final_volume_fraction` (each method adds its conditions with [`Spec::also`]).
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key(
+    "drying.final_volume_fraction",
+    "-",
+    Value("0.55"),
+    LeftOpen(0.0, 0.64),
+    "run until the mean volume fraction reaches this; or give drying.duration",
+);
+
+/// `drying.duration` (each method adds its conditions with [`Spec::also`]).
+pub const DRYING_DURATION: Spec = key(
+    "drying.duration",
+    "time",
+    Means("until final_volume_fraction"),
+    Positive,
+    "run for this time",
+);
+
+/// The drying rate as read: `(peclet, alpha)` with `alpha = 8 pi Pe D0` for spheres of
+/// diffusion coefficient `d0`, from `drying.peclet` or `drying.alpha` (not both).
+pub fn drying_rate(r: &Reader, d0: f64) -> Result<(f64, f64)> {
+    match r.opt_number(&DRYING_ALPHA)? {
+        Some(_) if r.has(&DRYING_PECLET) => bail!(ParamError::new(
+            DRYING_PECLET.path,
+            "give either drying.peclet or drying.alpha, not both",
+        )),
+        Some(alpha) => Ok((alpha / (8.0 * std::f64::consts::PI * d0), alpha)),
+        None => {
+            let pe = r.number(&DRYING_PECLET)?;
+            Ok((pe, 8.0 * std::f64::consts::PI * pe * d0))
+        }
+    }
+}
+
 /// `[solvent]`: the SRD solvent of both MPCD methods (MPCD units).
 pub const SOLVENT: Spec = key(
     "solvent",

@@ -101,7 +101,17 @@ fn build_replica(p: &BulkParams, replica: u32) -> Result<Replica> {
 fn keyed(e: BulkError) -> anyhow::Error {
     match e {
         BulkError::Packing(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_BOX_LENGTH.path),
-        BulkError::Initial(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_INITIAL.path),
+        BulkError::Initial(m) => anyhow::anyhow!(
+            "{}: {}",
+            keys::SYSTEM_INITIAL.path,
+            crate::keys::rekey_text(
+                &m,
+                &[
+                    ("particles", &keys::SYSTEM_PARTICLES),
+                    ("box_length", &keys::SYSTEM_BOX_LENGTH)
+                ]
+            )
+        ),
         other => other.into(),
     }
 }

@@ -10,7 +10,7 @@ pub mod params;
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::engine::flat;
-use crate::keys::Spec;
+use crate::keys::{Spec, rekey_text};
 use crate::method::{Checked, Finished, Method, Session};
 use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
 use crate::trajectory::FrameDigest;
@@ -29,6 +29,15 @@ use monitor::TemperatureMonitor;
 use params::Resolved;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
+
+/// The DPD engine's names of the parameters its errors advise changing, and their keys.
+const ENGINE_NAMES: &[(&str, &Spec)] =
+    &[("dt", &keys::RUN_DT), ("rank_grid", &keys::RUN_RANK_GRID)];
+
+/// An engine error as the user reads it: its parameters named by their keys.
+fn rekeyed(e: colloidsim_md::DpdError) -> String {
+    rekey_text(&e.to_string(), ENGINE_NAMES)
+}
 
 /// The DPD family of scenarios.
 pub struct DpdMethod;
@@ -104,7 +113,10 @@ fn start(
     let (sync_every, _) = periods(s.steps);
     let mut sim = match comm {
         None => s.setup.build()?,
-        Some(c) => s.setup.build_decomposed(c)?,
+        Some(c) => s
+            .setup
+            .build_decomposed(c)
+            .map_err(|e| anyhow::anyhow!(rekeyed(e)))?,
     };
     sim.set_sync_every(sync_every);
     DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
@@ -384,7 +396,7 @@ impl DpdSession {
             self.sim.advance()
         };
         if let Err(e) = result {
-            return Ok(Some(e.to_string()));
+            return Ok(Some(rekeyed(e)));
         }
         // The shear stress by part (kinetic, each pair force class) from the same step.
         if let Some(sh) = self.obs.shear.as_mut() {
@@ -637,7 +649,9 @@ impl crate::Engine for DpdEngine {
     }
     fn step(&mut self, steps: u64) -> Result<()> {
         for _ in 0..steps {
-            self.sim.advance()?;
+            self.sim
+                .advance()
+                .map_err(|e| anyhow::anyhow!(rekeyed(e)))?;
         }
         Ok(())
     }
@@ -1499,4 +1513,21 @@ fn solvent_viscosity_kinetic_theory(s: &Resolved) -> f64 {
     let pi = std::f64::consts::PI;
     45.0 * m * p.kt / (4.0 * pi * p.gamma * p.rc.powi(3))
         + 2.0 * pi * p.gamma * rho * rho * p.rc.powi(5) / 1575.0
+}
+
+#[cfg(test)]
+mod engine_names {
+    /// The engine advises changing `dt`; the user reads the key.
+    #[test]
+    fn dpd_errors_name_the_keys() {
+        let e = colloidsim_md::DpdError::NonFinite {
+            step: 7,
+            tag: 2,
+            what: "position",
+        };
+        assert_eq!(
+            super::rekeyed(e),
+            "the run went non-finite at step 7: particle 2 (position); reduce run.dt or check the forces"
+        );
+    }
 }

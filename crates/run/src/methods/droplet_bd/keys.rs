@@ -8,7 +8,7 @@
 use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{
-    DIAMETER, HYDRO_MAX_ITERATIONS, HYDRO_MODEL, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS,
+    self, DIAMETER, DRYING, DRYING_ALPHA, DRYING_PECLET, HYDRO_MAX_ITERATIONS, HYDRO_MODEL, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS,
     INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS, KT, RUN_DT, RUN_INTEGRATOR,
     RUN_SKIN, TRAJECTORY, TRAJECTORY_EVERY, VISCOSITY,
 };
@@ -40,24 +40,9 @@ pub const SYSTEM_INITIAL: Spec = key("system.initial", "-", Means("random insert
     "start from the last frame of this GSD file (HOOMD schema) instead of random insertion")
     .also("must hold system.particles particles within R0 + offset + range");
 
-pub const DRYING: Spec = key("drying", "-", Means("Pe = 10 to phi = 0.55"), Table,
-    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi))");
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = shared::DRYING_FINAL_VOLUME_FRACTION.also("> phi0");
 
-pub const DRYING_PECLET: Spec = key("drying.peclet", "-", Value("10"), NonNegative,
-    "Pe = R |dR/dt| / D0, constant in time; give this or drying.alpha. 0: a static droplet (R = R0), for equilibrium profiles")
-    .also("0 needs drying.duration");
-
-pub const DRYING_ALPHA: Spec = key("drying.alpha", "length^2 / time", Means("8 pi Pe D0"), Positive,
-    "rate of loss of surface area");
-
-pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key("drying.final_volume_fraction", "-",
-    Value("0.55"), LeftOpen(0.0, 0.64),
-    "run until the mean volume fraction reaches this; or give drying.duration")
-    .also("> phi0");
-
-pub const DRYING_DURATION: Spec = key("drying.duration", "time",
-    Means("until final_volume_fraction"), Positive,
-    "run for this time")
+pub const DRYING_DURATION: Spec = shared::DRYING_DURATION
     .also("before R^2 would turn negative (t < 4 pi R0^2 / alpha)");
 
 pub const RUN: Spec = key("run", "-", Means("defaults"), Table, "time stepping");

@@ -276,7 +276,11 @@ fn build_replica(p: &DropletParams, replica: u32) -> Result<Replica> {
 fn keyed(e: DropletError) -> anyhow::Error {
     match e {
         DropletError::Packing(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_PHI0.path),
-        DropletError::Initial(m) => anyhow::anyhow!("{}: {m}", keys::SYSTEM_INITIAL.path),
+        DropletError::Initial(m) => anyhow::anyhow!(
+            "{}: {}",
+            keys::SYSTEM_INITIAL.path,
+            crate::keys::rekey_text(&m, &[("particles", &keys::SYSTEM_PARTICLES)])
+        ),
         DropletError::Param(e) => params::keyed(e).into(),
         other => other.into(),
     }

@@ -4,8 +4,9 @@
 
 use super::keys::*;
 use crate::keys::shared::{
-    self, HYDRO_MAX_ITERATIONS, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS, INTERFACE_OFFSET,
-    INTERFACE_RANGE, INTERFACE_STIFFNESS, RUN_DT, RUN_SKIN, Spheres, TRAJECTORY_EVERY,
+    self, DRYING_PECLET, HYDRO_MAX_ITERATIONS, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS,
+    INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS, RUN_DT, RUN_SKIN, Spheres,
+    TRAJECTORY_EVERY,
 };
 use crate::keys::{Reader, SEED_KEY, Spec, rekey};
 use anyhow::{Result, bail};
@@ -113,17 +114,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
     }
 
     // The drying law: alpha = 8 pi Pe D0 (Pe = R |dR/dt| / D0), from peclet or alpha.
-    let (peclet, alpha) = match (r.has(&DRYING_PECLET), r.opt_number(&DRYING_ALPHA)?) {
-        (true, Some(_)) => bail!(ParamError::new(
-            DRYING_PECLET.path,
-            "give either drying.peclet or drying.alpha, not both",
-        )),
-        (false, Some(a)) => (a / (8.0 * PI * d0), a),
-        (_, None) => {
-            let pe = r.number(&DRYING_PECLET)?;
-            (pe, 8.0 * PI * pe * d0)
-        }
-    };
+    let (peclet, alpha) = shared::drying_rate(r, d0)?;
     let duration = r.opt_number(&DRYING_DURATION)?;
     let final_given = r.has(&DRYING_FINAL_VOLUME_FRACTION);
     if alpha == 0.0 && duration.is_none() {

@@ -17,6 +17,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
+use colloidsim_core::ParamError;
 use colloidsim_core::output::{OutputDir, read_table};
 use colloidsim_dft::radial::{
     DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
@@ -24,7 +25,15 @@ use colloidsim_dft::radial::{
 };
 use colloidsim_md::droplet::DropletParams;
 
+use super::keys::{
+    DRYING_DURATION, DRYING_FINAL_VOLUME_FRACTION, OBSERVE_PROFILE_FRACTIONS, SYSTEM_PARTICLES,
+    SYSTEM_RADIUS,
+};
 use crate::control::Control;
+use crate::keys::shared::{
+    DIAMETER, DRYING_ALPHA, DRYING_PECLET, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
+};
+use crate::keys::{Spec, rekey};
 use crate::output::profile_name;
 use crate::plot::{self, Scale, Series};
 use crate::{Report, Scenario as Source, TheoryOptions};
@@ -45,6 +54,58 @@ fn grid_spacing(p: &DropletParams, dx: Option<f64>) -> Result<f64> {
     Ok(dr)
 }
 
+/// The DFT's names of its parameters, and the scenario keys that set them.
+const ENGINE_NAMES: &[(&str, &Spec)] = &[
+    ("particles", &SYSTEM_PARTICLES),
+    ("diameter", &DIAMETER),
+    ("r0", &SYSTEM_RADIUS),
+    ("alpha", &DRYING_ALPHA),
+    ("peclet", &DRYING_PECLET),
+    ("t_end", &DRYING_DURATION),
+    ("final_volume_fraction", &DRYING_FINAL_VOLUME_FRACTION),
+    ("times", &OBSERVE_PROFILE_FRACTIONS),
+    ("stiffness", &INTERFACE_STIFFNESS),
+    ("range", &INTERFACE_RANGE),
+    ("offset", &INTERFACE_OFFSET),
+];
+
+/// The theory's own parameters (its grid, from `--dx`, and its solvers' settings), which no
+/// scenario key sets: errors show them as `theory.<name>`.
+const THEORY_NAMES: &[&str] = &[
+    "dr",
+    "r_max",
+    "cells",
+    "dt",
+    "dt_max",
+    "dt_min",
+    "tolerance",
+    "max_iterations",
+    "mixing",
+    "eject_potential",
+    "eject_tolerance",
+    "potential_cutoff",
+    "initial",
+    "hydrodynamics",
+    "pair_range",
+    "pair_eta_max",
+];
+
+/// A DFT error about one of its parameters, naming the scenario key that sets it (or the
+/// theory's own parameter as `theory.<name>`, and the derived `D0` as `system.d0`).
+fn relabel(e: RadialError) -> RadialError {
+    let RadialError::Param(p) = e else {
+        return e;
+    };
+    let p = rekey(p, ENGINE_NAMES);
+    RadialError::Param(if p.key == "d0" {
+        ParamError::new("system.d0", p.message)
+    } else if THEORY_NAMES.contains(&p.key.as_str()) {
+        ParamError::new(format!("theory.{}", p.key), p.message)
+    } else {
+        p
+    })
+}
+
 /// The library setup for a validated BD scenario (stiffness converted to kT units).
 pub fn setup_from(p: &DropletParams, dr: f64) -> Result<DropletSetup> {
     Ok(DropletSetup {
@@ -53,7 +114,8 @@ pub fn setup_from(p: &DropletParams, dr: f64) -> Result<DropletSetup> {
         d0: p.d0,
         r0: p.r0,
         alpha: p.alpha,
-        interface: HarmonicInterface::new(p.stiffness / p.kt, p.range, p.offset)?,
+        interface: HarmonicInterface::new(p.stiffness / p.kt, p.range, p.offset)
+            .map_err(relabel)?,
         t_end: p.t_end,
         dr,
         hydrodynamics: Hydrodynamics::FreeDraining,
@@ -119,6 +181,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     };
     setup
         .validate()
+        .map_err(relabel)
         .map_err(|e| anyhow!("{}: {e}", src.label()))?;
 
     let out = topts
@@ -149,7 +212,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
                 write_err.get_or_insert(e);
             }
             // Reference: equilibrium of the same N in a static droplet of radius R(t).
-            match equilibrium_at(&setup, s.radius, &eq_opts) {
+            match equilibrium_at(&setup, s.radius, &eq_opts).map_err(relabel) {
                 Ok((g, eq)) => {
                     let width = s.radius / p.bins as f64;
                     let edges: Vec<f64> = (0..=p.bins).map(|k| k as f64 * width).collect();
@@ -177,7 +240,8 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
             }
         },
         |rep| pb.advance((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
-    );
+    )
+    .map_err(relabel);
     pb.end();
     let wall = start.elapsed().as_secs_f64();
     if let Some(e) = write_err {
@@ -449,6 +513,43 @@ fn draw(
 mod tests {
     use super::*;
     use colloidsim_dft::radial::DdftOptions;
+
+    /// The DFT names its own parameters; the theory's errors name the scenario keys (or the
+    /// theory's `theory.<name>`), as before the engine stopped knowing them.
+    #[test]
+    fn dft_errors_name_the_keys() {
+        let text = "method = \"droplet-bd\"\n[system]\nparticles = 20\nradius = 4.0\n[drying]\npeclet = 1\n";
+        let p = super::super::params::read(&toml::from_str(text).unwrap(), Path::new("."), None)
+            .unwrap();
+        let ok = setup_from(&p, 0.05).unwrap();
+        let err = |s: DropletSetup| relabel(s.validate().unwrap_err()).to_string();
+        assert!(err(DropletSetup { dr: 0.5, ..ok }).starts_with("theory.dr: "));
+        assert!(
+            err(DropletSetup {
+                particles: -1.0,
+                ..ok
+            })
+            .starts_with("system.particles: ")
+        );
+        assert!(err(DropletSetup { d0: 0.0, ..ok }).starts_with("system.d0: "));
+        assert!(err(DropletSetup { t_end: 1e9, ..ok }).starts_with("drying.duration: "));
+        assert!(err(DropletSetup { r0: -1.0, ..ok }).starts_with("system.radius: "));
+        let e = relabel(HarmonicInterface::new(-1.0, 0.5, 0.0).unwrap_err()).to_string();
+        assert!(e.starts_with("interface.stiffness: "), "{e}");
+        let opts = DdftOptions::new(p.d0, p.diameter);
+        let e = run_droplet(
+            &ok,
+            &[1.0, 0.0],
+            &opts,
+            &EquilibriumOptions::default(),
+            |_, _| {},
+            |_| {},
+        )
+        .map_err(relabel)
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("observe.profile.fractions: "), "{e}");
+    }
 
     /// Fraction of particles with `r > lambda R(t)` in the theory profile.
     fn theory_outer(grid: &RadialGrid, s: &Snapshot, lambda: f64, n: f64) -> f64 {

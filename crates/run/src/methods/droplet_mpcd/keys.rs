@@ -46,30 +46,13 @@ pub const SYSTEM_BOX: Spec = key("system.box", "length",
     "edge of the periodic box")
     .also("at least 2 R0 + 4 cells, a whole number of cells");
 
-/// `drying`.
-pub const DRYING: Spec = key("drying", "-", Means("-"), Table,
-    "the drying law R(t) = sqrt(R0^2 - alpha t / (4 pi)), as droplet-bd's");
+/// `drying.final_volume_fraction` (with its conditions here).
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = shared::DRYING_FINAL_VOLUME_FRACTION
+    .also("> phi0; with colloids only");
 
-/// `drying.peclet`.
-pub const DRYING_PECLET: Spec = key("drying.peclet", "-", Value("10"), NonNegative,
-    "Pe = R |dR/dt| / D0 (0: a static droplet)")
-    .also("not with drying.alpha");
-
-/// `drying.alpha`.
-pub const DRYING_ALPHA: Spec = key("drying.alpha", "length^2 / time", Means("8 pi Pe D0"), Positive,
-    "rate of loss of surface area");
-
-/// `drying.final_volume_fraction`.
-pub const DRYING_FINAL_VOLUME_FRACTION: Spec = key("drying.final_volume_fraction", "-",
-    Means("0.55 with colloids"), LeftOpen(0.0, 0.64),
-    "stop at this mean colloid volume fraction")
-    .also("with colloids; not with drying.duration");
-
-/// `drying.duration`.
-pub const DRYING_DURATION: Spec = key("drying.duration", "time",
-    Means("required without colloids"), Positive,
-    "stop after this time")
-    .also("R must stay above two cells");
+/// `drying.duration` (with its conditions here).
+pub const DRYING_DURATION: Spec = shared::DRYING_DURATION
+    .also("required without colloids; R must stay above two cells");
 
 /// `interface.range` (with its condition here).
 pub const INTERFACE_RANGE: Spec = shared::INTERFACE_RANGE.also("at most R0");

@@ -244,20 +244,8 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         None => box_edge(&SYSTEM_BOX, (min_box / a).ceil() * a, a, 2)?,
     };
     let d0 = srd.kt / (3.0 * PI * solvent.viscosity_theory * d);
-    let (peclet, alpha) = match r.opt_number(&DRYING_ALPHA)? {
-        Some(_) if r.has(&DRYING_PECLET) => {
-            return Err(refuse(
-                &DRYING_PECLET,
-                "give either drying.peclet or drying.alpha, not both",
-            ));
-        }
-        Some(alpha) => (alpha / (8.0 * PI * d0), alpha),
-        None => {
-            let pe = r.number(&DRYING_PECLET)?;
-            (pe, 8.0 * PI * pe * d0)
-        }
-    };
-    let final_fraction = r.opt_number(&DRYING_FINAL_VOLUME_FRACTION)?;
+    let (peclet, alpha) = shared::drying_rate(r, d0)?;
+    let final_fraction = r.if_given(&DRYING_FINAL_VOLUME_FRACTION, Reader::number)?;
     let t_end = match (final_fraction, r.opt_number(&DRYING_DURATION)?) {
         (Some(_), _) if particles == 0 => {
             return Err(refuse(
@@ -279,7 +267,10 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
                     "missing: a pure-solvent droplet needs drying.duration (the time to run)",
                 ));
             }
-            let phi_f = phi_f.unwrap_or(0.55);
+            let phi_f = match phi_f {
+                Some(phi_f) => phi_f,
+                None => r.number(&DRYING_FINAL_VOLUME_FRACTION)?,
+            };
             if phi_f <= phi0 {
                 return Err(refuse(
                     &DRYING_FINAL_VOLUME_FRACTION,
