@@ -704,7 +704,9 @@ fn drive(
     // The steps run on a worker of the thread pool, so that each step's parallel passes start
     // without a hand-over from this thread.
     let failure = rayon::scope(|_| -> Result<Option<String>> {
-        let mut chunk = 16u64;
+        // One unit first (a unit can be long: an MC sweep over 1e8 cells), so that an interrupt
+        // is seen soon; the chunk doubles while chunks are short.
+        let mut chunk = 1u64;
         // Interrupted where no checkpoint can be written before the end: run to the end.
         let mut draining = false;
         loop {
