@@ -496,6 +496,36 @@ fn cells_per_edge(edge: f64, d: f64) -> usize {
     (fit - fit % 4).max(2)
 }
 
+/// Refuse a container whose grid of cells (side >= `d`) is far larger than its `n` spheres
+/// need: a sweep visits every cell, so the run would spend its time (and the slots' memory) on
+/// empty cells. Checked before the spheres are placed (placing them on a lattice is as costly).
+pub(crate) fn check_cell_count(edge: f64, d: f64, n: usize) -> Result<(), McError> {
+    let nc = cells_per_edge(edge, d);
+    let cells = (nc as f64).powi(3);
+    let most = (CELLS_PER_SPHERE * n as f64).max(MIN_CELL_BOUND);
+    if cells > most {
+        return Err(ParamError::new(
+            "system",
+            format!(
+                "{nc}^3 = {cells:.3e} cells of side >= d for {n} spheres (a volume fraction of \
+                 {:.1e}): each sweep visits every cell, so the run would spend its time on \
+                 empty cells; at most {most:.3e} cells (volume fraction about 1e-4): use a \
+                 smaller container or more spheres",
+                n as f64 * std::f64::consts::PI / 6.0 * d.powi(3) / edge.powi(3)
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// Cells of the grid per sphere at most (a volume fraction of about 1e-4), above
+/// [`MIN_CELL_BOUND`].
+const CELLS_PER_SPHERE: f64 = 4096.0;
+
+/// Cells any container may have whatever its spheres (64^3).
+const MIN_CELL_BOUND: f64 = 262_144.0;
+
 /// Largest delta the tuner may choose, in cell sides (a larger cube always leaves the cell).
 const MAX_DELTA_PER_SIDE: f64 = 0.5;
 
@@ -532,6 +562,7 @@ impl HardSphereMc {
         let nc = cells_per_edge(edge, d);
         let cells = (nc as f64).powi(3);
         let n = positions.len();
+        check_cell_count(edge, d, n)?;
         // Slots (3 coordinates, a tag) at the initial capacity, counts, particle arrays.
         let cap0 = 8usize;
         let bytes = cells * (cap0 as f64 * 28.0 + 4.0) + n as f64 * 80.0;

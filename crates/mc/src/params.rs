@@ -94,6 +94,13 @@ impl McRun {
         key: &str,
     ) -> Result<HardSphereMc, McError> {
         let geometry = self.geometry();
+        if self.diameter.is_finite() && self.diameter > 0.0 {
+            crate::engine::check_cell_count(
+                geometry.box_edge(self.diameter),
+                self.diameter,
+                self.particles,
+            )?;
+        }
         let lattice;
         let pos = match positions {
             Some(p) => {
