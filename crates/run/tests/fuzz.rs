@@ -696,7 +696,13 @@ fn fuzz_every_key(method: &str, per_key: u32) {
                 set(&mut doc, key.path, v.clone());
                 let case = format!("base {b} of {method}, {} = {}", key.path, show(&v));
                 cases += 1;
-                match std::panic::catch_unwind(|| run_checked(&doc)) {
+                let t0 = std::time::Instant::now();
+                let outcome = std::panic::catch_unwind(|| run_checked(&doc));
+                let secs = t0.elapsed().as_secs_f64();
+                if secs > 2.0 {
+                    eprintln!("slow ({secs:.1} s): {case}");
+                }
+                match outcome {
                     Ok(Ok(r)) => ran += usize::from(r),
                     Ok(Err(why)) => failures.push(format!("{case}: {why}")),
                     Err(_) => failures.push(format!("{case}: panicked")),
