@@ -215,6 +215,79 @@ fn hostile() -> impl Strategy<Value = toml::Value> {
     ]
 }
 
+/// Values a user could type for the key `spec`, drawn from its declaration: the ends of its
+/// allowed range, points inside it (log-uniform over many decades for an open-ended range, where
+/// a value such as kT = 1e300 is allowed but may still make nonsense), every allowed word,
+/// mixed with [`hostile`] values.
+fn declared(spec: &colloidsim_run::keys::Spec) -> BoxedStrategy<toml::Value> {
+    use colloidsim_run::keys::Allowed as A;
+    use toml::Value as V;
+    let log = |lo: f64, hi: f64| {
+        (lo.log10()..hi.log10())
+            .prop_map(|e| V::Float(10f64.powf(e)))
+            .boxed()
+    };
+    let within = |lo: f64, hi: f64| {
+        prop_oneof![
+            Just(V::Float(lo)),
+            Just(V::Float(hi)),
+            (lo..=hi).prop_map(V::Float),
+        ]
+        .boxed()
+    };
+    let own = match spec.allowed {
+        A::Positive => prop_oneof![
+            log(1e-6, 1e6),
+            Just(V::Float(1e-300)),
+            Just(V::Float(1e300)),
+            Just(V::Float(9.223372036854776e18)),
+        ]
+        .boxed(),
+        A::NonNegative => {
+            prop_oneof![Just(V::Float(0.0)), log(1e-6, 1e6), Just(V::Float(1e300))].boxed()
+        }
+        A::Finite => prop_oneof![
+            Just(V::Float(0.0)),
+            log(1e-6, 1e6),
+            log(1e-6, 1e6).prop_map(|v| V::Float(-v.as_float().unwrap())),
+            Just(V::Float(1e300)),
+            Just(V::Float(-1e300)),
+        ]
+        .boxed(),
+        A::Closed(lo, hi) | A::LeftOpen(lo, hi) => within(lo, hi),
+        A::Integer(lo, hi) => {
+            let top = hi.min(1 << 20);
+            prop_oneof![
+                Just(V::Integer(lo)),
+                Just(V::Integer(hi)),
+                Just(V::Integer(lo.saturating_add(1).min(hi))),
+                (lo..=top.max(lo)).prop_map(V::Integer),
+            ]
+            .boxed()
+        }
+        A::OneOf(words) => proptest::sample::select(words)
+            .prop_map(|w| V::String(w.to_string()))
+            .boxed(),
+        A::Bool => any::<bool>().prop_map(V::Boolean).boxed(),
+        A::Numbers(lo, hi, len) => {
+            proptest::collection::vec(lo..=hi, len.unwrap_or(1)..=len.unwrap_or(4))
+                .prop_map(|v| V::Array(v.into_iter().map(V::Float).collect()))
+                .boxed()
+        }
+        A::Path | A::Table => hostile().boxed(),
+    };
+    prop_oneof![3 => own, 1 => hostile()].boxed()
+}
+
+/// `v` as a scenario would write it, floats in the shortest form (`1e-300`, not 300 digits).
+fn show(v: &toml::Value) -> String {
+    match v {
+        toml::Value::Float(x) => format!("{x:e}"),
+        toml::Value::Array(a) => format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", ")),
+        other => other.to_string(),
+    }
+}
+
 /// Set `path` (dotted) in `t`, replacing whatever is in the way.
 fn set(t: &mut toml::Table, path: &str, v: toml::Value) {
     let mut parts: Vec<&str> = path.split('.').collect();
@@ -460,5 +533,249 @@ fn every_base_scenario_is_valid_and_steps() {
         colloidsim_run::check(&sc).unwrap_or_else(|e| panic!("{e:#}\n{text}"));
         let mut e = colloidsim_run::engine(&sc, None).unwrap();
         e.step(3).unwrap();
+    }
+}
+
+/// A progress sink that asks a fuzzed run to stop (as Ctrl-C would) once it has taken
+/// `seconds` of wall time: a mutated key may make a run long, and its interim outputs must be
+/// finite as well.
+struct Deadline {
+    start: std::time::Instant,
+    seconds: f64,
+}
+
+impl colloidsim_run::Progress for Deadline {
+    fn poll(&self) -> bool {
+        self.start.elapsed().as_secs_f64() > self.seconds
+    }
+}
+
+/// The non-finite numbers in the files of `dir` (CSV fields, JSON numbers, GSD
+/// floating-point chunks), one line each; empty when every number is finite.
+fn non_finite_outputs(dir: &Path) -> Vec<String> {
+    let mut bad = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return bad;
+    };
+    for e in entries.flatten() {
+        let path = e.path();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Ok(bytes) = std::fs::read(&path) else {
+            continue;
+        };
+        if name.ends_with(".csv") {
+            let text = String::from_utf8_lossy(&bytes);
+            for (line, row) in text.lines().enumerate() {
+                for field in row.split(',') {
+                    if let Ok(x) = field.trim().parse::<f64>()
+                        && !x.is_finite()
+                    {
+                        bad.push(format!("{name} line {}: {field}", line + 1));
+                    }
+                }
+            }
+        } else if name.ends_with(".json") {
+            // serde_json writes a non-finite number as null; a bare NaN or Infinity (a writer
+            // formatting its own JSON) makes the file unreadable to every JSON reader.
+            if serde_json::from_slice::<serde_json::Value>(&bytes).is_err() {
+                bad.push(format!("{name}: not valid JSON"));
+            }
+        } else if name.ends_with(".gsd") {
+            bad.extend(non_finite_gsd(&path, &name));
+        }
+    }
+    bad
+}
+
+/// The floating-point chunks of a GSD file with a non-finite value, as `file frame k: chunk`.
+fn non_finite_gsd(path: &Path, name: &str) -> Vec<String> {
+    use hoomd_gsd::file_layer::{DataType, GsdFile, Mode};
+    let Ok(file) = GsdFile::open(path, Mode::Read) else {
+        return vec![format!("{name}: not a readable GSD file")];
+    };
+    fn finite<T: hoomd_gsd::file_layer::Type + Into<f64>, const M: usize>(
+        file: &GsdFile,
+        k: u64,
+        chunk: &str,
+    ) -> bool {
+        file.iter_arrays::<T, M>(k, chunk)
+            .map(|mut it| it.all(|row| row.into_iter().all(|x| x.into().is_finite())))
+            .unwrap_or(true)
+    }
+    let mut bad = Vec::new();
+    let mut names: Vec<&String> = file.name_id().keys().collect();
+    names.sort();
+    for k in 0..file.n_frames() {
+        for chunk in &names {
+            let Some(e) = file.find_chunk(k, chunk) else {
+                continue;
+            };
+            let ok = match (e.data_type(), e.columns()) {
+                (Some(DataType::F32), 1) => finite::<f32, 1>(&file, k, chunk),
+                (Some(DataType::F32), 3) => finite::<f32, 3>(&file, k, chunk),
+                (Some(DataType::F32), 4) => finite::<f32, 4>(&file, k, chunk),
+                (Some(DataType::F32), 6) => finite::<f32, 6>(&file, k, chunk),
+                (Some(DataType::F64), 1) => finite::<f64, 1>(&file, k, chunk),
+                (Some(DataType::F64), 3) => finite::<f64, 3>(&file, k, chunk),
+                _ => true,
+            };
+            if !ok {
+                bad.push(format!("{name} frame {k}: {chunk}"));
+            }
+        }
+    }
+    bad
+}
+
+/// Run the mutated scenario `doc` to its end (or to an interrupt after a few seconds) in a
+/// fresh folder, if `check` accepts it; every number of every output must then be finite,
+/// whether the run completed, was interrupted or stopped with an error. `Ok(true)`: it ran;
+/// `Ok(false)`: refused; `Err` names what is wrong.
+fn run_checked(doc: &toml::Table) -> Result<bool, String> {
+    let sc = match Scenario::from_table(doc, Path::new(".")) {
+        Ok(sc) => sc,
+        Err(e) => {
+            if std::env::var_os("FUZZ_DEBUG").is_some() {
+                eprintln!("unreadable: {e:#}");
+            }
+            return Ok(false);
+        }
+    };
+    if let Err(e) = colloidsim_run::check(&sc) {
+        if std::env::var_os("FUZZ_DEBUG").is_some() {
+            eprintln!("refused: {e:#}");
+        }
+        return Ok(false);
+    }
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let out = dir.path().join("run");
+    let opts = RunOptions {
+        out: Some(out.clone()),
+        ..RunOptions::default()
+    };
+    let ctl = Control::new(std::sync::Arc::new(Deadline {
+        start: std::time::Instant::now(),
+        seconds: 0.5,
+    }));
+    let ended = colloidsim_run::run(&sc, &opts, &ctl);
+    let bad = non_finite_outputs(&out);
+    if !bad.is_empty() {
+        return Err(format!(
+            "non-finite numbers written ({}): {}",
+            match &ended {
+                Ok(_) => "completed".to_string(),
+                Err(e) => format!("{e:#}"),
+            },
+            bad.iter().take(4).cloned().collect::<Vec<_>>().join("; ")
+        ));
+    }
+    Ok(true)
+}
+
+/// The fuzz of one method, in CI: every key it declares (taken from the declarations, so that
+/// a new key is fuzzed without anyone listing it), set in each of the method's base scenarios
+/// to values drawn from its declaration ([`declared`]) with a fixed seed, must give a clean refusal or a run whose
+/// every output is finite. `per_key` values a key.
+fn fuzz_every_key(method: &str, per_key: u32) {
+    use proptest::strategy::ValueTree;
+    let spec = colloidsim_run::registry::find(method).unwrap().keys();
+    let bases: Vec<&str> = BASES
+        .iter()
+        .copied()
+        .filter(|b| method_of(b) == method)
+        .collect();
+    assert!(!bases.is_empty(), "no base scenario of {method}");
+    let mut runner = proptest::test_runner::TestRunner::new(fuzz_config(per_key));
+    let mut failures = Vec::new();
+    let (mut cases, mut ran) = (0, 0);
+    for key in spec {
+        for (b, text) in bases.iter().enumerate() {
+            for _ in 0..per_key {
+                let v = declared(key).new_tree(&mut runner).unwrap().current();
+                let mut doc: toml::Table = toml::from_str(text).unwrap();
+                set(&mut doc, key.path, v.clone());
+                let case = format!("base {b} of {method}, {} = {}", key.path, show(&v));
+                cases += 1;
+                let t0 = std::time::Instant::now();
+                let outcome = std::panic::catch_unwind(|| run_checked(&doc));
+                let secs = t0.elapsed().as_secs_f64();
+                if secs > 2.0 {
+                    eprintln!("slow ({secs:.1} s): {case}");
+                }
+                match outcome {
+                    Ok(Ok(r)) => ran += usize::from(r),
+                    Ok(Err(why)) => failures.push(format!("{case}: {why}")),
+                    Err(_) => failures.push(format!("{case}: panicked")),
+                }
+            }
+        }
+    }
+    eprintln!("{method}: {cases} mutated scenarios, {ran} accepted and run");
+    assert!(
+        failures.is_empty(),
+        "{} of the fuzzed {method} scenarios failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    // Most mutations are refused; the fuzz must still run many (else it tests the refusal only).
+    assert!(ran * 10 >= cases, "{method}: only {ran} of {cases} ran");
+}
+
+/// One fuzz test per registered method (each is listed: a method without one fails
+/// `every_method_is_fuzzed_key_by_key`).
+macro_rules! fuzz_methods {
+    ($($test:ident => $method:literal),* $(,)?) => {
+        $(
+            #[test]
+            fn $test() {
+                fuzz_every_key($method, 2);
+            }
+        )*
+        const FUZZED: &[&str] = &[$($method),*];
+    };
+}
+
+fuzz_methods! {
+    every_bcd_key_fuzzed => "bcd",
+    every_droplet_bd_key_fuzzed => "droplet-bd",
+    every_bd_key_fuzzed => "bd",
+    every_dpd_key_fuzzed => "dpd",
+    every_mpcd_key_fuzzed => "mpcd",
+    every_droplet_mpcd_key_fuzzed => "droplet-mpcd",
+    every_hs_mc_key_fuzzed => "hs-mc",
+}
+
+/// The output check finds what it is for (a check that passes on anything would hide them).
+#[test]
+fn the_output_check_finds_non_finite_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ok.csv"), "x,y\n1,2.5e-3\n").unwrap();
+    std::fs::write(
+        dir.path().join("ok.json"),
+        "{\"a\": null, \"b\": \"information\"}",
+    )
+    .unwrap();
+    assert!(non_finite_outputs(dir.path()).is_empty());
+    std::fs::write(dir.path().join("bad.csv"), "x,y\n1,inf\nNaN,2\n").unwrap();
+    std::fs::write(dir.path().join("bad.json"), "{\"a\": NaN}").unwrap();
+    let mut g =
+        hoomd_gsd::file_layer::GsdFile::create(dir.path().join("bad.gsd"), "test", "hoomd", (1, 4))
+            .unwrap();
+    g.write_arrays("particles/position", [[0.0f32, f32::NAN, 0.0]])
+        .unwrap();
+    g.end_frame().unwrap();
+    drop(g);
+    let bad = non_finite_outputs(dir.path());
+    assert_eq!(bad.len(), 4, "{bad:?}");
+}
+
+#[test]
+fn every_method_is_fuzzed_key_by_key() {
+    for m in colloidsim_run::registry::all() {
+        assert!(
+            m.names().iter().any(|n| FUZZED.contains(n)),
+            "{} has no key-by-key fuzz test",
+            m.names()[0]
+        );
     }
 }
