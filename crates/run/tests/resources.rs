@@ -248,7 +248,10 @@ fn a_cell_grid_far_larger_than_its_spheres_need_is_refused() {
     let text = "method = \"hs-mc\"\n[system]\ngeometry = \"hard-wall\"\nparticles = 20\n\
                 radius = 304.5\n[mc]\nsweeps = 20\nwarmup_sweeps = 10\nblocks = 2\n";
     let e = refusal(text);
-    assert!(e.contains("system") && e.contains("each sweep visits every cell"), "{e}");
+    assert!(
+        e.contains("system") && e.contains("each sweep visits every cell"),
+        "{e}"
+    );
     // The same spheres in a droplet the grid bound allows are accepted.
     let near = text.replace("radius = 304.5", "radius = 30.0");
     let sc = colloidsim_run::Scenario::from_toml(&near, std::path::Path::new(".")).unwrap();
