@@ -82,7 +82,8 @@ fn too_large_a_time_step_is_reported_with_step_and_particle() {
     let p = droplet_params(&text);
     let mut sim = p.build_replica(0).unwrap();
     match sim.run(p.steps) {
-        Err(e @ BdError::BlowUp { .. }) => assert!(e.to_string().contains("run.dt")),
+        // The engine names its parameter (`dt`); the run layer names the key.
+        Err(e @ BdError::BlowUp { .. }) => assert!(e.to_string().contains("`dt`")),
         other => panic!("expected a blow-up, got {other:?}"),
     }
     // A drying too fast for the step is refused before it starts, naming the key.

@@ -47,8 +47,11 @@ pub const SYSTEM_BOX: Spec = key("system.box", "length",
     .also("at least 2 R0 + 4 cells, a whole number of cells");
 
 /// `drying.final_volume_fraction` (with its conditions here).
-pub const DRYING_FINAL_VOLUME_FRACTION: Spec = shared::DRYING_FINAL_VOLUME_FRACTION
-    .also("> phi0; with colloids only");
+/// Its default applies with colloids only (a pure-solvent droplet has no volume fraction).
+pub const DRYING_FINAL_VOLUME_FRACTION: Spec = Spec {
+    default: Means("0.55 with colloids; without, give drying.duration"),
+    ..shared::DRYING_FINAL_VOLUME_FRACTION.also("> phi0; with colloids only")
+};
 
 /// `drying.duration` (with its conditions here).
 pub const DRYING_DURATION: Spec = shared::DRYING_DURATION

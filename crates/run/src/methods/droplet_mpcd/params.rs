@@ -269,7 +269,8 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
             }
             let phi_f = match phi_f {
                 Some(phi_f) => phi_f,
-                None => r.number(&DRYING_FINAL_VOLUME_FRACTION)?,
+                // The shared declaration's default (this method's says when it applies).
+                None => r.number(&shared::DRYING_FINAL_VOLUME_FRACTION)?,
             };
             if phi_f <= phi0 {
                 return Err(refuse(
