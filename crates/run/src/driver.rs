@@ -723,7 +723,9 @@ fn drive(
                 ctl.interrupt();
             }
             if hooks.pause == Some(pos) {
-                eprintln!("paused at step {pos} (test hook)");
+                // One write, so that the lines of several ranks on one pipe do not interleave.
+                let line = format!("paused at step {pos} (test hook)\n");
+                let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
                 let waited = Instant::now();
                 while !ctl.interrupted()
                     && !timer.must_stop(pos, s.stop_point(), 0)
