@@ -100,20 +100,14 @@ pub const OBSERVE_SOLVENT_WINDOW: Spec = key("observe.solvent.window", "collisio
     Means("collisions / 10"), Integer(1, COUNT),
     "each solvent profile averages this many collisions ending at its time (10 blocks for the errors)");
 
-/// `observe.trajectory`.
-pub const OBSERVE_TRAJECTORY: Spec = key("observe.trajectory", "-", Means("-"), Table,
-    "GSD trajectory");
+/// `observe.trajectory` and its `every`: as in `mpcd`.
+pub use crate::methods::mpcd::keys::{OBSERVE_TRAJECTORY, OBSERVE_TRAJECTORY_EVERY};
 
-/// `observe.trajectory.every`.
-pub const OBSERVE_TRAJECTORY_EVERY: Spec = key("observe.trajectory.every", "collisions",
-    Value("0"), Integer(0, COUNT),
-    "collisions between frames (0: none)");
-
-/// `observe.trajectory.solvent`.
-pub const OBSERVE_TRAJECTORY_SOLVENT: Spec = key("observe.trajectory.solvent", "-",
-    Value("false"), Bool,
-    "frames hold the solvent (type S, with velocities; log/radius)")
-    .also("true when frames are written without colloids");
+/// `observe.trajectory.solvent`: as in `mpcd`, the frames logging the droplet radius.
+pub const OBSERVE_TRAJECTORY_SOLVENT: Spec = Spec {
+    doc: "frames hold the solvent (type S, with velocities; log/radius)",
+    ..crate::methods::mpcd::keys::OBSERVE_TRAJECTORY_SOLVENT
+};
 
 /// Every key of `droplet-mpcd` scenarios, in the order `colloidsim keys` lists them.
 pub static KEYS: &[Spec] = &[
