@@ -905,6 +905,13 @@ fn ensemble_member(plan: impl FnOnce() -> Result<Ensemble>, k: usize, how: &Laun
     let ctl = control(how.quiet, Signals::All, how.walltime.as_ref());
     if let Err(e) = plan.run_member(k, &ctl) {
         if let Some(i) = e.downcast_ref::<colloidsim_run::Interrupted>() {
+            if i.cause == Stop::WallTime && i.checkpoint == i.started {
+                bail!(
+                    "member {k}: the wall-time budget (--walltime {}) ran out before a step could be made; \
+                     continue with a longer one: colloidsim ensemble --restart {out} --member {k} --walltime ...",
+                    how.walltime.as_ref().map_or("?", |w| &w.text),
+                );
+            }
             return Err(Stopped {
                 status: stop_status(i.cause),
                 message: Some(format!(
@@ -953,27 +960,39 @@ fn ensemble(plan: impl FnOnce() -> Result<Ensemble>, how: &Launch) -> Result<()>
     })?;
     let quiet = how.quiet;
     let ctl = control(quiet || rank != 0, Signals::All, how.walltime.as_ref());
-    let mine: serde_json::Map<String, serde_json::Value> = plan
-        .run_share(rank, size, &ctl)
+    let (failed, progressed) = plan.run_share(rank, size, &ctl);
+    let mine: serde_json::Map<String, serde_json::Value> = failed
         .into_iter()
         .map(|(k, e)| (k.to_string(), e.into()))
         .collect();
+    let progressed = ranks
+        .all_gather(&u8::from(progressed).to_string())
+        .iter()
+        .any(|p| p == "1");
     let code = ranks
         .all_gather(&ctl.stop_cause().map_or(0, Stop::code).to_string())
         .iter()
         .filter_map(|c| c.parse::<u8>().ok())
         .max()
         .and_then(Stop::from_code);
+    let out = shell_word(&plan.out().display().to_string());
     agree_stopped(
         &ranks,
         match code {
+            // As for `run`: a budget too short for any step is an error, so that a loop of
+            // restarts does not go on forever.
+            Some(Stop::WallTime) if !progressed => Err(anyhow::anyhow!(
+                "the wall-time budget (--walltime {}) ran out before any member could make a step; \
+                 continue with a longer one: {}colloidsim ensemble --restart {out} --walltime ...",
+                how.walltime.as_ref().map_or("?", |w| &w.text),
+                if size > 1 { "mpirun -n N " } else { "" },
+            )),
             Some(cause) => Err(Stopped {
                 status: stop_status(cause),
                 message: Some(format!(
-                    "{}; continue with: {}colloidsim ensemble --restart {}{}",
+                    "{}; continue with: {}colloidsim ensemble --restart {out}{}",
                     cause.what(),
                     if size > 1 { "mpirun -n N " } else { "" },
-                    shell_word(&plan.out().display().to_string()),
                     walltime_again(how.walltime.as_ref())
                 )),
             }

@@ -235,6 +235,45 @@ fn a_real_budget_stops_a_long_run_and_one_too_short_for_a_step_is_an_error() {
     assert!(c.join("checkpoint.bin").exists());
 }
 
+/// An ensemble (or one member of it) whose budget is spent before any member makes a step
+/// is an error, status 1, as a run's is: a job loop of restarts with that budget would never
+/// end. A longer budget then continues it.
+#[test]
+fn an_ensemble_budget_too_short_for_a_step_is_an_error() {
+    let (tmp, sc, _) = setup();
+    let out = tmp.path().join("e");
+    let o = cli(&sweep(&sc, &out, &["--walltime", "0.000001"]), &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("ran out before any member could make a step"),
+        "{}",
+        text(&o)
+    );
+    let os = out.to_str().unwrap();
+    let o = cli(
+        &[
+            "ensemble",
+            "--restart",
+            os,
+            "--member",
+            "1",
+            "--walltime",
+            "0.000001",
+            "--quiet",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o)
+            .contains("member 1: the wall-time budget (--walltime 0.000001) ran out before a step"),
+        "{}",
+        text(&o)
+    );
+    let o = cli(&["ensemble", "--restart", os, "--quiet"], &[]);
+    assert!(o.status.success(), "{}", text(&o));
+}
+
 #[test]
 fn bad_walltimes_are_refused_naming_the_flag_and_slurm_s_forms_are_accepted() {
     let (tmp, sc, _) = setup();

@@ -322,7 +322,7 @@ fn colloids_beyond_the_memory_are_refused_naming_their_count() {
             "system.colloids",
         ),
         (
-            "method = \"droplet-mpcd\"\n[system]\nradius = 8\nparticles = 1000\ndiameter = 0.1\n[drying]\nduration = 1\n",
+            "method = \"droplet-mpcd\"\n[system]\nradius = 8\nparticles = 1000\ndiameter = 0.6\n[drying]\nduration = 1\n",
             "system.particles",
         ),
     ] {

@@ -79,7 +79,8 @@ pub struct NonFinite {
     pub rows: usize,
     /// The first such data row (0-based).
     pub first_row: usize,
-    /// Why, where the method said ([`OutputDir::explain`]); else `None`.
+    /// Why, where the method said ([`OutputDir::explain`]); else `None` (not written).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
 }
 
@@ -178,6 +179,20 @@ impl OutputDir {
             .1;
         w.retain(|(f, c, _)| !(f == file && c == column));
         w.push((file.into(), column.into(), reason.into()));
+    }
+
+    /// The reason given with [`Self::explain`] for `column` of `file`, if any (for
+    /// `summary.json`, the column is the value's path, as `viscosity` or `momentum[2]`).
+    pub fn reason(&self, file: &str, column: &str) -> Option<String> {
+        let w = &self
+            .non_finite
+            .0
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .1;
+        w.iter()
+            .find(|(f, c, _)| f == file && c == column)
+            .map(|w| w.2.clone())
     }
 
     /// The record the folder's writers add to (for a [`CsvLog`] of this folder).

@@ -137,6 +137,68 @@ impl<'a> Timer<'a> {
     }
 }
 
+/// The reason of a `null` in `summary.json` that its method did not explain.
+pub const UNEXPLAINED_NULL: &str =
+    "no value: not measured or not applicable in this run, or not a finite number";
+
+/// Every `null` among a method's summary values (`parameters`, the resolved input where `null`
+/// means "not set", and the texts `why_null`, `note` and `*_note` aside), by path (`viscosity`, `momentum[2]`, `temperature.value`), with its
+/// reason: the method's ([`OutputDir::explain`] with file `summary.json`), a pointer to the
+/// `why_null` beside it, or [`UNEXPLAINED_NULL`]. JSON has no NaN or infinity: serde writes them as `null`, and
+/// this says so wherever one is.
+pub(crate) fn null_reasons(
+    summary: &serde_json::Value,
+    out: &OutputDir,
+) -> std::collections::BTreeMap<String, String> {
+    use serde_json::Value;
+    fn walk(
+        v: &Value,
+        path: String,
+        why: Option<&str>,
+        out: &OutputDir,
+        found: &mut std::collections::BTreeMap<String, String>,
+    ) {
+        match v {
+            Value::Null => {
+                let reason = out
+                    .reason("summary.json", &path)
+                    .or(why.map(String::from))
+                    .unwrap_or_else(|| UNEXPLAINED_NULL.into());
+                found.insert(path, reason);
+            }
+            Value::Object(m) => {
+                let why = m
+                    .get("why_null")
+                    .filter(|w| w.is_string())
+                    .map(|_| format!("see {path}.why_null"));
+                // The texts that say why (null: nothing to say) are not values.
+                let says_why = |k: &str| k == "why_null" || k == "note" || k.ends_with("_note");
+                for (k, x) in m.iter().filter(|(k, x)| !(x.is_null() && says_why(k))) {
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(x, p, why.as_deref(), out, found);
+                }
+            }
+            Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(x, format!("{path}[{i}]"), why, out, found);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut found = std::collections::BTreeMap::new();
+    if let Some(m) = summary.as_object() {
+        for (k, v) in m.iter().filter(|(k, _)| k.as_str() != "parameters") {
+            walk(v, k.clone(), None, out, &mut found);
+        }
+    }
+    found
+}
+
 /// The resolved parameters and seed as a restart compares them.
 fn resolved(s: &dyn Session) -> Result<String> {
     Ok(serde_json::to_string(
@@ -843,9 +905,13 @@ fn drive(
         ctl.progress().warning(&w);
         warnings.push(w);
     }
+    let nulls = null_reasons(&summary, &out);
     if let Some(m) = summary.as_object_mut() {
         if !non_finite.is_empty() {
             m.insert("non_finite".into(), json!(non_finite));
+        }
+        if !nulls.is_empty() {
+            m.insert("nulls".into(), json!(nulls));
         }
         m.insert("completed".into(), json!(failure.is_none()));
         m.insert("error".into(), json!(failure));
@@ -874,4 +940,37 @@ fn drive(
         warnings,
         message: fin.message,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A NaN or infinity becomes `null` in JSON: every such value of a summary is listed with
+    /// the method's reason, the `why_null` beside it, or the generic one; the resolved
+    /// parameters and the texts that say why are not values.
+    #[test]
+    fn every_null_of_a_summary_has_its_reason() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = OutputDir::create(dir.path().join("o"), false).unwrap();
+        out.explain("summary.json", "viscosity", "not observed");
+        let summary = json!({
+            "parameters": { "drive": null },
+            "viscosity": f64::NAN,
+            "temperature": [1.0, f64::INFINITY],
+            "k": { "value": null, "why_null": "no force", "note": null },
+            "d": { "value": 2.0, "why_null": null, "velocity_note": null },
+            "steps": 10,
+        });
+        let nulls = null_reasons(&summary, &out);
+        let want: std::collections::BTreeMap<String, String> = [
+            ("k.value", "see k.why_null"),
+            ("temperature[1]", UNEXPLAINED_NULL),
+            ("viscosity", "not observed"),
+        ]
+        .into_iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+        assert_eq!(nulls, want);
+    }
 }

@@ -598,6 +598,20 @@ impl Ensemble {
             } else {
                 pool_summaries(&folders)?
             };
+            for (k, (m, e, _)) in &obs {
+                let at = format!("points[{}].observables.{k}", observables.len());
+                if !m.is_finite() {
+                    out.explain(
+                        "summary.json",
+                        &format!("{at}.mean"),
+                        "no member gave a finite value",
+                    );
+                }
+                if !e.is_finite() {
+                    let why = "fewer than 2 replicas gave a finite value: no standard error";
+                    out.explain("summary.json", &format!("{at}.err"), why);
+                }
+            }
             observables.push(json!({
                 "point": p,
                 "set": values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
@@ -637,6 +651,10 @@ impl Ensemble {
         summary["points"] = Value::Array(observables);
         summary["files"] = json!(files);
         summary["warnings"] = json!(warnings);
+        let nulls = crate::driver::null_reasons(&summary, &out);
+        if !nulls.is_empty() {
+            summary["nulls"] = json!(nulls);
+        }
         out.write_json("summary.json", &summary)?;
         let message = format!(
             "ran {} member(s) ({} point(s) x {} replica(s)) and wrote their averages into {}",
@@ -719,22 +737,39 @@ impl Ensemble {
     /// Run the members `k` with `k mod size == rank` in turn (an MPI rank's share; all of them
     /// for `rank = 0, size = 1`), stopping before the next member once interrupted; returns
     /// the errors of the members that failed, by index.
-    pub fn run_share(&self, rank: usize, size: usize, ctl: &Control) -> BTreeMap<usize, String> {
+    ///
+    /// Also says whether any member went forward (completed here, or stopped at a checkpoint
+    /// beyond where it began): a wall-time budget spent before that is an error, not a stop
+    /// to continue from.
+    pub fn run_share(
+        &self,
+        rank: usize,
+        size: usize,
+        ctl: &Control,
+    ) -> (BTreeMap<usize, String>, bool) {
         let mut failed = BTreeMap::new();
+        let mut progressed = false;
         for k in (rank..self.members.len()).step_by(size.max(1)) {
             if ctl.interrupted() {
                 break;
             }
-            if let Err(e) = self.run_member(k, ctl) {
-                failed.insert(k, format!("{e:#}"));
+            let done_before = self.member_state(k) == MemberState::Complete;
+            match self.run_member(k, ctl) {
+                Ok(()) => progressed |= !done_before,
+                Err(e) => {
+                    if let Some(i) = e.downcast_ref::<crate::Interrupted>() {
+                        progressed |= i.checkpoint > i.started;
+                    }
+                    failed.insert(k, format!("{e:#}"));
+                }
             }
         }
-        failed
+        (failed, progressed)
     }
 
     /// Run every member in turn and combine them; an interrupt stops after the member running.
     fn run_all(&self, start: std::time::Instant, ctl: &Control) -> Result<Report> {
-        let failed = self.run_share(0, 1, ctl);
+        let (failed, _) = self.run_share(0, 1, ctl);
         if ctl.interrupted() {
             bail!(
                 "interrupted; continue with: colloidsim ensemble --restart {}",

@@ -577,14 +577,69 @@ fn non_finite_outputs(dir: &Path) -> Vec<String> {
         } else if name.ends_with(".json") {
             // serde_json writes a non-finite number as null; a bare NaN or Infinity (a writer
             // formatting its own JSON) makes the file unreadable to every JSON reader.
-            if serde_json::from_slice::<serde_json::Value>(&bytes).is_err() {
-                bad.push(format!("{name}: not valid JSON"));
+            match serde_json::from_slice::<serde_json::Value>(&bytes) {
+                Err(_) => bad.push(format!("{name}: not valid JSON")),
+                // Every null of a summary (a number that was not finite, or a value not
+                // measured) has its reason in `nulls`.
+                Ok(v) if name == "summary.json" => {
+                    for path in unexplained_nulls(&v) {
+                        bad.push(format!("{name}: {path} is null without a reason in nulls"));
+                    }
+                    // Every table column with empty fields (numbers that were not finite) has
+                    // its reason.
+                    for n in v["non_finite"].as_array().into_iter().flatten() {
+                        if !n["reason"].is_string() {
+                            bad.push(format!("{name}: non_finite without a reason: {n}"));
+                        }
+                    }
+                }
+                Ok(_) => {}
             }
         } else if name.ends_with(".gsd") {
             bad.extend(non_finite_gsd(&path, &name));
         }
     }
     bad
+}
+
+/// The paths of the nulls of `summary` that its `nulls` does not list (the resolved
+/// `parameters`, `error` and the texts `why_null`, `note`, `*_note` aside).
+fn unexplained_nulls(summary: &serde_json::Value) -> Vec<String> {
+    use serde_json::Value;
+    fn walk(v: &Value, path: String, found: &mut Vec<String>) {
+        match v {
+            Value::Null => found.push(path),
+            Value::Object(m) => {
+                for (k, x) in m {
+                    let text = k == "why_null" || k == "note" || k.ends_with("_note");
+                    if !(x.is_null() && text) {
+                        let p = if path.is_empty() {
+                            k.clone()
+                        } else {
+                            format!("{path}.{k}")
+                        };
+                        walk(x, p, found);
+                    }
+                }
+            }
+            Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(x, format!("{path}[{i}]"), found);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut found = Vec::new();
+    if let Some(m) = summary.as_object() {
+        for (k, v) in m {
+            if !["parameters", "error", "nulls", "non_finite"].contains(&k.as_str()) {
+                walk(v, k.clone(), &mut found);
+            }
+        }
+    }
+    found.retain(|p| summary["nulls"].get(p).is_none());
+    found
 }
 
 /// The floating-point chunks of a GSD file with a non-finite value, as `file frame k: chunk`.

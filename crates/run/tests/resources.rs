@@ -63,13 +63,17 @@ equilibrate = 0
 "#;
 
 /// One MPCD colloid of diameter 1e-300 in a box of 10: its placement grid had 1024^3 cells
-/// (24 GiB, an abort); the grid now holds no more cells than the colloids need.
+/// (24 GiB, an abort); the grid now holds no more cells than the colloids need (the engine's
+/// `grids_over_the_colloids_stay_small_for_any_diameter`), and `check` refuses such a colloid,
+/// whose bonds cannot hold its shape (it went non-finite at its first step).
 #[test]
-fn a_tiny_mpcd_colloid_is_placed_without_a_huge_grid() {
-    let dir = tempfile::tempdir().unwrap();
-    let text = MPCD.replace("diameter = 4", "diameter = 1e-300");
-    let sc = Scenario::from_toml(&text, dir.path()).unwrap();
-    colloidsim_run::check(&sc).unwrap();
+fn a_tiny_mpcd_colloid_is_refused_by_check() {
+    let e = refusal(&MPCD.replace("diameter = 4", "diameter = 1e-300"));
+    assert!(
+        e.contains("system.diameter: a colloid of diameter 1e-300")
+            && e.contains("not held in shape"),
+        "{e}"
+    );
 }
 
 /// The colloids' velocity autocorrelation holds `lags + 1` velocity sets: 1e15 lags are

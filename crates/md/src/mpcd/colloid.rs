@@ -119,6 +119,10 @@ impl Geometry {
     }
 }
 
+/// Largest thermal bond strain [`ColloidParams::thermal_bond_strain`] accepted: 10 % of the
+/// shortest bond (the default `k = 5000 kT / a^2` keeps it at 10 % down to `d = 0.52 a`).
+pub const MAX_BOND_STRAIN: f64 = 0.1;
+
 /// Parameters of the discrete-particle colloids (MPCD units: lengths in the cell edge `a`,
 /// masses in the solvent mass `m`, energies in `kT`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -180,6 +184,25 @@ impl ColloidParams {
             )));
         }
         Ok(())
+    }
+
+    /// Root-mean-square thermal stretch `sqrt(kT / k)` of one bond at temperature `kt`
+    /// (equipartition), divided by the shortest rest length of the mesh: the fraction by which
+    /// the colloid's shape fluctuates. Above [`MAX_BOND_STRAIN`] the bonds no longer hold a sphere
+    /// of diameter `d` (a tiny `d` or a soft `k`).
+    pub fn thermal_bond_strain(&self, kt: f64) -> f64 {
+        let geo = Geometry::subdivided_icosahedron();
+        let shortest = geo
+            .edges
+            .iter()
+            .map(|&[i, j]| {
+                let (a, b) = (geo.vertices[i], geo.vertices[j]);
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
+            * 0.5
+            * self.diameter;
+        (kt / self.bond_k).sqrt() / shortest
     }
 
     /// WCA cut-off `2^(1/6) d`.

@@ -19,7 +19,9 @@ pub mod theory;
 use colloidsim_core::rng::{Purpose, stream};
 
 pub use boundary::{Confinement, WallKind};
-pub use colloid::{ColloidParams, ColloidState, DiscreteColloids, MpcdSystem, Region};
+pub use colloid::{
+    ColloidParams, ColloidState, DiscreteColloids, MAX_BOND_STRAIN, MpcdSystem, Region,
+};
 pub use srd::{Acceleration, Embedded, Srd, SrdParams};
 
 /// What a random stream of the MPCD engine is drawn for (the top byte of its index).

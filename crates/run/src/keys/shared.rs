@@ -11,7 +11,7 @@ use colloidsim_core::param::show;
 use colloidsim_md::brownian::Integrator;
 use colloidsim_md::hydro::params::{DEFAULT_BOX_FACTOR, DEFAULT_DIRECT_MAX};
 use colloidsim_md::hydro::{HydroMethod, HydroModel, HydroParams};
-use colloidsim_md::mpcd::{ColloidParams, SrdParams};
+use colloidsim_md::mpcd::{ColloidParams, MAX_BOND_STRAIN, SrdParams};
 
 /// `[interface]`: the harmonic interface of a droplet (docs/droplet.md).
 pub const INTERFACE: Spec = key(
@@ -310,15 +310,46 @@ pub fn solvent(r: &Reader, seed: u32) -> Result<SrdParams> {
 }
 
 /// Read `[colloid]` into the model of colloids of diameter `d` (WCA energy kT).
-pub fn colloid(r: &Reader, d: f64) -> Result<ColloidParams> {
-    Ok(ColloidParams {
+/// With `colloids` (any to simulate), the bonds must hold the sphere: a thermal bond strain
+/// above [`MAX_BOND_STRAIN`] (a `d` far below the cell or a soft `colloid.bond_k`) is refused,
+/// naming `diameter` (the key the caller read `d` from) unless only `colloid.bond_k` was given.
+pub fn colloid(r: &Reader, diameter: &Spec, d: f64, colloids: bool) -> Result<ColloidParams> {
+    let p = ColloidParams {
         diameter: d,
         vertex_mass: r.number(&COLLOID_VERTEX_MASS)?,
         centre_mass: r.number(&COLLOID_CENTRE_MASS)?,
         bond_k: r.number(&COLLOID_BOND_K)?,
         md_steps: r.integer(&COLLOID_MD_STEPS)? as u32,
         wca_epsilon: r.number(&SOLVENT_KT)?,
-    })
+    };
+    let kt = r.number(&SOLVENT_KT)?;
+    let strain = p.thermal_bond_strain(kt);
+    if colloids && (strain > MAX_BOND_STRAIN || strain.is_nan()) {
+        let key = if r.has(&COLLOID_BOND_K) && !r.has(diameter) {
+            &COLLOID_BOND_K
+        } else {
+            diameter
+        };
+        let stretch = (kt / p.bond_k).sqrt();
+        let k_min = kt / (MAX_BOND_STRAIN * stretch / strain).powi(2);
+        let stiffer = match k_min.is_finite() {
+            true => format!(", or k at least {:.4e} at this diameter", k_min),
+            false => String::new(),
+        };
+        return Err(ParamError::new(
+            key.path,
+            format!(
+                "a colloid of diameter {} with {} = {} is not held in shape: its bonds stretch by sqrt(kT/k) = {stretch:.3e}, \
+                 {strain:.3e} of the shortest bond (at most {MAX_BOND_STRAIN}); the diameter must be at least {:.4} at this k{stiffer}",
+                show(d),
+                COLLOID_BOND_K.path,
+                show(p.bond_k),
+                d * strain / MAX_BOND_STRAIN,
+            ),
+        )
+        .into());
+    }
+    Ok(p)
 }
 
 // The spheres, the solvent, the time stepping and the hydrodynamics of the Brownian-dynamics

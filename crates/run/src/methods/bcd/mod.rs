@@ -978,6 +978,27 @@ where
         files.push("trajectory.gsd".into());
     }
     let steps = bcd.steps();
+    for (key, why) in [
+        (
+            "mean_velocity",
+            "no current observed (observe.current off, or no sample yet)",
+        ),
+        (
+            "particle_current",
+            "no current observed (observe.current off, or no sample yet)",
+        ),
+        (
+            "theory",
+            "no exact equilibrium beside this run (see theory_error and warnings)",
+        ),
+        (
+            "ddft",
+            "no DDFT steady state: the ring is not driven, or the density is not observed",
+        ),
+        ("theory_error", "no error"),
+    ] {
+        out.explain("summary.json", key, why);
+    }
     let summary = json!({
         "software": crate::software(),
         "method": sc.method,

@@ -538,6 +538,15 @@ impl BdMethod<ConstantForce> for BulkObs {
             files.push("trajectory.gsd".into());
         }
         let particle_steps = (p.steps * p.replicas as u64) as f64 * p.particles as f64;
+        if p.force == 0.0 {
+            for k in ["along_force", "along_force_error"] {
+                out.explain(
+                    "summary.json",
+                    &format!("mean_velocity.{k}"),
+                    "no body force (system.body_force)",
+                );
+            }
+        }
         let summary = json!({
             "software": crate::software(),
             "method": "bd",

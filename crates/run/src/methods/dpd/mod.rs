@@ -513,6 +513,9 @@ impl Session for DpdSession {
         if self.s.setup.colloids == 0 {
             out.explain("thermo.csv", "T_colloid", "no colloids");
         }
+        if self.s.setup.solvent == 0 {
+            out.explain("thermo.csv", "T_solvent", "no solvent beads");
+        }
         if self.s.observe.thermo_every > 0 {
             let (vol, tau) = (self.sim.sbox.volume(), self.s.setup.tau);
             self.thermo_log = Some(CsvLog::start_in(
@@ -612,6 +615,26 @@ impl Session for DpdSession {
         let summary = summary(
             &self.s, &self.sim, &self.obs, diffusion, builds, wall, &warnings,
         );
+        // A value left null has its reason in the note beside it (summary.json's nulls).
+        for (note, keys) in [
+            ("viscosity_note", &NOTED_VISCOSITY[..]),
+            ("shear_viscosity_note", &NOTED_SHEAR[..]),
+            ("colloid_diffusion_note", &NOTED_DIFFUSION[..]),
+        ] {
+            if summary[note].is_string() {
+                for k in keys {
+                    out.explain("summary.json", k, &format!("see {note}"));
+                }
+            }
+        }
+        if self.s.setup.colloids == 0 {
+            for k in [
+                "final_temperature_by_type[1]",
+                "mean_colloid_temperature_second_half",
+            ] {
+                out.explain("summary.json", k, "no colloids");
+            }
+        }
         let (s, dt, tau) = (&self.s, self.s.setup.params.dt, self.s.setup.tau);
         let message = format!(
             "dpd: {} colloids + {} solvent beads, {} steps ({:.3} tau_D) in {:.1} s -> {}\nwrote {}",
@@ -1209,6 +1232,9 @@ fn write_outputs(
                 }
             })
             .collect();
+        if obs.gr_samples < 2 {
+            out.explain("gr.csv", "err", "one sample: no standard error");
+        }
         out.write_table(
             "gr.csv",
             &[
@@ -1347,6 +1373,13 @@ fn write_outputs(
         let (y, v, _) = sh.profile(sim.sbox.l[1]);
         let imposed: Vec<f64> = y.iter().map(|y| s.setup.params.shear_rate * y).collect();
         let samples = vec![sh.profile_samples as f64; y.len()];
+        if v.iter().any(|x| !x.is_finite()) {
+            out.explain(
+                "velocity_profile.csv",
+                "v_x",
+                "no particle sampled in the bin (particle_samples = 0)",
+            );
+        }
         out.write_table(
             "velocity_profile.csv",
             &[
@@ -1364,6 +1397,27 @@ fn write_outputs(
     }
     Ok((files, diffusion))
 }
+
+/// The summary values that `viscosity_note`, `shear_viscosity_note` and
+/// `colloid_diffusion_note` explain when they are null.
+const NOTED_VISCOSITY: [&str; 4] = [
+    "viscosity",
+    "viscosity_error",
+    "viscosity_off_diagonal",
+    "viscosity_off_diagonal_error",
+];
+const NOTED_SHEAR: [&str; 6] = [
+    "shear_stress",
+    "shear_stress_error",
+    "shear_viscosity",
+    "shear_viscosity_error",
+    "shear_stress_parts",
+    "velocity_profile_slope",
+];
+const NOTED_DIFFUSION: [&str; 2] = [
+    "colloid_diffusion_long_time",
+    "colloid_diffusion_over_stokes_einstein",
+];
 
 /// The method's summary fields.
 fn summary(

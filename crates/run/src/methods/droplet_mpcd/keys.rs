@@ -28,7 +28,8 @@ pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-", Value("0"), Inte
 /// `system.diameter`.
 pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length",
     Derived("4 solvent.cell", |r| Ok(4.0 * r.number(&SOLVENT_CELL)?)), Positive,
-    "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe");
+    "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe")
+    .also("held in shape: sqrt(kT / colloid.bond_k) at most 0.1 of the shortest bond 0.273 d");
 
 /// `system.radius`.
 pub const SYSTEM_RADIUS: Spec = key("system.radius", "length", Required, Positive,

@@ -655,6 +655,16 @@ impl Session for DropletSession {
                     dof += 1;
                 }
             }
+            if worst.is_nan() {
+                out.explain(
+                    "summary.json",
+                    &format!(
+                        "solvent_uniformity[{}].max_relative_density_deviation",
+                        uniformity.len()
+                    ),
+                    "no bin with a standard error yet (too few samples for blocks)",
+                );
+            }
             uniformity.push(json!({
                 "fraction": f,
                 "collision": cf,

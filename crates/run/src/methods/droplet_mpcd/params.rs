@@ -140,7 +140,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
     let particles = r.count(&SYSTEM_PARTICLES)? as usize;
     let d = r.number(&SYSTEM_DIAMETER)?;
     let kt = srd.kt;
-    let colloid = shared::colloid(r, d)?;
+    let colloid = shared::colloid(r, &SYSTEM_DIAMETER, d, particles > 0)?;
     let n = particles as f64;
     // system.radius is required unless system.phi0 gives it.
     let radius = match r.has(&SYSTEM_RADIUS) {

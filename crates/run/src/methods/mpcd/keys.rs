@@ -29,7 +29,7 @@ pub const SYSTEM_COLLOIDS: Spec = key("system.colloids", "-", Value("0"), Intege
 pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length",
     Derived("4 solvent.cell", |r| Ok(4.0 * r.number(&SOLVENT_CELL)?)), Positive,
     "colloid diameter d")
-    .also("the box above twice the WCA cut-off 2^(1/6) d");
+    .also("the box above twice the WCA cut-off 2^(1/6) d; held in shape: sqrt(kT / colloid.bond_k) at most 0.1 of the shortest bond 0.273 d");
 
 /// `run`.
 pub const RUN: Spec = key("run", "-", Required, Table, "collisions");

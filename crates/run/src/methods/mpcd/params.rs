@@ -173,7 +173,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<BulkRun> {
             ),
         ));
     }
-    let colloid = shared::colloid(r, d)?;
+    let colloid = shared::colloid(r, &SYSTEM_DIAMETER, d, nc > 0)?;
     let nu = eta / rho;
     let slowest = l * l / (4.0 * PI * PI * nu);
     let vacf_lags = r
@@ -310,5 +310,37 @@ mod tests {
             let e = bulk(&format!("method = \"mpcd\"\n{text}")).unwrap_err();
             assert!(format!("{e:#}").starts_with(key), "{text}: {e:#}");
         }
+    }
+
+    /// A colloid far below the cell (here 1e-300, which went non-finite at its first step) is
+    /// not held in shape by its bonds: refused before the run, naming the key that was given;
+    /// the limit at the default `k = 5000 kT` is d = 0.5175 cells.
+    #[test]
+    fn colloids_must_keep_their_shape() {
+        let run = |system: &str, colloid: &str| {
+            bulk(&format!(
+                "method = \"mpcd\"\n[system]\nbox = 10\ncolloids = 1\n{system}\n[colloid]\n{colloid}\n\
+                 [run]\ncollisions = 100\n[observe]\nvacf_lags = 10"
+            ))
+        };
+        for d in ["1e-300", "0.5"] {
+            let e = run(&format!("diameter = {d}"), "").unwrap_err();
+            let e = format!("{e:#}");
+            assert!(
+                e.starts_with("system.diameter: a colloid of diameter"),
+                "{e}"
+            );
+            assert!(e.contains("at least 0.5175"), "{e}");
+        }
+        assert!(run("diameter = 0.52", "").is_ok());
+        let e = run("", "bond_k = 1").unwrap_err();
+        assert!(format!("{e:#}").starts_with("colloid.bond_k:"), "{e:#}");
+        // Without colloids the model is not used, and not checked.
+        assert!(
+            bulk(
+                "method = \"mpcd\"\n[system]\nbox = 10\ndiameter = 1e-300\n[run]\ncollisions = 100"
+            )
+            .is_ok()
+        );
     }
 }
