@@ -38,6 +38,7 @@ mod ranks;
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::domain::Domain;
 use crate::neighbor::BoxTooSmall;
+pub use crate::gsd::ListState;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
@@ -157,21 +158,6 @@ pub enum BdError {
     /// Inconsistent particle data.
     #[error("invalid particle data: {0}")]
     Invalid(String),
-}
-
-/// What a checkpoint needs besides the particles to continue bitwise: the engine's storage
-/// order, its positions and image counts exactly as stored (not wrapped since the last list
-/// build), and the positions at that build, all in storage order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ListState {
-    /// Input index of each stored particle ([`Brownian::order`]).
-    pub order: Vec<u32>,
-    /// Positions of the stored particles when the lists were last built (wrapped then).
-    pub reference: Vec<[f64; 3]>,
-    /// Current positions as stored.
-    pub positions: Vec<[f64; 3]>,
-    /// Current image counts as stored.
-    pub images: Vec<[i32; 3]>,
 }
 
 /// One z-layer of cells: its particles, their half neighbour lists and force buffer.

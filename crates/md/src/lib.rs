@@ -10,13 +10,9 @@ mod cells;
 mod domain;
 pub mod dpd;
 pub mod droplet;
-pub mod gsd;
 pub mod hydro_bd;
-pub mod init;
 pub mod mpcd;
 pub mod neighbor;
-pub mod potential;
-pub mod state;
 
 pub use brownian::{BdError, BdParams, Brownian, Integrator};
 pub use colloidsim_hydro as hydro;
@@ -24,8 +20,9 @@ pub use dpd::{Dpd, DpdError, DpdParams};
 pub use droplet::DropletParams;
 pub use hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 pub use neighbor::NeighborList;
-pub use potential::{
+pub use colloidsim_particles::potential::{
     ConstantForce, External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair,
     Pair, PairSum, SphereAreaLaw,
 };
-pub use state::{Particles, SimBox};
+pub use colloidsim_particles::state::{Particles, SimBox};
+pub use colloidsim_particles::{gsd, init, potential, state};
