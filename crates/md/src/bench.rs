@@ -3,7 +3,7 @@
 
 use crate::brownian::{BdError, BdParams, Brownian};
 use crate::dpd::{Dpd, DpdError, DpdParams};
-use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
+use crate::brownian::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::init::random_in_box;
 use crate::potential::{LennardJones, NoExternal};
 use crate::state::{Particles, SimBox};

@@ -37,7 +37,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::mean_and_error;
-use colloidsim_md::bulk::{BulkError, BulkParams};
+use colloidsim_md::brownian::bulk::{BulkError, BulkParams};
 use colloidsim_md::{Brownian, ConstantForce};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};

@@ -22,7 +22,7 @@ use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::droplet::{DropletError, DropletSim};
+use colloidsim_md::brownian::droplet::{DropletError, DropletSim};
 use colloidsim_md::{DropletParams, HarmonicInterface, LennardJones, Particles};
 use serde::{Deserialize, Serialize};
 use serde_json::json;

@@ -32,8 +32,16 @@
 //! chunk by chunk the external force, the noise and the new positions (into a second buffer;
 //! the buffers are then swapped). Leimkuhler–Matthews draws its deviates `xi_{n+1}` in a third
 //! pass, by input index, before the positions.
+//!
+//! Beside the engine, this folder holds Brownian dynamics with hydrodynamic interactions
+//! ([`hydrodynamic`]) and the two BD scenarios: the drying droplet ([`droplet`]) and the bulk
+//! periodic box ([`bulk`]).
 
+pub mod bulk;
+pub mod droplet;
+pub mod hydrodynamic;
 mod ranks;
+mod scenario;
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::domain::Domain;
