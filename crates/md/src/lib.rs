@@ -23,11 +23,11 @@ pub use brownian::droplet::DropletParams;
 pub use brownian::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
 pub use brownian::{BdError, BdParams, Brownian, Integrator};
 pub use colloidsim_hydro as hydro;
-pub use dpd::{Dpd, DpdError, DpdParams};
-pub use neighbor::NeighborList;
 pub use colloidsim_particles::potential::{
     ConstantForce, External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair,
     Pair, PairSum, SphereAreaLaw,
 };
 pub use colloidsim_particles::state::{Particles, SimBox};
 pub use colloidsim_particles::{gsd, init, potential, state};
+pub use dpd::{Dpd, DpdError, DpdParams};
+pub use neighbor::NeighborList;

@@ -45,8 +45,8 @@ mod scenario;
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::domain::Domain;
-use crate::neighbor::BoxTooSmall;
 pub use crate::gsd::ListState;
+use crate::neighbor::BoxTooSmall;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
