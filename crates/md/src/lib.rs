@@ -7,7 +7,7 @@
 //! - [`mpcd`]: multiparticle collision dynamics (SRD solvent, discrete colloids, droplet walls);
 //!
 //! and what the engines share: the cell sort and half stencil (`cells`), the Verlet list
-//! ([`neighbor`]), the slab decomposition over ranks (`domain`), benchmark setups ([`bench`]).
+//! ([`neighbor`]), the slab decomposition over ranks (`domain`), benchmark setups ([`mod@bench`]).
 //! The state they move (particles and box, potentials, initial configurations, GSD frames) is
 //! `colloidsim-particles`, re-exported here as [`state`], [`potential`], [`init`] and [`gsd`].
 
