@@ -17,7 +17,7 @@ pub use structure::{
     Window, default_q_grid, percus_yevick_g, structure_factor, structure_factor_windowed,
 };
 
-use colloidsim_md::gsd::{GsdError, frame_count, read_frame};
+use colloidsim_particles::gsd::{GsdError, frame_count, read_frame};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::path::Path;

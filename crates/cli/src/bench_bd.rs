@@ -61,7 +61,7 @@ const DT: f64 = 1e-4;
 fn worker(a: &BenchArgs, k: usize) -> Result<()> {
     let ranks = crate::bench_dpd_ranks::worker_ranks(&a.threads)?;
     let l = (a.n as f64 * std::f64::consts::PI / 6.0 / a.phi).cbrt();
-    let sbox = colloidsim_md::SimBox::new([l, l, k as f64 * l]);
+    let sbox = colloidsim_particles::SimBox::new([l, l, k as f64 * l]);
     let n = k * a.n;
     let sim = colloidsim_md::bench::wca_periodic_box(n, sbox, DT, 1, a.skin)?;
     let mut sim = sim.decomposed(ranks.exchange()?)?;

@@ -13,7 +13,7 @@ use crate::dpd_bench::BenchArgs;
 use anyhow::{Context, Result, bail};
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdParams};
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::{Particles, SimBox};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;

@@ -5,8 +5,8 @@
 
 use crate::common::{cpu_seconds, lammps_loop_time, load_average, median};
 use anyhow::{Context, Result};
-use colloidsim_md::SimBox;
 use colloidsim_md::mpcd::{Acceleration, Confinement, Srd, SrdParams};
+use colloidsim_particles::SimBox;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

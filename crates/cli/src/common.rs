@@ -78,8 +78,8 @@ pub fn lammps_loop_time(text: &str) -> anyhow::Result<LammpsLoop> {
 pub fn write_lammps_data(
     path: &Path,
     title: &str,
-    p: &colloidsim_md::Particles,
-    sbox: &colloidsim_md::SimBox,
+    p: &colloidsim_particles::Particles,
+    sbox: &colloidsim_particles::SimBox,
     velocities: bool,
 ) -> anyhow::Result<()> {
     use anyhow::Context;

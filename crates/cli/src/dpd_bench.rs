@@ -4,7 +4,7 @@
 use crate::common::{cpu_seconds, lammps_loop_time, load_average, median, write_lammps_data};
 use anyhow::{Context, Result, bail};
 use colloidsim_md::dpd::{Dpd, DpdParams, NeighborMode};
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::{Particles, SimBox};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

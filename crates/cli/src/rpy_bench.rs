@@ -219,8 +219,8 @@ fn hard_systems(sizes: &[usize], phi: f64) -> Result<(Vec<System>, Vec<f64>)> {
     let mut edges = Vec::new();
     for &n in sizes {
         let l = box_edge(n, phi);
-        let sbox = colloidsim_md::SimBox::cube(l);
-        let pos = colloidsim_md::init::random_in_box(n, 2.0 * RADIUS, &sbox, 1, 0)?;
+        let sbox = colloidsim_particles::SimBox::cube(l);
+        let pos = colloidsim_particles::init::random_in_box(n, 2.0 * RADIUS, &sbox, 1, 0)?;
         systems.push((pos, random_system(n, l, 1).1));
         edges.push(l);
     }

@@ -113,8 +113,8 @@ fn the_examples_are_valid() {
 
 /// Write a GSD frame with these positions (a starting configuration).
 fn gsd_with(path: &Path, pos: Vec<[f64; 3]>) {
-    use colloidsim_md::gsd::GsdWriter;
-    use colloidsim_md::{Particles, SimBox};
+    use colloidsim_particles::gsd::GsdWriter;
+    use colloidsim_particles::{Particles, SimBox};
     let mut w = GsdWriter::create_new(path).unwrap();
     w.write_frame(
         0,

@@ -330,7 +330,7 @@ fn restarted_trajectories_are_byte_identical_for_every_method() {
 /// at --restart, for a method of each family.
 #[test]
 fn a_flipped_bit_in_any_chunk_of_a_frame_is_refused() {
-    use colloidsim_md::gsd::GsdIndex;
+    use colloidsim_particles::gsd::GsdIndex;
     for method in ["dpd", "droplet-bd", "mpcd"] {
         let (_, scenario, _, kill) = MANY_FRAMES.iter().find(|c| c.0 == method).unwrap();
         let tmp = tempfile::tempdir().unwrap();

@@ -10,7 +10,7 @@
 
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{finite, positive, show};
-use colloidsim_md::potential::{External, HarmonicInterface, SphereAreaLaw};
+use colloidsim_particles::potential::{External, HarmonicInterface, SphereAreaLaw};
 
 /// Interface energy (in kT) beyond which the interface geometry places a hard outer wall: a
 /// Boltzmann factor of 4e-18, so no sampled configuration can tell.
@@ -80,7 +80,7 @@ pub enum Geometry {
         /// Droplet radius R (surface of the colloids at contact).
         radius: f64,
     },
-    /// The harmonic droplet interface of `colloidsim_md::potential::HarmonicInterface`
+    /// The harmonic droplet interface of `colloidsim_particles::potential::HarmonicInterface`
     /// (static), sampled by Metropolis on its energy; centres with more than
     /// [`INTERFACE_CUT_KT`] of interface energy are refused outright (`cutoff`).
     Interface {
@@ -135,7 +135,7 @@ impl Geometry {
             range,
             offset,
         };
-        // Bisect the md crate's own energy for the distance where it reaches the cut (the
+        // Bisect the interface's own energy for the distance where it reaches the cut (the
         // energy grows monotonically beyond the wall).
         let wall = radius + offset;
         // Positions near the wall are numbers of about `wall`, spaced `wall * 2^-52` apart: the

@@ -1,8 +1,8 @@
 //! colloidsim-mc: hard-sphere Monte Carlo (NVT, single-particle displacement moves).
 //!
 //! - [`geometry`]: the periodic cube (bulk), the hard spherical wall of radius R (the droplet;
-//!   centres within `R - d/2`) and the BD droplet's harmonic interface (Metropolis on the md
-//!   crate's own `HarmonicInterface` energy).
+//!   centres within `R - d/2`) and the BD droplet's harmonic interface (Metropolis on the
+//!   `HarmonicInterface` energy of `colloidsim-particles`, the one BD uses).
 //! - [`engine`]: [`HardSphereMc`], checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
 //!   254, 27 (2013)) with counter-based random streams keyed by (seed, sweep, cell), so that a
 //!   run is fixed by its seed whatever the number of threads; move-size tuning in the warm-up.

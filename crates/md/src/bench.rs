@@ -1,9 +1,9 @@
 //! Benchmark systems: WCA Brownian dynamics of hard-sphere-like colloids in a periodic cube
 //! (`colloidsim bench bd`) and pure DPD water (`colloidsim bench dpd`).
 
+use crate::brownian::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::brownian::{BdError, BdParams, Brownian};
 use crate::dpd::{Dpd, DpdError, DpdParams};
-use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
 use crate::init::random_in_box;
 use crate::potential::{LennardJones, NoExternal};
 use crate::state::{Particles, SimBox};

@@ -1,31 +1,33 @@
-//! colloidsim-md: 3D particles (state and box, neighbour search, pair and external forces,
-//! Brownian dynamics, initial configurations, GSD input/output), the drying-droplet scenario
-//! and the bulk periodic Brownian-dynamics scenario.
+//! colloidsim-md: the particle dynamics engines, each in its folder —
+//!
+//! - [`brownian`]: Brownian dynamics, free draining ([`Brownian`]) or with hydrodynamic
+//!   interactions ([`HydroBrownian`]), and its two scenarios: the drying droplet
+//!   ([`brownian::droplet`]) and the bulk periodic box ([`brownian::bulk`]);
+//! - [`dpd`]: dissipative particle dynamics of colloids in an explicit solvent;
+//! - [`mpcd`]: multiparticle collision dynamics (SRD solvent, discrete colloids, droplet walls);
+//!
+//! and what the engines share: the cell sort and half stencil (`cells`), the Verlet list
+//! ([`neighbor`]), the slab decomposition over ranks (`domain`), benchmark setups ([`mod@bench`]).
+//! The state they move (particles and box, potentials, initial configurations, GSD frames) is
+//! `colloidsim-particles`, re-exported here as [`state`], [`potential`], [`init`] and [`gsd`].
 
-mod bd_scenario;
 pub mod bench;
 pub mod brownian;
-pub mod bulk;
 mod cells;
 mod domain;
 pub mod dpd;
-pub mod droplet;
-pub mod gsd;
-pub mod hydro_bd;
-pub mod init;
 pub mod mpcd;
 pub mod neighbor;
-pub mod potential;
-pub mod state;
 
+pub use brownian::droplet::DropletParams;
+pub use brownian::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
 pub use brownian::{BdError, BdParams, Brownian, Integrator};
 pub use colloidsim_hydro as hydro;
-pub use dpd::{Dpd, DpdError, DpdParams};
-pub use droplet::DropletParams;
-pub use hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
-pub use neighbor::NeighborList;
-pub use potential::{
+pub use colloidsim_particles::potential::{
     ConstantForce, External, HarmonicInterface, LennardJones, LjParams, Morse, NoExternal, NoPair,
     Pair, PairSum, SphereAreaLaw,
 };
-pub use state::{Particles, SimBox};
+pub use colloidsim_particles::state::{Particles, SimBox};
+pub use colloidsim_particles::{gsd, init, potential, state};
+pub use dpd::{Dpd, DpdError, DpdParams};
+pub use neighbor::NeighborList;

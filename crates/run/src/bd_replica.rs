@@ -12,9 +12,10 @@ use crate::trajectory::FrameDigest;
 use anyhow::{Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::gsd::{self, GsdFrame, GsdWriter};
 use colloidsim_md::hydro::AnyMobility;
-use colloidsim_md::{Brownian, External, HydroBrownian, LennardJones, Particles, SimBox};
+use colloidsim_md::{Brownian, HydroBrownian};
+use colloidsim_particles::gsd::{self, GsdFrame, GsdWriter};
+use colloidsim_particles::{External, LennardJones, Particles, SimBox};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

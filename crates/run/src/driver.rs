@@ -731,7 +731,9 @@ fn advance(s: &mut dyn Session, until: u64) -> Result<Option<String>> {
     match s.advance(until) {
         Err(e) => {
             let non_finite = e.chain().find_map(|c| match c.downcast_ref() {
-                Some(g @ colloidsim_md::gsd::GsdError::NonFinite { .. }) => Some(g.to_string()),
+                Some(g @ colloidsim_particles::gsd::GsdError::NonFinite { .. }) => {
+                    Some(g.to_string())
+                }
                 _ => None,
             });
             match non_finite {

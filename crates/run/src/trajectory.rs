@@ -9,13 +9,13 @@
 //! file), so its cost is that of reading each frame once.
 //!
 //! With the digest the checkpoint keeps the file's layout after those frames
-//! ([`colloidsim_md::gsd::Layout`]). The GSD writer's bytes depend on the frames alone, so a
-//! restart that cuts the file back to that layout (dropping what a killed run wrote after the
-//! checkpoint) and appends the same frames writes the file an uninterrupted run writes, byte
-//! for byte.
+//! ([`colloidsim_particles::gsd::Layout`]). The GSD writer's bytes depend on the frames alone,
+//! so a restart that cuts the file back to that layout (dropping what a killed run wrote after
+//! the checkpoint) and appends the same frames writes the file an uninterrupted run writes,
+//! byte for byte.
 
 use anyhow::{Result, bail};
-use colloidsim_md::gsd::{GsdIndex, Layout, restore_layout};
+use colloidsim_particles::gsd::{GsdIndex, Layout, restore_layout};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -7,8 +7,9 @@
 mod common;
 
 use colloidsim_md::brownian::ListState;
-use colloidsim_md::potential::{ConstantForce, External};
-use colloidsim_md::{BdError, BdParams, Brownian, Integrator, LennardJones, Particles, SimBox};
+use colloidsim_md::{BdError, BdParams, Brownian, Integrator};
+use colloidsim_particles::potential::{ConstantForce, External};
+use colloidsim_particles::{LennardJones, Particles, SimBox};
 use common::on_ranks;
 use std::f64::consts::PI;
 
@@ -29,7 +30,7 @@ fn sedimenting(integrator: Integrator) -> (Particles, SimBox, BdParams) {
     let n = 1500;
     let l = (n as f64 * PI / 6.0 / 0.2).cbrt();
     let sbox = SimBox::cube(l);
-    let pos = colloidsim_md::init::random_in_box(n, 1.2, &sbox, 31, 0).unwrap();
+    let pos = colloidsim_particles::init::random_in_box(n, 1.2, &sbox, 31, 0).unwrap();
     let mut p = Particles::monodisperse(pos, 1.0);
     for (i, d) in p.diameter.iter_mut().enumerate() {
         *d = 0.8 + 0.4 * ((i * 7919) % 1000) as f64 / 1000.0;

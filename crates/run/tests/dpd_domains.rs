@@ -5,9 +5,9 @@
 #[path = "../../md/tests/common/mod.rs"]
 mod common;
 
-use colloidsim_md::Particles;
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};
+use colloidsim_particles::Particles;
 use colloidsim_run::methods::dpd::params;
 use common::on_ranks;
 

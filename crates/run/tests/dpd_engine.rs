@@ -3,7 +3,7 @@
 
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdError, DpdParams, LubricationNoise, NeighborMode};
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::{Particles, SimBox};
 use colloidsim_run::methods::dpd::monitor::TemperatureMonitor;
 use colloidsim_run::methods::dpd::params;
 

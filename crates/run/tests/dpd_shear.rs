@@ -4,9 +4,9 @@
 //! slope; the shear viscosity of DPD water agrees with the Green–Kubo value; results do not
 //! depend on the threads; restarts continue bitwise; bad input is refused with the key.
 
-use colloidsim_md::Particles;
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, NeighborMode};
+use colloidsim_particles::Particles;
 use colloidsim_run::methods::dpd::params;
 
 #[path = "../../md/tests/common/mod.rs"]

@@ -1,6 +1,7 @@
 //! The drying droplet: conservation and confinement, bad input.
 
-use colloidsim_md::{BdError, External};
+use colloidsim_md::BdError;
+use colloidsim_particles::External;
 
 fn scenario(extra_run: &str) -> String {
     format!(

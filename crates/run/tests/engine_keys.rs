@@ -1,5 +1,5 @@
 //! Engines know no input format: no string literal in the engine crates (bcd, md, mc, hydro,
-//! dft) names a scenario key of any method. An engine names its own parameters (`dt`,
+//! dft) or the state they share (particles) names a scenario key of any method. An engine names its own parameters (`dt`,
 //! `particles`) and the run layer renames them to keys (`colloidsim_run::keys::rekey`).
 
 use std::path::{Path, PathBuf};
@@ -144,7 +144,7 @@ fn no_engine_crate_names_a_scenario_key() {
     );
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let mut found = Vec::new();
-    for krate in ["bcd", "md", "mc", "hydro", "dft"] {
+    for krate in ["bcd", "particles", "md", "mc", "hydro", "dft"] {
         let mut files = Vec::new();
         sources(&root.join("crates").join(krate).join("src"), &mut files);
         files.sort();

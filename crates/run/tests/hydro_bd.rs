@@ -7,9 +7,8 @@ use colloidsim_md::hydro::{
     AnyMobility, FreeDraining, HydroError, HydroMethod, HydroModel, HydroParams, LanczosError,
     Mobility, Pse, PseParams,
 };
-use colloidsim_md::{
-    HydroBdError, HydroBdParams, HydroBrownian, NoExternal, NoPair, Particles, SimBox,
-};
+use colloidsim_md::{HydroBdError, HydroBdParams, HydroBrownian};
+use colloidsim_particles::{NoExternal, NoPair, Particles, SimBox};
 use std::f64::consts::PI;
 
 fn lattice(n_side: usize, l: f64) -> Vec<[f64; 3]> {
@@ -246,7 +245,7 @@ fn dilute_sedimentation_follows_k_1_minus_5_phi() {
     // + O(phi a / L, phi^2): the self term with its periodic images (Hasimoto) and the excluded overlap
     // region int_{r<2a} n (A + B/3) d^3r = 5 phi (the rest of the pair sum cancels against
     // the zero-mean-flow backflow). The paper's value K = 1 - 5 phi is the N -> infinity limit.
-    use colloidsim_md::init::random_in_box;
+    use colloidsim_particles::init::random_in_box;
     let (a, eta, phi, n) = (0.5, 1.0, 0.02, 2000);
     let l = (n as f64 * PI / 6.0 / phi).cbrt();
     let mu0 = 1.0 / (6.0 * PI * eta * a);

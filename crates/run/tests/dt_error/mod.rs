@@ -2,8 +2,9 @@
 //! the contact layer at the interface, sampled in equilibrium (shared by the test
 //! `tests/droplet_dt_error.rs` and the sweep `examples/droplet_dt_errors.rs`).
 
-use colloidsim_md::droplet::DropletParams;
-use colloidsim_md::{Brownian, Integrator, LennardJones, Pair};
+use colloidsim_md::brownian::droplet::DropletParams;
+use colloidsim_md::{Brownian, Integrator};
+use colloidsim_particles::{LennardJones, Pair};
 
 /// A static droplet (`drying.peclet = 0`) of radius `r0` (in d) at mean volume fraction `phi`,
 /// d = kT = 1, eta = 1 (D0 = 1 / (3 pi)), the default interface (k = 50 kT/d^2, range d/2,

@@ -25,7 +25,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem, bulk};
-use colloidsim_md::gsd::GsdFileWriter as GsdFile;
+use colloidsim_particles::gsd::GsdFileWriter as GsdFile;
 use params::{Resolved, Scenario};
 use serde::{Deserialize, Serialize};
 use serde_json::json;

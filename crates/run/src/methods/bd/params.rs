@@ -11,8 +11,8 @@ use crate::keys::{Reader, SEED_KEY, Spec, rekey};
 use anyhow::{Result, bail};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
-use colloidsim_md::bulk::{BulkParams, MAX_BODY_DRIFT, WCA_RANGE};
-use colloidsim_md::droplet::{MAX_PHI_FINAL, MAX_PHI0};
+use colloidsim_md::brownian::bulk::{BulkParams, MAX_BODY_DRIFT, WCA_RANGE};
+use colloidsim_md::brownian::droplet::{MAX_PHI_FINAL, MAX_PHI0};
 use colloidsim_md::hydro::{HydroError, HydroModel, PseGeometry};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -236,7 +236,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
 mod tests {
     use super::*;
     use colloidsim_md::Integrator;
-    use colloidsim_md::bulk::dilute_sedimentation;
+    use colloidsim_md::brownian::bulk::dilute_sedimentation;
     use colloidsim_md::hydro::ewald::hasimoto;
 
     const BASE: &str = r#"

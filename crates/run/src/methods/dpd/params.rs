@@ -8,11 +8,11 @@ use super::keys::*;
 use crate::keys::Reader;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::in_range;
-use colloidsim_md::SimBox;
 use colloidsim_md::dpd::setup::{DpdSetup, RadiusDistribution};
 use colloidsim_md::dpd::{
     ColloidForces, DpdParams, LubricationNoise, NeighborMode, colloid_solvent_cutoff,
 };
+use colloidsim_particles::SimBox;
 use std::f64::consts::PI;
 
 /// The shortest DPD time step (DPD times `rc sqrt(m / kT)`).

@@ -13,7 +13,7 @@ use anyhow::{Result, bail};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_md::DropletParams;
-use colloidsim_md::droplet::{HOLD_KT, MAX_PHI_FINAL, MAX_PHI0, MIN_DRYING_STEPS};
+use colloidsim_md::brownian::droplet::{HOLD_KT, MAX_PHI_FINAL, MAX_PHI0, MIN_DRYING_STEPS};
 use colloidsim_md::hydro::HydroModel;
 use std::f64::consts::PI;
 use std::path::Path;

@@ -23,7 +23,7 @@ use colloidsim_dft::radial::{
     DdftOptions, DropletSetup, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
     PairCorrelation, RadialError, RadialGrid, Snapshot, bin_average, equilibrium_at, run_droplet,
 };
-use colloidsim_md::droplet::DropletParams;
+use colloidsim_md::brownian::droplet::DropletParams;
 
 use super::keys::{
     DRYING_DURATION, DRYING_FINAL_VOLUME_FRACTION, OBSERVE_PROFILE_FRACTIONS, SYSTEM_PARTICLES,

@@ -13,7 +13,7 @@ use anyhow::Result;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_md::mpcd::ColloidParams;
-use colloidsim_md::potential::{HarmonicInterface, SphereAreaLaw};
+use colloidsim_particles::potential::{HarmonicInterface, SphereAreaLaw};
 use serde::Serialize;
 use std::f64::consts::PI;
 

@@ -25,8 +25,8 @@ use colloidsim_mc::observe::{
 };
 use colloidsim_mc::params::McRun;
 use colloidsim_mc::{HardSphereMc, McError, SweepStats};
-use colloidsim_md::gsd::{self, GsdWriter};
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::gsd::{self, GsdWriter};
+use colloidsim_particles::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::f64::consts::PI;

@@ -8,12 +8,12 @@ use colloidsim_core::ParamError;
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::param::show;
-use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region, VERTICES};
 use colloidsim_md::mpcd::drying::remove_excess;
 use colloidsim_md::mpcd::{Acceleration, Confinement, Srd};
 use colloidsim_md::mpcd::{SrdParams, theory};
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::gsd::GsdWriter;
+use colloidsim_particles::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
 
 /// The exact state of the solvent, as checkpoints hold it.
@@ -228,7 +228,7 @@ pub(crate) struct SolventEngine {
     /// The discrete-particle colloids, if any.
     pub(crate) colloids: Option<DiscreteColloids>,
     /// The droplet's interface on the colloid centres (droplet-mpcd).
-    pub(crate) interface: Option<colloidsim_md::potential::HarmonicInterface>,
+    pub(crate) interface: Option<colloidsim_particles::potential::HarmonicInterface>,
     pub(crate) method: &'static str,
     pub(crate) conf: Confinement,
     pub(crate) drive: Acceleration,
@@ -258,7 +258,7 @@ impl crate::Engine for SolventEngine {
             if let Some(col) = self.colloids.as_mut() {
                 match &self.interface {
                     Some(h) => col.advance(t - tau, tau, h)?,
-                    None => col.advance(t - tau, tau, &colloidsim_md::NoExternal)?,
+                    None => col.advance(t - tau, tau, &colloidsim_particles::NoExternal)?,
                 }
             }
             if !matches!(self.conf, Confinement::None) {
@@ -310,7 +310,7 @@ impl crate::Engine for SolventEngine {
             let t = self.time();
             f.extend(match &self.interface {
                 Some(h) => c.forces_at(t, h),
-                None => c.forces_at(t, &colloidsim_md::NoExternal),
+                None => c.forces_at(t, &colloidsim_particles::NoExternal),
             });
         }
         Ok(crate::engine::flat(&f))

@@ -19,11 +19,11 @@ use crate::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
-use colloidsim_md::SimBox;
-use colloidsim_md::gsd::GsdWriter;
 use colloidsim_md::mpcd::colloid::{ColloidState, DiscreteColloids, Region};
 use colloidsim_md::mpcd::measure::{BlockAverage, PoiseuilleProbe};
 use colloidsim_md::mpcd::{Acceleration, Confinement, Srd};
+use colloidsim_particles::SimBox;
+use colloidsim_particles::gsd::GsdWriter;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::f64::consts::PI;
@@ -362,7 +362,7 @@ impl BulkSession {
                 return Ok(Some(e.to_string()));
             }
             if let Some(col) = self.colloids.as_mut()
-                && let Err(e) = col.advance(t - tau, tau, &colloidsim_md::NoExternal)
+                && let Err(e) = col.advance(t - tau, tau, &colloidsim_particles::NoExternal)
             {
                 return Ok(Some(e.to_string()));
             }

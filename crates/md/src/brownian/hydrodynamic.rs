@@ -5,7 +5,7 @@
 //! with the mobility M of `colloidsim_hydro` (free draining, RPY by direct free-space sums, or
 //! RPY by positively split Ewald in the periodic box). No drift term `kT div M dt`: these
 //! mobilities are divergence-free. The forces are those of the free-draining engine
-//! ([`crate::brownian`]): a pair potential on a full Verlet list ([`NeighborList`]) plus an
+//! ([`super::Brownian`]): a pair potential on a full Verlet list ([`NeighborList`]) plus an
 //! external field.
 //!
 //! **Determinism and restarts.** Particles stay in input order; the noise of particle `i` at

@@ -10,7 +10,6 @@
 //! Readers fall back to frame 0 for chunks a frame lacks, as the schema specifies, and to the
 //! schema's defaults after that.
 
-use crate::brownian::ListState;
 use crate::state::{Particles, SimBox};
 use hoomd_gsd::file_layer::{GsdFile, Mode};
 use std::path::{Path, PathBuf};
@@ -25,6 +24,22 @@ const ORDER: &str = "log/particles/storage_order";
 const REFERENCE: &str = "log/particles/list_reference_position_f64";
 const STORED_POS: &str = "log/particles/stored_position_f64";
 const STORED_IMAGE: &str = "log/particles/stored_image";
+
+/// What a Brownian-dynamics checkpoint needs besides the particles to continue bitwise: the
+/// engine's storage order, its positions and image counts exactly as stored (not wrapped since
+/// the last list build), and the positions at that build, all in storage order. The engine
+/// (`colloidsim_md::Brownian`) makes and takes it; checkpoint frames store it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ListState {
+    /// Input index of each stored particle (`Brownian::order`).
+    pub order: Vec<u32>,
+    /// Positions of the stored particles when the lists were last built (wrapped then).
+    pub reference: Vec<[f64; 3]>,
+    /// Current positions as stored.
+    pub positions: Vec<[f64; 3]>,
+    /// Current image counts as stored.
+    pub images: Vec<[i32; 3]>,
+}
 
 /// A GSD error with the file involved.
 #[derive(Debug, thiserror::Error)]

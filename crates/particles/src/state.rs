@@ -23,6 +23,7 @@ impl SimBox {
     }
 
     /// Volume.
+    #[inline]
     pub fn volume(&self) -> f64 {
         self.l[0] * self.l[1] * self.l[2]
     }
@@ -165,16 +166,19 @@ impl Particles {
     }
 
     /// Number of particles.
+    #[inline]
     pub fn len(&self) -> usize {
         self.pos.len()
     }
 
     /// No particles?
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.pos.is_empty()
     }
 
     /// Number of types.
+    #[inline]
     pub fn n_types(&self) -> usize {
         self.type_names.len().max(1)
     }

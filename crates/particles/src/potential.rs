@@ -22,6 +22,7 @@ pub trait Pair: Sync + Send {
 pub struct NoPair;
 
 impl Pair for NoPair {
+    #[inline]
     fn r_cut_max(&self) -> f64 {
         0.0
     }
@@ -29,6 +30,7 @@ impl Pair for NoPair {
     fn force_over_r(&self, _: f64, _: u32, _: u32, _: f64, _: f64) -> f64 {
         0.0
     }
+    #[inline]
     fn energy(&self, _: f64, _: u32, _: u32, _: f64, _: f64) -> f64 {
         0.0
     }
@@ -107,6 +109,7 @@ impl LennardJones {
 }
 
 impl Pair for LennardJones {
+    #[inline]
     fn r_cut_max(&self) -> f64 {
         self.r_cut_max
     }
@@ -122,6 +125,7 @@ impl Pair for LennardJones {
         if r2 < rc2 { f } else { 0.0 }
     }
 
+    #[inline]
     fn energy(&self, r2: f64, ti: u32, tj: u32, _: f64, _: f64) -> f64 {
         let [s2, _, e4, rc2, shift] = self.table[ti as usize * self.n_types + tj as usize];
         if r2 >= rc2 {
@@ -161,6 +165,7 @@ impl Morse {
 }
 
 impl Pair for Morse {
+    #[inline]
     fn r_cut_max(&self) -> f64 {
         self.d_max + self.h_cut
     }
@@ -175,6 +180,7 @@ impl Pair for Morse {
         -self.u_and_du(h).1 / r
     }
 
+    #[inline]
     fn energy(&self, r2: f64, _: u32, _: u32, di: f64, dj: f64) -> f64 {
         let h = r2.sqrt() - 0.5 * (di + dj);
         if h >= self.h_cut {
@@ -189,6 +195,7 @@ impl Pair for Morse {
 pub struct PairSum<A, B>(pub A, pub B);
 
 impl<A: Pair, B: Pair> Pair for PairSum<A, B> {
+    #[inline]
     fn r_cut_max(&self) -> f64 {
         self.0.r_cut_max().max(self.1.r_cut_max())
     }
@@ -196,6 +203,7 @@ impl<A: Pair, B: Pair> Pair for PairSum<A, B> {
     fn force_over_r(&self, r2: f64, ti: u32, tj: u32, di: f64, dj: f64) -> f64 {
         self.0.force_over_r(r2, ti, tj, di, dj) + self.1.force_over_r(r2, ti, tj, di, dj)
     }
+    #[inline]
     fn energy(&self, r2: f64, ti: u32, tj: u32, di: f64, dj: f64) -> f64 {
         self.0.energy(r2, ti, tj, di, dj) + self.1.energy(r2, ti, tj, di, dj)
     }
@@ -218,6 +226,7 @@ impl External for NoExternal {
     fn force(&self, _: [f64; 3], _: f64) -> [f64; 3] {
         [0.0; 3]
     }
+    #[inline]
     fn energy(&self, _: [f64; 3], _: f64) -> f64 {
         0.0
     }
@@ -232,6 +241,7 @@ impl External for ConstantForce {
     fn force(&self, _: [f64; 3], _: f64) -> [f64; 3] {
         self.0
     }
+    #[inline]
     fn energy(&self, p: [f64; 3], _: f64) -> f64 {
         -(self.0[0] * p[0] + self.0[1] * p[1] + self.0[2] * p[2])
     }
@@ -291,6 +301,7 @@ impl External for HarmonicInterface {
         [f * d[0], f * d[1], f * d[2]]
     }
 
+    #[inline]
     fn energy(&self, p: [f64; 3], t: f64) -> f64 {
         let d = [
             p[0] - self.centre[0],

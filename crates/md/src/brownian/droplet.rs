@@ -6,9 +6,9 @@
 //! scenario into them. Both the particle engine (`colloidsim run`) and the radial DDFT
 //! (`colloidsim theory`) take them.
 
-use crate::bd_scenario::{one_species, read_initial};
-use crate::brownian::{BdError, BdParams, Brownian, Integrator};
-use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
+use super::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
+use super::scenario::{one_species, read_initial};
+use super::{BdError, BdParams, Brownian, Integrator};
 use crate::init::random_in_sphere;
 use crate::potential::{HarmonicInterface, LennardJones, SphereAreaLaw};
 use crate::state::{Particles, SimBox};

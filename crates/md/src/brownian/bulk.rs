@@ -11,9 +11,9 @@
 //! free diffusivity is `D0 = kT / (3 pi eta d) = 1 / (3 pi)` and the diffusion time
 //! `d^2 / D0 = 9.42`.
 
-use crate::bd_scenario::{one_species, read_initial};
-use crate::brownian::{BdError, BdParams, Brownian, Integrator};
-use crate::hydro_bd::{HydroBdError, HydroBdParams, HydroBrownian};
+use super::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
+use super::scenario::{one_species, read_initial};
+use super::{BdError, BdParams, Brownian, Integrator};
 use crate::init::{PackingError, random_in_box};
 use crate::potential::{ConstantForce, LennardJones};
 use crate::state::{Particles, SimBox};

@@ -32,11 +32,20 @@
 //! chunk by chunk the external force, the noise and the new positions (into a second buffer;
 //! the buffers are then swapped). Leimkuhler–Matthews draws its deviates `xi_{n+1}` in a third
 //! pass, by input index, before the positions.
+//!
+//! Beside the engine, this folder holds Brownian dynamics with hydrodynamic interactions
+//! ([`hydrodynamic`]) and the two BD scenarios: the drying droplet ([`droplet`]) and the bulk
+//! periodic box ([`bulk`]).
 
+pub mod bulk;
+pub mod droplet;
+pub mod hydrodynamic;
 mod ranks;
+mod scenario;
 
 use crate::cells::{CellSort, permute, scan_layer};
 use crate::domain::Domain;
+pub use crate::gsd::ListState;
 use crate::neighbor::BoxTooSmall;
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
@@ -157,21 +166,6 @@ pub enum BdError {
     /// Inconsistent particle data.
     #[error("invalid particle data: {0}")]
     Invalid(String),
-}
-
-/// What a checkpoint needs besides the particles to continue bitwise: the engine's storage
-/// order, its positions and image counts exactly as stored (not wrapped since the last list
-/// build), and the positions at that build, all in storage order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ListState {
-    /// Input index of each stored particle ([`Brownian::order`]).
-    pub order: Vec<u32>,
-    /// Positions of the stored particles when the lists were last built (wrapped then).
-    pub reference: Vec<[f64; 3]>,
-    /// Current positions as stored.
-    pub positions: Vec<[f64; 3]>,
-    /// Current image counts as stored.
-    pub images: Vec<[i32; 3]>,
 }
 
 /// One z-layer of cells: its particles, their half neighbour lists and force buffer.

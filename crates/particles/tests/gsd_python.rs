@@ -2,8 +2,8 @@
 //! freud and OVITO read them). Skips with a notice when Python or `gsd` is absent, fails then
 //! where `COLLOIDSIM_REQUIRE_TOOLS` is set (CI).
 
-use colloidsim_md::gsd::GsdWriter;
-use colloidsim_md::{Particles, SimBox};
+use colloidsim_particles::gsd::GsdWriter;
+use colloidsim_particles::{Particles, SimBox};
 use std::process::Command;
 
 fn python_has_gsd() -> bool {
