@@ -442,11 +442,7 @@ impl<E: External> Replicas<E> {
             && let Some(traj) = &self.traj
         {
             // On a restart the file holds exactly the checkpoint's frames (FrameDigest::restore).
-            self.gsd = Some(if traj.exists() {
-                GsdWriter::append(traj)?
-            } else {
-                GsdWriter::create_new(traj)?
-            });
+            self.gsd = Some(crate::trajectory::writer(traj, true)?);
         }
         Ok(())
     }

@@ -15,9 +15,20 @@
 //! byte for byte.
 
 use anyhow::{Result, bail};
-use colloidsim_particles::gsd::{GsdIndex, Layout, restore_layout};
+use colloidsim_particles::gsd::{GsdIndex, GsdWriter, Layout, restore_layout};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// The writer of a run's trajectory `path`: appending to it when `append` and the file is
+/// there (a restart: [`FrameDigest::restore`] has cut it back to the checkpoint's frames), else
+/// a new file (a fresh run, or a restart whose run had written no frame yet).
+pub fn writer(path: &Path, append: bool) -> Result<GsdWriter> {
+    Ok(if append && path.exists() {
+        GsdWriter::append(path)?
+    } else {
+        GsdWriter::create_new(path)?
+    })
+}
 
 /// CRC-32 of the first `frames` frames of a trajectory, and the file's layout after them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

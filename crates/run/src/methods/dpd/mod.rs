@@ -528,12 +528,7 @@ impl Session for DpdSession {
         }
         if self.s.observe.trajectory_every > 0 {
             let traj = out.join("trajectory.gsd");
-            // On a restart the file holds exactly the checkpoint's frames (FrameDigest::restore).
-            self.gsd = Some(if traj.exists() {
-                GsdWriter::append(&traj)?.with_velocities()
-            } else {
-                GsdWriter::create_new(&traj)?.with_velocities()
-            });
+            self.gsd = Some(crate::trajectory::writer(&traj, !fresh)?.with_velocities());
         }
         if fresh {
             self.record()?;

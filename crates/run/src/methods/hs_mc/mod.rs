@@ -305,11 +305,7 @@ impl Session for McSession {
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         let traj = out.join("trajectory.gsd");
         if self.p.trajectory_every > 0 {
-            self.gsd = Some(if traj.exists() && !fresh {
-                GsdWriter::append(&traj)?
-            } else {
-                GsdWriter::create_new(&traj)?
-            });
+            self.gsd = Some(crate::trajectory::writer(&traj, !fresh)?);
         }
         self.traj = Some(traj);
         if fresh {

@@ -129,12 +129,9 @@ pub(crate) fn open_trajectory(
     if every == 0 {
         return Ok(None);
     }
-    let path = out.join("trajectory.gsd");
-    Ok(Some(if path.exists() && !fresh {
-        GsdWriter::append(&path)?.with_velocities()
-    } else {
-        GsdWriter::create_new(&path)?.with_velocities()
-    }))
+    Ok(Some(
+        crate::trajectory::writer(&out.join("trajectory.gsd"), !fresh)?.with_velocities(),
+    ))
 }
 
 /// The first position at or after `pos` past which a regular checkpoint (every ~10 %) is due.
