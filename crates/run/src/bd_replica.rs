@@ -8,7 +8,7 @@ use crate::engine::flat;
 use crate::keys::shared::{HYDRO_MAX_ITERATIONS, RUN_DT};
 use crate::keys::{Spec, rekey_text};
 use crate::method::{Finished, Session};
-use crate::trajectory::FrameDigest;
+use crate::output::trajectory::FrameDigest;
 use anyhow::{Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
@@ -442,7 +442,7 @@ impl<E: External> Replicas<E> {
             && let Some(traj) = &self.traj
         {
             // On a restart the file holds exactly the checkpoint's frames (FrameDigest::restore).
-            self.gsd = Some(crate::trajectory::writer(traj, true)?);
+            self.gsd = Some(crate::output::trajectory::writer(traj, true)?);
         }
         Ok(())
     }

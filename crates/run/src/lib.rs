@@ -15,11 +15,9 @@ pub mod extrapolate;
 pub mod keys;
 pub mod method;
 pub mod methods;
-mod output;
-pub mod plot;
+pub mod output;
 pub mod registry;
 pub mod scenario;
-pub mod trajectory;
 
 mod bd_replica;
 pub mod two_body;

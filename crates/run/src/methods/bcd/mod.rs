@@ -10,11 +10,11 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{
+use crate::output::plot::{
     Labels, Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors,
     linear_picture, picture,
 };
-use crate::trajectory::FrameDigest;
+use crate::output::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_bcd::forces::Field;

@@ -30,8 +30,8 @@ use crate::bd_replica::{
 use crate::checkpoint::Envelope;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
-use crate::plot::{Scale, Series, line_plot_with_errors, picture};
-use crate::trajectory::FrameDigest;
+use crate::output::plot::{Scale, Series, line_plot_with_errors, picture};
+use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::msd::Msd;

@@ -12,8 +12,8 @@ use crate::checkpoint::Envelope;
 use crate::engine::flat;
 use crate::keys::{Spec, rekey_text};
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
-use crate::trajectory::FrameDigest;
+use crate::output::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
+use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
@@ -528,7 +528,7 @@ impl Session for DpdSession {
         }
         if self.s.observe.trajectory_every > 0 {
             let traj = out.join("trajectory.gsd");
-            self.gsd = Some(crate::trajectory::writer(&traj, !fresh)?.with_velocities());
+            self.gsd = Some(crate::output::trajectory::writer(&traj, !fresh)?.with_velocities());
         }
         if fresh {
             self.record()?;

@@ -11,12 +11,12 @@ use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
-use crate::output::profile_name;
-use crate::plot::{
+use crate::output::plot::{
     Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
     picture,
 };
-use crate::trajectory::FrameDigest;
+use crate::output::profile_name;
+use crate::output::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::radial_profile;

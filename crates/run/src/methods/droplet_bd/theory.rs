@@ -34,8 +34,8 @@ use crate::keys::shared::{
     DIAMETER, DRYING_ALPHA, DRYING_PECLET, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
 };
 use crate::keys::{Spec, rekey};
+use crate::output::plot::{self, Scale, Series};
 use crate::output::profile_name;
-use crate::plot::{self, Scale, Series};
 use crate::{Report, Scenario as Source, TheoryOptions};
 
 /// Theory grid spacing: `--dx`, else `d / 100`.

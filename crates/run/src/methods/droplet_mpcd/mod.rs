@@ -7,10 +7,10 @@ use crate::checkpoint::Envelope;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
 use crate::methods::mpcd::common::*;
-use crate::plot::{
+use crate::output::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
 };
-use crate::trajectory::FrameDigest;
+use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};

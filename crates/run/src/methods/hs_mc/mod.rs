@@ -12,8 +12,8 @@ pub mod params;
 use crate::engine::flat;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
-use crate::trajectory::FrameDigest;
+use crate::output::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
+use crate::output::trajectory::FrameDigest;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -305,7 +305,7 @@ impl Session for McSession {
     fn begin(&mut self, out: &OutputDir, fresh: bool) -> Result<()> {
         let traj = out.join("trajectory.gsd");
         if self.p.trajectory_every > 0 {
-            self.gsd = Some(crate::trajectory::writer(&traj, !fresh)?);
+            self.gsd = Some(crate::output::trajectory::writer(&traj, !fresh)?);
         }
         self.traj = Some(traj);
         if fresh {

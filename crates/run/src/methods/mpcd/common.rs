@@ -130,7 +130,7 @@ pub(crate) fn open_trajectory(
         return Ok(None);
     }
     Ok(Some(
-        crate::trajectory::writer(&out.join("trajectory.gsd"), !fresh)?.with_velocities(),
+        crate::output::trajectory::writer(&out.join("trajectory.gsd"), !fresh)?.with_velocities(),
     ))
 }
 

@@ -1,6 +1,11 @@
-//! Names and writers that several methods share (the drying droplet's profile files of
-//! droplet-bd, its theory and droplet-mpcd). The trajectory lives in [`crate::trajectory`],
-//! pictures in [`crate::plot`], atomic tables in `colloidsim_core::output`.
+//! The writers every session shares: the GSD trajectory (its opener, frame digest and trim on
+//! restart: [`trajectory`]), pictures ([`plot`]) and the drying droplet's profile names (of
+//! droplet-bd, its theory and droplet-mpcd). Tables, thermo logs (`CsvLog`), JSON and the
+//! atomic writes under them, with the rule that every number is finite or empty with its
+//! reason, are `colloidsim_core::output`'s, which the engine crates use too.
+
+pub mod plot;
+pub mod trajectory;
 
 /// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,
 /// more when the fraction needs them).
