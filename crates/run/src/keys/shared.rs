@@ -254,7 +254,8 @@ pub const COLLOID_MD_STEPS: Spec = key(
     Value("50"),
     Integer(1, 100_000),
     "velocity Verlet steps per collision time",
-);
+)
+.also("resolve the bonds: omega dt at most 1, omega their fastest vibration");
 
 /// The fewest mean particles per collision cell an SRD solvent may have.
 pub const MIN_SOLVENT_DENSITY: f64 = 3.0;
@@ -345,6 +346,48 @@ pub fn colloid(r: &Reader, diameter: &Spec, d: f64, colloids: bool) -> Result<Co
                 COLLOID_BOND_K.path,
                 show(p.bond_k),
                 d * strain / MAX_BOND_STRAIN,
+            ),
+        )
+        .into());
+    }
+    // Velocity Verlet over the bonds: omega dt at most 1 (stable below 2; at 1 the vibration's
+    // frequency is already 5 % off).
+    let tau = r.number(&SOLVENT_TAU)?;
+    let omega = p.highest_bond_frequency();
+    let dt = tau / p.md_steps as f64;
+    if colloids && omega * dt > 1.0 {
+        let key = [
+            &COLLOID_BOND_K,
+            &SOLVENT_TAU,
+            &COLLOID_VERTEX_MASS,
+            &COLLOID_CENTRE_MASS,
+        ]
+        .into_iter()
+        .find(|k| r.has(k) && !r.has(&COLLOID_MD_STEPS))
+        .unwrap_or(&COLLOID_MD_STEPS);
+        let steps = (omega * tau).ceil();
+        let more = match steps <= 100_000.0 {
+            true => format!("at least {steps} {} at this k, or ", COLLOID_MD_STEPS.path),
+            false => String::new(),
+        };
+        return Err(ParamError::new(
+            key.path,
+            format!(
+                "{} Verlet steps per collision time {} = {} (dt = {}) do not resolve the colloid bonds' fastest \
+                 vibration, omega = {:.4e} per time ({} = {}, masses {} and {}): omega dt = {:.4e}, at most 1 \
+                 (velocity Verlet diverges above 2); {more}a softer {} (at most {:.4e})",
+                p.md_steps,
+                SOLVENT_TAU.path,
+                show(tau),
+                show(dt),
+                omega,
+                COLLOID_BOND_K.path,
+                show(p.bond_k),
+                show(p.vertex_mass),
+                show(p.centre_mass),
+                omega * dt,
+                COLLOID_BOND_K.path,
+                p.bond_k / (omega * dt).powi(2),
             ),
         )
         .into());

@@ -58,6 +58,10 @@ pub const DRYING_FINAL_VOLUME_FRACTION: Spec = Spec {
 pub const DRYING_DURATION: Spec = shared::DRYING_DURATION
     .also("required without colloids; R must stay above two cells");
 
+/// `interface.stiffness` (with its condition here).
+pub const INTERFACE_STIFFNESS: Spec = shared::INTERFACE_STIFFNESS
+    .also("with the bonds, omega dt at most 1 (dt = solvent.tau / colloid.md_steps)");
+
 /// `interface.range` (with its condition here).
 pub const INTERFACE_RANGE: Spec = shared::INTERFACE_RANGE.also("at most R0");
 

@@ -206,6 +206,26 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         ));
     }
     let it = shared::interface(r, d, kt)?;
+    // The interface's spring on each centre adds at most stiffness / m_centre to the bonds'
+    // omega^2 (Weyl): velocity Verlet must still resolve it (as the bonds, `shared::colloid`).
+    let dt = srd.tau / colloid.md_steps as f64;
+    let omega =
+        (colloid.highest_bond_frequency().powi(2) + it.stiffness / colloid.centre_mass).sqrt();
+    if particles > 0 && omega * dt > 1.0 {
+        return Err(refuse(
+            &INTERFACE_STIFFNESS,
+            format!(
+                "{} on colloid centres of mass {} with their bonds vibrates at up to omega = {omega:.4e} per time: \
+                 omega dt = {:.4e} with dt = solvent.tau / colloid.md_steps = {}, at most 1 (velocity Verlet \
+                 diverges above 2); at most {:.4e}",
+                show(it.stiffness),
+                show(colloid.centre_mass),
+                omega * dt,
+                show(dt),
+                (dt.powi(-2) - colloid.highest_bond_frequency().powi(2)) * colloid.centre_mass,
+            ),
+        ));
+    }
     if it.range > r0 {
         return Err(refuse(
             &INTERFACE_RANGE,
@@ -483,6 +503,10 @@ mod tests {
             (
                 "[drying]\nduration = 20\n[interface]\nrange = 7",
                 "interface.range:",
+            ),
+            (
+                "particles = 2\n[drying]\nduration = 20\n[interface]\nstiffness = 1e300",
+                "interface.stiffness: 1e300 on colloid centres",
             ),
             (
                 "box = 12\n[drying]\nduration = 20",

@@ -316,7 +316,7 @@ mod tests {
     /// not held in shape by its bonds: refused before the run, naming the key that was given;
     /// the limit at the default `k = 5000 kT` is d = 0.5175 cells.
     #[test]
-    fn colloids_must_keep_their_shape() {
+    fn colloids_must_keep_their_shape_and_their_verlet_step_resolve_their_bonds() {
         let run = |system: &str, colloid: &str| {
             bulk(&format!(
                 "method = \"mpcd\"\n[system]\nbox = 10\ncolloids = 1\n{system}\n[colloid]\n{colloid}\n\
@@ -335,6 +335,24 @@ mod tests {
         assert!(run("diameter = 0.52", "").is_ok());
         let e = run("", "bond_k = 1").unwrap_err();
         assert!(format!("{e:#}").starts_with("colloid.bond_k:"), "{e:#}");
+        // Velocity Verlet over the bonds (omega = 122.7 at k = 5000 kT, masses 5): these went
+        // non-finite at their first step; refused naming the key given.
+        for (solvent, colloid, key) in [
+            ("tau = 3.5", "", "solvent.tau:"),
+            ("", "bond_k = 1e6", "colloid.bond_k:"),
+            ("", "md_steps = 5", "colloid.md_steps:"),
+            ("", "centre_mass = 1e-3", "colloid.centre_mass:"),
+        ] {
+            let e = bulk(&format!(
+                "method = \"mpcd\"\n[solvent]\n{solvent}\n[system]\nbox = 10\ncolloids = 1\n\
+                 [colloid]\n{colloid}\n[run]\ncollisions = 100\n[observe]\nvacf_lags = 10"
+            ))
+            .unwrap_err();
+            let e = format!("{e:#}");
+            assert!(e.starts_with(key) && e.contains("omega dt"), "{e}");
+        }
+        assert!(run("", "md_steps = 13").is_ok());
+        assert!(run("", "md_steps = 12").is_err());
         // Without colloids the model is not used, and not checked.
         assert!(
             bulk(
