@@ -230,29 +230,20 @@ impl DropletParams {
     /// The free-draining engine's parameters of replica `replica` (a fresh start and a
     /// restart take them from here alike).
     pub fn bd_params(&self, replica: u32) -> BdParams {
-        BdParams {
-            kt: self.kt,
-            viscosity: self.viscosity,
-            dt: self.dt,
-            seed: self.seed,
+        super::scenario::free_draining(
+            self.kt,
+            self.viscosity,
+            self.dt,
+            self.seed,
             replica,
-            skin: self.skin,
-            sort_every: 500,
-            max_drift: 0.2,
-            integrator: self.integrator,
-        }
+            self.skin,
+            self.integrator,
+        )
     }
 
     /// The hydrodynamic engine's parameters of replica `replica`.
     pub fn hydro_bd_params(&self, replica: u32) -> HydroBdParams {
-        HydroBdParams {
-            kt: self.kt,
-            dt: self.dt,
-            seed: self.seed,
-            replica,
-            skin: self.skin,
-            max_drift: 0.2,
-        }
+        super::scenario::hydrodynamic(self.kt, self.dt, self.seed, replica, self.skin)
     }
 
     /// Set up replica `replica` (0-based) at step 0: random insertion (stream index

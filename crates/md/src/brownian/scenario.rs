@@ -1,6 +1,8 @@
 //! What the Brownian-dynamics scenarios (`droplet-bd`, `bd`) share: an initial configuration
-//! read from a GSD file.
+//! read from a GSD file, and the engines' parameters of a replica.
 
+use super::hydrodynamic::HydroBdParams;
+use super::{BdParams, Integrator};
 use crate::gsd::{GsdFrame, read_frame};
 use crate::state::Particles;
 use std::path::Path;
@@ -36,4 +38,41 @@ pub(crate) fn one_species(
     }
     p.diameter.iter_mut().for_each(|x| *x = d);
     Ok(())
+}
+
+/// The free-draining engine's parameters of replica `replica` (a fresh start and a restart
+/// take them from here alike): the scenario's values, the neighbour list's sorting and drift
+/// fixed for both scenarios.
+pub(crate) fn free_draining(
+    kt: f64,
+    viscosity: f64,
+    dt: f64,
+    seed: u32,
+    replica: u32,
+    skin: f64,
+    integrator: Integrator,
+) -> BdParams {
+    BdParams {
+        kt,
+        viscosity,
+        dt,
+        seed,
+        replica,
+        skin,
+        sort_every: 500,
+        max_drift: 0.2,
+        integrator,
+    }
+}
+
+/// The hydrodynamic engine's parameters of replica `replica`, as [`free_draining`].
+pub(crate) fn hydrodynamic(kt: f64, dt: f64, seed: u32, replica: u32, skin: f64) -> HydroBdParams {
+    HydroBdParams {
+        kt,
+        dt,
+        seed,
+        replica,
+        skin,
+        max_drift: 0.2,
+    }
 }
