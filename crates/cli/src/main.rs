@@ -619,11 +619,14 @@ fn continue_hint(e: anyhow::Error, launcher: &str, walltime: Option<&WallTime>) 
         shell_word(&i.out.display().to_string())
     );
     if i.cause == Stop::WallTime && i.checkpoint == i.started {
-        return anyhow::anyhow!(
-            "{i}: the wall-time budget (--walltime {}) ran out before a step could be made; \
-             continue with a longer one: {launcher}colloidsim run --restart {} --walltime ...",
-            walltime.map_or("?", |w| &w.text),
-            shell_word(&i.out.display().to_string())
+        return budget_too_short(
+            &format!("{i}: "),
+            "a step could be made",
+            walltime,
+            &format!(
+                "{launcher}colloidsim run --restart {}",
+                shell_word(&i.out.display().to_string())
+            ),
         );
     }
     Stopped {
@@ -631,6 +634,22 @@ fn continue_hint(e: anyhow::Error, launcher: &str, walltime: Option<&WallTime>) 
         message: Some(format!("{i}. Continue with: {command}")),
     }
     .into()
+}
+
+/// A wall-time budget spent before `what`: an error (status 1), not a stop to continue from,
+/// so that a loop of restarts with the same budget does not go on forever; `command` continues
+/// with a longer one.
+fn budget_too_short(
+    prefix: &str,
+    what: &str,
+    walltime: Option<&WallTime>,
+    command: &str,
+) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{prefix}the wall-time budget (--walltime {}) ran out before {what}; \
+         continue with a longer one: {command} --walltime ...",
+        walltime.map_or("?", |w| &w.text),
+    )
 }
 
 /// `s` quoted for a POSIX shell when it needs it.
@@ -906,11 +925,12 @@ fn ensemble_member(plan: impl FnOnce() -> Result<Ensemble>, k: usize, how: &Laun
     if let Err(e) = plan.run_member(k, &ctl) {
         if let Some(i) = e.downcast_ref::<colloidsim_run::Interrupted>() {
             if i.cause == Stop::WallTime && i.checkpoint == i.started {
-                bail!(
-                    "member {k}: the wall-time budget (--walltime {}) ran out before a step could be made; \
-                     continue with a longer one: colloidsim ensemble --restart {out} --member {k} --walltime ...",
-                    how.walltime.as_ref().map_or("?", |w| &w.text),
-                );
+                return Err(budget_too_short(
+                    &format!("member {k}: "),
+                    "a step could be made",
+                    how.walltime.as_ref(),
+                    &format!("colloidsim ensemble --restart {out} --member {k}"),
+                ));
             }
             return Err(Stopped {
                 status: stop_status(i.cause),
@@ -981,11 +1001,14 @@ fn ensemble(plan: impl FnOnce() -> Result<Ensemble>, how: &Launch) -> Result<()>
         match code {
             // As for `run`: a budget too short for any step is an error, so that a loop of
             // restarts does not go on forever.
-            Some(Stop::WallTime) if !progressed => Err(anyhow::anyhow!(
-                "the wall-time budget (--walltime {}) ran out before any member could make a step; \
-                 continue with a longer one: {}colloidsim ensemble --restart {out} --walltime ...",
-                how.walltime.as_ref().map_or("?", |w| &w.text),
-                if size > 1 { "mpirun -n N " } else { "" },
+            Some(Stop::WallTime) if !progressed => Err(budget_too_short(
+                "",
+                "any member could make a step",
+                how.walltime.as_ref(),
+                &format!(
+                    "{}colloidsim ensemble --restart {out}",
+                    if size > 1 { "mpirun -n N " } else { "" }
+                ),
             )),
             Some(cause) => Err(Stopped {
                 status: stop_status(cause),

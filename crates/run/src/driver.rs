@@ -142,7 +142,7 @@ pub const UNEXPLAINED_NULL: &str =
     "no value: not measured or not applicable in this run, or not a finite number";
 
 /// Every `null` among a method's summary values (`parameters`, the resolved input where `null`
-/// means "not set", and the texts `why_null`, `note` and `*_note` aside), by path (`viscosity`, `momentum[2]`, `temperature.value`), with its
+/// means "not set", and the texts `error`, `why_null`, `note` and `*_note` aside), by path (`viscosity`, `momentum[2]`, `temperature.value`), with its
 /// reason: the method's ([`OutputDir::explain`] with file `summary.json`), a pointer to the
 /// `why_null` beside it, or [`UNEXPLAINED_NULL`]. JSON has no NaN or infinity: serde writes them as `null`, and
 /// this says so wherever one is.
@@ -192,7 +192,10 @@ pub(crate) fn null_reasons(
     }
     let mut found = std::collections::BTreeMap::new();
     if let Some(m) = summary.as_object() {
-        for (k, v) in m.iter().filter(|(k, _)| k.as_str() != "parameters") {
+        for (k, v) in m
+            .iter()
+            .filter(|(k, _)| !["parameters", "error"].contains(&k.as_str()))
+        {
             walk(v, k.clone(), None, out, &mut found);
         }
     }

@@ -600,16 +600,17 @@ impl Ensemble {
             };
             for (k, (m, e, _)) in &obs {
                 let at = format!("points[{}].observables.{k}", observables.len());
-                if !m.is_finite() {
-                    out.explain(
-                        "summary.json",
-                        &format!("{at}.mean"),
-                        "no member gave a finite value",
-                    );
-                }
-                if !e.is_finite() {
-                    let why = "fewer than 2 replicas gave a finite value: no standard error";
-                    out.explain("summary.json", &format!("{at}.err"), why);
+                for (x, field, why) in [
+                    (m, "mean", "no member gave a finite value"),
+                    (
+                        e,
+                        "err",
+                        "fewer than 2 replicas gave a finite value: no standard error",
+                    ),
+                ] {
+                    if !x.is_finite() {
+                        out.explain("summary.json", &format!("{at}.{field}"), why);
+                    }
                 }
             }
             observables.push(json!({
