@@ -6,6 +6,7 @@
 
 mod contacts;
 mod network;
+mod stratification;
 mod structure;
 
 pub use contacts::contacts;
@@ -13,6 +14,7 @@ pub use network::{
     BondTracker, ClusterStats, cluster_labels, cluster_stats, coordination_histogram,
     coordination_numbers,
 };
+pub use stratification::{Stratification, stratification};
 pub use structure::{
     Window, default_q_grid, percus_yevick_g, structure_factor, structure_factor_windowed,
 };

@@ -25,6 +25,10 @@ fn volatile(key: &str) -> bool {
 /// Every example, with the overrides that make it take a second or less.
 const EXAMPLES: &[(&str, &[&str])] = &[
     (
+        "droplet/bidisperse-bd.toml",
+        &["replicas=2", "drying.final_volume_fraction=0.06"],
+    ),
+    (
         "bcd/channel-trap.toml",
         &[
             "run.equilibrate=0.05",

@@ -15,7 +15,7 @@ use colloidsim_core::output::OutputDir;
 use colloidsim_md::hydro::AnyMobility;
 use colloidsim_md::{Brownian, HydroBrownian};
 use colloidsim_particles::gsd::{self, GsdFrame, GsdWriter};
-use colloidsim_particles::{External, LennardJones, Particles, SimBox};
+use colloidsim_particles::{External, Interaction, Particles, SimBox};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -28,9 +28,9 @@ const ENGINE_NAMES: &[(&str, &Spec)] =
 /// or Brownian dynamics with a hydrodynamic mobility.
 pub(crate) enum Replica<E: External> {
     /// Free draining ([`Brownian`]: cell-ordered lists, Euler or Leimkuhler–Matthews).
-    Free(Box<Brownian<LennardJones, E>>),
+    Free(Box<Brownian<Interaction, E>>),
     /// `dx = M F dt + sqrt(2 kT dt) M^(1/2) xi` ([`HydroBrownian`]).
-    Hydro(Box<HydroBrownian<LennardJones, E, AnyMobility>>),
+    Hydro(Box<HydroBrownian<Interaction, E, AnyMobility>>),
 }
 
 impl<E: External> Replica<E> {
@@ -235,15 +235,15 @@ pub(crate) const CHECKPOINT_FILES: [&str; 2] = ["checkpoint-0.gsd", "checkpoint-
 
 /// Read the GSD checkpoint `state` names for replica `replica` at `step`, verified against its
 /// CRC-32, its step, its exactness and its engine (`hydro`: positions and images only; free
-/// draining: with the list state); diameters are set to `diameter` (GSD stores them in single
-/// precision).
+/// draining: with the list state); each particle gets its species' diameter from `diameters`
+/// (GSD stores them in single precision).
 pub(crate) fn read_replica_checkpoint(
     out: &OutputDir,
     state: &ReplicaState,
     step: u64,
     replica: usize,
     hydro: bool,
-    diameter: f64,
+    diameters: &[f64],
 ) -> Result<GsdFrame> {
     let (name, crc, _) = state;
     let path = out.join(name);
@@ -261,7 +261,16 @@ pub(crate) fn read_replica_checkpoint(
             path.display(),
         );
     }
-    f.particles.diameter.fill(diameter);
+    let p = &mut f.particles;
+    for (d, &t) in p.diameter.iter_mut().zip(&p.typeid) {
+        match diameters.get(t as usize) {
+            Some(&x) => *d = x,
+            None => bail!(
+                "{}: particle typeid {t} is not a species of the scenario",
+                path.display()
+            ),
+        }
+    }
     Ok(f)
 }
 

@@ -8,14 +8,14 @@ mod common;
 
 use colloidsim_md::brownian::ListState;
 use colloidsim_md::{BdError, BdParams, Brownian, Integrator};
-use colloidsim_particles::potential::{ConstantForce, External};
+use colloidsim_particles::potential::{ConstantForce, External, Pair};
 use colloidsim_particles::{LennardJones, Particles, SimBox};
 use common::on_ranks;
 use std::f64::consts::PI;
 
 /// `n` steps one at a time: [`Brownian::run`] runs them on a worker of the thread pool, where
 /// ranks that are threads of one process would wait for each other with too few workers.
-fn steps<E: External>(sim: &mut Brownian<LennardJones, E>, n: u64) {
+fn steps<P: Pair, E: External>(sim: &mut Brownian<P, E>, n: u64) {
     for _ in 0..n {
         sim.advance().unwrap();
     }
@@ -70,7 +70,7 @@ struct End {
     builds: u64,
 }
 
-fn end<E: External>(sim: &Brownian<LennardJones, E>) -> End {
+fn end<P: Pair, E: External>(sim: &Brownian<P, E>) -> End {
     End {
         snap: sim.snapshot(),
         forces: sim.forces(),

@@ -15,12 +15,14 @@ use super::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
 use super::scenario::{one_species, read_initial};
 use super::{BdError, BdParams, Brownian, Integrator};
 use crate::init::{PackingError, random_in_box};
-use crate::potential::{ConstantForce, LennardJones};
+use crate::potential::ConstantForce;
 use crate::state::{Particles, SimBox};
+use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_hydro::ewald::hasimoto;
 use colloidsim_hydro::{AnyMobility, HydroModel, HydroParams, Pse, PseGeometry};
+use colloidsim_particles::{Interaction, PairSpec};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -42,6 +44,9 @@ pub struct BulkParams {
     pub box_length: f64,
     /// Sphere diameter d.
     pub diameter: f64,
+    /// The pair interaction (`None`: WCA with eps = kT at the diameter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pair: Option<PairSpec>,
     /// Thermal energy kT.
     pub kt: f64,
     /// Solvent viscosity eta.
@@ -127,12 +132,15 @@ pub enum BulkError {
     /// The hydrodynamic engine or its mobility refused the configuration.
     #[error(transparent)]
     Hydro(#[from] HydroBdError),
+    /// A parameter of the pair interaction is out of range.
+    #[error(transparent)]
+    Param(#[from] ParamError),
 }
 
 /// The free-draining engine of a bulk run.
-pub type BulkSim = Brownian<LennardJones, ConstantForce>;
+pub type BulkSim = Brownian<Interaction, ConstantForce>;
 /// The engine of a bulk run with RPY (PSE).
-pub type HydroBulkSim = HydroBrownian<LennardJones, ConstantForce, AnyMobility>;
+pub type HydroBulkSim = HydroBrownian<Interaction, ConstantForce, AnyMobility>;
 
 impl BulkParams {
     /// Does a replica run with RPY ([`Self::build_hydro_replica`]) rather than free draining
@@ -148,9 +156,13 @@ impl BulkParams {
         SimBox::cube(self.box_length)
     }
 
-    /// The WCA pair potential (`epsilon = kT`, `sigma = d`).
-    pub fn pair(&self) -> LennardJones {
-        LennardJones::wca(self.kt, self.diameter)
+    /// The pair interaction ([`Self::pair`]; WCA with `epsilon = kT`, `sigma = d` by default).
+    pub fn pair(&self) -> Result<Interaction, ParamError> {
+        let d = [self.diameter];
+        match &self.pair {
+            Some(p) => p.build(&d, self.kt),
+            None => PairSpec::wca(self.kt, 1).build(&d, self.kt),
+        }
     }
 
     /// The body force.
@@ -263,7 +275,7 @@ impl BulkParams {
         Ok(Brownian::new(
             self.initial_particles(replica)?,
             self.sbox(),
-            self.pair(),
+            self.pair()?,
             self.body(),
             self.bd_params(replica),
             0,
@@ -299,7 +311,7 @@ impl BulkParams {
         Ok(HydroBrownian::new(
             particles,
             self.sbox(),
-            self.pair(),
+            self.pair()?,
             self.body(),
             mobility,
             params,

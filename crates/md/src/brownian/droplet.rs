@@ -7,10 +7,10 @@
 //! (`colloidsim theory`) take them.
 
 use super::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
-use super::scenario::{one_species, read_initial};
+use super::scenario::{read_initial, species_from_file};
 use super::{BdError, BdParams, Brownian, Integrator};
-use crate::init::random_in_sphere;
-use crate::potential::{HarmonicInterface, LennardJones, SphereAreaLaw};
+use crate::init::random_mixture_in_sphere;
+use crate::potential::{HarmonicInterface, Pair, SpeciesInterface, SphereAreaLaw};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
 use colloidsim_hydro::direct::DEFAULT_MAX_DIRECT;
@@ -18,6 +18,7 @@ use colloidsim_hydro::{
     AnyMobility, DirectRpy, FreeDraining, HydroMethod, HydroModel, HydroParams, Pse, PseGeometry,
     PseParams,
 };
+use colloidsim_particles::{Interaction, Mixture, PairSpec};
 use serde::Serialize;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -41,17 +42,23 @@ pub struct DropletParams {
     pub seed: u32,
     /// Independent replicas.
     pub replicas: usize,
-    /// Number of colloids.
+    /// Number of colloids (of all species).
     pub particles: usize,
-    /// Colloid diameter d.
+    /// Colloid diameter d: the smallest species' (the length of the defaults).
     pub diameter: f64,
+    /// The species and their numbers (absent from the resolved parameters when one).
+    #[serde(skip_serializing_if = "Mixture::is_single")]
+    pub species: Mixture,
+    /// The pair interaction (`None`: WCA with eps = kT at each pair's mean diameter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pair: Option<PairSpec>,
     /// Thermal energy kT.
     pub kt: f64,
     /// Solvent viscosity.
     pub viscosity: f64,
-    /// Stokes friction `3 pi eta d`.
+    /// Stokes friction `3 pi eta d` (of the smallest species).
     pub friction: f64,
-    /// Free diffusivity `D0 = kT / (3 pi eta d)`.
+    /// Free diffusivity `D0 = kT / (3 pi eta d)` (of the smallest species).
     pub d0: f64,
     /// Initial volume fraction.
     pub phi0: f64,
@@ -111,9 +118,19 @@ impl DropletParams {
             .sqrt()
     }
 
-    /// Mean volume fraction `N d^3 / (8 R^3)` at radius `r`.
+    /// Mean volume fraction `sum_s N_s d_s^3 / (8 R^3)` at radius `r`.
     pub fn volume_fraction_at_radius(&self, r: f64) -> f64 {
-        self.particles as f64 * self.diameter.powi(3) / (8.0 * r.powi(3))
+        self.species.sum_n_d3() / (8.0 * r.powi(3))
+    }
+
+    /// The pair interaction of the species ([`Self::pair`]; WCA with eps = kT by default).
+    pub fn interaction(&self) -> Result<Interaction, ParamError> {
+        match &self.pair {
+            Some(p) => p.build(&self.species.diameters, self.kt),
+            None => {
+                PairSpec::wca(self.kt, self.species.len()).build(&self.species.diameters, self.kt)
+            }
+        }
     }
 
     /// A static droplet (`drying.peclet = 0`): the radius stays R0.
@@ -158,10 +175,11 @@ pub enum DropletError {
 
 /// The engine of a droplet replica with hydrodynamics (`[hydrodynamics]`): WCA colloids inside
 /// the moving harmonic interface, moved by the chosen mobility.
-pub type HydroDropletSim = HydroBrownian<LennardJones, HarmonicInterface, AnyMobility>;
+pub type HydroDropletSim = HydroBrownian<Interaction, SpeciesInterface, AnyMobility>;
 
-/// The engine a droplet replica runs: WCA colloids inside the moving harmonic interface.
-pub type DropletSim = Brownian<LennardJones, HarmonicInterface>;
+/// The engine a droplet replica runs: colloids (WCA by default) inside the moving harmonic
+/// interface.
+pub type DropletSim = Brownian<Interaction, SpeciesInterface>;
 
 impl DropletParams {
     /// The droplet interface (centred on the origin).
@@ -178,29 +196,36 @@ impl DropletParams {
         }
     }
 
+    /// The interface as each species meets it: `offset` places it for the smallest spheres,
+    /// a sphere of diameter `d` meets it `(d - d_min) / 2` further in.
+    pub fn species_interface(&self) -> SpeciesInterface {
+        SpeciesInterface {
+            interface: self.interface(),
+            reference_diameter: self.diameter,
+        }
+    }
+
     /// Edge of the (periodic) simulation box: the droplet with its interface range and
     /// two neighbour ranges of margin, so that no interaction crosses the boundary.
     pub fn box_edge(&self) -> f64 {
         let reach = self.r0 + self.offset.max(0.0) + self.range;
-        2.0 * (reach + 2.0 * (2f64.powf(1.0 / 6.0) * self.diameter + self.skin))
-            + 2.0 * self.diameter
+        let r_cut = self
+            .interaction()
+            .map_or(2f64.powf(1.0 / 6.0) * self.diameter, |p| p.r_cut_max());
+        2.0 * (reach + 2.0 * (r_cut + self.skin)) + 2.0 * self.species.d_max()
     }
 
     /// The initial particles of replica `replica`: random insertion (stream index `replica`)
     /// or the last frame of `system.initial`.
     fn initial_particles(&self, replica: u32) -> Result<Particles, DropletError> {
         Ok(match &self.initial {
-            None => Particles::monodisperse(
-                random_in_sphere(
-                    self.particles,
-                    self.diameter,
-                    [0.0; 3],
-                    self.r0 + self.offset,
-                    self.seed,
-                    replica as u64,
-                )?,
-                self.diameter,
-            ),
+            None => self.species.particles(random_mixture_in_sphere(
+                &self.species.particle_diameters(),
+                [0.0; 3],
+                self.r0 + self.offset,
+                self.seed,
+                replica as u64,
+            )?),
             Some(path) => {
                 let f = read_initial(path, self.particles).map_err(DropletError::Initial)?;
                 let mut p = f.particles;
@@ -220,7 +245,7 @@ impl DropletParams {
                         path.display()
                     )));
                 }
-                one_species(path, &mut p, "droplet", self.diameter)
+                species_from_file(path, &mut p, "droplet", &self.species)
                     .map_err(DropletError::Initial)?;
                 p
             }
@@ -254,8 +279,8 @@ impl DropletParams {
         Ok(Brownian::new(
             particles,
             sbox,
-            LennardJones::wca(self.kt, self.diameter),
-            self.interface(),
+            self.interaction()?,
+            self.species_interface(),
             self.bd_params(replica),
             0,
         )?)
@@ -272,7 +297,7 @@ impl DropletParams {
             return Ok(self.box_edge());
         }
         let l = hydro.box_factor * 2.0 * self.r0;
-        let min = self.box_edge() - 2.0 * self.diameter;
+        let min = self.box_edge() - 2.0 * self.species.d_max();
         if l < min {
             return Err(ParamError::new(
                 "box_factor",
@@ -309,6 +334,11 @@ impl DropletParams {
             other => ParamError::new("hydrodynamics", other.to_string()),
         };
         match h.method {
+            Some(HydroMethod::Pse) if !self.species.is_single() => Err(ParamError::new(
+                "method",
+                "\"pse\" takes one species so far; for unequal radii use method = \"direct\" \
+                 (free-space RPY of unequal spheres, Zuk et al. 2014)",
+            )),
             Some(HydroMethod::Pse) => {
                 let l = self.hydro_box_edge(h)?;
                 h.check_pse_extent(l, "splitting")?;
@@ -377,24 +407,24 @@ impl DropletParams {
     ) -> Result<HydroDropletSim, DropletError> {
         let l = self.hydro_box_edge(hydro)?;
         let n = particles.len();
-        let a = 0.5 * self.diameter;
+        let radii: Vec<f64> = particles.diameter.iter().map(|d| 0.5 * d).collect();
         let mobility = match (hydro.model, hydro.method) {
             (HydroModel::FreeDraining, _) => AnyMobility::FreeDraining(
-                FreeDraining::new(&vec![a; n], self.viscosity).map_err(HydroBdError::from)?,
+                FreeDraining::new(&radii, self.viscosity).map_err(HydroBdError::from)?,
             ),
             (HydroModel::Rpy, Some(HydroMethod::Pse)) => AnyMobility::Pse(Box::new(
                 Pse::new(n, self.pse_params(hydro, l)).map_err(HydroBdError::from)?,
             )),
             (HydroModel::Rpy, _) => AnyMobility::Direct(Box::new(
-                DirectRpy::new(n, a, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)
+                DirectRpy::with_radii(&radii, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)
                     .map_err(HydroBdError::from)?,
             )),
         };
         Ok(HydroBrownian::new(
             particles,
             SimBox::cube(l),
-            LennardJones::wca(self.kt, self.diameter),
-            self.interface(),
+            self.interaction()?,
+            self.species_interface(),
             mobility,
             params,
             step,

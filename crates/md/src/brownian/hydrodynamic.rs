@@ -227,7 +227,7 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             .with_min_len(256)
             .for_each(|(i, f)| {
                 let xi = p.pos[i];
-                let mut s = external.force(xi, t);
+                let mut s = external.force_on(xi, t, p.diameter[i]);
                 for &j in nlist.neighbors(i) {
                     let j = j as usize;
                     let xj = p.pos[j];

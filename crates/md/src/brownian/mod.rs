@@ -738,7 +738,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let mut pair_force = PairForceCursor::new(&slabs, &self.slab_of, 0);
         for (k, &tag) in self.tag.iter().enumerate() {
             let mut f = pair_force.force(k);
-            let e = self.external.force(p.pos[k], t);
+            let e = self.external.force_on(p.pos[k], t, p.diameter[k]);
             for a in 0..3 {
                 f[a] += e[a];
             }
@@ -904,6 +904,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let pass = StepPass {
             pos: &self.particles.pos,
             kinetics: &self.kinetics,
+            diameter: &self.particles.diameter,
             ref_pos: &self.ref_pos,
             tag: &self.tag,
             slabs: &self.slabs,
@@ -980,6 +981,7 @@ type LmDeviates<'a> = (&'a [[f64; 3]], &'a [[f64; 3]]);
 struct StepPass<'a, E> {
     pos: &'a [[f64; 3]],
     kinetics: &'a [[f64; 3]],
+    diameter: &'a [f64],
     ref_pos: &'a [[f64; 3]],
     tag: &'a [u32],
     slabs: &'a [Slab],
@@ -1016,7 +1018,7 @@ impl<E: External> StepPass<'_, E> {
                 let [drift_per_force, amp, limit2] = self.kinetics[i];
                 let x = self.pos[i];
                 let fp = pair_force.force(i);
-                let fe = self.external.force(x, self.t);
+                let fe = self.external.force_on(x, self.t, self.diameter[i]);
                 let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
                 let drift = [
                     f[0] * drift_per_force,

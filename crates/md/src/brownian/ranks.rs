@@ -512,7 +512,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let mut mine = Vec::with_capacity(4 * self.owned());
         for k in self.owned_slots() {
             let fp = cursor.force(k);
-            let fe = self.external.force(self.particles.pos[k], t);
+            let fe = self
+                .external
+                .force_on(self.particles.pos[k], t, self.particles.diameter[k]);
             mine.push(self.tag[k] as f64);
             mine.extend_from_slice(&[fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]]);
         }

@@ -5,6 +5,7 @@ use super::hydrodynamic::HydroBdParams;
 use super::{BdParams, Integrator};
 use crate::gsd::{GsdFrame, read_frame};
 use crate::state::Particles;
+use colloidsim_particles::Mixture;
 use std::path::Path;
 
 /// The last frame of `path` (`system.initial`), which must hold `n` particles; the error
@@ -37,6 +38,46 @@ pub(crate) fn one_species(
         ));
     }
     p.diameter.iter_mut().for_each(|x| *x = d);
+    Ok(())
+}
+
+/// The particles read from `path` hold the species of `mixture`: each particle's typeid names
+/// its species, the counts match, and every particle gets its species' diameter. One species:
+/// [`one_species`].
+pub(crate) fn species_from_file(
+    path: &Path,
+    p: &mut Particles,
+    what: &str,
+    mixture: &Mixture,
+) -> Result<(), String> {
+    if mixture.is_single() {
+        return one_species(path, p, what, mixture.diameters[0]);
+    }
+    let mut counts = vec![0usize; mixture.len()];
+    for (i, &t) in p.typeid.iter().enumerate() {
+        match counts.get_mut(t as usize) {
+            Some(c) => *c += 1,
+            None => {
+                return Err(format!(
+                    "{}: particle {i} has typeid {t}, but the {what} has {} species (typeids 0 to {})",
+                    path.display(),
+                    mixture.len(),
+                    mixture.len() - 1
+                ));
+            }
+        }
+    }
+    if counts != mixture.counts {
+        return Err(format!(
+            "{}: holds {counts:?} particles of each species, the scenario {:?}",
+            path.display(),
+            mixture.counts
+        ));
+    }
+    for (d, &t) in p.diameter.iter_mut().zip(&p.typeid) {
+        *d = mixture.diameters[t as usize];
+    }
+    p.type_names = mixture.names.clone();
     Ok(())
 }
 

@@ -371,6 +371,7 @@ pub(crate) const SEED_KEY: Spec = key(
 pub(crate) const COUNT: i64 = 1 << 53;
 
 pub mod shared;
+pub mod species;
 
 /// Check a scenario's table against a method's keys: unknown keys (with the keys of that
 /// table), types and each key's own range. `prefix` is the path of `table` (empty at the top).
@@ -467,6 +468,11 @@ impl<'a> Reader<'a> {
             v = v.as_table()?.get(p)?;
         }
         Some(v)
+    }
+
+    /// Is `k` one of this method's keys?
+    pub fn declares(&self, k: &Spec) -> bool {
+        self.spec.iter().any(|s| s.path == k.path)
     }
 
     /// Does the scenario give `k` (a key, or a table)?
@@ -594,6 +600,11 @@ impl<'a> Reader<'a> {
                 .collect(),
             other => bail!("{}: expected a list of numbers, got {other:?}", k.path),
         }
+    }
+
+    /// A list of numbers the scenario may leave out ([`Omitted::Means`]).
+    pub fn opt_numbers(&self, k: &Spec) -> Result<Option<Vec<f64>>> {
+        self.optional(k, Self::numbers)
     }
 
     /// A file name as written (relative to the scenario's folder), if given.

@@ -402,7 +402,10 @@ pub fn colloid(r: &Reader, diameter: &Spec, d: f64, colloids: bool) -> Result<Co
 pub const DIAMETER: Spec = key(
     "system.diameter",
     "length",
-    Value("1"),
+    Derived(
+        "1; with system.species, the smallest of its diameters",
+        |r| Ok(super::species::smallest_diameter(r)?.unwrap_or(1.0)),
+    ),
     Positive,
     "colloid diameter d",
 );

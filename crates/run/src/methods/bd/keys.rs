@@ -11,6 +11,7 @@ use crate::keys::shared::{
     DIAMETER, HYDRO_MAX_ITERATIONS, HYDRO_MODEL, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS,
     KT, RUN_DT, RUN_INTEGRATOR, RUN_SKIN, TRAJECTORY, TRAJECTORY_EVERY, VISCOSITY,
 };
+use crate::keys::species::*;
 use crate::keys::{SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["bd"]),
@@ -81,6 +82,20 @@ pub static KEYS: &[Spec] = &[
     VISCOSITY,
     SYSTEM_BODY_FORCE,
     SYSTEM_INITIAL,
+    PAIR,
+    PAIR_KIND,
+    PAIR_EPSILON,
+    PAIR_CUTOFF,
+    PAIR_CHARGES,
+    PAIR_BJERRUM,
+    PAIR_DEBYE,
+    PAIR_RANGE,
+    PAIR_DEPTH,
+    PAIR_KAPPA,
+    PAIR_H0,
+    PAIR_DEPLETANT_DIAMETER,
+    PAIR_DEPLETANT_FRACTION,
+    PAIR_TABLE,
     RUN,
     RUN_TIME,
     RUN_DT,

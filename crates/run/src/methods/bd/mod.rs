@@ -239,7 +239,7 @@ fn restore_replica(
     state: &ReplicaState,
 ) -> Result<(Replica, u64)> {
     let hydro = p.has_hydrodynamics();
-    let f = read_replica_checkpoint(out, state, saved.step, saved.replica, hydro, p.diameter)?;
+    let f = read_replica_checkpoint(out, state, saved.step, saved.replica, hydro, &[p.diameter])?;
     let path = out.join(&state.0);
     let engine = &state.2;
     let sim = if hydro {
@@ -252,7 +252,7 @@ fn restore_replica(
             Brownian::restart(
                 f.particles,
                 f.sbox,
-                p.pair(),
+                p.pair()?,
                 p.body(),
                 p.bd_params(saved.replica as u32),
                 f.step,

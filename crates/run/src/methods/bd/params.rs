@@ -14,6 +14,7 @@ use colloidsim_core::param::show;
 use colloidsim_md::brownian::bulk::{BulkParams, MAX_BODY_DRIFT, WCA_RANGE};
 use colloidsim_md::brownian::droplet::{MAX_PHI_FINAL, MAX_PHI0};
 use colloidsim_md::hydro::{HydroError, HydroModel, PseGeometry};
+use colloidsim_particles::{Mixture, Pair};
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -82,12 +83,17 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
     let time = r.number(&RUN_TIME)?;
     let equilibrate = r.number(&RUN_EQUILIBRATE)?;
     let skin = within(&RUN_SKIN, r.number(&RUN_SKIN)?, 1e-3 * d, 5.0 * d)?;
-    let range = WCA_RANGE * d + skin;
+    let pair = crate::keys::species::pair(r, &Mixture::one(d, particles), kt, base)?;
+    let r_cut = match &pair {
+        Some(spec) => spec.build(&[d], kt)?.r_cut_max(),
+        None => WCA_RANGE * d,
+    };
+    let range = r_cut + skin;
     if l <= 2.0 * range {
         bail!(ParamError::new(
             SYSTEM_BOX_LENGTH.path,
             format!(
-                "an edge of {} is too small for the neighbour range 2^(1/6) d + run.skin = {range:.4}: \
+                "an edge of {} is too small for the neighbour range (pair cut-off + run.skin) = {range:.4}: \
                  it must exceed twice that, {:.4} (or lower run.skin)",
                 show(l),
                 2.0 * range
@@ -179,6 +185,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         particles,
         box_length: l,
         diameter: d,
+        pair,
         kt,
         viscosity: eta,
         friction,

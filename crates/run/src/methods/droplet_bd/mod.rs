@@ -24,7 +24,7 @@ use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::DropletParams;
 use colloidsim_md::brownian::droplet::{DropletError, DropletSim};
-use colloidsim_particles::{HarmonicInterface, LennardJones, Particles};
+use colloidsim_particles::{Particles, SpeciesInterface};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
@@ -35,6 +35,7 @@ pub struct DropletBd;
 #[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
+mod species;
 pub mod theory;
 
 /// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
@@ -190,6 +191,9 @@ struct Accum {
     digest: FrameDigest,
     /// Checkpoints written so far (alternates the GSD file name).
     checkpoints: u64,
+    /// Two or more species: their profiles and the stratification.
+    #[serde(default)]
+    species: species::SpeciesAccum,
 }
 
 impl Accum {
@@ -206,6 +210,7 @@ impl Accum {
             frames: 0,
             digest: FrameDigest::default(),
             checkpoints: 0,
+            species: Default::default(),
         }
     }
 }
@@ -228,7 +233,7 @@ fn restore_replica(
         saved.step,
         saved.replica,
         hydro.is_some(),
-        p.diameter,
+        &p.species.diameters,
     )?;
     let path = out.join(&state.0);
     let engine = &state.2;
@@ -237,8 +242,8 @@ fn restore_replica(
             DropletSim::restart(
                 f.particles,
                 f.sbox,
-                LennardJones::wca(p.kt, p.diameter),
-                p.interface(),
+                p.interaction()?,
+                p.species_interface(),
                 p.bd_params(saved.replica as u32),
                 f.step,
                 f.list.as_ref(),
@@ -261,7 +266,7 @@ fn restore_replica(
 }
 
 /// A running droplet replica, in the moving harmonic interface.
-type Replica = crate::bd_replica::Replica<HarmonicInterface>;
+type Replica = crate::bd_replica::Replica<SpeciesInterface>;
 
 /// Replica `replica` of `p` at step 0, with the engine its hydrodynamics ask for.
 fn build_replica(p: &DropletParams, replica: u32) -> Result<Replica> {
@@ -288,7 +293,7 @@ fn keyed(e: DropletError) -> anyhow::Error {
 }
 
 /// A droplet run: replicas one after the other.
-type DropletSession = BdSession<HarmonicInterface, DropletObs>;
+type DropletSession = BdSession<SpeciesInterface, DropletObs>;
 
 /// What a droplet run observes: profiles, the excursion beyond the wall, trajectory frames,
 /// the cross-section of replica 0.
@@ -330,19 +335,19 @@ impl DropletObs {
     }
 }
 
-impl Observe<HarmonicInterface> for DropletObs {
+impl Observe<SpeciesInterface> for DropletObs {
     fn build(&self, replica: u32) -> Result<Replica> {
         build_replica(&self.p, replica)
     }
 
-    fn next_event(&self, run: &Replicas<HarmonicInterface>, step: u64) -> u64 {
+    fn next_event(&self, run: &Replicas<SpeciesInterface>, step: u64) -> u64 {
         let k = self.stops.partition_point(|&e| e <= step);
         self.stops.get(k).copied().unwrap_or(run.steps)
     }
 
     /// Record what is due at step `ev` of the running replica: profiles, the excursion
     /// beyond the wall, trajectory frames.
-    fn record(&mut self, run: &mut Replicas<HarmonicInterface>, ev: u64) -> Result<()> {
+    fn record(&mut self, run: &mut Replicas<SpeciesInterface>, ev: u64) -> Result<()> {
         let Some((s, _)) = &run.sim else {
             return Ok(());
         };
@@ -369,6 +374,7 @@ impl Observe<HarmonicInterface> for DropletObs {
                 acc.counts[j] += 1;
                 acc.radii[j] = radius;
                 acc.r_axes[j] = prof.r;
+                acc.species.record(p, j, &part, radius);
                 if ev == p.steps {
                     acc.outside_final += prof.outside as u64;
                 }
@@ -381,7 +387,7 @@ impl Observe<HarmonicInterface> for DropletObs {
         Ok(())
     }
 
-    fn replica_done(&mut self, run: &Replicas<HarmonicInterface>, builds: u64) -> Result<()> {
+    fn replica_done(&mut self, run: &Replicas<SpeciesInterface>, builds: u64) -> Result<()> {
         if run.rep == 0
             && let (Some(width), Some(out), Some((s, _))) =
                 (self.p.cross_section, &self.folder, &run.sim)
@@ -397,7 +403,7 @@ impl Observe<HarmonicInterface> for DropletObs {
     }
 }
 
-impl BdMethod<HarmonicInterface> for DropletObs {
+impl BdMethod<SpeciesInterface> for DropletObs {
     type Acc = Accum;
 
     fn acc(&self) -> &Accum {
@@ -428,9 +434,13 @@ impl BdMethod<HarmonicInterface> for DropletObs {
                 .is_some_and(|f| f.parse::<f64>().is_ok())
         };
         profile("profile_")
+            || profile("species_profile_")
             || [
                 "profiles.png",
                 "profile_mean.csv",
+                "species_profiles.png",
+                "stratification.csv",
+                "stratification.png",
                 "cross_section.csv",
                 "cross_section.png",
             ]
@@ -453,6 +463,7 @@ impl BdMethod<HarmonicInterface> for DropletObs {
             outside_final,
             builds,
             frames,
+            species,
             ..
         } = self.acc;
         let mut warnings = Vec::new();
@@ -543,6 +554,16 @@ impl BdMethod<HarmonicInterface> for DropletObs {
                 files.push("profile_mean.csv".into());
             }
         }
+        let stratification = species.write(
+            out,
+            p,
+            &drawn,
+            &counts,
+            &radii,
+            &r_axes,
+            &mut files,
+            &mut warnings,
+        )?;
         if p.cross_section.is_some() && out.join("cross_section.csv").exists() {
             files.push("cross_section.csv".into());
             if out.join("cross_section.png").exists() {
@@ -570,7 +591,7 @@ impl BdMethod<HarmonicInterface> for DropletObs {
             files.push("trajectory.gsd".into());
         }
         let particle_steps = (p.steps * p.replicas as u64) as f64 * p.particles as f64;
-        let summary = json!({
+        let mut summary = json!({
             "software": crate::software(),
             "method": "droplet-bd",
             "seed": p.seed,
@@ -588,6 +609,9 @@ impl BdMethod<HarmonicInterface> for DropletObs {
             "trajectory_frames": frames,
             "warnings": warnings,
         });
+        if !stratification.is_null() {
+            summary["stratification"] = stratification;
+        }
         let message = format!(
             "{} replica(s) x {} steps of {} colloids in {wall_s:.1} s ({:.3e} particle-steps/s); outputs in {}",
             p.replicas,

@@ -60,8 +60,11 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
         friction,
         d0,
     } = shared::spheres(r)?;
+    let species = crate::keys::species::species(r, particles, d, &shared::DIAMETER)?;
+    let pair = crate::keys::species::pair(r, &species, kt, base)?;
     let initial = r.file(&SYSTEM_INITIAL).map(|f| base.join(f));
-    let n = particles as f64;
+    // Spheres of diameter d with the colloids' volume (N for one species).
+    let n = species.equivalent_number(d);
     // Random insertion packs to MAX_PHI0; a configuration read from a file may be denser.
     let max_phi0 = if initial.is_some() {
         MAX_PHI_FINAL
@@ -88,7 +91,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
                 bail!(ParamError::new(
                     SYSTEM_RADIUS.path,
                     format!(
-                        "{particles} particles of diameter {d} in radius {radius} give phi0 = {phi:.4}, \
+                        "{particles} particles (diameter {d}) in radius {radius} give phi0 = {phi:.4}, \
                          which cannot be packed (at most {max_phi0}); \
                          the radius must be at least {:.4}",
                         d * (n / (8.0 * max_phi0)).cbrt()
@@ -318,6 +321,8 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
         replicas,
         particles,
         diameter: d,
+        species,
+        pair,
         kt,
         viscosity: eta,
         friction,
