@@ -47,10 +47,10 @@ pub fn rosenfeld_phi(n3: f64, n2: f64, nv2: f64, a: f64) -> (f64, f64, f64, f64)
 /// Refuse a `diameter` that is not positive, a grid that does not resolve it
 /// (`diameter / dr < 10`, naming `dr`) or one shorter than it (naming `r_max`).
 pub(crate) fn check_resolution(grid: &RadialGrid, diameter: f64) -> Result<(), RadialError> {
-        colloidsim_core::param::positive("diameter", diameter)?;
-        let dr = grid.dr();
-        if diameter / dr < MIN_CELLS_PER_DIAMETER {
-            return Err(colloidsim_core::ParamError::new(
+    colloidsim_core::param::positive("diameter", diameter)?;
+    let dr = grid.dr();
+    if diameter / dr < MIN_CELLS_PER_DIAMETER {
+        return Err(colloidsim_core::ParamError::new(
                 "dr",
                 format!(
                     "grid spacing {dr} does not resolve the particle: need dr <= diameter / {MIN_CELLS_PER_DIAMETER} = {}",
@@ -58,18 +58,18 @@ pub(crate) fn check_resolution(grid: &RadialGrid, diameter: f64) -> Result<(), R
                 ),
             )
             .into());
-        }
-        if grid.r_max() < diameter {
-            return Err(colloidsim_core::ParamError::new(
-                "r_max",
-                format!(
-                    "grid extent {} is shorter than the diameter {diameter}",
-                    grid.r_max()
-                ),
-            )
-            .into());
-        }
-        Ok(())
+    }
+    if grid.r_max() < diameter {
+        return Err(colloidsim_core::ParamError::new(
+            "r_max",
+            format!(
+                "grid extent {} is shorter than the diameter {diameter}",
+                grid.r_max()
+            ),
+        )
+        .into());
+    }
+    Ok(())
 }
 
 /// The exact cell integrals of the radial kernels for spheres of one diameter (module docs):

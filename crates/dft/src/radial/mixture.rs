@@ -57,8 +57,8 @@ use colloidsim_core::{ParamError, param};
 
 use super::droplet::CLOSE_PACKING;
 use super::{
-    DdftOptions, DryingSchedule, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
-    RadialError, RadialGrid, StepReport,
+    DdftOptions, DryingSchedule, EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError,
+    RadialGrid, StepReport,
 };
 
 /// One species of a mixture.
@@ -144,7 +144,10 @@ impl MixtureSetup {
                 sp.interface.stiffness,
             )?;
             param::positive(&format!("species[{s}].interface.range"), sp.interface.range)?;
-            param::finite(&format!("species[{s}].interface.offset"), sp.interface.offset)?;
+            param::finite(
+                &format!("species[{s}].interface.offset"),
+                sp.interface.offset,
+            )?;
             if sp.diameter / self.dr < super::fmt::MIN_CELLS_PER_DIAMETER {
                 return Err(ParamError::new(
                     "dr",

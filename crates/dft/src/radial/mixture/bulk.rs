@@ -59,9 +59,7 @@ pub fn excess_free_energy_density(functional: Functional, rho: &[f64], diameters
         * match functional {
             Functional::Rosenfeld => -x0 * l + 3.0 * x1 * x2 * q + 1.5 * x2.powi(3) * q * q,
             Functional::WhiteBear => {
-                (x2.powi(3) / (x3 * x3) - x0) * l
-                    + 3.0 * x1 * x2 * q
-                    + x2.powi(3) / x3 * q * q
+                (x2.powi(3) / (x3 * x3) - x0) * l + 3.0 * x1 * x2 * q + x2.powi(3) / x3 * q * q
             }
         }
 }

@@ -42,7 +42,10 @@ pub fn solve_mixture_equilibrium(
     if particles.len() != ns {
         return Err(colloidsim_core::ParamError::new(
             "particles",
-            format!("needs one number per species ({ns}), got {}", particles.len()),
+            format!(
+                "needs one number per species ({ns}), got {}",
+                particles.len()
+            ),
         )
         .into());
     }
@@ -50,7 +53,11 @@ pub fn solve_mixture_equilibrium(
         param::positive(&format!("particles[{s}]"), p)?;
     }
     let n = grid.len();
-    assert_eq!(beta_v.len(), ns * n, "potential of every species at every cell");
+    assert_eq!(
+        beta_v.len(),
+        ns * n,
+        "potential of every species at every cell"
+    );
     let vol = grid.volumes();
     let mut x = vec![0.0; ns * n];
     let mut g = vec![0.0; ns * n];

@@ -193,7 +193,11 @@ impl MixtureFmt {
     /// density is not finite (time `NaN` for the caller to fill in).
     pub fn evaluate(&mut self, rho: &[f64], active: usize) -> Result<f64, RadialError> {
         let n = self.n;
-        assert_eq!(rho.len(), n * self.species(), "one density per species and cell");
+        assert_eq!(
+            rho.len(),
+            n * self.species(),
+            "one density per species and cell"
+        );
         let active = active.min(n);
         let rows = self.rows_touched(active);
         for v in self.wd.iter_mut() {
@@ -301,5 +305,29 @@ impl MixtureFmt {
     /// `beta mu_ex` of species `s` at the centres.
     pub fn mu_ex(&self, s: usize) -> &[f64] {
         &self.mu[s * self.n..(s + 1) * self.n]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// White Bear's `phi3`: the series meets the closed form at `n3 = 0.01`, starts at
+    /// Rosenfeld's `1 / (24 pi)`, and its derivative is the finite difference of the function.
+    #[test]
+    fn white_bear_phi3_series_closed_form_and_derivative_agree() {
+        let wb = Functional::WhiteBear;
+        let (below, dbelow) = wb.phi3(0.01 - 1e-15);
+        let (above, dabove) = wb.phi3(0.01);
+        assert!((below / above - 1.0).abs() < 1e-12, "{below} {above}");
+        assert!((dbelow / dabove - 1.0).abs() < 1e-9, "{dbelow} {dabove}");
+        assert!((wb.phi3(0.0).0 * 24.0 * PI - 1.0).abs() < 1e-15);
+        for x in [1e-3, 0.02, 0.3, 0.6] {
+            for f in [Functional::Rosenfeld, Functional::WhiteBear] {
+                let h = 1e-6;
+                let fd = (f.phi3(x + h).0 - f.phi3(x - h).0) / (2.0 * h);
+                assert!((fd / f.phi3(x).1 - 1.0).abs() < 1e-7, "{f:?} {x}");
+            }
+        }
     }
 }

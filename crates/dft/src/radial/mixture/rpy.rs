@@ -182,7 +182,10 @@ mod tests {
             for (x, y) in [(3.0, 3.4), (3.0, 2.2), (0.7, 0.5), (0.3, 1.4), (5.0, 6.3)] {
                 let k = kernel(x, y, ai, aj);
                 let q = direct(x, y, ai, aj);
-                assert!((k - q).abs() < 1e-6 * (1.0 + q.abs()), "({x},{y}) {k} vs {q}");
+                assert!(
+                    (k - q).abs() < 1e-6 * (1.0 + q.abs()),
+                    "({x},{y}) {k} vs {q}"
+                );
             }
         }
         // One size: 6 pi a D0 K = M of the one-size kernel (D0 = 1).
