@@ -196,6 +196,12 @@ fn run(setup: &MixtureSetup) -> (Result<Vec<f64>, RadialError>, Vec<MixtureSnaps
 
 #[test]
 fn one_species_mixture_run_is_the_single_species_run() {
+    for hydro in [Hydrodynamics::FreeDraining, Hydrodynamics::Rpy] {
+        one_species_run(hydro);
+    }
+}
+
+fn one_species_run(hydro: Hydrodynamics) {
     let (r0, phi0, phi_end): (f64, f64, f64) = (6.0, 0.1, 0.2);
     let schedule = DryingSchedule::from_peclet(r0, 10.0, 1.0).unwrap();
     let t_end = schedule.time_at_radius(r0 * (phi0 / phi_end).cbrt());
@@ -208,7 +214,7 @@ fn one_species_mixture_run_is_the_single_species_run() {
         interface: wall(1.0),
         t_end,
         dr: 0.05,
-        hydrodynamics: Hydrodynamics::FreeDraining,
+        hydrodynamics: hydro,
         pair: Default::default(),
     };
     let mix = MixtureSetup {
@@ -223,7 +229,7 @@ fn one_species_mixture_run_is_the_single_species_run() {
         t_end,
         dr: 0.05,
         functional: Functional::Rosenfeld,
-        hydrodynamics: Hydrodynamics::FreeDraining,
+        hydrodynamics: hydro,
     };
     let times = [0.5 * t_end, t_end];
     let eq = EquilibriumOptions::default();
@@ -264,8 +270,14 @@ fn mixture_particle_numbers_are_conserved_to_rounding() {
         let (drift, snaps) = run(&setup);
         let drift = drift.unwrap();
         assert_eq!(snaps.len(), 2);
+        let grid = setup.grid(setup.ddft_options().potential_cutoff).unwrap();
         for (s, d) in drift.iter().enumerate() {
             assert!(*d < 1e-11, "{hydro:?} species {s}: drift {d}");
+            let all = snaps[1].particles_beyond(&grid, s, 0.0);
+            let n = setup.species[s].particles;
+            assert!((all / n - 1.0).abs() < 1e-11, "{all} vs {n}");
+            let outer = snaps[1].particles_beyond(&grid, s, snaps[1].radius - 2.0);
+            assert!(outer > 0.0 && outer < all);
         }
         eprintln!(
             "{hydro:?}: drift {drift:?}, <r> at the end {:?}",

@@ -285,6 +285,22 @@ pub struct MixtureSnapshot {
     pub mean_radius: Vec<f64>,
 }
 
+impl MixtureSnapshot {
+    /// Number of particles of species `s` whose centres lie beyond `r` (cells piecewise
+    /// constant, the cell containing `r` counted by its overlap): with `r = radius - w` the
+    /// outer-shell composition the stratification measures use.
+    pub fn particles_beyond(&self, grid: &RadialGrid, s: usize, r: f64) -> f64 {
+        let faces = grid.faces();
+        (0..grid.len())
+            .filter(|&i| faces[i + 1] > r)
+            .map(|i| {
+                let lo = faces[i].max(r);
+                4.0 * PI / 3.0 * (faces[i + 1].powi(3) - lo.powi(3)) * self.rho[s][i]
+            })
+            .sum()
+    }
+}
+
 /// Summary of a mixture run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MixtureOutcome {
