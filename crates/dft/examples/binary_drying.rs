@@ -79,9 +79,9 @@ fn main() -> Result<(), RadialError> {
                 let (a, b) = (vol(0, 1.0), vol(1, 2.0));
                 a / (a + b)
             };
-            let peak = |s: usize| snap.phi[s].iter().cloned().fold(0.0, f64::max);
+            let peak = |s: usize| snap.n3_species[s].iter().cloned().fold(0.0, f64::max);
             println!(
-                "{:>4.0} %  R = {:.3}  <r>_s/R = {:.4}  <r>_l/R = {:.4}  outer-shell small share / mean = {:.4}  peak phi_s = {:.3}  peak phi_l = {:.3}  max n3 = {:.3}  ({:.1} s)",
+                "{:>4.0} %  R = {:.3}  <r>_s/R = {:.4}  <r>_l/R = {:.4}  outer-shell small share / mean = {:.4}  peak n3_s = {:.3}  peak n3_l = {:.3}  max n3 = {:.3}  ({:.1} s)",
                 100.0 * fractions[k],
                 snap.radius,
                 snap.mean_radius[0] / snap.radius,

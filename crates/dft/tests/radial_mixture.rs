@@ -279,6 +279,13 @@ fn mixture_particle_numbers_are_conserved_to_rounding() {
             let outer = snaps[1].particles_beyond(&grid, s, snaps[1].radius - 2.0);
             assert!(outer > 0.0 && outer < all);
         }
+        let last = &snaps[1];
+        for i in 0..grid.len() {
+            let sum = last.n3_species[0][i] + last.n3_species[1][i];
+            assert!((sum - last.n3[i]).abs() < 1e-14, "n3 shares at {i}");
+            let phi = PI * 8.0 * last.rho[1][i] / 6.0;
+            assert!((last.phi[1][i] - phi).abs() <= 1e-15 * phi, "phi_l at {i}");
+        }
         eprintln!(
             "{hydro:?}: drift {drift:?}, <r> at the end {:?}",
             snaps[1].mean_radius

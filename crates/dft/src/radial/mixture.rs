@@ -14,7 +14,8 @@
 //! (tested).
 //!
 //! Engine entry: [`run_mixture_droplet`] (equilibrium at `R0`, then DDFT, a
-//! [`MixtureSnapshot`] per output time with each species' `rho_s(r)`, `phi_s(r)` and mean radius).
+//! [`MixtureSnapshot`] per output time with each species' `rho_s(r)`, `phi_s(r) = pi d_s^3 rho_s / 6`,
+//! its share of the weighted `n3`, and its mean radius).
 //!
 //! ```no_run
 //! use colloidsim_dft::radial::*;
@@ -276,9 +277,12 @@ pub struct MixtureSnapshot {
     pub radius: f64,
     /// Number density `rho_s(r)` of each species at the cell centres.
     pub rho: Vec<Vec<f64>>,
-    /// Local packing fraction of each species, `phi_s(r)`: its share `n3_s` of the FMT weighted
-    /// packing fraction (the density averaged over a particle's volume; `sum_s phi_s = n3`).
+    /// Volume fraction of each species' centres, `phi_s(r) = pi d_s^3 rho_s(r) / 6` (the
+    /// quantity a particle run's centre histogram measures, as `phi` of the one-size theory).
     pub phi: Vec<Vec<f64>>,
+    /// Each species' share `n3_s` of the FMT weighted packing fraction (its density averaged
+    /// over a particle's volume; `sum_s n3_species[s] = n3`).
+    pub n3_species: Vec<Vec<f64>>,
     /// Total local packing fraction `n3`.
     pub n3: Vec<f64>,
     /// Mean distance from the centre of each species, `int r rho_s dV / N_s`.
@@ -391,7 +395,13 @@ pub fn run_mixture_droplet(
         let time = ddft.time();
         let rho: Vec<Vec<f64>> = (0..ns).map(|s| ddft.rho_of(s).to_vec()).collect();
         let f = ddft.functional_now()?;
-        let phi: Vec<Vec<f64>> = (0..ns).map(|s| f.n3_of(s).to_vec()).collect();
+        let n3_species: Vec<Vec<f64>> = (0..ns).map(|s| f.n3_of(s).to_vec()).collect();
+        let phi: Vec<Vec<f64>> = (0..ns)
+            .map(|s| {
+                let c = PI * diameters[s].powi(3) / 6.0;
+                rho[s].iter().map(|r| c * r).collect()
+            })
+            .collect();
         let n3 = f.n3().to_vec();
         let mut mean_radius = vec![0.0; ns];
         for s in 0..ns {
@@ -409,6 +419,7 @@ pub fn run_mixture_droplet(
                 radius,
                 rho,
                 phi,
+                n3_species,
                 n3,
                 mean_radius,
             },
