@@ -13,6 +13,8 @@
 //! - [`g2`]: the RPY kernel of a tabulated inhomogeneous pair correlation `g2(r1, r2, s)`.
 //! - [`pair`]: bulk hard-sphere pair correlation `g(r; eta)` (Trokhymchuk et al. 2005).
 //! - [`bulk`]: Percus–Yevick (compressibility) bulk equation of state, the FMT bulk limit.
+//! - [`mixture`]: the same for a mixture of any number of species (Rosenfeld or White Bear,
+//!   free-draining or pairwise unequal-radius RPY flux; engine entry [`mixture::run_mixture_droplet`]).
 //!
 //! ```no_run
 //! use colloidsim_dft::radial::*;
@@ -47,6 +49,7 @@ pub mod fmt;
 pub mod g2;
 pub mod grid;
 pub mod interface;
+pub mod mixture;
 pub mod pair;
 pub mod rpy;
 

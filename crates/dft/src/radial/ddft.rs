@@ -81,7 +81,7 @@ impl DdftOptions {
         }
     }
 
-    fn validate(&self) -> Result<(), RadialError> {
+    pub(crate) fn validate(&self) -> Result<(), RadialError> {
         param::positive("d0", self.d0)?;
         param::positive("dt", self.dt)?;
         param::positive("dt_max", self.dt_max)?;

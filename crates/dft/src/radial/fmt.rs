@@ -44,37 +44,13 @@ pub fn rosenfeld_phi(n3: f64, n2: f64, nv2: f64, a: f64) -> (f64, f64, f64, f64)
     (phi, p3, p2, pv)
 }
 
-/// Rosenfeld hard-sphere functional on a [`RadialGrid`], with preallocated workspace.
-#[derive(Debug, Clone)]
-pub struct Rosenfeld {
-    diameter: f64,
-    n: usize,
-    bw: usize,
-    j0: Vec<usize>,
-    w3: Vec<f64>,
-    w2: Vec<f64>,
-    wv2: Vec<f64>,
-    wt: Vec<f64>,
-    vol: Vec<f64>,
-    n3: Vec<f64>,
-    n2: Vec<f64>,
-    nv2: Vec<f64>,
-    s3: Vec<f64>,
-    s2: Vec<f64>,
-    sv2: Vec<f64>,
-    mu: Vec<f64>,
-}
-
-impl Rosenfeld {
-    /// Precompute the cell weights for spheres of `diameter` on `grid`.
-    ///
-    /// Errors if the grid does not resolve the particle (`diameter / dr < 10`) or the grid is
-    /// shorter than one diameter.
-    pub fn new(grid: &RadialGrid, diameter: f64) -> Result<Self, RadialError> {
-        colloidsim_core::param::positive("diameter", diameter)?;
-        let dr = grid.dr();
-        if diameter / dr < MIN_CELLS_PER_DIAMETER {
-            return Err(colloidsim_core::ParamError::new(
+/// Refuse a `diameter` that is not positive, a grid that does not resolve it
+/// (`diameter / dr < 10`, naming `dr`) or one shorter than it (naming `r_max`).
+pub(crate) fn check_resolution(grid: &RadialGrid, diameter: f64) -> Result<(), RadialError> {
+    colloidsim_core::param::positive("diameter", diameter)?;
+    let dr = grid.dr();
+    if diameter / dr < MIN_CELLS_PER_DIAMETER {
+        return Err(colloidsim_core::ParamError::new(
                 "dr",
                 format!(
                     "grid spacing {dr} does not resolve the particle: need dr <= diameter / {MIN_CELLS_PER_DIAMETER} = {}",
@@ -82,17 +58,37 @@ impl Rosenfeld {
                 ),
             )
             .into());
-        }
-        if grid.r_max() < diameter {
-            return Err(colloidsim_core::ParamError::new(
-                "r_max",
-                format!(
-                    "grid extent {} is shorter than the diameter {diameter}",
-                    grid.r_max()
-                ),
-            )
-            .into());
-        }
+    }
+    if grid.r_max() < diameter {
+        return Err(colloidsim_core::ParamError::new(
+            "r_max",
+            format!(
+                "grid extent {} is shorter than the diameter {diameter}",
+                grid.r_max()
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// The exact cell integrals of the radial kernels for spheres of one diameter (module docs):
+/// row `i` holds `bw` cells from `j0[i]`; `w3`, `w2`, `wv2` give `n3, n2, nv2` at centre `i`,
+/// `wt` is the vector kernel's adjoint for the functional derivative.
+#[derive(Debug, Clone)]
+pub(crate) struct CellWeights {
+    pub(crate) bw: usize,
+    pub(crate) j0: Vec<usize>,
+    pub(crate) w3: Vec<f64>,
+    pub(crate) w2: Vec<f64>,
+    pub(crate) wv2: Vec<f64>,
+    pub(crate) wt: Vec<f64>,
+}
+
+impl CellWeights {
+    /// Weights of spheres of `diameter` on `grid` (the caller checked the resolution).
+    pub(crate) fn new(grid: &RadialGrid, diameter: f64) -> Result<Self, RadialError> {
+        let dr = grid.dr();
         let a = 0.5 * diameter;
         let n = grid.len();
         let bw = (2.0 * a / dr).ceil() as usize + 2;
@@ -154,6 +150,54 @@ impl Rosenfeld {
                 }
             }
         }
+        Ok(Self {
+            bw,
+            j0,
+            w3,
+            w2,
+            wv2,
+            wt,
+        })
+    }
+}
+
+/// Rosenfeld hard-sphere functional on a [`RadialGrid`], with preallocated workspace.
+#[derive(Debug, Clone)]
+pub struct Rosenfeld {
+    diameter: f64,
+    n: usize,
+    bw: usize,
+    j0: Vec<usize>,
+    w3: Vec<f64>,
+    w2: Vec<f64>,
+    wv2: Vec<f64>,
+    wt: Vec<f64>,
+    vol: Vec<f64>,
+    n3: Vec<f64>,
+    n2: Vec<f64>,
+    nv2: Vec<f64>,
+    s3: Vec<f64>,
+    s2: Vec<f64>,
+    sv2: Vec<f64>,
+    mu: Vec<f64>,
+}
+
+impl Rosenfeld {
+    /// Precompute the cell weights for spheres of `diameter` on `grid`.
+    ///
+    /// Errors if the grid does not resolve the particle (`diameter / dr < 10`) or the grid is
+    /// shorter than one diameter.
+    pub fn new(grid: &RadialGrid, diameter: f64) -> Result<Self, RadialError> {
+        check_resolution(grid, diameter)?;
+        let CellWeights {
+            bw,
+            j0,
+            w3,
+            w2,
+            wv2,
+            wt,
+        } = CellWeights::new(grid, diameter)?;
+        let n = grid.len();
         Ok(Self {
             diameter,
             n,
