@@ -213,27 +213,16 @@ pub const PAIR_KEYS: [Spec; 14] = [
 ];
 
 /// The smallest species diameter when the scenario has `[system.species]` (the derived
-/// default of `system.diameter`).
+/// default of `system.diameter`), the diameters checked first.
 pub fn smallest_diameter(r: &Reader) -> Result<Option<f64>> {
     if !r.declares(&SPECIES) || !r.has(&SPECIES) {
         return Ok(None);
     }
-    let d = r.numbers(&SPECIES_DIAMETERS)?;
-    Ok(d.iter().copied().reduce(f64::min))
+    Ok(diameters(r)?.into_iter().reduce(f64::min))
 }
 
-/// The species of a run of `particles` colloids (one of diameter `d` without
-/// `[system.species]`); each error names the key.
-pub fn species(r: &Reader, particles: usize, d: f64, diameter_key: &Spec) -> Result<Mixture> {
-    if !r.has(&SPECIES) {
-        return Ok(Mixture::one(d, particles));
-    }
-    if r.has(diameter_key) {
-        bail!(ParamError::new(
-            diameter_key.path,
-            "give the diameters in system.species.diameters, not system.diameter as well",
-        ));
-    }
+/// `system.species.diameters`, checked: 1 to 26, each finite and > 0, size ratio at most 100.
+fn diameters(r: &Reader) -> Result<Vec<f64>> {
     let diameters = r.numbers(&SPECIES_DIAMETERS)?;
     let n = diameters.len();
     if !(1..=MAX_SPECIES).contains(&n) {
@@ -258,6 +247,23 @@ pub fn species(r: &Reader, particles: usize, d: f64, diameter_key: &Spec) -> Res
             ),
         ));
     }
+    Ok(diameters)
+}
+
+/// The species of a run of `particles` colloids (one of diameter `d` without
+/// `[system.species]`); each error names the key.
+pub fn species(r: &Reader, particles: usize, d: f64, diameter_key: &Spec) -> Result<Mixture> {
+    if !r.has(&SPECIES) {
+        return Ok(Mixture::one(d, particles));
+    }
+    if r.has(diameter_key) {
+        bail!(ParamError::new(
+            diameter_key.path,
+            "give the diameters in system.species.diameters, not system.diameter as well",
+        ));
+    }
+    let diameters = diameters(r)?;
+    let n = diameters.len();
     let counts = match (r.has(&SPECIES_COUNTS), r.has(&SPECIES_VOLUME_FRACTIONS)) {
         (true, true) | (false, false) => bail!(ParamError::new(
             SPECIES_COUNTS.path,

@@ -37,6 +37,7 @@ pub mod keys;
 pub mod params;
 mod species;
 pub mod theory;
+mod theory_mixture;
 
 /// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
 /// replacing the scenario's.

@@ -167,6 +167,9 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
     let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;
+    if !p.species.is_single() {
+        return super::theory_mixture::theory(src, topts, ctl, &p, hydro, dr);
+    }
     // Output times of the BD run (`step * dt`, the last one up to dt past t_end), in ascending
     // order (fractions may be listed in any order).
     let mut order: Vec<usize> = (0..p.fractions.len()).collect();
