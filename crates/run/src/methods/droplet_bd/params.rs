@@ -422,7 +422,14 @@ method = "pse"
         let t: toml::Table = toml::from_str(FULL).unwrap();
         let r = Reader::new(&t, KEYS).unwrap();
         resolve(&r, Path::new("."), None).unwrap();
-        assert_eq!(r.unread(), Vec::<&str>::new());
+        // The species and pair keys are read by kind (one scenario cannot give them all):
+        // tests/species.rs reads each.
+        let unread: Vec<&str> = r
+            .unread()
+            .into_iter()
+            .filter(|k| !k.starts_with("pair.") && !k.starts_with("system.species."))
+            .collect();
+        assert_eq!(unread, Vec::<&str>::new());
     }
 
     #[test]
