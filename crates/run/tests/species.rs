@@ -157,11 +157,6 @@ fn bad_species_and_pairs_are_refused_naming_the_key() {
             "one species",
         ),
         (
-            with("", "[pair]\nkind = \"wca\"\ncharges = [1.0]\n"),
-            "pair.charges",
-            "not a parameter",
-        ),
-        (
             with(
                 "",
                 "[pair]\nkind = \"yukawa\"\nbjerrum_length = 0.7\ndebye_length = 1.0\n",

@@ -77,7 +77,7 @@ impl TabulatedPair {
         }
         if r_bins == 0 || s_bins <= per.round() as usize {
             return Err(ParamError::new(
-                "pair.table",
+                "g2_table",
                 format!(
                     "needs at least one radial bin and s bins beyond contact, got {r_bins} radial and {s_bins} s bins"
                 ),
@@ -86,7 +86,7 @@ impl TabulatedPair {
         let want = r_bins * r_bins * s_bins;
         if h.len() != want || h.iter().any(|v| !v.is_finite() || *v < -1.0) {
             return Err(ParamError::new(
-                "pair.table",
+                "g2_table",
                 format!("needs {want} finite values of h >= -1, got {}", h.len()),
             ));
         }
@@ -462,9 +462,9 @@ mod tests {
         let e = TabulatedPair::new(1.0, 0.1, 2, 0.3, 10, vec![0.0; 40]).unwrap_err();
         assert!(e.to_string().contains("pair.s_bin"), "{e}");
         let e = TabulatedPair::new(1.0, 0.1, 2, 0.25, 10, vec![0.0; 39]).unwrap_err();
-        assert!(e.to_string().contains("pair.table"), "{e}");
+        assert!(e.to_string().contains("g2_table"), "{e}");
         let e = TabulatedPair::new(1.0, 0.1, 2, 0.25, 10, vec![-2.0; 40]).unwrap_err();
-        assert!(e.to_string().contains("pair.table"), "{e}");
+        assert!(e.to_string().contains("g2_table"), "{e}");
         let t = TabulatedPair::new(1.0, 0.1, 2, 0.25, 10, vec![0.0; 40]).unwrap();
         let grid = RadialGrid::new(0.1, 20).unwrap();
         assert!(

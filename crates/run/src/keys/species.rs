@@ -85,7 +85,7 @@ pub const PAIR_EPSILON: Spec = key(
 pub const PAIR_CUTOFF: Spec = key(
     "pair.cutoff",
     "contact distances",
-    Value("2.5"),
+    Means("2.5"),
     Closed(1.0, 100.0),
     "lj: cut-off (shifted to zero there), in units of the pair's contact distance",
 );
@@ -151,7 +151,7 @@ pub const PAIR_KAPPA: Spec = key(
 pub const PAIR_H0: Spec = key(
     "pair.h0",
     "length",
-    Value("0"),
+    Means("0"),
     Finite,
     "morse: surface distance of the minimum",
 )
@@ -330,18 +330,12 @@ pub fn pair(r: &Reader, mixture: &Mixture, kt: f64, base: &Path) -> Result<Optio
         "ao" => &[&PAIR_DEPLETANT_DIAMETER, &PAIR_DEPLETANT_FRACTION],
         _ => &[&PAIR_TABLE],
     };
-    if let Some(k) = PAIR_KEYS[2..]
+    // Keys of other kinds are consulted and left unused (a scenario may switch kinds).
+    let _unused: Vec<bool> = PAIR_KEYS[2..]
         .iter()
-        .find(|k| r.has(k) && !uses.iter().any(|u| u.path == k.path))
-    {
-        bail!(ParamError::new(
-            k.path,
-            format!(
-                "is not a parameter of pair.kind = \"{kind}\" (its keys: {})",
-                uses.iter().map(|u| u.path).collect::<Vec<_>>().join(", ")
-            ),
-        ));
-    }
+        .filter(|k| !uses.iter().any(|u| u.path == k.path))
+        .map(|k| r.has(k))
+        .collect();
     let need = |k: &Spec| -> Result<f64> {
         r.opt_number(k)?.ok_or_else(|| {
             ParamError::new(
@@ -364,7 +358,7 @@ pub fn pair(r: &Reader, mixture: &Mixture, kt: f64, base: &Path) -> Result<Optio
         },
         "lj" => PairSpec::Lj {
             epsilon: epsilon()?,
-            cutoff: r.number(&PAIR_CUTOFF)?,
+            cutoff: r.opt_number(&PAIR_CUTOFF)?.unwrap_or(2.5),
         },
         "yukawa" => {
             let debye_length = need(&PAIR_DEBYE)?;
@@ -381,7 +375,7 @@ pub fn pair(r: &Reader, mixture: &Mixture, kt: f64, base: &Path) -> Result<Optio
             }
         }
         "morse" => {
-            let (kappa, h0) = (need(&PAIR_KAPPA)?, r.number(&PAIR_H0)?);
+            let (kappa, h0) = (need(&PAIR_KAPPA)?, r.opt_number(&PAIR_H0)?.unwrap_or(0.0));
             PairSpec::Morse {
                 depth: need(&PAIR_DEPTH)?,
                 kappa,
