@@ -384,6 +384,8 @@ pub struct Pse {
     self_rows: Vec<f64>,
     /// Wave-space functions of each pair of species ([`pair_index`]).
     tables: Vec<WaveTable>,
+    /// Squared real-space cut-off of each pair of species (the largest is the geometry's).
+    rc2s: Vec<f64>,
     /// The general (species) wave-space path: the kernel without the sinc factors, which
     /// `filters` apply per species. Off for one species, which keeps `sinc^2` in the kernel.
     general: bool,
@@ -488,7 +490,7 @@ impl PseGeometry {
     fn with_tables(
         params: &PseParams,
         radii: &[f64],
-    ) -> Result<(Self, Vec<WaveTable>, Vec<f64>), HydroError> {
+    ) -> Result<(Self, Vec<WaveTable>, Vec<f64>, Vec<f64>), HydroError> {
         let (a_min, a_max) = (radii[0], radii[radii.len() - 1]);
         let p = PseParams {
             radius: a_max,
@@ -621,24 +623,26 @@ impl PseGeometry {
             .enumerate()
             .map(|(s, &a_s)| 1.0 / (6.0 * PI * p.viscosity * a_s) - tables[pair_index(s, s)].a[0])
             .collect();
-        // The cut-off: the largest over the pairs of species of the distance beyond which the
-        // real-space functions stay below the threshold (relative to the largest sphere's
-        // mobility, the smallest).
-        let mut r_cut = 0.0f64;
+        // The cut-off of each pair of species: the distance beyond which its real-space
+        // functions stay below the threshold, relative to the pair's smaller Stokes mobility
+        // (the larger sphere's); the geometry's cut-off is the largest.
+        let mut r_cuts = vec![0.0f64; tables.len()];
         for (t, &at) in radii.iter().enumerate() {
+            let mu_pair = 1.0 / (6.0 * PI * p.viscosity * at);
             for (s, &a_s) in radii[..=t].iter().enumerate() {
                 let table = &tables[pair_index(s, t)];
                 for i in (0..table.a.len() - 3).rev() {
                     let r = i as f64 * table.dr;
                     let m = rpy_pair(r, a_s, at, p.viscosity);
                     let (aw, bw) = table.eval(r);
-                    if (m.a - aw).abs().max((m.b - bw).abs()) > REAL_SHARE * eps * mu0 {
-                        r_cut = r_cut.max(r + table.dr);
+                    if (m.a - aw).abs().max((m.b - bw).abs()) > REAL_SHARE * eps * mu_pair {
+                        r_cuts[pair_index(s, t)] = r + table.dr;
                         break;
                     }
                 }
             }
         }
+        let r_cut = r_cuts.iter().copied().fold(0.0, f64::max);
         if r_cut >= 0.5 * l {
             return Err(ParamError::new(
                 "splitting",
@@ -660,7 +664,7 @@ impl PseGeometry {
             r_cut,
             gaussian_fraction: frac,
         };
-        Ok((geom, tables, self_reals))
+        Ok((geom, tables, self_reals, r_cuts))
     }
 }
 
@@ -818,7 +822,7 @@ impl Pse {
     ) -> Result<Self, HydroError> {
         let p = params;
         let n = species.len();
-        let (geom, tables, self_reals) = PseGeometry::with_tables(&p, &radii)?;
+        let (geom, tables, self_reals, r_cuts) = PseGeometry::with_tables(&p, &radii)?;
         let (a, xi, l) = (p.radius, p.splitting, p.box_length);
         let mu0s: Vec<f64> = radii
             .iter()
@@ -902,6 +906,7 @@ impl Pse {
             self_reals,
             self_rows: vec![0.0; n],
             tables,
+            rc2s: r_cuts.iter().map(|r| r * r).collect(),
             general,
             filters,
             tmp: if general {
@@ -1050,7 +1055,7 @@ impl Pse {
         }
         let geometry = RealSpace {
             box_length: l,
-            r_cut: self.geom.r_cut,
+            rc2s: &self.rc2s,
             radii: &self.radii,
             species: &self.species,
             viscosity: self.params.viscosity,
@@ -1491,7 +1496,7 @@ impl Pse {
 /// What the real-space pair tensors are computed from.
 struct RealSpace<'a> {
     box_length: f64,
-    r_cut: f64,
+    rc2s: &'a [f64],
     radii: &'a [f64],
     species: &'a [u32],
     viscosity: f64,
@@ -1509,7 +1514,6 @@ impl RealSpace<'_> {
     /// whenever the candidates were built).
     fn fill<T: Stored>(&self, entries: &mut [Entry<T>], counts: &mut [u32]) {
         let l = self.box_length;
-        let rc2 = self.r_cut * self.r_cut;
         let (off, cand, pos) = (self.offsets, self.candidates, self.pos);
         let mut rows: Vec<RowChunk<'_, Entry<T>, u32>> = Vec::new();
         for_row_chunks_collect(off, entries, counts, &mut rows);
@@ -1521,18 +1525,19 @@ impl RealSpace<'_> {
                 let mut k = off[r] - base;
                 for &j in &cand[off[r]..off[r + 1]] {
                     let (d, r2) = nearest_image(xi, pos[j as usize], l);
-                    if r2 < rc2 {
+                    let sj = self.species[j as usize] as usize;
+                    let pair = pair_index(si, sj);
+                    if r2 < self.rc2s[pair] {
                         // One division per pair (the tensors are most of `set_positions`).
                         let inv_r = 1.0 / r2.sqrt();
                         let r = r2 * inv_r;
-                        let sj = self.species[j as usize] as usize;
                         let (ai, aj) = (self.radii[si], self.radii[sj]);
                         let (ta, tb) = if ai == aj {
                             rpy_inv(r, inv_r, ai, self.viscosity)
                         } else {
                             rpy_unequal_inv(r, inv_r, ai, aj, self.viscosity)
                         };
-                        let (aw, bw) = self.tables[pair_index(si, sj)].eval(r);
+                        let (aw, bw) = self.tables[pair].eval(r);
                         out[k] = Entry {
                             j: self.row_of[j as usize],
                             a: T::store(ta - aw),
