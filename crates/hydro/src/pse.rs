@@ -1,4 +1,4 @@
-//! Positively split Ewald (PSE): the RPY mobility of monodisperse spheres in a periodic cube,
+//! Positively split Ewald (PSE): the RPY mobility of spheres (one radius or several) in a periodic cube,
 //! after Fiore, Balboa Usabiaga, Donev & Swan, J. Chem. Phys. 146, 124116 (2017).
 //!
 //! **Split.** In Fourier space the RPY tensor is `sinc^2(ka) (I − k̂k̂) / (eta k^2)` (the
@@ -22,6 +22,16 @@
 //!   RPY part is evaluated exactly, so the kink at `r = 2a` needs no table. Pairs within the
 //!   cut-off `r_c` are kept in neighbour lists (cells of edge `>= r_c`, nearest image); the
 //!   Brownian part is the Lanczos square root of `M^r` ([`crate::lanczos`]).
+//!
+//! **Unequal radii** ([`Pse::with_radii`]). The coupling of spheres of radii a_i, a_j is
+//! `sinc(k a_i) sinc(k a_j) (I − k̂k̂) / (eta k^2)` in Fourier space (Zuk et al. 2014): each
+//! distinct radius is a species; the kernel keeps `H(k) / (eta k^2)` only, each species' forces
+//! are spread and transformed on their own, multiplied by the species' `sinc(k a_s)` and summed,
+//! and the velocity spectrum is multiplied by each species' `sinc` before its inverse transform
+//! and the interpolation at that species' particles. The wave-space operator is then a sum of
+//! squares (positive) and its Fourier noise stays exact. The real space has a table and a
+//! cut-off per pair of species (the pair's near field, [`crate::rpy::rpy_unequal`]). One
+//! species takes the monodisperse path (`sinc^2` in the kernel) unchanged.
 //!
 //! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 6 eps`,
 //! `x = K^2/(4 xi^2)`; grid spacing `h <= pi / K` (n points per axis, the next even 2-3-5-smooth
