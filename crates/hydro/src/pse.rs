@@ -494,13 +494,10 @@ impl PseGeometry {
 
     /// The geometry, the tabulated wave-space functions of each pair of species
     /// ([`pair_index`]) and the real-space self term of each species, for the species radii
-    /// `radii` (ascending, distinct, positive; `params.radius` is not read). The box and the
-    /// tolerance's scale `mu0` are those of the largest sphere, the table spacing that of the
-    /// smallest.
-    fn with_tables(
-        params: &PseParams,
-        radii: &[f64],
-    ) -> Result<(Self, Vec<WaveTable>, Vec<f64>, Vec<f64>), HydroError> {
+    /// `radii` (ascending, distinct, positive; `params.radius` is not read). The box is checked
+    /// against the largest sphere, the table spacing follows the pair's smaller sphere, and each
+    /// pair's cut-off is relative to its larger sphere's mobility.
+    fn with_tables(params: &PseParams, radii: &[f64]) -> Result<(Self, RealTables), HydroError> {
         let (a_min, a_max) = (radii[0], radii[radii.len() - 1]);
         let p = PseParams {
             radius: a_max,
@@ -531,7 +528,6 @@ impl PseGeometry {
             )
             .into());
         }
-        let mu0 = 1.0 / (6.0 * PI * p.viscosity * a);
         // Fourier side.
         let k_cut = 2.0 * xi * hasimoto_cut(FOURIER_SHARE * eps).sqrt();
         let ln = (1.0 / (SUPPORT_SHARE * eps)).ln();
@@ -674,8 +670,23 @@ impl PseGeometry {
             r_cut,
             gaussian_fraction: frac,
         };
-        Ok((geom, tables, self_reals, r_cuts))
+        Ok((
+            geom,
+            RealTables {
+                tables,
+                self_reals,
+                r_cuts,
+            },
+        ))
     }
+}
+
+/// The real-space functions of each pair of species ([`pair_index`]), their cut-offs, and each
+/// species' real-space self term.
+struct RealTables {
+    tables: Vec<WaveTable>,
+    self_reals: Vec<f64>,
+    r_cuts: Vec<f64>,
 }
 
 /// Index of the pair of species `(s, t)` in the triangular list of tables (either order).
@@ -832,7 +843,14 @@ impl Pse {
     ) -> Result<Self, HydroError> {
         let p = params;
         let n = species.len();
-        let (geom, tables, self_reals, r_cuts) = PseGeometry::with_tables(&p, &radii)?;
+        let (
+            geom,
+            RealTables {
+                tables,
+                self_reals,
+                r_cuts,
+            },
+        ) = PseGeometry::with_tables(&p, &radii)?;
         let (a, xi, l) = (p.radius, p.splitting, p.box_length);
         let mu0s: Vec<f64> = radii
             .iter()
