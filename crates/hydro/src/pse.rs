@@ -492,6 +492,19 @@ impl PseGeometry {
         8 * (3 * g * g * g + half) + 16 * 4 * half
     }
 
+    /// Bytes that `species` radii add to [`Self::grid_bytes`] ([`Pse::with_radii`]): none for
+    /// one species; else a half spectrum of scratch and one filter (8 bytes per mode) per
+    /// species.
+    pub fn species_bytes(&self, species: usize) -> usize {
+        let g = self.grid;
+        let half = g * g * (g / 2 + 1);
+        if species > 1 {
+            (16 + 8 * species) * half
+        } else {
+            0
+        }
+    }
+
     /// The geometry, the tabulated wave-space functions of each pair of species
     /// ([`pair_index`]) and the real-space self term of each species, for the species radii
     /// `radii` (ascending, distinct, positive; `params.radius` is not read). The box is checked

@@ -399,6 +399,15 @@ fn bidisperse_pse_self_mobilities_are_per_species() {
     let (eta, l) = (1.0, 12.0);
     let radii = [0.5, 1.0, 0.5, 2.0];
     let m = Pse::with_radii(&radii, PseParams::paper(0.5, eta, l)).unwrap();
+    let mono = Pse::new(4, PseParams::paper(0.5, eta, l)).unwrap();
+    let g = m.geometry();
+    assert_eq!(
+        g.grid,
+        mono.geometry().grid,
+        "the grid does not depend on the radii"
+    );
+    assert!(m.bytes() >= mono.bytes() + g.species_bytes(3));
+    assert_eq!(g.species_bytes(1), 0);
     for (i, a) in radii.iter().enumerate() {
         assert_eq!(m.stokes_mobility(i), 1.0 / (6.0 * PI * eta * a));
     }
