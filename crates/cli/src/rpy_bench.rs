@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use colloidsim_md::hydro::bench::{
     PYSTOKES_SCRIPT, RADIUS, box_edge, median, pse_product, random_system, relative_difference,
-    time_direct, time_pse,
+    time_direct, time_pse, time_pse_radii,
 };
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -49,8 +49,19 @@ pub struct BenchArgs {
     /// Particle numbers of PSE's accuracy against pystokes' periodic Ewald sum.
     #[arg(long, value_delimiter = ',', default_value = "200,500")]
     pub periodic_sizes: Vec<usize>,
-    /// Parts to run: direct, pse, periodic (PSE's accuracy against pystokes.periodic), bd.
-    #[arg(long, value_delimiter = ',', default_value = "direct,pse,periodic,bd")]
+    /// Particle numbers of the bidisperse PSE comparison.
+    #[arg(long, value_delimiter = ',', default_value = "10000,30000")]
+    pub bidisperse_sizes: Vec<usize>,
+    /// Radius ratio of the bidisperse PSE comparison (half of the spheres this much larger).
+    #[arg(long, default_value_t = 2.0)]
+    pub ratio: f64,
+    /// Parts to run: direct, pse, bidisperse (PSE with two radii against one), periodic (PSE's
+    /// accuracy against pystokes.periodic), bd.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "direct,pse,bidisperse,periodic,bd"
+    )]
     pub parts: Vec<String>,
 }
 
@@ -135,6 +146,9 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     }
     if part("pse") {
         pse(a, reps)?;
+    }
+    if part("bidisperse") {
+        bidisperse(a, reps)?;
     }
     if part("periodic") && !a.no_pystokes {
         periodic(a)?;
@@ -288,6 +302,50 @@ fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
                 s(p.times.setup),
                 p.times.lanczos_iterations as f64 / reps as f64,
                 p.bytes_per_particle
+            );
+        }
+    }
+    Ok(())
+}
+
+/// PSE's displacement with two radii against one, at the same N, box, splitting and
+/// tolerance: the runs alternate (one monodisperse, one bidisperse, `reps` rounds, each the
+/// median of 3 steps).
+fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
+    println!(
+        "## bidisperse PSE: half of the spheres of radius {RADIUS}, half {} (same N, box as phi = {} of radius {RADIUS}, xi = 0.5/{RADIUS}, tolerance {}); step = new positions + displacement; the two alternate, {reps} rounds of 3 steps each",
+        a.ratio * RADIUS,
+        a.phi,
+        a.tolerance
+    );
+    println!(
+        "N\tthreads\tmono_step_s\tbi_step_s\tratio_of_medians\tmedian_of_round_ratios\tmono_neighbours\tbi_neighbours\tmono_lanczos_iters\tbi_lanczos_iters\tbi_fft_share"
+    );
+    for &n in &a.bidisperse_sizes {
+        for &t in &a.threads {
+            let (mut mono, mut bi, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+            let mut last = None;
+            for _ in 0..reps {
+                let m = time_pse_radii(n, a.phi, a.tolerance, t, 3, 1.0)
+                    .with_context(|| format!("PSE at N = {n}"))?;
+                let b = time_pse_radii(n, a.phi, a.tolerance, t, 3, a.ratio)
+                    .with_context(|| format!("bidisperse PSE at N = {n}, ratio {}", a.ratio))?;
+                mono.push(m.step);
+                bi.push(b.step);
+                ratios.push(b.step / m.step);
+                last = Some((m, b));
+            }
+            let Some((m, b)) = last else { continue };
+            let (mm, mb) = (median(&mut mono), median(&mut bi));
+            println!(
+                "{n}\t{t}\t{mm:.4e}\t{mb:.4e}\t{:.2}\t{:.2}\t{:.1}\t{:.1}\t{:.1}\t{:.1}\t{:.1}%",
+                mb / mm,
+                median(&mut ratios),
+                m.neighbours,
+                b.neighbours,
+                m.times.lanczos_iterations as f64 / 3.0,
+                b.times.lanczos_iterations as f64 / 3.0,
+                100.0 * b.times.fft / b.step_total
             );
         }
     }

@@ -18,7 +18,19 @@
 //! (`r < 2a`, nearest image; the box is at least `4a`) get the difference between the
 //! overlapping and the far branch added ([`crate::rpy`]).
 
-use crate::rpy::{rpy, rpy_far};
+//!
+//! **Unequal radii** ([`beenakker_matrix_radii`]). The far branch of the Zuk et al. tensor,
+//! `1/(8 pi eta r) [(1 + (a_i^2 + a_j^2)/(3 r^2)) I + (1 − (a_i^2 + a_j^2)/r^2) r̂r̂]`, is the
+//! Oseen tensor plus `(a_i^2 + a_j^2)/6` times its Laplacian, the monodisperse far tensor with
+//! `a^2` replaced by `s = (a_i^2 + a_j^2)/2`. Beenakker's terms are of two kinds, `mu0 a` (the
+//! Oseen part, `1/(6 pi eta)`) and `mu0 a^3` (the Laplacian part, `a^2/(6 pi eta)`), so the
+//! pair's sum follows with `mu0 a -> 1/(6 pi eta)` and `mu0 a^3 -> s/(6 pi eta)`; the self term
+//! is Beenakker's with the sphere's own radius, and overlapping pairs
+//! (`r <= a_i + a_j`, nearest image; the box is at least 4 radii of the largest sphere) get
+//! the difference between Zuk et al.'s overlapping (or inner) branch and the far branch.
+//! Independent of PSE: no splitting of the sinc factors, no grid, no tabulated functions.
+
+use crate::rpy::{PairTensor, rpy, rpy_far, rpy_unequal};
 use std::f64::consts::PI;
 
 /// Dense periodic RPY matrix (row-major, entry `(3 i + p, 3 j + q)`) of spheres of radius `a`
@@ -142,6 +154,148 @@ pub fn beenakker_matrix(pos: &[[f64; 3]], a: f64, eta: f64, l: f64, xi: f64) -> 
     m
 }
 
+/// The far branch of the unequal-radius RPY tensor (the `r > a_i + a_j` formula at any
+/// `r > 0`).
+fn rpy_far_unequal(r: f64, ai: f64, aj: f64, eta: f64) -> PairTensor {
+    let c = 1.0 / (8.0 * PI * eta * r);
+    let s2 = (ai * ai + aj * aj) / (r * r);
+    PairTensor {
+        a: c * (1.0 + s2 / 3.0),
+        b: c * (1.0 - s2),
+    }
+}
+
+/// Dense periodic RPY matrix of spheres of radii `radii` at `pos` in a cube of edge `l`,
+/// viscosity `eta`: Beenakker's Ewald sum generalised to unequal radii (module docs), Ewald
+/// parameter `xi`. Equal radii give [`beenakker_matrix`] to rounding.
+pub fn beenakker_matrix_radii(
+    pos: &[[f64; 3]],
+    radii: &[f64],
+    eta: f64,
+    l: f64,
+    xi: f64,
+) -> Vec<f64> {
+    let n = pos.len();
+    assert_eq!(radii.len(), n, "one radius per particle");
+    let a_max = radii.iter().copied().fold(0.0, f64::max);
+    assert!(
+        l >= 4.0 * a_max,
+        "the reference needs a box of at least 4 radii"
+    );
+    let c6 = 1.0 / (6.0 * PI * eta);
+    let sp = PI.sqrt();
+    let vol = l * l * l;
+    let r_cut = 6.2 / xi;
+    let n_img = (r_cut / l).ceil() as i32 + 1;
+    let k_cut = 2.0 * xi * 6.2;
+    let m_max = (k_cut * l / (2.0 * PI)).ceil() as i32;
+    // Real-space functions of a pair with s = (a_i^2 + a_j^2)/2, in units of 1/(6 pi eta).
+    let real = |r: f64, s: f64| -> (f64, f64) {
+        let (e, c) = ((-(xi * xi * r * r)).exp() / sp, libm::erfc(xi * r));
+        let (r2, x) = (r * r, xi);
+        let a1 = c * (0.75 / r + 0.5 * s / (r2 * r))
+            + e * (4.0 * x.powi(7) * s * r2 * r2 + 3.0 * x.powi(3) * r2
+                - 20.0 * x.powi(5) * s * r2
+                - 4.5 * x
+                + 14.0 * x.powi(3) * s
+                + x * s / r2);
+        let b1 = c * (0.75 / r - 1.5 * s / (r2 * r))
+            + e * (-4.0 * x.powi(7) * s * r2 * r2 - 3.0 * x.powi(3) * r2
+                + 16.0 * x.powi(5) * s * r2
+                + 1.5 * x
+                - 2.0 * x.powi(3) * s
+                - 3.0 * x * s / r2);
+        (a1, b1)
+    };
+    // Wave vectors, k^2 and the factor g(k) of (1 − s k^2 / 3) g(k).
+    let mut waves = Vec::new();
+    for mx in -m_max..=m_max {
+        for my in -m_max..=m_max {
+            for mz in -m_max..=m_max {
+                if mx == 0 && my == 0 && mz == 0 {
+                    continue;
+                }
+                let k = [mx, my, mz].map(|m| 2.0 * PI * m as f64 / l);
+                let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+                if k2 > k_cut * k_cut {
+                    continue;
+                }
+                let q = k2 / (4.0 * xi * xi);
+                let g = (1.0 + q + 2.0 * q * q) * 6.0 * PI / (k2 * vol) * (-q).exp();
+                waves.push((k, k2, g));
+            }
+        }
+    }
+    let mut m = vec![0.0; 9 * n * n];
+    for i in 0..n {
+        for j in 0..n {
+            let (ai, aj) = (radii[i], radii[j]);
+            let s = 0.5 * (ai * ai + aj * aj);
+            let mut b = [[0.0f64; 3]; 3];
+            let d0 = [0, 1, 2].map(|k| pos[i][k] - pos[j][k]);
+            let dm = d0.map(|x| x - l * (x / l).round());
+            for nx in -n_img..=n_img {
+                for ny in -n_img..=n_img {
+                    for nz in -n_img..=n_img {
+                        let d = [
+                            dm[0] + nx as f64 * l,
+                            dm[1] + ny as f64 * l,
+                            dm[2] + nz as f64 * l,
+                        ];
+                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        if r2 > r_cut * r_cut {
+                            continue;
+                        }
+                        if r2 == 0.0 {
+                            // i = j, or two spheres at one point: the limit r -> 0 of the
+                            // real-space term plus the inner branch 1/(6 pi eta a_max) (for
+                            // i = j Beenakker's self term), in units of 1/(6 pi eta).
+                            let t =
+                                1.0 / ai.max(aj) - 6.0 * xi / sp + 40.0 / 3.0 * xi.powi(3) * s / sp;
+                            for p in 0..3 {
+                                b[p][p] += t;
+                            }
+                            continue;
+                        }
+                        let r = r2.sqrt();
+                        let (a1, b1) = real(r, s);
+                        for p in 0..3 {
+                            for q in 0..3 {
+                                b[p][q] += if p == q { a1 } else { 0.0 } + b1 * d[p] * d[q] / r2;
+                            }
+                        }
+                    }
+                }
+            }
+            for &(k, k2, g) in &waves {
+                let c =
+                    (1.0 - s * k2 / 3.0) * g * (k[0] * dm[0] + k[1] * dm[1] + k[2] * dm[2]).cos();
+                for p in 0..3 {
+                    for q in 0..3 {
+                        b[p][q] += c * (if p == q { 1.0 } else { 0.0 } - k[p] * k[q] / k2);
+                    }
+                }
+            }
+            let r = (dm[0] * dm[0] + dm[1] * dm[1] + dm[2] * dm[2]).sqrt();
+            for p in 0..3 {
+                for q in 0..3 {
+                    m[(3 * i + p) * 3 * n + 3 * j + q] = c6 * b[p][q];
+                }
+            }
+            if i != j && r <= ai + aj && r > 0.0 {
+                let near = rpy_unequal(r, ai, aj, eta).matrix(dm);
+                let far = rpy_far_unequal(r, ai, aj, eta).matrix(dm);
+                for p in 0..3 {
+                    for q in 0..3 {
+                        m[(3 * i + p) * 3 * n + 3 * j + q] += near[p][q] - far[p][q];
+                    }
+                }
+            }
+        }
+    }
+    m
+}
+
 /// Hasimoto's self-mobility of a sphere of radius `a` in a periodic cube of edge `l`
 /// (H. Hasimoto, J. Fluid Mech. 5, 317 (1959)), relative to `mu0`:
 /// `1 − 2.837297 (a/L) + (4 pi / 3) (a/L)^3 − 27.4 (a/L)^6`. The RPY tensor reproduces the
@@ -205,6 +359,107 @@ mod tests {
                     m[4 * p] / mu0
                 );
             }
+        }
+    }
+
+    /// Three sizes (ratio 4), with an overlapping pair of unequal spheres and a small sphere
+    /// inside a large one.
+    fn mixture() -> (Vec<[f64; 3]>, Vec<f64>) {
+        let pos = vec![
+            [0.1, 0.2, -0.3],
+            [1.0, 0.4, 0.1],
+            [-1.9, 1.4, 0.9],
+            [1.7, -2.2, 2.4],
+            [-1.5, 1.0, 1.2],
+            [2.6, 2.1, -1.8],
+        ];
+        let radii = vec![1.0, 0.5, 0.25, 1.0, 0.25, 0.5];
+        (pos, radii)
+    }
+
+    fn max_diff(x: &[f64], y: &[f64]) -> f64 {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn unequal_radii_sum_does_not_depend_on_the_ewald_parameter() {
+        let (eta, l) = (1.0, 7.0);
+        let (pos, radii) = mixture();
+        let x0 = PI.sqrt() / l;
+        let m1 = beenakker_matrix_radii(&pos, &radii, eta, l, x0);
+        let mu = 1.0 / (6.0 * PI * eta * 1.0);
+        for f in [0.5, 2.0, 3.0] {
+            let m2 = beenakker_matrix_radii(&pos, &radii, eta, l, f * x0);
+            let err = max_diff(&m1, &m2);
+            assert!(err < 1e-12 * mu, "xi factor {f}: {err}");
+        }
+        // Symmetric.
+        let n3 = 3 * pos.len();
+        for r in 0..n3 {
+            for c in 0..n3 {
+                assert!((m1[r * n3 + c] - m1[c * n3 + r]).abs() < 1e-14 * mu);
+            }
+        }
+    }
+
+    #[test]
+    fn unequal_radii_sum_reduces_to_beenakker_for_equal_radii() {
+        let (a, eta, l) = (0.5, 1.0, 6.0);
+        let pos = scatter(8, l);
+        let xi = 1.3 * PI.sqrt() / l;
+        let want = beenakker_matrix(&pos, a, eta, l, xi);
+        let got = beenakker_matrix_radii(&pos, &[a; 8], eta, l, xi);
+        let mu0 = 1.0 / (6.0 * PI * eta * a);
+        assert!(max_diff(&got, &want) < 1e-14 * mu0);
+    }
+
+    #[test]
+    fn unequal_radii_single_spheres_give_hasimoto() {
+        let eta = 1.0;
+        for a in [0.25, 0.5, 1.0, 2.0] {
+            let mu0 = 1.0 / (6.0 * PI * eta * a);
+            for l in [8.0, 20.0] {
+                let m = beenakker_matrix_radii(&[[0.3, -0.2, 0.1]], &[a], eta, l, PI.sqrt() / l);
+                for p in 0..3 {
+                    let mu = m[4 * p] / mu0;
+                    assert!((mu - hasimoto_rpy(a, l)).abs() < 1e-6, "a {a}, L {l}: {mu}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn unequal_radii_sum_tends_to_free_space_as_the_box_grows() {
+        // M_per − M_free = −2.837297 / (6 pi eta L) I + O(r^2 / L^3) for every block (the
+        // self blocks: Hasimoto's series): once the O(1/L) term is taken out, the rest falls
+        // as 1 / L^3.
+        use crate::{DirectRpy, LanczosParams, Mobility};
+        let eta = 1.0;
+        let (pos, radii) = mixture();
+        let n = pos.len();
+        let mut d = DirectRpy::with_radii(&radii, eta, LanczosParams::default(), 100).unwrap();
+        d.set_positions(&pos).unwrap();
+        let free = crate::direct::dense_matrix(&mut d);
+        let mut prev = f64::INFINITY;
+        for l in [20.0, 40.0, 80.0] {
+            let per = beenakker_matrix_radii(&pos, &radii, eta, l, PI.sqrt() / l);
+            let c = 2.837297 / (6.0 * PI * eta * l);
+            let mut worst = 0.0f64;
+            for r in 0..3 * n {
+                for col in 0..3 * n {
+                    let hasimoto = if r % 3 == col % 3 { -c } else { 0.0 };
+                    let k = r * 3 * n + col;
+                    worst = worst.max((per[k] - free[k] - hasimoto).abs());
+                }
+            }
+            // Relative to the O(1/L) term itself: a few (r / L)^2 at most.
+            let rel = worst / c;
+            assert!(rel < 40.0 / (l * l), "L {l}: residual {rel}");
+            assert!(worst < prev / 6.0, "L {l}: {worst} after {prev}");
+            prev = worst;
         }
     }
 }

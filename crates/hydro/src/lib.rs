@@ -11,9 +11,10 @@
 //! - [`DirectRpy`]: the RPY tensor ([`rpy`]) in an unbounded fluid, both branches, equal or
 //!   unequal radii; the O(N^2) matrix-free product and a Lanczos square root ([`lanczos`]).
 //! - [`Pse`]: positively split Ewald (Fiore, Balboa Usabiaga, Donev & Swan, J. Chem. Phys. 146,
-//!   124116 (2017)) for the RPY tensor in a periodic cube, O(N log N).
+//!   124116 (2017)) for the RPY tensor in a periodic cube, O(N log N); unequal radii by one sinc
+//!   filter per species ([`Pse::with_radii`]).
 //! - [`ewald`]: Beenakker's Ewald sum of the RPY tensor (J. Chem. Phys. 85, 1581 (1986)) as a
-//!   dense reference for small N.
+//!   dense reference for small N, also for unequal radii.
 //!
 //! Random numbers come from the counter-based streams of `colloidsim_core::rng`, keyed by
 //! (seed, step, particle) ([`noise`]); every sum runs in a fixed order, so results do not

@@ -144,4 +144,68 @@ mod tests {
         let (x, y) = (rpy_unequal(1.1, ai, aj, eta), rpy_unequal(1.1, aj, ai, eta));
         assert_eq!(x, y);
     }
+
+    /// `(A, B)` of the RPY tensor from its definition, the Stokeslet averaged over the two
+    /// sphere surfaces: in Fourier space `sinc(k a_i) sinc(k a_j) (I − k̂k̂) / (eta k^2)`, so
+    /// `A = 1/(2 pi^2 eta) int_0^inf sinc(k a_i) sinc(k a_j) [j0(kr) − j1(kr)/(kr)] dk` and
+    /// `B = 1/(2 pi^2 eta) int_0^inf sinc(k a_i) sinc(k a_j) j2(kr) dk` (Simpson's rule to
+    /// k = 600; the integrands fall as k^-3).
+    fn fourier_rpy(r: f64, ai: f64, aj: f64, eta: f64) -> (f64, f64) {
+        let sinc = |x: f64| {
+            if x < 1e-3 {
+                1.0 - x * x / 6.0
+            } else {
+                x.sin() / x
+            }
+        };
+        let f = |k: f64| {
+            let x = k * r;
+            let (p, q) = if x < 1e-2 {
+                (2.0 / 3.0 - x * x / 10.0, x * x / 15.0)
+            } else {
+                let (s, c) = x.sin_cos();
+                let j0 = s / x;
+                let j1 = s / (x * x) - c / x;
+                let j2 = (3.0 / (x * x) - 1.0) * s / x - 3.0 * c / (x * x);
+                (j0 - j1 / x, j2)
+            };
+            let w = sinc(k * ai) * sinc(k * aj);
+            (w * p, w * q)
+        };
+        let (k_max, m) = (600.0, 600_000);
+        let h = k_max / m as f64;
+        let (mut sa, mut sb) = (0.0, 0.0);
+        for i in 0..=m {
+            let c = if i == 0 || i == m {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            let (p, q) = f(i as f64 * h);
+            sa += c * p;
+            sb += c * q;
+        }
+        let pre = h / 3.0 / (2.0 * PI * PI * eta);
+        (pre * sa, pre * sb)
+    }
+
+    #[test]
+    fn unequal_radii_match_the_fourier_definition_in_all_three_branches() {
+        // Zuk et al. (2014) Eqs. for r > a_i + a_j (apart), |a_i − a_j| < r <= a_i + a_j
+        // (overlapping) and r <= |a_i − a_j| (the small sphere inside the large one).
+        let (ai, aj, eta) = (1.0, 0.4, 1.3);
+        let mu = 1.0 / (6.0 * PI * eta * ai);
+        for r in [0.2, 0.5, 0.9, 1.2, 1.6, 3.0] {
+            let t = rpy_unequal(r, ai, aj, eta);
+            let (a, b) = fourier_rpy(r, ai, aj, eta);
+            assert!(
+                (t.a - a).abs() < 2e-5 * mu && (t.b - b).abs() < 2e-5 * mu,
+                "r {r}: closed form {t:?}, Fourier ({a}, {b})"
+            );
+        }
+        // The inner branch is exactly the larger sphere's Stokes mobility.
+        assert_eq!(rpy_unequal(0.3, ai, aj, eta), PairTensor { a: mu, b: 0.0 });
+    }
 }

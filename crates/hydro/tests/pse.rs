@@ -1,9 +1,10 @@
 //! Validation of positively split Ewald against Beenakker's Ewald sum, Hasimoto's
 //! self-mobility and fluctuation–dissipation.
 
-use colloidsim_hydro::ewald::{beenakker_matrix, hasimoto, hasimoto_rpy};
+use colloidsim_hydro::ewald::{beenakker_matrix, beenakker_matrix_radii, hasimoto, hasimoto_rpy};
 use colloidsim_hydro::params::MAX_TOLERANCE;
-use colloidsim_hydro::{HydroError, Mobility, NoiseKey, Pse, PseParams};
+use colloidsim_hydro::pse::{MAX_RADIUS_RATIO, MAX_SPECIES};
+use colloidsim_hydro::{HydroError, Mobility, NoiseKey, Pse, PseGeometry, PseParams};
 use std::f64::consts::PI;
 
 /// Uniform random positions in the cube of edge `l` (overlaps allowed) and random forces, from
@@ -314,4 +315,209 @@ fn pse_state_is_a_function_of_the_current_positions_whatever_the_history() {
     m2.set_positions(&pos1).unwrap();
     m2.displacement(&f, 1e-3, 1.0, key, &mut u2).unwrap();
     assert_eq!(u1, u2);
+}
+
+/// Radii alternating between `a` and `ratio a` (and a few pairs placed to overlap).
+fn bidisperse(
+    n: usize,
+    l: f64,
+    a: f64,
+    ratio: f64,
+    seed: u64,
+) -> (Vec<[f64; 3]>, Vec<f64>, Vec<[f64; 3]>) {
+    let (mut pos, f) = random_config(n, l, seed);
+    let radii: Vec<f64> = (0..n)
+        .map(|i| if i % 2 == 0 { a } else { ratio * a })
+        .collect();
+    // Overlapping unequal pairs: particle 2k + 1 (large) beside 2k (small), closer than
+    // a + ratio a, for k < 3; particle 7 (large) on top of particle 6 (small inside it).
+    for k in 0..3 {
+        let p = pos[2 * k];
+        pos[2 * k + 1] = [p[0] + 0.6 * (1.0 + ratio) * a, p[1] + 0.1 * a, p[2]];
+    }
+    let p = pos[6];
+    pos[7] = [p[0] + 0.2 * a, p[1], p[2] - 0.1 * a];
+    (pos, radii, f)
+}
+
+#[test]
+fn bidisperse_pse_matches_the_unequal_radius_ewald_sum() {
+    let eta = 1.0;
+    for (ratio, n, l, seed) in [(2.0, 40, 9.0, 5), (4.0, 30, 14.0, 6)] {
+        let a = 0.5;
+        let (pos, radii, f) = bidisperse(n, l, a, ratio, seed);
+        let want = matvec(
+            &beenakker_matrix_radii(&pos, &radii, eta, l, PI.sqrt() / l),
+            &f,
+        );
+        let mut prev = f64::INFINITY;
+        for tol in [1e-2, 1e-3, 1e-4] {
+            let mut p = PseParams::paper(a, eta, l);
+            p.tolerance = tol;
+            let mut m = Pse::with_radii(&radii, p).unwrap();
+            m.set_positions(&pos).unwrap();
+            let mut u = vec![[0.0; 3]; n];
+            m.apply(&f, &mut u);
+            let err = rel_err(&u, &want);
+            eprintln!(
+                "ratio {ratio} tol {tol:e}: error {err:.3e} {:?}",
+                m.geometry()
+            );
+            assert!(err < tol, "ratio {ratio}, tolerance {tol}: error {err}");
+            assert!(err < prev, "the error falls as the tolerance tightens");
+            prev = err;
+        }
+    }
+}
+
+/// The largest radius ratio PSE takes ([`MAX_RADIUS_RATIO`]): still within the tolerance
+/// (measured 0.1 to 0.25 of it, also at xi a_small = 0.05 and 0.2 in larger boxes).
+#[test]
+fn bidisperse_pse_meets_its_tolerance_at_the_largest_radius_ratio() {
+    let (a, eta, l, n) = (0.1, 1.0, 16.0, 30);
+    let ratio = MAX_RADIUS_RATIO;
+    let (pos, radii, f) = bidisperse(n, l, a, ratio, 7);
+    let want = matvec(
+        &beenakker_matrix_radii(&pos, &radii, eta, l, PI.sqrt() / l),
+        &f,
+    );
+    for tol in [1e-2, 1e-3] {
+        let mut p = PseParams::paper(a, eta, l);
+        p.tolerance = tol;
+        p.splitting = 1.25;
+        let mut m = Pse::with_radii(&radii, p).unwrap();
+        m.set_positions(&pos).unwrap();
+        let mut u = vec![[0.0; 3]; n];
+        m.apply(&f, &mut u);
+        let err = rel_err(&u, &want);
+        assert!(err < tol, "tolerance {tol}: error {err}");
+    }
+}
+
+#[test]
+fn bidisperse_pse_self_mobilities_are_per_species() {
+    let (eta, l) = (1.0, 12.0);
+    let radii = [0.5, 1.0, 0.5, 2.0];
+    let m = Pse::with_radii(&radii, PseParams::paper(0.5, eta, l)).unwrap();
+    let mono = Pse::new(4, PseParams::paper(0.5, eta, l)).unwrap();
+    let g = m.geometry();
+    assert_eq!(
+        g.grid,
+        mono.geometry().grid,
+        "the grid does not depend on the radii"
+    );
+    assert!(m.bytes() >= mono.bytes() + g.species_bytes(3));
+    assert_eq!(g.species_bytes(1), 0);
+    for (i, a) in radii.iter().enumerate() {
+        assert_eq!(m.stokes_mobility(i), 1.0 / (6.0 * PI * eta * a));
+    }
+    assert_eq!(m.species_radii(), &[0.5, 1.0, 2.0]);
+}
+
+#[test]
+fn one_species_given_as_radii_is_the_monodisperse_operator_bit_for_bit() {
+    let (a, eta, l, n) = (0.5, 1.0, 10.0, 120);
+    let (pos, f) = random_config(n, l, 8);
+    let key = NoiseKey {
+        seed: 4,
+        step: 3,
+        key0: 0,
+    };
+    let run = |mut m: Pse| {
+        m.set_positions(&pos).unwrap();
+        let mut u = vec![[0.0; 3]; n];
+        m.displacement(&f, 1e-3, 1.0, key, &mut u).unwrap();
+        let mut v = vec![[0.0; 3]; n];
+        m.apply(&f, &mut v);
+        (u, v)
+    };
+    let p = PseParams::paper(a, eta, l);
+    // `params.radius` is not read by `with_radii`.
+    let q = PseParams { radius: 3.0, ..p };
+    assert_eq!(
+        run(Pse::new(n, p).unwrap()),
+        run(Pse::with_radii(&vec![a; n], q).unwrap())
+    );
+}
+
+#[test]
+fn bidisperse_pse_noise_covariance_is_2_kt_dt_m() {
+    // Four spheres of two sizes (an unequal pair overlapping) in a small box.
+    let (eta, l) = (1.0, 8.0);
+    let pos = [
+        [0.0, 0.0, 0.0],
+        [0.9, 0.2, -0.1],
+        [-1.5, 1.0, 0.4],
+        [1.2, -2.3, 2.6],
+    ];
+    let radii = [0.5, 1.0, 1.0, 0.5];
+    let mut p = PseParams::paper(0.5, eta, l);
+    p.splitting = 1.2;
+    let mut m = Pse::with_radii(&radii, p).unwrap();
+    m.set_positions(&pos).unwrap();
+    let (worst, mean2) = common::fdt_deviation(&mut m, 12_000, 1.0, 0.02);
+    assert!(worst < 4.5, "largest deviation {worst} standard errors");
+    assert!((mean2 - 1.0).abs() < 0.5, "mean squared deviation {mean2}");
+}
+
+#[test]
+fn bidisperse_pse_follows_its_particles_through_a_reorder_with_set_radii() {
+    // The caller reorders its particles (as the BD engine does for locality): positions and
+    // radii given in the new order give the old velocities in the new order.
+    let (eta, l, n) = (1.0, 10.0, 60);
+    let (pos, radii, f) = bidisperse(n, l, 0.5, 2.0, 11);
+    let mut m = Pse::with_radii(&radii, PseParams::paper(0.5, eta, l)).unwrap();
+    m.set_positions(&pos).unwrap();
+    let mut u = vec![[0.0; 3]; n];
+    m.apply(&f, &mut u);
+    let perm: Vec<usize> = (0..n).map(|i| (7 * i + 3) % n).collect();
+    let take = |v: &[[f64; 3]]| perm.iter().map(|&k| v[k]).collect::<Vec<_>>();
+    let r2: Vec<f64> = perm.iter().map(|&k| radii[k]).collect();
+    m.set_radii(&r2).unwrap();
+    m.set_positions(&take(&pos)).unwrap();
+    let mut u2 = vec![[0.0; 3]; n];
+    m.apply(&take(&f), &mut u2);
+    for (x, y) in take(&u).iter().flatten().zip(u2.iter().flatten()) {
+        assert!((x - y).abs() < 1e-13, "{x} vs {y}");
+    }
+    // A radius the operator was not built with is refused, naming the radius.
+    let mut bad = r2.clone();
+    bad[5] = 0.7;
+    match m.set_radii(&bad) {
+        Err(HydroError::Param(e)) => assert_eq!(e.key, "radius"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn bad_radii_are_refused_naming_the_radius() {
+    let p = PseParams::paper(0.5, 1.0, 12.0);
+    let key = |radii: &[f64]| match Pse::with_radii(radii, p) {
+        Err(HydroError::Param(e)) => (e.key.clone(), e.to_string()),
+        other => panic!("{radii:?}: {other:?}"),
+    };
+    for bad in [0.0, -0.5, f64::NAN, f64::INFINITY] {
+        let (k, msg) = key(&[0.5, bad, 0.5]);
+        assert_eq!(k, "radius", "{bad}");
+        assert!(msg.contains("particle 1"), "{msg}");
+    }
+    // A size ratio beyond what PSE resolves.
+    let (k, msg) = key(&[0.1, 0.1 * (MAX_RADIUS_RATIO * 1.01)]);
+    assert_eq!(k, "radius");
+    assert!(msg.contains("differ by a factor"), "{msg}");
+    // More species than PSE takes.
+    let many: Vec<f64> = (0..=MAX_SPECIES).map(|i| 0.3 + 0.01 * i as f64).collect();
+    assert_eq!(key(&many).0, "radius");
+    // The largest sphere sets the box's minimum (4 radii).
+    let e = Pse::with_radii(&[0.5, 3.5], p).unwrap_err();
+    assert!(
+        matches!(&e, HydroError::Param(e) if e.key == "box_length"),
+        "{e}"
+    );
+    // The geometry alone says the same.
+    assert!(PseGeometry::with_radii(&p, &[0.5, 0.0]).is_err());
+    assert_eq!(
+        PseGeometry::with_radii(&p, &[0.5, 0.5]).unwrap(),
+        PseGeometry::new(&p).unwrap()
+    );
 }
