@@ -638,7 +638,7 @@ mod tests {
             assert!((g2[0][1] - g[0][0]).abs() < 1e-12 * g[0][0]);
         }
         for (xl, phi) in [(0.25, 0.3), (0.5, 0.3), (0.1, 0.45)] {
-            let d = [1.0, 2.0];
+            let d = [1.0f64, 2.0];
             let x = [1.0 - xl, xl];
             let mean3 = x[0] * d[0].powi(3) + x[1] * d[1].powi(3);
             let rho = phi * 6.0 / PI / mean3;
