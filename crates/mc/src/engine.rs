@@ -4,7 +4,8 @@
 //! # Algorithm
 //!
 //! The periodic box (the bulk cube, or a cube around the droplet with [`Geometry::box_edge`]'s
-//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` a multiple of 4 (or 2 in short boxes).
+//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d` (`d` the largest diameter
+//! of a mixture), `nc` a multiple of 4 (or 2 in short boxes).
 //! A sweep is:
 //!
 //! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the two parities of
@@ -15,8 +16,9 @@
 //!    layer) visits its `nc^2` cells in storage order, and each cell makes `nselect` (default 1)
 //!    times as many trial moves as it holds particles: pick one of its particles uniformly,
 //!    displace it uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre
-//!    leaves the cell, leaves the container, or overlaps any sphere, and (interface geometry)
-//!    accept it with the Metropolis probability `min(1, exp(-beta dV))`. Layers of one parity
+//!    leaves the cell, leaves the container, or overlaps any sphere (a centre distance below
+//!    the pair's mean diameter), and (interface geometry) accept it with the Metropolis
+//!    probability `min(1, exp(-beta dV))`. Layers of one parity
 //!    are a layer apart, `s >= d`, so a sphere moving in one can touch only spheres of its own
 //!    layer (updated in turn by the same task) and of the two layers beside it, which have the
 //!    other parity and stay fixed during the pass;

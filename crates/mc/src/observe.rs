@@ -625,7 +625,7 @@ mod tests {
 
     /// BMCSL: one species (any split of it into two species of one diameter) is
     /// Carnahan–Starling, Z and g(d+); a binary mixture's Z equals the virial sum over its
-    /// contact values (two independent closed forms); a hand value at size ratio 2.
+    /// contact values and Mansoori et al.'s Eq. 7 (other closed forms) at size ratio 2.
     #[test]
     fn bmcsl_reduces_to_carnahan_starling_and_its_contact_values_give_its_z() {
         for phi in [0.05, 0.3, 0.5] {
@@ -655,17 +655,40 @@ mod tests {
                 "{xl} {phi}: {virial} vs {z}"
             );
         }
-        // x_l = 0.5, d = (1, 2), phi = 0.3 by hand: rho = 0.3 * 6 / (4.5 pi), xi_0 = pi rho / 6,
-        // xi_1 = 1.5 xi_0, xi_2 = 2.5 xi_0, xi_3 = 0.3.
-        let rho = 1.8 / (4.5 * PI);
-        let x0 = PI * rho / 6.0;
-        let (x1, x2, x3) = (1.5 * x0, 2.5 * x0, 0.3);
-        let want = (x0 / (1.0 - x3)
-            + 3.0 * x1 * x2 / (1.0 - x3).powi(2)
-            + (3.0 - x3) * x2.powi(3) / (1.0 - x3).powi(3))
-            / x0;
-        let (z, _) = bmcsl(&[0.5 * rho, 0.5 * rho], &[1.0, 2.0]);
-        assert!((z - want).abs() < 1e-12 * z);
-        assert!((z - 3.505_830_903_790_088).abs() < 1e-9, "{z}");
+        // Against the other closed form of Z, Mansoori et al.'s Eq. 7:
+        // Z = [(1 + xi + xi^2) - 3 xi (y1 + y2 xi) - xi^3 y3] / (1 - xi)^3 with xi_i the
+        // partial packing fractions, Delta_ij = sqrt(xi_i xi_j) / xi (d_i - d_j)^2 / (d_i d_j)
+        // sqrt(x_i x_j), y1 = sum_{i<j} Delta_ij (d_i + d_j) / sqrt(d_i d_j),
+        // y2 = sum_{i<j} Delta_ij sum_k (xi_k / xi) sqrt(d_i d_j) / d_k,
+        // y3 = [sum_i (xi_i / xi)^(2/3) x_i^(1/3)]^3.
+        for (xl, phi, want) in [
+            (0.5, 0.3, 3.505_830_903_790_086),
+            (0.25, 0.3, 3.391_676_505_312_867),
+            (0.1, 0.45, 7.931_634_772_616_789),
+        ] {
+            let (x, d) = ([1.0 - xl, xl], [1.0f64, 2.0]);
+            let rho = phi * 6.0 / PI / (x[0] + 8.0 * x[1]);
+            let xs = [PI / 6.0 * rho * x[0], PI / 6.0 * rho * x[1] * 8.0];
+            let xi = xs[0] + xs[1];
+            let delta = (xs[0] * xs[1]).sqrt() / xi * (d[0] - d[1]).powi(2) / (d[0] * d[1])
+                * (x[0] * x[1]).sqrt();
+            let y1 = delta * (d[0] + d[1]) / (d[0] * d[1]).sqrt();
+            let y2 = delta
+                * (0..2)
+                    .map(|k| xs[k] / xi * (d[0] * d[1]).sqrt() / d[k])
+                    .sum::<f64>();
+            let y3 = (0..2)
+                .map(|i| (xs[i] / xi).powf(2.0 / 3.0) * x[i].cbrt())
+                .sum::<f64>()
+                .powi(3);
+            let eq7 = ((1.0 + xi + xi * xi) - 3.0 * xi * (y1 + y2 * xi) - xi.powi(3) * y3)
+                / (1.0 - xi).powi(3);
+            let (z, _) = bmcsl(&[x[0] * rho, x[1] * rho], &d);
+            assert!(
+                (z - eq7).abs() < 1e-12 * z,
+                "{xl} {phi}: {z} vs Eq. 7 {eq7}"
+            );
+            assert!((z - want).abs() < 1e-9 * z, "{xl} {phi}: {z}");
+        }
     }
 }
