@@ -349,3 +349,42 @@ fn a_short_binary_run_agrees_with_bmcsl() {
     assert!((z - want).abs() < 4.0 * se, "{z} +- {se} vs {want}");
     assert!(se < 0.1, "{se}");
 }
+
+/// A mixture's run starts in each droplet geometry (on the lattice, grown where it does not fit)
+/// with every sphere within its own confinement and no overlap; counts that do not add up to
+/// the spheres are refused naming `counts`.
+#[test]
+fn a_mixture_run_starts_in_each_droplet_geometry_and_bad_counts_are_refused() {
+    for (n, nl, radius) in [(40usize, 10usize, 4.0f64), (100, 25, 5.0)] {
+        for interface in [None, Some([50.0, 0.5, -0.5])] {
+            let mut run = bulk_run(n, 0.0, 0.3, 9);
+            run.mixture = Some(McMixture {
+                diameters: vec![1.0, 2.0],
+                counts: vec![n - nl, nl],
+            });
+            run.geometry = if interface.is_some() {
+                "interface"
+            } else {
+                "hard-wall"
+            }
+            .into();
+            run.radius = Some(radius);
+            run.interface = interface;
+            let mut mc = run.engine(None, "start").unwrap();
+            assert_eq!(mc.sweeps(), 0);
+            mc.run(20);
+            assert!(mc.first_overlap(1e-12).is_none());
+            let g = *mc.geometry();
+            for i in 0..mc.len() {
+                let p = mc.position(i);
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                let d = mc.diameters()[mc.types()[i] as usize];
+                assert!(r <= g.confinement_of(d, 1.0).unwrap() + 1e-12, "{i}: {r}");
+            }
+        }
+    }
+    let mut run = bulk_run(100, 0.25, 0.3, 9);
+    run.mixture.as_mut().unwrap().counts[0] += 1;
+    let e = run.engine(None, "start").unwrap_err();
+    assert!(e.to_string().starts_with("counts: "), "{e}");
+}
