@@ -273,6 +273,7 @@ fn stage_table(
             geometry: Geometry::tabulated(potential),
             seed: c.seed.wrapping_add(k as u32),
             delta: 0.2,
+            mixture: None,
         };
         let mut mc = HardSphereMc::new(&params, &positions, "stage configuration")
             .unwrap_or_else(|e| fail(format!("stage {k}: {e}")));

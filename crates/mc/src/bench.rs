@@ -21,6 +21,7 @@ pub fn bulk_system(n: usize, phi: f64, seed: u32, warmup: u64) -> Result<HardSph
         geometry: Geometry::Bulk { edge },
         seed,
         delta: 0.1,
+        mixture: None,
     };
     let mut mc = HardSphereMc::new(&params, &pos, "system")?;
     mc.warm_up(warmup, 100, 0.3);

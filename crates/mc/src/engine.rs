@@ -4,7 +4,8 @@
 //! # Algorithm
 //!
 //! The periodic box (the bulk cube, or a cube around the droplet with [`Geometry::box_edge`]'s
-//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d`, `nc` a multiple of 4 (or 2 in short boxes).
+//! margin) is tiled by `nc^3` cubic cells of side `s = L / nc >= d` (`d` the largest diameter
+//! of a mixture), `nc` a multiple of 4 (or 2 in short boxes).
 //! A sweep is:
 //!
 //! 1. draw a random grid offset uniform in `[0, s)^3` and a random order of the two parities of
@@ -15,8 +16,9 @@
 //!    layer) visits its `nc^2` cells in storage order, and each cell makes `nselect` (default 1)
 //!    times as many trial moves as it holds particles: pick one of its particles uniformly,
 //!    displace it uniformly in the cube `[-delta, delta)^3`, reject the move if the new centre
-//!    leaves the cell, leaves the container, or overlaps any sphere, and (interface geometry)
-//!    accept it with the Metropolis probability `min(1, exp(-beta dV))`. Layers of one parity
+//!    leaves the cell, leaves the container, or overlaps any sphere (a centre distance below
+//!    the pair's mean diameter), and (interface geometry) accept it with the Metropolis
+//!    probability `min(1, exp(-beta dV))`. Layers of one parity
 //!    are a layer apart, `s >= d`, so a sphere moving in one can touch only spheres of its own
 //!    layer (updated in turn by the same task) and of the two layers beside it, which have the
 //!    other parity and stay fixed during the pass;
@@ -61,7 +63,7 @@ pub enum McError {
     Param(#[from] ParamError),
     /// Two spheres of the initial configuration overlap.
     #[error(
-        "{key}: spheres {i} and {j} overlap (centre distance {distance:.6} < diameter {diameter}); a hard-sphere configuration needs every centre distance >= d"
+        "{key}: spheres {i} and {j} overlap (centre distance {distance:.6} < diameter {diameter}); a hard-sphere configuration needs every centre distance >= d (the pair's mean diameter in a mixture)"
     )]
     Overlap {
         /// Scenario key of the configuration.
@@ -72,7 +74,7 @@ pub enum McError {
         j: usize,
         /// Their centre distance.
         distance: f64,
-        /// The diameter.
+        /// Their contact distance: the diameter, or the pair's mean diameter `(d_i + d_j) / 2`.
         diameter: f64,
     },
     /// A sphere of the initial configuration lies outside its container.
@@ -92,9 +94,11 @@ pub enum McError {
 }
 
 /// Settings of [`HardSphereMc`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct McParams {
-    /// Sphere diameter d (length unit).
+    /// Sphere diameter d (length unit): the diameter of every sphere when `mixture` is `None`;
+    /// with a mixture, the reference diameter the geometry's lengths were given for (the
+    /// interface's `offset`, see [`Geometry::confinement_of`]).
     pub diameter: f64,
     /// Container.
     pub geometry: Geometry,
@@ -102,6 +106,34 @@ pub struct McParams {
     pub seed: u32,
     /// Initial half-width of the trial displacement cube.
     pub delta: f64,
+    /// The species of an additive mixture (`None`: one species, every sphere of `diameter`).
+    pub mixture: Option<Mixture>,
+}
+
+/// The species of an additive hard-sphere mixture: spheres `i` and `j` overlap when their
+/// centre distance is below `(d_ti + d_tj) / 2`.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct Mixture {
+    /// Diameter of each species (at least one).
+    pub diameters: Vec<f64>,
+    /// Species of each sphere, in the order of the positions (each below `diameters.len()`).
+    pub types: Vec<u32>,
+}
+
+impl Mixture {
+    /// `counts[s]` spheres of species `s` (of diameter `diameters[s]`), species after species:
+    /// the first `counts[0]` spheres are of species 0, and so on.
+    pub fn from_counts(diameters: &[f64], counts: &[usize]) -> Self {
+        let types = counts
+            .iter()
+            .enumerate()
+            .flat_map(|(s, &c)| std::iter::repeat_n(s as u32, c))
+            .collect();
+        Self {
+            diameters: diameters.to_vec(),
+            types,
+        }
+    }
 }
 
 /// Counts of one or more sweeps.
@@ -160,7 +192,11 @@ impl<'a> Frozen<'a> {
 /// Everything a cell's pass needs apart from the slots (copied into each task).
 #[derive(Clone, Copy)]
 struct Pass {
-    d2: f64,
+    /// Largest sphere radius (half the largest diameter, times the growth scale).
+    r_max: f64,
+    /// Reference radius (half [`McParams::diameter`]): a sphere of another radius `r` sees the
+    /// container's confinement and energy shifted by `r - r_ref` ([`Geometry::confinement_of`]).
+    r_ref: f64,
     side: f64,
     edge: f64,
     nc: usize,
@@ -177,8 +213,11 @@ struct Pass {
     shift: [f64; 3],
     inv_side: f64,
     geometry: Geometry,
-    /// Squared largest centre distance from the droplet centre (infinite in bulk).
-    confine2: f64,
+    /// Largest centre distance from the droplet centre of a sphere of radius `r_ref` (infinite
+    /// in bulk).
+    confine: f64,
+    /// Whether the confinement shrinks by `r - r_ref` for a sphere of radius `r`.
+    shrinks: bool,
 }
 
 /// A uniform deviate in [0, 1) from 53 bits.
@@ -257,6 +296,7 @@ impl Pass {
         parity: usize,
         k: usize,
         layer: [&mut [f64]; 3],
+        radii: &[f64],
         counts: &[u32],
         frozen: &Frozen<'_>,
     ) -> (u64, u64) {
@@ -292,6 +332,7 @@ impl Pass {
                 let (a, l) = self.cell_moves(
                     [&xs, &ys, &zs],
                     [&mut lx, &mut ly, &mut lz],
+                    radii,
                     first * cap,
                     n,
                     counts,
@@ -310,12 +351,13 @@ impl Pass {
     /// holds the slots of its layer, whose first slot has global index `layer_base`: the cell's
     /// own `cap` slots (positions relative to its corner, the `n` occupied ones first and
     /// [`EMPTY`] beyond) and those of its eight neighbours in the layer, which the same task
-    /// updates in turn; the neighbours above and below are read from `frozen`. Returns
+    /// updates in turn; the neighbours above and below are read from `frozen`; `radii` holds
+    /// every slot's sphere radius (global slot index; fixed during the sweep). Returns
     /// (accepted, left the cell).
     ///
-    /// A move to `u` can touch only the neighbour cells within `d` of `u`: along each axis the
-    /// lower one when `u < d`, the upper one when `u > s - d` (with `s >= 2 d` about 7 of the
-    /// 27 cells). Each is scanned over all its slots (empty ones hold [`EMPTY`], far from
+    /// A sphere of radius `r_p` moved to `u` can touch only the neighbour cells within
+    /// `r_p + r_max` of `u`: along each axis the lower one when `u < r_p + r_max`, the upper one
+    /// when `u > s - r_p - r_max` (one species, `s >= 2 d`: about 7 of the 27 cells). Each is scanned over all its slots (empty ones hold [`EMPTY`], far from
     /// everything), a fixed-length loop that vectorises and never mispredicts its end.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
@@ -323,6 +365,7 @@ impl Pass {
         &self,
         around: [&[usize; 3]; 3],
         layer: [&mut [f64]; 3],
+        radii: &[f64],
         layer_base: usize,
         n: usize,
         counts: &[u32],
@@ -330,7 +373,7 @@ impl Pass {
         rng: &mut impl Rng,
     ) -> (u64, u64) {
         let [lx, ly, lz] = layer;
-        let (s, cap, d) = (self.side, self.cap, self.d2.sqrt());
+        let (s, cap) = (self.side, self.cap);
         let c = [around[0][1], around[1][1], around[2][1]];
         let own = self.id(c) * cap - layer_base;
         // Slots of the 27 cells around (index 9 dz + 3 dy + dx, own cell at 13), and whether
@@ -353,9 +396,14 @@ impl Pass {
             |u: [f64; 3]| -> [f64; 3] { std::array::from_fn(|a| centre[a] + u[a] - half_side) };
         let soft = self.geometry.is_soft();
         let (mut accepted, mut left) = (0u64, 0u64);
-        let range = |u: f64| (usize::from(u >= d), 1 + usize::from(u > s - d));
+        let own_radii = &radii[layer_base..];
         for _ in 0..n * self.nselect {
             let p = own + below(rng.next_u64(), n);
+            let rp = own_radii[p];
+            // One species: rp + r_max = d and h = 0, exactly.
+            let reach = rp + self.r_max;
+            let h = rp - self.r_ref;
+            let range = |u: f64| (usize::from(u >= reach), 1 + usize::from(u > s - reach));
             let step = |b: u64| self.delta * (2.0 * unit(b) - 1.0);
             let new = [
                 lx[p] + step(rng.next_u64()),
@@ -367,14 +415,20 @@ impl Pass {
                 continue;
             }
             let r = at(new);
-            if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > self.confine2 {
+            let confine = if self.shrinks {
+                self.confine - h
+            } else {
+                self.confine
+            };
+            if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > confine * confine {
                 continue;
             }
             // The own cell, without p itself.
             let mut hit = false;
             for q in own..own + len[13] {
                 let (a, b, cc) = (new[0] - lx[q], new[1] - ly[q], new[2] - lz[q]);
-                hit |= (a * a + b * b + cc * cc < self.d2) & (q != p);
+                let contact = rp + own_radii[q];
+                hit |= (a * a + b * b + cc * cc < contact * contact) & (q != p);
             }
             let (xr, yr, zr) = (range(new[0]), range(new[1]), range(new[2]));
             'scan: for dz in zr.0..=zr.1 {
@@ -400,7 +454,8 @@ impl Pass {
                             new[1] - (dy as f64 - 1.0) * s,
                             new[2] - (dz as f64 - 1.0) * s,
                         ];
-                        hit = any_within(x, y, z, q, self.d2);
+                        let rq = &radii[base[k]..base[k] + len[k]];
+                        hit = any_within(x, y, z, rq, q, rp);
                     }
                 }
             }
@@ -408,8 +463,8 @@ impl Pass {
                 continue;
             }
             if soft {
-                let du = self.geometry.beta_energy(r)
-                    - self.geometry.beta_energy(at([lx[p], ly[p], lz[p]]));
+                let du = self.geometry.beta_energy_of(r, h)
+                    - self.geometry.beta_energy_of(at([lx[p], ly[p], lz[p]]), h);
                 if du > 0.0 && unit(rng.next_u64()) >= (-du).exp() {
                     continue;
                 }
@@ -427,14 +482,16 @@ impl Pass {
 /// the slots of a cell never see it as a neighbour (its squared distances stay finite).
 pub(crate) const EMPTY: f64 = 1e30;
 
-/// Whether any of the points `(x, y, z)` (a cell's slots, a multiple of eight) lies closer
-/// than `sqrt(d2)` to `p`: a fixed-length, branch-free loop that vectorises.
+/// Whether any of the spheres at `(x, y, z)` of radii `r` (a cell's slots, a multiple of
+/// eight) overlaps a sphere of radius `rp` at `p` (centre distance below `rp + r`): a
+/// fixed-length, branch-free loop that vectorises.
 #[inline(always)]
-fn any_within(x: &[f64], y: &[f64], z: &[f64], p: [f64; 3], d2: f64) -> bool {
+fn any_within(x: &[f64], y: &[f64], z: &[f64], r: &[f64], p: [f64; 3], rp: f64) -> bool {
     let mut hit = false;
-    for ((x, y), z) in x.iter().zip(y).zip(z) {
+    for (((x, y), z), r) in x.iter().zip(y).zip(z).zip(r) {
         let (a, b, c) = (p[0] - x, p[1] - y, p[2] - z);
-        hit |= a * a + b * b + c * c < d2;
+        let contact = rp + r;
+        hit |= a * a + b * b + c * c < contact * contact;
     }
     hit
 }
@@ -442,7 +499,18 @@ fn any_within(x: &[f64], y: &[f64], z: &[f64], p: [f64; 3], d2: f64) -> bool {
 /// Hard spheres in a [`Geometry`], moved by checkerboard Monte Carlo sweeps.
 #[derive(Debug, Clone)]
 pub struct HardSphereMc {
+    /// Reference diameter ([`McParams::diameter`]).
     diameter: f64,
+    /// Diameter of each species.
+    diameters: Vec<f64>,
+    /// Species of each sphere.
+    types: Vec<u32>,
+    /// Radius of each sphere: half its species' diameter, times `scale`.
+    radius: Vec<f64>,
+    /// Factor on every diameter: 1 except while [`Self::grow`] inflates a compressed start.
+    scale: f64,
+    /// Largest species diameter.
+    d_max: f64,
     geometry: Geometry,
     seed: u32,
     delta: f64,
@@ -462,6 +530,8 @@ pub struct HardSphereMc {
     slot: [Vec<f64>; 3],
     /// Particle index per slot.
     tag: Vec<u32>,
+    /// Sphere radius per slot (0 in empty slots).
+    slot_r: Vec<f64>,
     /// Grid offset of the current binning.
     offset: [f64; 3],
     /// Per particle: its cell and its slot (scratch of the binning, kept to avoid allocating
@@ -477,6 +547,15 @@ pub struct HardSphereMc {
     /// range's group ends.
     bucket: Vec<u32>,
     bucket_end: Vec<u32>,
+}
+
+/// Half of `diameter` times `scale` (exactly `diameter / 2` at scale 1).
+fn radius_of(diameter: f64, scale: f64) -> f64 {
+    if scale == 1.0 {
+        0.5 * diameter
+    } else {
+        0.5 * diameter * scale
+    }
 }
 
 /// Fewest particles per part of the parallel binning.
@@ -530,50 +609,137 @@ const MIN_CELL_BOUND: f64 = 262_144.0;
 const MAX_DELTA_PER_SIDE: f64 = 0.5;
 
 impl HardSphereMc {
-    /// Spheres at `positions` (relative to the box centre, or the droplet centre). Errors:
-    /// parameters out of range, overlaps, centres outside the container, a cell grid larger
-    /// than the memory (`key` names where the positions came from in messages; other errors
-    /// name the parameter: `diameter`, `delta`, `radius`, `box`).
+    /// Spheres at `positions` (relative to the box centre, or the droplet centre), of the
+    /// species of `params.mixture` (or all of `params.diameter`). Errors: parameters out of
+    /// range, overlaps (centre distance below the pair's mean diameter), centres outside the
+    /// container, a cell grid larger than the memory (`key` names where the positions came from
+    /// in messages; other errors name the parameter: `diameter`, `diameters`, `types`, `delta`,
+    /// `radius`, `box`).
     pub fn new(params: &McParams, positions: &[[f64; 3]], key: &str) -> Result<Self, McError> {
+        Self::new_scaled(params, positions, key, 1.0)
+    }
+
+    /// [`Self::new`] with every diameter times `scale` (in (0, 1]): the compressed start that
+    /// [`Self::grow`] inflates. The cells and the box are those of the full diameters.
+    pub(crate) fn new_scaled(
+        params: &McParams,
+        positions: &[[f64; 3]],
+        key: &str,
+        scale: f64,
+    ) -> Result<Self, McError> {
         let d = positive("diameter", params.diameter)?;
         positive("delta", params.delta)?;
-        let edge = params.geometry.box_edge(d);
+        let n = positions.len();
+        let (diameters, types) = match &params.mixture {
+            None => (vec![d], vec![0u32; n]),
+            Some(m) => {
+                if m.diameters.is_empty() {
+                    return Err(ParamError::new("diameters", "needs at least one species").into());
+                }
+                for (s, &ds) in m.diameters.iter().enumerate() {
+                    if !(ds.is_finite() && ds > 0.0) {
+                        return Err(ParamError::new(
+                            "diameters",
+                            format!(
+                                "species {s}: the diameter must be positive and finite, got {}",
+                                show(ds)
+                            ),
+                        )
+                        .into());
+                    }
+                }
+                if m.types.len() != n {
+                    return Err(ParamError::new(
+                        "types",
+                        format!(
+                            "names {} spheres' species, there are {n} spheres",
+                            m.types.len()
+                        ),
+                    )
+                    .into());
+                }
+                if let Some(i) = m
+                    .types
+                    .iter()
+                    .position(|&t| t as usize >= m.diameters.len())
+                {
+                    return Err(ParamError::new(
+                        "types",
+                        format!(
+                            "sphere {i} is of species {}, there are {} species",
+                            m.types[i],
+                            m.diameters.len()
+                        ),
+                    )
+                    .into());
+                }
+                (m.diameters.clone(), m.types.clone())
+            }
+        };
+        let d_max = diameters.iter().fold(0.0f64, |a, &b| a.max(b));
+        let edge = params.geometry.box_edge_of(d, &diameters);
         positive("box", edge)?;
         if let Geometry::HardWall { radius } = params.geometry
-            && radius <= 0.5 * d
+            && radius <= 0.5 * d_max
         {
             return Err(ParamError::new(
                 "radius",
-                format!("must exceed d/2 = {} (no room for a centre)", show(0.5 * d)),
+                format!(
+                    "must exceed d/2 = {} (no room for a centre)",
+                    show(0.5 * d_max)
+                ),
             )
             .into());
         }
-        if edge < 2.0 * d {
+        for &ds in &diameters {
+            if let Some(c) = params.geometry.confinement_of(ds, d)
+                && c <= 0.0
+            {
+                return Err(ParamError::new(
+                    "diameters",
+                    format!(
+                        "a sphere of diameter {} has no room for its centre in the container",
+                        show(ds)
+                    ),
+                )
+                .into());
+            }
+        }
+        if edge < 2.0 * d_max {
             return Err(ParamError::new(
                 "box",
                 format!(
                     "the periodic box edge must be at least 2 d = {}, got {}",
-                    show(2.0 * d),
+                    show(2.0 * d_max),
                     show(edge)
                 ),
             )
             .into());
         }
-        let nc = cells_per_edge(edge, d);
+        let nc = cells_per_edge(edge, d_max);
         let cells = (nc as f64).powi(3);
-        let n = positions.len();
-        check_cell_count(edge, d, n)?;
-        // Slots (3 coordinates, a tag) at the initial capacity, counts, particle arrays.
+        check_cell_count(edge, d_max, n)?;
+        // Slots (3 coordinates, a radius, a tag) at the initial capacity, counts, particle
+        // arrays.
         let cap0 = 8usize;
-        let bytes = cells * (cap0 as f64 * 28.0 + 4.0) + n as f64 * 80.0;
+        let bytes = cells * (cap0 as f64 * 36.0 + 4.0) + n as f64 * 100.0;
         ensure_fits(
             "system",
             &format!("a grid of {nc}^3 Monte Carlo cells"),
             bytes,
         )?;
         let nc_cells = nc * nc * nc;
+        let radius = types
+            .iter()
+            .map(|&t| radius_of(diameters[t as usize], scale))
+            .collect();
         let mut mc = Self {
             diameter: d,
+            diameters,
+            types,
+            radius,
+            scale,
+            d_max,
             geometry: params.geometry,
             seed: params.seed,
             delta: params.delta,
@@ -587,6 +753,7 @@ impl HardSphereMc {
             count: vec![0; nc_cells],
             slot: std::array::from_fn(|_| vec![0.0; nc_cells * cap0]),
             tag: vec![0; nc_cells * cap0],
+            slot_r: vec![0.0; nc_cells * cap0],
             offset: [0.0; 3],
             cell_of: vec![0; n],
             slot_of: vec![0; n],
@@ -597,7 +764,6 @@ impl HardSphereMc {
             bucket_end: Vec::new(),
         };
         mc.delta = mc.delta.min(mc.max_delta());
-        let max = params.geometry.confinement(d);
         for (i, p) in positions.iter().enumerate() {
             if p.iter().any(|x| !x.is_finite()) {
                 return Err(
@@ -605,7 +771,7 @@ impl HardSphereMc {
                 );
             }
             let mut q = *p;
-            if let Some(max) = max {
+            if let Some(max) = mc.confinement_of_sphere(i) {
                 let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
                 if r > max {
                     return Err(McError::OutsideWall {
@@ -634,10 +800,97 @@ impl HardSphereMc {
                 i,
                 j,
                 distance: r,
-                diameter: d,
+                diameter: mc.radius[i] + mc.radius[j],
             });
         }
         Ok(mc)
+    }
+
+    /// Largest centre distance from the droplet centre of sphere `i` at its current radius
+    /// (`None` in bulk): [`Geometry::confinement_of`] as the moves apply it.
+    fn confinement_of_sphere(&self, i: usize) -> Option<f64> {
+        let c = self.geometry.confinement(self.diameter)?;
+        Some(if self.geometry.shrinks() {
+            c - (self.radius[i] - 0.5 * self.diameter)
+        } else {
+            c
+        })
+    }
+
+    /// Inflate a compressed start ([`Self::new_scaled`]) to the full diameters: sweeps (with
+    /// the move size tuned towards acceptance 0.3 every 10), after each of which every diameter
+    /// grows to the largest factor (at most 1) that the closest pair (relative to its contact
+    /// distance) and the walls allow, less a relative 1e-9. The sweeps draw from streams far
+    /// beyond any run's (sweep numbers from 2^62), and afterwards the sweep count is 0 again
+    /// and delta is `delta`, so the run starts as from any other configuration. Error (key
+    /// `system.volume_fraction`) when `max_sweeps` sweeps do not reach the full diameters.
+    pub fn grow(&mut self, max_sweeps: u64, delta: f64) -> Result<u64, McError> {
+        const FIRST: u64 = 1 << 62;
+        let (sweep0, delta0) = (self.sweep, self.delta);
+        self.sweep = FIRST;
+        let mut window = SweepStats::default();
+        let mut done = 0;
+        while self.scale < 1.0 {
+            if done == max_sweeps {
+                return Err(ParamError::new(
+                    "n",
+                    format!(
+                        "{max_sweeps} Monte Carlo sweeps grew the mixture from its lattice to only {:.4} of its diameters: pack it less densely",
+                        self.scale
+                    ),
+                )
+                .into());
+            }
+            window += self.sweep();
+            done += 1;
+            if done % 10 == 0 {
+                self.tune(window.acceptance(), 0.3);
+                window = SweepStats::default();
+            }
+            let grown = (self.largest_scale() * (1.0 - 1e-9)).min(1.0);
+            if grown > self.scale {
+                self.set_scale(grown);
+            }
+        }
+        self.sweep = sweep0;
+        self.delta = delta0;
+        self.set_delta(delta);
+        Ok(done)
+    }
+
+    /// The largest diameter factor the current positions allow: over pairs `r / d_ij`, over
+    /// spheres in a shrinking container `(c_ref + r_ref - |x|) / r_i` (`r_i`, `r_ref`: full
+    /// radii); at least the current scale.
+    fn largest_scale(&self) -> f64 {
+        let full: Vec<f64> = self
+            .types
+            .iter()
+            .map(|&t| 0.5 * self.diameters[t as usize])
+            .collect();
+        let mut best = f64::INFINITY;
+        self.for_each_pair(self.d_max, |i, j, r2| {
+            best = best.min(r2.sqrt() / (full[i] + full[j]));
+        });
+        if self.geometry.shrinks()
+            && let Some(c) = self.geometry.confinement(self.diameter)
+        {
+            let top = c + 0.5 * self.diameter;
+            for (i, &ri) in full.iter().enumerate() {
+                let p = self.position(i);
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                best = best.min((top - r) / ri);
+            }
+        }
+        best.max(self.scale)
+    }
+
+    /// Set the diameter factor (1: the full diameters, exactly).
+    fn set_scale(&mut self, scale: f64) {
+        self.scale = scale;
+        for (r, &t) in self.radius.iter_mut().zip(&self.types) {
+            *r = radius_of(self.diameters[t as usize], scale);
+        }
+        self.rebin(self.offset);
     }
 
     /// Number of spheres.
@@ -650,9 +903,39 @@ impl HardSphereMc {
         self.len() == 0
     }
 
-    /// Sphere diameter.
+    /// Sphere diameter (one species), or the reference diameter of a mixture
+    /// ([`McParams::diameter`]).
     pub fn diameter(&self) -> f64 {
         self.diameter
+    }
+
+    /// Diameter of each species (one species: `[diameter]`).
+    pub fn diameters(&self) -> &[f64] {
+        &self.diameters
+    }
+
+    /// Species of each sphere (one species: all 0).
+    pub fn types(&self) -> &[u32] {
+        &self.types
+    }
+
+    /// Number of species.
+    pub fn species(&self) -> usize {
+        self.diameters.len()
+    }
+
+    /// Spheres of each species.
+    pub fn species_counts(&self) -> Vec<usize> {
+        let mut c = vec![0; self.diameters.len()];
+        for &t in &self.types {
+            c[t as usize] += 1;
+        }
+        c
+    }
+
+    /// Largest species diameter (the cells are sized by it).
+    pub fn max_diameter(&self) -> f64 {
+        self.d_max
     }
 
     /// The container.
@@ -735,7 +1018,8 @@ impl HardSphereMc {
     fn pass(&self) -> Pass {
         let confine = self.geometry.confinement(self.diameter);
         Pass {
-            d2: self.diameter * self.diameter,
+            r_max: 0.5 * self.scale * self.d_max,
+            r_ref: 0.5 * self.diameter,
             side: self.side,
             edge: self.edge,
             nc: self.nc,
@@ -749,7 +1033,8 @@ impl HardSphereMc {
             shift: self.offset.map(|o| 0.5 * self.edge - o),
             inv_side: 1.0 / self.side,
             geometry: self.geometry,
-            confine2: confine.map_or(f64::INFINITY, |r| r * r),
+            confine: confine.unwrap_or(f64::INFINITY),
+            shrinks: self.geometry.shrinks(),
         }
     }
 
@@ -830,7 +1115,7 @@ impl HardSphereMc {
             fullest = fullest.max(*total as usize);
         }
         while fullest > self.cap {
-            self.grow();
+            self.grow_slots();
         }
         let part_count = &self.part_count[..parts * cells];
         // 3. Slot indices per part, and the slots per range of cells.
@@ -840,6 +1125,7 @@ impl HardSphereMc {
         let (bucket, bucket_end) = (&self.bucket, &self.bucket_end);
         let [sx, sy, sz] = &mut self.slot;
         let (tag, cell_seen) = (&mut self.tag, &mut self.cell_seen);
+        let (radius, slot_r) = (&self.radius, &mut self.slot_r);
         rayon::join(
             || {
                 self.slot_of
@@ -861,9 +1147,10 @@ impl HardSphereMc {
                     .zip(sy.par_chunks_mut(range * cap))
                     .zip(sz.par_chunks_mut(range * cap))
                     .zip(tag.par_chunks_mut(range * cap))
+                    .zip(slot_r.par_chunks_mut(range * cap))
                     .zip(cell_seen.par_chunks_mut(range))
                     .enumerate()
-                    .for_each(|(k, ((((x, y), z), tag), seen))| {
+                    .for_each(|(k, (((((x, y), z), tag), rad), seen))| {
                         let first = k * range;
                         seen.fill(0);
                         // This range's particles, part after part: particle order.
@@ -880,6 +1167,7 @@ impl HardSphereMc {
                             let (_, u) = pass.bin(px[i], py[i], pz[i]);
                             (x[slot], y[slot], z[slot]) = (u[0], u[1], u[2]);
                             tag[slot] = i as u32;
+                            rad[slot] = radius[i];
                         }
                         // Pad each cell to a whole vector of eight (the scans read that far).
                         for (c, &m) in seen.iter().enumerate() {
@@ -887,7 +1175,8 @@ impl HardSphereMc {
                                 c * cap + m as usize..c * cap + (m as usize).next_multiple_of(8);
                             x[pad.clone()].fill(EMPTY);
                             y[pad.clone()].fill(EMPTY);
-                            z[pad].fill(EMPTY);
+                            z[pad.clone()].fill(EMPTY);
+                            rad[pad].fill(0.0);
                         }
                     })
             },
@@ -895,13 +1184,14 @@ impl HardSphereMc {
     }
 
     /// Eight more slots per cell (a multiple of eight keeps the scans in whole vectors).
-    fn grow(&mut self) {
+    fn grow_slots(&mut self) {
         self.cap += 8;
         let total = self.count.len() * self.cap;
         for s in &mut self.slot {
             s.resize(total, 0.0);
         }
         self.tag.resize(total, 0);
+        self.slot_r.resize(total, 0.0);
     }
 
     /// Write the slots back into the particle-order positions (in parallel): each particle's
@@ -947,7 +1237,7 @@ impl HardSphereMc {
         let layer = pass.nc * pass.nc * self.cap;
         let span = pass.half * layer;
         let (mut accepted, mut left) = (0, 0);
-        let counts = &self.count;
+        let (counts, radii) = (&self.count, &self.slot_r);
         for parity in parities {
             let (lo, hi) = (parity * span, (parity + 1) * span);
             let [sx, sy, sz] = &mut self.slot;
@@ -968,7 +1258,9 @@ impl HardSphereMc {
                 .zip(yc.par_chunks_mut(layer))
                 .zip(zc.par_chunks_mut(layer))
                 .enumerate()
-                .map(|(k, ((x, y), z))| pass.layer_moves(parity, k, [x, y, z], counts, &frozen))
+                .map(|(k, ((x, y), z))| {
+                    pass.layer_moves(parity, k, [x, y, z], radii, counts, &frozen)
+                })
                 .reduce(|| (0, 0), |p, q| (p.0 + q.0, p.1 + q.1));
             accepted += a;
             left += b;
@@ -1063,13 +1355,15 @@ impl HardSphereMc {
         }
     }
 
-    /// The first pair closer than `d (1 - tolerance)` (particle indices and distance), if any.
-    /// Positions are re-expressed relative to a new cell each sweep, so distances carry a
-    /// rounding error of a few ulp of the box edge; the checks of the tests allow 1e-12.
+    /// The first pair closer than its contact distance `(d_i + d_j) / 2` times
+    /// `1 - tolerance` (particle indices and distance), if any. Positions are re-expressed
+    /// relative to a new cell each sweep, so distances carry a rounding error of a few ulp of
+    /// the box edge; the checks of the tests allow 1e-12.
     pub fn first_overlap(&self, tolerance: f64) -> Option<(usize, usize, f64)> {
-        let lim = self.diameter * (1.0 - tolerance);
         let mut found = None;
-        self.for_each_pair(self.diameter, |i, j, r2| {
+        let r = &self.radius;
+        self.for_each_pair(self.scale * self.d_max, |i, j, r2| {
+            let lim = (r[i] + r[j]) * (1.0 - tolerance);
             if found.is_none() && r2 < lim * lim {
                 found = Some((i.min(j), i.max(j), r2.sqrt()));
             }

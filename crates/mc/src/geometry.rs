@@ -212,6 +212,48 @@ impl Geometry {
         }
     }
 
+    /// Whether the confinement of a centre shrinks as its sphere grows: the hard wall (centres
+    /// within `R - d/2`) and the interface (its wall at `R + offset`, the offset given for one
+    /// diameter); not the bulk box, nor the tabulated potential (which acts on centres).
+    #[inline(always)]
+    pub fn shrinks(&self) -> bool {
+        matches!(self, Geometry::HardWall { .. } | Geometry::Interface { .. })
+    }
+
+    /// Largest distance from the origin of the centre of a sphere of diameter `diameter` in a
+    /// mixture whose geometry was given for spheres of diameter `reference` (`None` in bulk):
+    /// `confinement(reference) - (diameter - reference) / 2` where the geometry
+    /// [`shrinks`](Self::shrinks) (the hard wall's `R - d/2` per sphere; the interface's wall
+    /// moved in by half the extra diameter, so that every species' surface meets the same
+    /// interface, as `offset = -d/2` makes it for one species), else `confinement(reference)`.
+    /// Equal to `confinement(reference)` for `diameter == reference`, exactly.
+    pub fn confinement_of(&self, diameter: f64, reference: f64) -> Option<f64> {
+        let c = self.confinement(reference)?;
+        Some(if self.shrinks() {
+            c - (0.5 * diameter - 0.5 * reference)
+        } else {
+            c
+        })
+    }
+
+    /// [`Self::box_edge`] for a mixture of `diameters` whose geometry was given for `reference`:
+    /// the bulk box, or the largest confinement of any species ([`Self::confinement_of`]) with
+    /// four of the largest diameters to spare on each side. One species of `reference`:
+    /// `box_edge(reference)`, exactly.
+    pub fn box_edge_of(&self, reference: f64, diameters: &[f64]) -> f64 {
+        match *self {
+            Geometry::Bulk { edge } => edge,
+            _ => {
+                let d_max = diameters.iter().fold(0.0f64, |m, &d| m.max(d));
+                let c = diameters
+                    .iter()
+                    .map(|&d| self.confinement_of(d, reference).unwrap_or(0.0))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                2.0 * c + 8.0 * d_max
+            }
+        }
+    }
+
     /// Edge of the periodic box the cells tile: the bulk box, or the droplet with four
     /// diameters to spare on each side, so that no pair ever interacts across the box boundary
     /// and no cell straddling it holds a sphere (a cell is shorter than 4 d, see
@@ -235,6 +277,24 @@ impl Geometry {
             Geometry::Tabulated { potential } => {
                 4.0 / 3.0 * std::f64::consts::PI * potential.radius.powi(3)
             }
+        }
+    }
+
+    /// External energy / kT at position `r` of a sphere whose radius exceeds the reference
+    /// one (see [`Self::confinement_of`]) by `h`: the interface acts on it with its wall moved
+    /// in by `h` (`offset - h`); the tabulated potential acts on centres whatever the radius.
+    /// `h = 0` gives [`Self::beta_energy`] exactly.
+    #[inline(always)]
+    pub fn beta_energy_of(&self, r: [f64; 3], h: f64) -> f64 {
+        match self {
+            Geometry::Interface { interface, kt, .. } => {
+                let shifted = HarmonicInterface {
+                    offset: interface.offset - h,
+                    ..*interface
+                };
+                shifted.energy(r, 0.0) / kt
+            }
+            _ => self.beta_energy(r),
         }
     }
 
@@ -276,6 +336,7 @@ mod tests {
             geometry: Geometry::tabulated(potential),
             seed: 5,
             delta: 0.05,
+            mixture: None,
         };
         let start = init::fcc_in_sphere(10, 0.1, 0.95).unwrap();
         let mut mc = HardSphereMc::new(&params, &start, "positions").unwrap();

@@ -3,12 +3,13 @@
 //! - [`geometry`]: the periodic cube (bulk), the hard spherical wall of radius R (the droplet;
 //!   centres within `R - d/2`) and the BD droplet's harmonic interface (Metropolis on the
 //!   `HarmonicInterface` energy of `colloidsim-particles`, the one BD uses).
-//! - [`engine`]: [`HardSphereMc`], checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
+//! - [`engine`]: [`HardSphereMc`] (one species, or an additive mixture: [`engine::Mixture`],
+//!   overlap below the pair's mean diameter), checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
 //!   254, 27 (2013)) with counter-based random streams keyed by (seed, sweep, cell), so that a
 //!   run is fixed by its seed whatever the number of threads; move-size tuning in the warm-up.
 //! - [`init`]: lattice starting configurations (melted by the warm-up).
-//! - [`observe`]: pair-distance and radial histograms, contact values extrapolated to contact,
-//!   block-average errors, the Carnahan–Starling reference.
+//! - [`observe`]: pair-distance and radial histograms (per species too), contact values
+//!   extrapolated to contact, block-average errors, the Carnahan–Starling and BMCSL references.
 //! - [`radial_pairs`]: the droplet's two-body density in the `(r1, r2, s)` bins of the DDFT's RPY
 //!   flux kernel (issue #15 item 4).
 //! - [`params`]: the parameters of a run ([`params::McRun`]) and the engine they start.

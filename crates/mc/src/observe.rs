@@ -23,6 +23,42 @@ pub fn carnahan_starling_contact(phi: f64) -> f64 {
     (carnahan_starling(phi) - 1.0) / (4.0 * phi)
 }
 
+/// The Boublík–Mansoori–Carnahan–Starling–Leland equation of state of an additive hard-sphere
+/// mixture (Boublík, J. Chem. Phys. 53, 471 (1970); Mansoori, Carnahan, Starling, Leland,
+/// J. Chem. Phys. 54, 1523 (1971)): with number densities `rho[s]` of diameters `d[s]` and
+/// `xi_k = (pi / 6) sum_s rho_s d_s^k`,
+///
+/// `Z = (6 / (pi rho)) [xi_0 / (1 - xi_3) + 3 xi_1 xi_2 / (1 - xi_3)^2
+///      + (3 - xi_3) xi_2^3 / (1 - xi_3)^3]`,
+///
+/// and the contact values of the partial pair correlations, with `z_ij = d_i d_j / (d_i + d_j)`,
+///
+/// `g_ij(d_ij+) = 1 / (1 - xi_3) + 3 xi_2 z_ij / (1 - xi_3)^2 + 2 xi_2^2 z_ij^2 / (1 - xi_3)^3`.
+///
+/// The two are consistent through the virial `Z = 1 + (2 pi / 3) rho sum_ij x_i x_j d_ij^3
+/// g_ij(d_ij+)` (`d_ij = (d_i + d_j) / 2`); one species gives Carnahan–Starling. Returns `Z`
+/// and `g[i][j]`.
+pub fn bmcsl(rho: &[f64], d: &[f64]) -> (f64, Vec<Vec<f64>>) {
+    let xi = |k: i32| PI / 6.0 * rho.iter().zip(d).map(|(r, d)| r * d.powi(k)).sum::<f64>();
+    let (x0, x1, x2, x3) = (xi(0), xi(1), xi(2), xi(3));
+    let v = 1.0 - x3;
+    let total: f64 = rho.iter().sum();
+    let z = 6.0 / (PI * total)
+        * (x0 / v + 3.0 * x1 * x2 / (v * v) + (3.0 - x3) * x2.powi(3) / v.powi(3));
+    let g = d
+        .iter()
+        .map(|&di| {
+            d.iter()
+                .map(|&dj| {
+                    let zij = di * dj / (di + dj);
+                    1.0 / v + 3.0 * x2 * zij / (v * v) + 2.0 * (x2 * zij).powi(2) / v.powi(3)
+                })
+                .collect()
+        })
+        .collect();
+    (z, g)
+}
+
 /// Least-squares polynomial of degree `degree` (at most 3) through the points `(x, y)`,
 /// evaluated at `x0` (the normal equations in `x - x0`, solved by Gaussian elimination).
 pub fn extrapolate(x: &[f64], y: &[f64], degree: usize, x0: f64) -> f64 {
@@ -194,6 +230,25 @@ impl RadialHistogram {
     pub fn sample(&mut self, mc: &HardSphereMc) {
         let [x, y, z] = mc.positions();
         for i in 0..x.len() {
+            let r = (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt();
+            if r >= self.lo {
+                let b = ((r - self.lo) / self.width) as usize;
+                if b < self.counts.len() {
+                    self.counts[b] += 1;
+                }
+            }
+        }
+        self.samples += 1;
+    }
+
+    /// Add the spheres of species `species` of the current configuration (the profile of one
+    /// species of a mixture; the profiles of all species sum to [`Self::sample`]'s).
+    pub fn sample_species(&mut self, mc: &HardSphereMc, species: u32) {
+        let [x, y, z] = mc.positions();
+        for (i, &t) in mc.types().iter().enumerate() {
+            if t != species {
+                continue;
+            }
             let r = (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt();
             if r >= self.lo {
                 let b = ((r - self.lo) / self.width) as usize;
@@ -408,6 +463,140 @@ pub fn contact_pairs(h: &PairHistogram, d: f64) -> f64 {
     extrapolate_log(&h.centres(), &h.pair_density(), 2, d)
 }
 
+/// The pair distances next to contact of every pair of species `a <= b` of a mixture: one
+/// [`PairHistogram`] of [`CONTACT_BINS`] bins over `[d_ab, d_ab (1 + CONTACT_WINDOW))` per pair
+/// (`d_ab = (d_a + d_b) / 2`), filled in one pass over the pairs; its contact values
+/// `g_ab(d_ab+)` and the virial compressibility factor of the bulk mixture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PartialContacts {
+    diameters: Vec<f64>,
+    /// Spheres of each species.
+    counts: Vec<usize>,
+    /// Histograms of the pairs `(a, b)`, `a <= b`, in the order `(0,0), (0,1), .., (1,1), ..`.
+    pairs: Vec<PairHistogram>,
+}
+
+impl PartialContacts {
+    /// Empty histograms for the species of `mc`.
+    pub fn new(mc: &HardSphereMc) -> Self {
+        let diameters = mc.diameters().to_vec();
+        let mut pairs = Vec::new();
+        for a in 0..diameters.len() {
+            for b in a..diameters.len() {
+                let dab = 0.5 * (diameters[a] + diameters[b]);
+                pairs.push(PairHistogram::new(
+                    dab,
+                    dab * (1.0 + CONTACT_WINDOW),
+                    CONTACT_BINS,
+                ));
+            }
+        }
+        Self {
+            counts: mc.species_counts(),
+            diameters,
+            pairs,
+        }
+    }
+
+    /// Index of the pair of species `a <= b`.
+    fn index(&self, a: usize, b: usize) -> usize {
+        let m = self.diameters.len();
+        a * m - a * (a + 1) / 2 + b
+    }
+
+    /// The histogram of the pair of species `(a, b)` (either order).
+    pub fn pair(&self, a: usize, b: usize) -> &PairHistogram {
+        &self.pairs[self.index(a.min(b), a.max(b))]
+    }
+
+    /// Add the pairs of the current configuration.
+    pub fn sample(&mut self, mc: &HardSphereMc) {
+        let types = mc.types();
+        let rcut = self.pairs.iter().fold(0.0f64, |m, h| m.max(h.hi));
+        let m = self.diameters.len();
+        let pairs = &mut self.pairs;
+        mc.for_each_pair(rcut, |i, j, r2| {
+            let (ti, tj) = (types[i] as usize, types[j] as usize);
+            let (a, b) = (ti.min(tj), ti.max(tj));
+            let h = &mut pairs[a * m - a * (a + 1) / 2 + b];
+            let r = r2.sqrt();
+            if r >= h.lo {
+                let k = ((r - h.lo) / h.width) as usize;
+                if k < h.counts.len() {
+                    h.counts[k] += 1;
+                }
+            }
+        });
+        for h in &mut self.pairs {
+            h.samples += 1;
+        }
+    }
+
+    /// Samples taken.
+    pub fn samples(&self) -> u64 {
+        self.pairs.first().map_or(0, |h| h.samples)
+    }
+
+    /// Number of pairs of species `a <= b`: `N_a N_b`, or `N_a (N_a - 1) / 2` for `a = b`.
+    fn pair_count(&self, a: usize, b: usize) -> f64 {
+        let (na, nb) = (self.counts[a] as f64, self.counts[b] as f64);
+        if a == b {
+            na * (na - 1.0) / 2.0
+        } else {
+            na * nb
+        }
+    }
+
+    /// `g_ab(d_ab+)` in a periodic box of volume `volume`, `[a][b]` (symmetric): the pair
+    /// counts over the ideal-gas pairs in each shell, `P_ab / V * 4 pi / 3 (r_hi^3 - r_lo^3)`
+    /// per sample, extrapolated to contact as [`bulk_contact`] does (`NaN` for a species pair
+    /// without pairs).
+    pub fn contact_values(&self, volume: f64) -> Vec<Vec<f64>> {
+        let m = self.diameters.len();
+        let mut g = vec![vec![f64::NAN; m]; m];
+        for a in 0..m {
+            for b in a..m {
+                let h = &self.pairs[self.index(a, b)];
+                let pairs = self.pair_count(a, b);
+                if pairs <= 0.0 {
+                    continue;
+                }
+                let gr: Vec<f64> = h
+                    .pair_correlation(2, volume)
+                    .iter()
+                    .map(|v| v / pairs)
+                    .collect();
+                let v = extrapolate_log(&h.centres(), &gr, 2, h.lo);
+                (g[a][b], g[b][a]) = (v, v);
+            }
+        }
+        g
+    }
+
+    /// The virial compressibility factor of the bulk mixture in volume `volume` from
+    /// [`Self::contact_values`]: `beta P V = N + (1/3) sum_pairs d_ab n_c,ab` with
+    /// `n_c,ab = P_ab / V 4 pi d_ab^2 g_ab(d_ab+)` pairs per unit distance at contact, so
+    /// `Z = 1 + 4 pi / (3 N V) sum_{a <= b} P_ab d_ab^3 g_ab(d_ab+)`, exact for `N` spheres
+    /// (`N -> infinity`: `1 + (2 pi / 3) rho sum_ij x_i x_j d_ij^3 g_ij`; one species:
+    /// [`compressibility`]).
+    pub fn compressibility(&self, volume: f64) -> f64 {
+        let g = self.contact_values(volume);
+        let n: usize = self.counts.iter().sum();
+        let m = self.diameters.len();
+        let mut sum = 0.0;
+        for a in 0..m {
+            for b in a..m {
+                let pairs = self.pair_count(a, b);
+                if pairs > 0.0 {
+                    let dab = 0.5 * (self.diameters[a] + self.diameters[b]);
+                    sum += pairs * dab.powi(3) * g[a][b];
+                }
+            }
+        }
+        1.0 + 4.0 * PI / (3.0 * n as f64 * volume) * sum
+    }
+}
+
 /// Centre density at the wall `rho(R - d/2)` (quadratic extrapolation of the last bins).
 pub fn wall_contact_density(h: &RadialHistogram, contact: f64) -> f64 {
     extrapolate_log(&h.centres(), &h.density(), 2, contact)
@@ -432,5 +621,74 @@ mod tests {
         assert!((carnahan_starling_contact(0.3) - 2.478_134_110_787_173_5).abs() < 1e-12);
         let (m, e) = mean_and_error(&[1.0, 2.0, 3.0, 4.0]);
         assert!((m - 2.5).abs() < 1e-15 && (e - (5.0f64 / 12.0).sqrt()).abs() < 1e-15);
+    }
+
+    /// BMCSL: one species (any split of it into two species of one diameter) is
+    /// Carnahan–Starling, Z and g(d+); a binary mixture's Z equals the virial sum over its
+    /// contact values and Mansoori et al.'s Eq. 7 (other closed forms) at size ratio 2.
+    #[test]
+    fn bmcsl_reduces_to_carnahan_starling_and_its_contact_values_give_its_z() {
+        for phi in [0.05, 0.3, 0.5] {
+            let rho = phi * 6.0 / PI / 1.5f64.powi(3);
+            let (z, g) = bmcsl(&[rho], &[1.5]);
+            assert!((z - carnahan_starling(phi)).abs() < 1e-12 * z, "{phi}");
+            assert!((g[0][0] - carnahan_starling_contact(phi)).abs() < 1e-12 * g[0][0]);
+            let (z2, g2) = bmcsl(&[0.3 * rho, 0.7 * rho], &[1.5, 1.5]);
+            assert!((z2 - z).abs() < 1e-12 * z);
+            assert!((g2[0][1] - g[0][0]).abs() < 1e-12 * g[0][0]);
+        }
+        for (xl, phi) in [(0.25, 0.3), (0.5, 0.3), (0.1, 0.45)] {
+            let d = [1.0f64, 2.0];
+            let x = [1.0 - xl, xl];
+            let mean3 = x[0] * d[0].powi(3) + x[1] * d[1].powi(3);
+            let rho = phi * 6.0 / PI / mean3;
+            let (z, g) = bmcsl(&[x[0] * rho, x[1] * rho], &d);
+            let mut virial = 1.0;
+            for i in 0..2 {
+                for j in 0..2 {
+                    let dij: f64 = 0.5 * (d[i] + d[j]);
+                    virial += 2.0 * PI / 3.0 * rho * x[i] * x[j] * dij.powi(3) * g[i][j];
+                }
+            }
+            assert!(
+                (virial - z).abs() < 1e-12 * z,
+                "{xl} {phi}: {virial} vs {z}"
+            );
+        }
+        // Against the other closed form of Z, Mansoori et al.'s Eq. 7:
+        // Z = [(1 + xi + xi^2) - 3 xi (y1 + y2 xi) - xi^3 y3] / (1 - xi)^3 with xi_i the
+        // partial packing fractions, Delta_ij = sqrt(xi_i xi_j) / xi (d_i - d_j)^2 / (d_i d_j)
+        // sqrt(x_i x_j), y1 = sum_{i<j} Delta_ij (d_i + d_j) / sqrt(d_i d_j),
+        // y2 = sum_{i<j} Delta_ij sum_k (xi_k / xi) sqrt(d_i d_j) / d_k,
+        // y3 = [sum_i (xi_i / xi)^(2/3) x_i^(1/3)]^3.
+        for (xl, phi, want) in [
+            (0.5, 0.3, 3.505_830_903_790_086),
+            (0.25, 0.3, 3.391_676_505_312_867),
+            (0.1, 0.45, 7.931_634_772_616_789),
+        ] {
+            let (x, d) = ([1.0 - xl, xl], [1.0f64, 2.0]);
+            let rho = phi * 6.0 / PI / (x[0] + 8.0 * x[1]);
+            let xs = [PI / 6.0 * rho * x[0], PI / 6.0 * rho * x[1] * 8.0];
+            let xi = xs[0] + xs[1];
+            let delta = (xs[0] * xs[1]).sqrt() / xi * (d[0] - d[1]).powi(2) / (d[0] * d[1])
+                * (x[0] * x[1]).sqrt();
+            let y1 = delta * (d[0] + d[1]) / (d[0] * d[1]).sqrt();
+            let y2 = delta
+                * (0..2)
+                    .map(|k| xs[k] / xi * (d[0] * d[1]).sqrt() / d[k])
+                    .sum::<f64>();
+            let y3 = (0..2)
+                .map(|i| (xs[i] / xi).powf(2.0 / 3.0) * x[i].cbrt())
+                .sum::<f64>()
+                .powi(3);
+            let eq7 = ((1.0 + xi + xi * xi) - 3.0 * xi * (y1 + y2 * xi) - xi.powi(3) * y3)
+                / (1.0 - xi).powi(3);
+            let (z, _) = bmcsl(&[x[0] * rho, x[1] * rho], &d);
+            assert!(
+                (z - eq7).abs() < 1e-12 * z,
+                "{xl} {phi}: {z} vs Eq. 7 {eq7}"
+            );
+            assert!((z - want).abs() < 1e-9 * z, "{xl} {phi}: {z}");
+        }
     }
 }

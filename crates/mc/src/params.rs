@@ -1,7 +1,7 @@
 //! The parameters of a hard-sphere Monte Carlo run ([`McRun`]: plain data, as the run layer
 //! reads them from a scenario) and the engine they start.
 
-use crate::engine::{HardSphereMc, McError, McParams};
+use crate::engine::{HardSphereMc, McError, McParams, Mixture};
 use crate::geometry::Geometry;
 use crate::init::{fcc_in_box, fcc_in_sphere, shuffled};
 use colloidsim_core::ParamError;
@@ -16,18 +16,37 @@ pub const MAX_PHI: f64 = 0.64;
 /// Largest `mc.nselect` (trial moves per sphere per sweep).
 pub const NSELECT_MAX: usize = 1000;
 
+/// Most sweeps [`HardSphereMc::grow`] may take to inflate a mixture's compressed lattice.
+pub const GROW_SWEEPS: u64 = 100_000;
+
+/// The species of a mixture run: `counts[s]` spheres of diameter `diameters[s]`, the first
+/// `counts[0]` spheres (in the order of `system.initial`, or of the shuffled lattice) of
+/// species 0, and so on.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct McMixture {
+    /// Diameter of each species.
+    pub diameters: Vec<f64>,
+    /// Spheres of each species (summing to [`McRun::particles`]).
+    pub counts: Vec<usize>,
+}
+
 /// A validated hard-sphere Monte Carlo run.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct McRun {
     /// Seed of the streams.
     pub seed: u32,
-    /// Spheres N.
+    /// Spheres N (of every species).
     pub particles: usize,
-    /// Diameter d.
+    /// Diameter d; with a mixture, the reference diameter the interface's offset was given for
+    /// (see [`Geometry::confinement_of`]).
     pub diameter: f64,
+    /// The species (`None`: one species, every sphere of `diameter`; not serialised then).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mixture: Option<McMixture>,
     /// `bulk`, `hard-wall` or `interface`.
     pub geometry: String,
-    /// Volume fraction (bulk: of the box; droplet: `N d^3 / (8 R^3)`).
+    /// Volume fraction (bulk: of the box; droplet: `N d^3 / (8 R^3)`; a mixture: the sum over
+    /// species).
     pub volume_fraction: f64,
     /// Droplet radius R (droplets).
     pub radius: Option<f64>,
@@ -86,22 +105,64 @@ impl McRun {
         self.radius.is_none()
     }
 
+    /// Diameter of each species (one species: `[diameter]`).
+    pub fn diameters(&self) -> Vec<f64> {
+        match &self.mixture {
+            None => vec![self.diameter],
+            Some(m) => m.diameters.clone(),
+        }
+    }
+
     /// The engine at `positions` (`key` names where they came from in errors), or on an FCC
-    /// lattice (sites in a random order).
+    /// lattice (sites in a random order; a mixture's species assigned in blocks of `counts` to
+    /// the shuffled sites, so at random). The lattice's neighbour distance is at least the
+    /// largest diameter when that fits (one species always does, below `MAX_PHI`); else the
+    /// mixture starts on a lattice at every diameter scaled down to fit and is inflated to its
+    /// full diameters by Monte Carlo sweeps ([`HardSphereMc::grow`], at most [`GROW_SWEEPS`]).
     pub fn engine(
         &self,
         positions: Option<&[[f64; 3]]>,
         key: &str,
     ) -> Result<HardSphereMc, McError> {
         let geometry = self.geometry();
-        if self.diameter.is_finite() && self.diameter > 0.0 {
+        let d = self.diameter;
+        let diameters = self.diameters();
+        let d_max = diameters.iter().fold(0.0f64, |a, &b| a.max(b));
+        let mixture = match &self.mixture {
+            None => None,
+            Some(m) => {
+                let total: usize = m.counts.iter().sum();
+                if m.counts.len() != m.diameters.len() || total != self.particles {
+                    return Err(ParamError::new(
+                        "counts",
+                        format!(
+                            "{} counts summing to {total} for {} species and {} spheres",
+                            m.counts.len(),
+                            m.diameters.len(),
+                            self.particles
+                        ),
+                    )
+                    .into());
+                }
+                Some(Mixture::from_counts(&m.diameters, &m.counts))
+            }
+        };
+        if diameters.iter().all(|d| d.is_finite() && *d > 0.0) && d.is_finite() && d > 0.0 {
             crate::engine::check_cell_count(
-                geometry.box_edge(self.diameter),
-                self.diameter,
+                geometry.box_edge_of(d, &diameters),
+                d_max,
                 self.particles,
             )?;
         }
+        let params = McParams {
+            diameter: d,
+            geometry,
+            seed: self.seed,
+            delta: self.delta,
+            mixture,
+        };
         let lattice;
+        let mut scale = 1.0;
         let pos = match positions {
             Some(p) => {
                 if p.len() != self.particles {
@@ -114,30 +175,56 @@ impl McRun {
                 p
             }
             None => {
-                lattice = shuffled(
-                    match self.radius {
-                        None => fcc_in_box(self.particles, self.diameter, self.box_edge)?,
-                        Some(_) => fcc_in_sphere(
-                            self.particles,
-                            self.diameter,
-                            geometry
-                                .confinement(self.diameter)
-                                .unwrap_or(0.0)
-                                .min(self.radius.unwrap_or(0.0) - 0.5 * self.diameter),
-                        )?,
-                    },
-                    self.seed,
-                );
+                // Centres of spheres of every diameter times `f` within the droplet.
+                let within = |f: f64| {
+                    diameters
+                        .iter()
+                        .map(|&ds| {
+                            let c = geometry.confinement(d).unwrap_or(0.0);
+                            let c = if f == 1.0 {
+                                geometry.confinement_of(ds, d).unwrap_or(0.0)
+                            } else if geometry.shrinks() {
+                                c - (0.5 * ds * f - 0.5 * d)
+                            } else {
+                                c
+                            };
+                            c.min(self.radius.unwrap_or(0.0) - 0.5 * ds * f)
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                };
+                let place = |f: f64| match self.radius {
+                    None => fcc_in_box(self.particles, f * d_max, self.box_edge),
+                    Some(_) => fcc_in_sphere(self.particles, f * d_max, within(f)),
+                };
+                let sites = match (place(1.0), self.mixture.is_some()) {
+                    (Ok(s), _) => s,
+                    (Err(e), false) => return Err(e),
+                    (Err(e), true) => {
+                        // The largest factor whose lattice fits (bisection).
+                        let (mut lo, mut hi) = (0.0, 1.0);
+                        for _ in 0..40 {
+                            let mid = 0.5 * (lo + hi);
+                            if place(mid).is_ok() {
+                                lo = mid;
+                            } else {
+                                hi = mid;
+                            }
+                        }
+                        if lo == 0.0 {
+                            return Err(e);
+                        }
+                        scale = lo;
+                        place(lo)?
+                    }
+                };
+                lattice = shuffled(sites, self.seed);
                 &lattice
             }
         };
-        let params = McParams {
-            diameter: self.diameter,
-            geometry,
-            seed: self.seed,
-            delta: self.delta,
-        };
-        let mut mc = HardSphereMc::new(&params, pos, key)?;
+        let mut mc = HardSphereMc::new_scaled(&params, pos, key, scale)?;
+        if scale < 1.0 {
+            mc.grow(GROW_SWEEPS, self.delta)?;
+        }
         mc.set_nselect(self.nselect);
         Ok(mc)
     }

@@ -19,6 +19,7 @@ fn bulk(n: usize, phi: f64, d: f64, seed: u32) -> HardSphereMc {
         geometry: Geometry::Bulk { edge },
         seed,
         delta: 0.1,
+        mixture: None,
     };
     HardSphereMc::new(&p, &pos, "test").unwrap()
 }
@@ -31,6 +32,7 @@ fn droplet(n: usize, radius: f64, d: f64, seed: u32) -> HardSphereMc {
         geometry: Geometry::HardWall { radius },
         seed,
         delta: 0.1,
+        mixture: None,
     };
     HardSphereMc::new(&p, &pos, "test").unwrap()
 }
@@ -236,6 +238,7 @@ fn no_overlaps_and_no_escape_after_any_sweep() {
                     geometry,
                     seed: 3,
                     delta: 0.1,
+                    mixture: None,
                 };
                 HardSphereMc::new(&p, &pos, "test").unwrap()
             },
@@ -279,6 +282,7 @@ fn no_overlaps_and_no_escape_after_any_sweep() {
             geometry: *mc.geometry(),
             seed: 1,
             delta: 0.1,
+            mixture: None,
         };
         match HardSphereMc::new(&p, &pos, "start.gsd") {
             Err(McError::Overlap { key, .. }) => assert_eq!(key, "start.gsd"),
@@ -361,6 +365,7 @@ fn bad_configurations_are_refused_naming_the_key() {
         geometry: Geometry::HardWall { radius: 3.0 },
         seed: 1,
         delta: 0.1,
+        mixture: None,
     };
     let e = HardSphereMc::new(&p, &[[0.0; 3], [2.6, 0.0, 0.0]], "start.gsd").unwrap_err();
     assert!(
@@ -580,6 +585,7 @@ fn two_body_density_is_symmetric_and_normalised() {
         geometry: Geometry::HardWall { radius },
         seed: 9,
         delta: 0.1,
+        mixture: None,
     };
     let mut mc = HardSphereMc::new(&p, &pos, "test").unwrap();
     mc.warm_up(500, 100, 0.3);

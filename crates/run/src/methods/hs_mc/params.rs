@@ -227,6 +227,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
         seed,
         particles,
         diameter: d,
+        mixture: None,
         geometry,
         volume_fraction: phi,
         radius: (!bulk).then_some(size),
