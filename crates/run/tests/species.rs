@@ -151,10 +151,10 @@ fn bad_species_and_pairs_are_refused_naming_the_key() {
             "not system.diameter",
         ),
         (
-            sp("diameters = [1.0, 2.0]\ncounts = [200, 100]")
-                + "[hydrodynamics]\nmodel = \"rpy\"\nmethod = \"pse\"\n",
-            "hydrodynamics.method",
-            "one species",
+            sp("diameters = [1.0, 20.0]\ncounts = [299, 1]")
+                + "[hydrodynamics]\nmodel = \"rpy\"\nmethod = \"pse\"\nbox_factor = 4\n",
+            "system.species.diameters",
+            "16",
         ),
         (
             with(
@@ -225,4 +225,33 @@ fn each_pair_kind_runs_a_static_droplet() {
         sim.run(100).unwrap_or_else(|e| panic!("{pair}: {e}"));
         assert!(sim.snapshot().pos.iter().flatten().all(|x| x.is_finite()));
     }
+}
+
+#[test]
+fn a_mixture_drifts_with_pse_at_each_species_stokes_mobility() {
+    let p = read(&with(
+        "",
+        "[system.species]\ndiameters = [1.0, 2.0]\ncounts = [280, 20]\n\
+         [hydrodynamics]\nmodel = \"rpy\"\nmethod = \"pse\"\ntolerance = 1e-3\n",
+    ))
+    .unwrap();
+    let hydro = p.hydrodynamics.clone().unwrap();
+    let mut sim = p.build_hydro_replica(0, &hydro).unwrap();
+    use colloidsim_md::hydro::Mobility;
+    let eta = p.viscosity;
+    for (i, d) in sim.particles().diameter.iter().enumerate() {
+        let want = 1.0 / (3.0 * std::f64::consts::PI * eta * d);
+        let got = sim.mobility().stokes_mobility(i);
+        assert!(
+            (got / want - 1.0).abs() < 1e-12,
+            "particle {i}: {got} vs {want}"
+        );
+    }
+    sim.run(20).unwrap();
+    let pos = sim.particles().pos.clone();
+    assert!(pos.iter().flatten().all(|x| x.is_finite()));
+    // Reproducible: the same replica again is the same run.
+    let mut again = p.build_hydro_replica(0, &hydro).unwrap();
+    again.run(20).unwrap();
+    assert_eq!(again.particles().pos, pos);
 }

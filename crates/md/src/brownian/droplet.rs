@@ -205,6 +205,11 @@ impl DropletParams {
         }
     }
 
+    /// The radius of each species (half its diameter).
+    fn species_radii(&self) -> Vec<f64> {
+        self.species.diameters.iter().map(|d| 0.5 * d).collect()
+    }
+
     /// Edge of the (periodic) simulation box: the droplet with its interface range and
     /// two neighbour ranges of margin, so that no interaction crosses the boundary.
     pub fn box_edge(&self) -> f64 {
@@ -334,15 +339,10 @@ impl DropletParams {
             other => ParamError::new("hydrodynamics", other.to_string()),
         };
         match h.method {
-            Some(HydroMethod::Pse) if !self.species.is_single() => Err(ParamError::new(
-                "method",
-                "\"pse\" takes one species so far; for unequal radii use method = \"direct\" \
-                 (free-space RPY of unequal spheres, Zuk et al. 2014)",
-            )),
             Some(HydroMethod::Pse) => {
                 let l = self.hydro_box_edge(h)?;
                 h.check_pse_extent(l, "splitting")?;
-                PseGeometry::new(&self.pse_params(h, l))
+                PseGeometry::with_radii(&self.pse_params(h, l), &self.species_radii())
                     .map(Some)
                     .map_err(as_param)
             }
@@ -406,14 +406,13 @@ impl DropletParams {
         step: u64,
     ) -> Result<HydroDropletSim, DropletError> {
         let l = self.hydro_box_edge(hydro)?;
-        let n = particles.len();
         let radii: Vec<f64> = particles.diameter.iter().map(|d| 0.5 * d).collect();
         let mobility = match (hydro.model, hydro.method) {
             (HydroModel::FreeDraining, _) => AnyMobility::FreeDraining(
                 FreeDraining::new(&radii, self.viscosity).map_err(HydroBdError::from)?,
             ),
             (HydroModel::Rpy, Some(HydroMethod::Pse)) => AnyMobility::Pse(Box::new(
-                Pse::new(n, self.pse_params(hydro, l)).map_err(HydroBdError::from)?,
+                Pse::with_radii(&radii, self.pse_params(hydro, l)).map_err(HydroBdError::from)?,
             )),
             (HydroModel::Rpy, _) => AnyMobility::Direct(Box::new(
                 DirectRpy::with_radii(&radii, self.viscosity, hydro.lanczos(), DEFAULT_MAX_DIRECT)

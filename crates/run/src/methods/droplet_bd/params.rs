@@ -360,7 +360,14 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
         &format!("{particles} colloids in a box of {cells:.3e} neighbour cells"),
         bytes,
     )?;
-    params.pse = params.check_hydrodynamics().map_err(keyed)?;
+    // PSE's radii are the species' when there are several.
+    params.pse = params.check_hydrodynamics().map_err(|e| {
+        if e.key == "radius" && !params.species.is_single() {
+            rekey(e, &[("radius", &crate::keys::species::SPECIES_DIAMETERS)])
+        } else {
+            keyed(e)
+        }
+    })?;
     Ok(params)
 }
 
