@@ -20,13 +20,17 @@ S > 0 is small-on-top, S < 0 large-on-top. The threshold of small-on-top is the 
 which S turns positive (interpolated in log Pe_s between grid points at each phi0).
 
 Each point is one folder RUNS/<method>/phi<phi0>-pe<Pe_s>; a folder whose summary.json says the
-run completed is skipped, so the script can be stopped and started again.
+run completed (or the theory stopped) is skipped, so the script can be stopped and started
+again.
 
-Outputs: DATA/stratification_study.csv (one row per method and point: Delta and its standard
-error over the droplets, Delta_eq, S, the shell enrichment, wall seconds), DATA/thresholds.csv,
-IMG/stratification-diagram.png (S on the Pe_s x phi_s plane per method, with the lines
-Pe_s phi_s = 1/alpha^2 and 1), IMG/stratification-vs-pephi.png (S against Pe_s phi_s), and a
-markdown table on stdout.
+Outputs: DATA/stratification_study.csv (one row per method, point and profile time, half way
+and at the end: Delta and its standard error over the droplets, Delta_eq, S, wall seconds),
+DATA/stratification_thresholds.csv, IMG/stratification-diagram-t050.png and -t100.png (S on the
+Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
+IMG/stratification-vs-pephi-t050.png and -t100.png (S against Pe_s phi_s), and a markdown table
+on stdout. A theory run that stopped early (particles ejected through the interface: the DDFT
+with the RPY flux and the dilute pair correlation does, as the paper's did) is kept, and its
+profile times up to the stop are used.
 
 Usage (from the repository root):
   python3 scripts/stratification_study.py --bin target/release/colloidsim --runs /tmp/strat \\
@@ -44,6 +48,8 @@ import time
 
 ALPHA = 2.0
 EQ_PECLET = 0.01
+# The profile times compared (fractions of the drying time): half way, and the end.
+FRACTIONS = (0.5, 1.0)
 BASE = "examples/droplet/bidisperse-bd.toml"
 DDFT_DX = "0.05"
 
@@ -74,15 +80,17 @@ def scenario(pe, phi0, replicas, method, particles=900):
     return text
 
 
-def completed(folder):
+def state(folder):
+    """'done' (completed), 'stopped' (the theory stopped early, e.g. on ejection, with the
+    profiles up to then: kept and used up to where it got) or None (run it)."""
     try:
         with open(os.path.join(folder, "summary.json")) as f:
             s = json.load(f)
     except (OSError, ValueError):
-        return False
+        return None
     if "completed" in s:  # colloidsim run
-        return s["completed"] is True
-    return s.get("status") == "ok"  # colloidsim theory
+        return "done" if s["completed"] is True else None
+    return {"ok": "done", "failed": "stopped"}.get(s.get("status"))
 
 
 def points(args, method):
@@ -97,7 +105,7 @@ def folder_of(runs, method, pe, phi0):
 
 def run_point(args, method, pe, phi0, log):
     folder = folder_of(args.runs, method, pe, phi0)
-    if completed(folder):
+    if state(folder):
         return
     os.makedirs(os.path.dirname(folder), exist_ok=True)
     scen = folder + ".toml"
@@ -113,27 +121,33 @@ def run_point(args, method, pe, phi0, log):
     t0 = time.time()
     res = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.time() - t0
-    ok = res.returncode == 0 and completed(folder)
-    print(f"{method} phi0={phi0} Pe={pe}: {'ok' if ok else 'FAILED'} {wall:.0f} s "
+    got = state(folder)
+    print(f"{method} phi0={phi0} Pe={pe}: {got or 'FAILED'} {wall:.0f} s "
           f"{' '.join(cmd)}", file=log, flush=True)
-    if not ok:
+    if got != "done":
         print(res.stderr[-2000:], file=log, flush=True)
+    if got is None:
         return
     with open(folder + ".wall", "w") as f:
         f.write(f"{wall:.1f}\n")
 
 
-def last_stratification(folder):
-    """(Delta, its standard error or None, shell enrichment, its error, final radius)."""
+def measures(folder):
+    """{fraction: (Delta, its standard error over the droplets or None)} at each profile time
+    the run reached: stratification.csv of colloidsim run, summary.json of the theory."""
+    path = os.path.join(folder, "stratification.csv")
+    if os.path.exists(path):
+        with open(path) as f:
+            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+        head, out = rows[0], {}
+        i, j = head.index("radius_difference"), head.index("radius_difference_err")
+        num = lambda x: float(x) if x not in ("", "null", "NaN", "nan") else None
+        for r in rows[1:]:
+            out[round(float(r[0]), 6)] = (num(r[i]), num(r[j]))
+        return out
     with open(os.path.join(folder, "summary.json")) as f:
-        s = json.load(f)
-    st = s["stratification"]
-    if isinstance(st, list):  # the theory: one entry per profile time, no errors
-        last = st[-1]
-        return last["radius_difference"], None, None, None, last["radius"]
-    d = st["radius_difference"]
-    e = st["shell_enrichment"]
-    return d["mean"], d["err"], e["mean"], e["err"], None
+        st = json.load(f)["stratification"]
+    return {round(x["fraction"], 6): (x["radius_difference"], None) for x in st}
 
 
 def analyse(args):
@@ -141,51 +155,57 @@ def analyse(args):
     eq = {}
     for phi0 in args.phi0:
         f = folder_of(args.runs, "eq", EQ_PECLET, phi0)
-        if completed(f):
-            eq[phi0] = last_stratification(f)[0]
+        if state(f) == "done":
+            eq[phi0] = measures(f)
     for method in args.methods:
         if method == "eq":
             continue
         for pe, phi0 in points(args, method):
             f = folder_of(args.runs, method, pe, phi0)
-            if not completed(f):
+            if not state(f):
                 continue
-            delta, err, shell, shell_err, _ = last_stratification(f)
             wall = None
             if os.path.exists(f + ".wall"):
                 with open(f + ".wall") as w:
                     wall = float(w.read())
-            base = eq.get(phi0)
-            rows.append({
-                "method": method, "phi0": phi0, "phi_s": phi0 / 2, "pe_s": pe,
-                "pe_phi_s": pe * phi0 / 2, "delta": delta, "delta_err": err,
-                "delta_eq": base, "S": None if base is None else delta - base,
-                "shell_enrichment": shell, "shell_err": shell_err, "wall_s": wall,
-            })
+            for fraction, (delta, err) in sorted(measures(f).items()):
+                if fraction not in FRACTIONS or delta is None:
+                    continue
+                base = eq.get(phi0, {}).get(fraction, (None, None))[0]
+                rows.append({
+                    "method": method, "fraction": fraction, "phi0": phi0, "phi_s": phi0 / 2,
+                    "pe_s": pe, "pe_phi_s": pe * phi0 / 2, "delta": delta, "delta_err": err,
+                    "delta_eq": base, "S": None if base is None else delta - base,
+                    "wall_s": wall,
+                })
     return rows, eq
 
 
 def thresholds(rows, methods, phi0s):
-    """Pe_s phi_s where S turns positive, per method and phi0 (log-linear interpolation)."""
+    """Pe_s phi_s where S turns positive, per method, profile time and phi0 (log-linear
+    interpolation in Pe_s between grid points)."""
     out = []
     for method in methods:
-        for phi0 in phi0s:
-            pts = sorted((r["pe_s"], r["S"]) for r in rows
-                         if r["method"] == method and r["phi0"] == phi0 and r["S"] is not None)
-            if not pts:
-                continue
-            value, note = None, ""
-            if pts[0][1] > 0:
-                note = f"small-on-top at every Pe_s: below {pts[0][0] * phi0 / 2:g}"
-            elif all(s <= 0 for _, s in pts):
-                note = f"never small-on-top: above {pts[-1][0] * phi0 / 2:g}"
-            else:
-                for (p0, s0), (p1, s1) in zip(pts, pts[1:]):
-                    if s0 <= 0 < s1:
-                        x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
-                        value = math.exp(x) * phi0 / 2
-                        break
-            out.append({"method": method, "phi0": phi0, "threshold_pe_phi_s": value, "note": note})
+        for fraction in FRACTIONS:
+            for phi0 in phi0s:
+                pts = sorted((r["pe_s"], r["S"]) for r in rows
+                             if r["method"] == method and r["phi0"] == phi0
+                             and r["fraction"] == fraction and r["S"] is not None)
+                if not pts:
+                    continue
+                value, note = None, ""
+                if pts[0][1] > 0:
+                    note = f"small-on-top at every Pe_s: below {pts[0][0] * phi0 / 2:g}"
+                elif all(s <= 0 for _, s in pts):
+                    note = f"never small-on-top: above {pts[-1][0] * phi0 / 2:g}"
+                else:
+                    for (p0, s0), (p1, s1) in zip(pts, pts[1:]):
+                        if s0 <= 0 < s1:
+                            x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
+                            value = math.exp(x) * phi0 / 2
+                            break
+                out.append({"method": method, "fraction": fraction, "phi0": phi0,
+                            "threshold_pe_phi_s": value, "note": note})
     return out
 
 
@@ -199,19 +219,22 @@ def write_csv(path, rows):
             w.writerow({k: ("" if v is None else v) for k, v in r.items()})
 
 
-def figures(rows, methods, img):
+def figures(all_rows, methods, img, fraction):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import TwoSlopeNorm
 
+    rows = [r for r in all_rows if r["fraction"] == fraction]
+    when = "end of drying" if fraction == 1.0 else f"{fraction:.0%} of the drying time"
+    tag = f"t{int(round(100 * fraction)):03d}"
     shown = [m for m in methods if m != "eq" and any(r["method"] == m for r in rows)]
     if not shown or all(r["S"] is None for r in rows):
         return
     smax = max(abs(r["S"]) for r in rows if r["S"] is not None) or 1.0
     norm = TwoSlopeNorm(vmin=-smax, vcenter=0.0, vmax=smax)
-    fig, axes = plt.subplots(1, len(shown), figsize=(3.6 * len(shown) + 1.0, 3.6),
-                             sharey=True, squeeze=False)
+    fig, axes = plt.subplots(1, len(shown), figsize=(3.4 * len(shown) + 1.4, 3.6),
+                             sharey=True, squeeze=False, layout="constrained")
     for ax, m in zip(axes[0], shown):
         rs = [r for r in rows if r["method"] == m and r["S"] is not None]
         sc = ax.scatter([r["pe_s"] for r in rs], [r["phi_s"] for r in rs],
@@ -225,13 +248,16 @@ def figures(rows, methods, img):
         ax.set_yscale("log")
         ax.set_xlim(0.6, 200)
         ax.set_ylim(0.015, 0.15)
-        ax.set_title(m)
+        ax.set_xticks([1, 3, 10, 30, 100], ["1", "3", "10", "30", "100"])
+        ax.set_yticks([0.025, 0.05, 0.1], ["0.025", "0.05", "0.1"])
+        ax.minorticks_off()
+        ax.set_title(f"{m} ({when})", fontsize=9)
         ax.set_xlabel(r"$Pe_s$")
     axes[0][0].set_ylabel(r"$\phi_s$ (initial)")
     axes[0][0].legend(fontsize=7, loc="lower left")
     fig.colorbar(sc, ax=axes[0].tolist(),
                  label=r"$S = \Delta - \Delta_{eq}$ ($>0$: small-on-top)")
-    fig.savefig(os.path.join(img, "stratification-diagram.png"), dpi=130)
+    fig.savefig(os.path.join(img, f"stratification-diagram-{tag}.png"), dpi=130)
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
@@ -252,9 +278,10 @@ def figures(rows, methods, img):
     ax.set_xscale("log")
     ax.set_xlabel(r"$Pe_s \phi_s$")
     ax.set_ylabel(r"$S = \Delta - \Delta_{eq}$")
+    ax.set_title(when, fontsize=9)
     ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
-    fig.savefig(os.path.join(img, "stratification-vs-pephi.png"), dpi=130)
+    fig.savefig(os.path.join(img, f"stratification-vs-pephi-{tag}.png"), dpi=130)
     plt.close(fig)
 
 
@@ -287,18 +314,19 @@ def main():
     write_csv(os.path.join(args.data, "stratification_study.csv"), rows)
     th = thresholds(rows, [m for m in args.methods if m != "eq"], args.phi0)
     write_csv(os.path.join(args.data, "stratification_thresholds.csv"), th)
-    figures(rows, args.methods, args.img)
-    print("| method | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_eq | S | wall (s) |")
-    print("|---|---|---|---|---|---|---|---|")
+    for fraction in FRACTIONS:
+        figures(rows, args.methods, args.img, fraction)
+    print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_eq | S | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         err = f" ± {r['delta_err']:.3f}" if r["delta_err"] is not None else ""
         fmt = lambda x: "n/a" if x is None else f"{x:.3f}"
-        print(f"| {r['method']} | {r['phi0']:g} | {r['pe_s']:g} | {r['pe_phi_s']:.3g} | "
+        print(f"| {r['method']} | {r['fraction']:g} | {r['phi0']:g} | {r['pe_s']:g} | {r['pe_phi_s']:.3g} | "
               f"{r['delta']:.3f}{err} | {fmt(r['delta_eq'])} | {fmt(r['S'])} | "
               f"{fmt(r['wall_s'])} |")
     for t in th:
         v = t["threshold_pe_phi_s"]
-        print(f"threshold {t['method']} phi0={t['phi0']:g}: "
+        print(f"threshold {t['method']} t/t_end={t['fraction']:g} phi0={t['phi0']:g}: "
               f"{'%.3g' % v if v is not None else t['note']}")
 
 

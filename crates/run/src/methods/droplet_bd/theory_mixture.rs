@@ -16,7 +16,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow, bail};
 use colloidsim_core::output::OutputDir;
 use colloidsim_dft::radial::mixture::{Functional, MixtureSetup, Species, run_mixture_droplet};
-use colloidsim_dft::radial::{EquilibriumOptions, HarmonicInterface, Hydrodynamics, bin_average};
+use colloidsim_dft::radial::{
+    EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError, bin_average,
+};
 use colloidsim_md::DropletParams;
 use serde_json::json;
 
@@ -24,6 +26,38 @@ use crate::control::Control;
 use crate::output::plot::{self, Scale, Series};
 use crate::output::profile_name;
 use crate::{Report, Scenario as Source, TheoryOptions};
+
+/// The mixture DDFT of the droplet `p` up to `t_end` (grid spacing `dr`, fluxes `hydro`): each
+/// species with its Stokes diffusivity and the interface as the BD spheres of its size meet
+/// it (`SpeciesInterface`: the wall `(d_s - d) / 2` further in), White Bear mark I.
+pub(super) fn mixture_setup(
+    p: &DropletParams,
+    hydro: Hydrodynamics,
+    dr: f64,
+    t_end: f64,
+) -> Result<MixtureSetup, RadialError> {
+    let m = &p.species;
+    let species = (0..m.len())
+        .map(|s| {
+            let d = m.diameters[s];
+            let wall = HarmonicInterface::new(
+                p.stiffness / p.kt,
+                p.range,
+                p.offset - 0.5 * (d - p.diameter),
+            )?;
+            Species::stokes(d, m.counts[s] as f64, p.kt, p.viscosity, wall)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(MixtureSetup {
+        species,
+        r0: p.r0,
+        alpha: p.alpha,
+        t_end,
+        dr,
+        functional: Functional::WhiteBear,
+        hydrodynamics: hydro,
+    })
+}
 
 /// The mixture DDFT of the validated scenario `p` (grid spacing `dr`, fluxes `hydro`).
 pub(super) fn theory(
@@ -38,31 +72,12 @@ pub(super) fn theory(
         bail!("--pair: the mixture DDFT has the dilute pair correlation only");
     }
     let m = &p.species;
-    let species = (0..m.len())
-        .map(|s| {
-            let d = m.diameters[s];
-            let wall = HarmonicInterface::new(
-                p.stiffness / p.kt,
-                p.range,
-                p.offset - 0.5 * (d - p.diameter),
-            )?;
-            Species::stokes(d, m.counts[s] as f64, p.kt, p.viscosity, wall)
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let mut order: Vec<usize> = (0..p.fractions.len()).collect();
     let time_of = |k: usize| p.profile_steps[k] as f64 * p.dt;
     order.sort_by(|&a, &b| time_of(a).total_cmp(&time_of(b)));
     let times: Vec<f64> = order.iter().map(|&k| time_of(k)).collect();
-    let setup = MixtureSetup {
-        species,
-        r0: p.r0,
-        alpha: p.alpha,
-        t_end: times.last().copied().unwrap_or(0.0).max(p.t_end),
-        dr,
-        functional: Functional::WhiteBear,
-        hydrodynamics: hydro,
-    };
+    let t_end = times.last().copied().unwrap_or(0.0).max(p.t_end);
+    let setup = mixture_setup(p, hydro, dr, t_end).map_err(|e| anyhow!("{}: {e}", src.label()))?;
     setup
         .validate()
         .map_err(|e| anyhow!("{}: {e}", src.label()))?;
@@ -209,4 +224,117 @@ fn argmin(v: &[f64]) -> usize {
 
 fn argmax(v: &[f64]) -> usize {
     (0..v.len()).fold(0, |a, k| if v[k] > v[a] { k } else { a })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use colloidsim_dft::radial::mixture::mixture_equilibrium_at;
+
+    /// Static bidisperse droplet (issue 43, "Checks"): BD of a binary WCA mixture (d and 2d,
+    /// equal volumes, mean phi 0.2, R = 6 d: 186 + 20 spheres) against the binary White Bear
+    /// equilibrium of the same numbers in the same per-size interface. 3 replicas sampled every
+    /// 0.5 d^2/D0_s from t = 4 to 12 d^2/D0_s after random insertion (the large spheres'
+    /// slowest relaxation, ~R^2 / (pi^2 D_coll,l), is ~3 d^2/D0_s). Per species, the fractions
+    /// of its centres within d_k/4 and within d_k of its own wall; binomial error over N_k x
+    /// snapshots, tolerance 4 sigma + 3e-3 (WCA against hard spheres). A theory whose large
+    /// spheres meet the wall of the small ones (no (d_l - d_s)/2 shift) must fail.
+    #[test]
+    fn binary_equilibrium_theory_matches_brownian_dynamics_in_a_static_droplet() {
+        let text = r#"
+            method = "droplet-bd"
+            replicas = 3
+            [system]
+            particles = 206
+            radius = 6.0
+            [system.species]
+            diameters = [1.0, 2.0]
+            counts = [186, 20]
+            [drying]
+            peclet = 1e-6
+            duration = 188.5
+            [observe.profile]
+            fractions = [0.0]
+        "#;
+        let p = super::super::params::read(
+            &toml::from_str(text).unwrap(),
+            std::path::Path::new("."),
+            None,
+        )
+        .unwrap();
+        let m = &p.species;
+        let tau = p.diameter * p.diameter / p.d0;
+        // Each species' wall, and the cuts d_k/4 and d_k inside it.
+        let cuts: Vec<[f64; 2]> = m
+            .diameters
+            .iter()
+            .map(|&d| {
+                let edge = p.r0 + p.offset - 0.5 * (d - p.diameter);
+                [edge - 0.25 * d, edge - d]
+            })
+            .collect();
+        let mut bd = vec![[0.0; 2]; m.len()];
+        let mut samples = 0.0;
+        for rep in 0..p.replicas {
+            let mut sim = p.build_replica(rep as u32).unwrap();
+            for snap in 0..17 {
+                let t = 4.0 + 0.5 * snap as f64;
+                let stop = (t * tau / p.dt).round() as u64;
+                sim.run(stop - sim.step).unwrap();
+                let parts = sim.particles();
+                for (x, &ty) in parts.pos.iter().zip(&parts.typeid) {
+                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                    let k = ty as usize;
+                    for (c, out) in cuts[k].iter().zip(bd[k].iter_mut()) {
+                        if r > *c {
+                            *out += 1.0 / m.counts[k] as f64;
+                        }
+                    }
+                }
+                samples += 1.0;
+            }
+        }
+        bd.iter_mut().flatten().for_each(|x| *x /= samples);
+        let theory = |shift: bool| {
+            let mut setup = mixture_setup(&p, Hydrodynamics::FreeDraining, 0.02, 0.0).unwrap();
+            if !shift {
+                for s in setup.species.iter_mut() {
+                    s.interface =
+                        HarmonicInterface::new(p.stiffness / p.kt, p.range, p.offset).unwrap();
+                }
+            }
+            let (g, eq) =
+                mixture_equilibrium_at(&setup, p.r0, &EquilibriumOptions::default()).unwrap();
+            let cells = eq.rho.len() / m.len();
+            (0..m.len())
+                .map(|k| {
+                    let rho = &eq.rho[k * cells..(k + 1) * cells];
+                    cuts[k].map(|c| {
+                        let inner = bin_average(&g, rho, &[0.0, c])[0] * 4.0 * PI / 3.0 * c.powi(3);
+                        1.0 - inner / m.counts[k] as f64
+                    })
+                })
+                .collect::<Vec<_>>()
+        };
+        let worst = |th: &[[f64; 2]]| {
+            let mut w = 0.0f64;
+            for k in 0..m.len() {
+                for j in 0..2 {
+                    let n = m.counts[k] as f64 * samples;
+                    let sigma = (th[k][j] * (1.0 - th[k][j]) / n).sqrt();
+                    w = w.max((bd[k][j] - th[k][j]).abs() / (4.0 * sigma + 3e-3));
+                }
+            }
+            w
+        };
+        let good = theory(true);
+        let wrong = theory(false);
+        eprintln!(
+            "BD {bd:?}\ntheory {good:?} (worst {:.2})\nunshifted walls {wrong:?} (worst {:.2})",
+            worst(&good),
+            worst(&wrong)
+        );
+        assert!(worst(&good) < 1.0);
+        assert!(worst(&wrong) > 1.0);
+    }
 }
