@@ -12,19 +12,24 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
   eq         the binary FMT equilibrium reference: the DDFT dried at Pe_s = EQ_PECLET, slow
              enough that every profile is the static one at its radius
 
-The measure is the difference of the species' mean centre distances over R at the end of
-drying, Delta = <r>_s / R - <r>_l / R (colloidsim_analysis::stratification). A mixed droplet
-has Delta > 0 already, because a small centre reaches (d_l - d_s) / 2 closer to the surface;
-so each run is compared with the equilibrium droplet of the same radius: S = Delta - Delta_eq.
-S > 0 is small-on-top, S < 0 large-on-top. The threshold of small-on-top is the Pe_s phi_s at
-which S turns positive (interpolated in log Pe_s between grid points at each phi0).
+The measure is the difference of the species' mean centre distances over R, Delta =
+<r>_s / R - <r>_l / R (colloidsim_analysis::stratification), half way through drying and at
+its end. A mixed droplet has Delta > 0 already, because a small centre reaches (d_l - d_s) / 2
+closer to the surface; so each run is compared with the uniform mixture at the same radius
+(Delta_ideal: each species' centres distributed as exp(-beta V_k) in its own interface, no
+correlations): S = Delta - Delta_ideal > 0 is small-on-top, S < 0 large-on-top. The threshold
+of small-on-top is the Pe_s phi_s at which S turns positive (interpolated in log Pe_s between
+grid points at each phi0). The binary FMT equilibrium at the same radius (Delta_eq, from the
+`eq` runs) is the second reference: S_eq = Delta - Delta_eq says how far from equilibrium the
+droplet is (at phi = 0.5 the equilibrium has the large spheres layered at the wall).
 
 Each point is one folder RUNS/<method>/phi<phi0>-pe<Pe_s>; a folder whose summary.json says the
 run completed (or the theory stopped) is skipped, so the script can be stopped and started
 again.
 
 Outputs: DATA/stratification_study.csv (one row per method, point and profile time, half way
-and at the end: Delta and its standard error over the droplets, Delta_eq, S, wall seconds),
+and at the end: R, Delta and its standard error over the droplets, Delta_ideal, S, Delta_eq,
+S_eq, wall seconds),
 DATA/stratification_thresholds.csv, IMG/stratification-diagram-t050.png and -t100.png (S on the
 Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
 IMG/stratification-vs-pephi-t050.png and -t100.png (S against Pe_s phi_s), and a markdown table
@@ -34,7 +39,7 @@ profile times up to the stop are used.
 
 Usage (from the repository root):
   python3 scripts/stratification_study.py --bin target/release/colloidsim --runs /tmp/strat \\
-      [--methods bd-fd,ddft-fd,ddft-rpy,eq] [--peclet 1,3,10,30,100] [--phi0 0.05,0.1,0.2] \\
+      [--methods bd-fd,ddft-fd,ddft-rpy,eq] [--peclet 0.3,1,3,10,30,100] [--phi0 0.05,0.1,0.2] \\
       [--replicas 4] [--particles 900] [--threads 2] [--analyse-only]
 """
 import argparse
@@ -133,8 +138,11 @@ def run_point(args, method, pe, phi0, log):
 
 
 def measures(folder):
-    """{fraction: (Delta, its standard error over the droplets or None)} at each profile time
-    the run reached: stratification.csv of colloidsim run, summary.json of the theory."""
+    """{fraction: (Delta, its standard error over the droplets or None, R)} at each profile
+    time the run reached (stratification.csv of colloidsim run, summary.json of the theory),
+    and the run's parameters."""
+    with open(os.path.join(folder, "summary.json")) as f:
+        summary = json.load(f)
     path = os.path.join(folder, "stratification.csv")
     if os.path.exists(path):
         with open(path) as f:
@@ -143,20 +151,49 @@ def measures(folder):
         i, j = head.index("radius_difference"), head.index("radius_difference_err")
         num = lambda x: float(x) if x not in ("", "null", "NaN", "nan") else None
         for r in rows[1:]:
-            out[round(float(r[0]), 6)] = (num(r[i]), num(r[j]))
-        return out
-    with open(os.path.join(folder, "summary.json")) as f:
-        st = json.load(f)["stratification"]
-    return {round(x["fraction"], 6): (x["radius_difference"], None) for x in st}
+            out[round(float(r[0]), 6)] = (num(r[i]), num(r[j]), float(r[head.index("R")]))
+        return out, summary["parameters"]
+    st = summary["stratification"]
+    out = {round(x["fraction"], 6): (x["radius_difference"], None, x["radius"]) for x in st}
+    return out, summary["parameters"]
+
+
+def ideal_delta(p, radius):
+    """Delta of the uniform (ideal) mixture at droplet radius R: each species' centres
+    distributed as exp(-beta V_k(r)) in its own interface (wall at R + offset - (d_k - d)/2,
+    harmonic of stiffness k over `range`, linear beyond), no correlations. A mixed droplet has
+    Delta > 0 only because small centres reach (d_l - d_s)/2 closer to the surface."""
+    kt = p.get("kt", 1.0)
+    k, rng = p["stiffness"] / kt, p["range"]
+    diam = p["species"]["diameters"]
+    means = []
+    for d in diam:
+        wall = radius + p["offset"] - 0.5 * (d - p["diameter"])
+        n, h = 4000, (wall + rng + 60.0 / (k * rng)) / 4000
+        num = den = 0.0
+        for i in range(n):
+            r = (i + 0.5) * h
+            s_ = r - wall
+            v = 0.0 if s_ < 0 else (0.5 * k * s_ * s_ if s_ < rng else
+                                    0.5 * k * rng * rng + k * rng * (s_ - rng))
+            w = r * r * math.exp(-v)
+            num += r * w
+            den += w
+        means.append(num / den / radius)
+    small, large = diam.index(min(diam)), diam.index(max(diam))
+    return means[small] - means[large]
 
 
 def analyse(args):
+    """One row per method, point and profile time in FRACTIONS: Delta, S_eq = Delta - Delta_eq
+    (the binary FMT equilibrium at the same R) and S = Delta - Delta_ideal (the uniform mixture
+    at the same R: the measure of small-on-top)."""
     rows = []
     eq = {}
     for phi0 in args.phi0:
         f = folder_of(args.runs, "eq", EQ_PECLET, phi0)
         if state(f) == "done":
-            eq[phi0] = measures(f)
+            eq[phi0] = measures(f)[0]
     for method in args.methods:
         if method == "eq":
             continue
@@ -168,14 +205,17 @@ def analyse(args):
             if os.path.exists(f + ".wall"):
                 with open(f + ".wall") as w:
                     wall = float(w.read())
-            for fraction, (delta, err) in sorted(measures(f).items()):
+            got, params = measures(f)
+            for fraction, (delta, err, radius) in sorted(got.items()):
                 if fraction not in FRACTIONS or delta is None:
                     continue
-                base = eq.get(phi0, {}).get(fraction, (None, None))[0]
+                base = eq.get(phi0, {}).get(fraction, (None,))[0]
+                ideal = ideal_delta(params, radius)
                 rows.append({
                     "method": method, "fraction": fraction, "phi0": phi0, "phi_s": phi0 / 2,
-                    "pe_s": pe, "pe_phi_s": pe * phi0 / 2, "delta": delta, "delta_err": err,
-                    "delta_eq": base, "S": None if base is None else delta - base,
+                    "pe_s": pe, "pe_phi_s": pe * phi0 / 2, "R": radius, "delta": delta,
+                    "delta_err": err, "delta_ideal": ideal, "S": delta - ideal,
+                    "delta_eq": base, "S_eq": None if base is None else delta - base,
                     "wall_s": wall,
                 })
     return rows, eq
@@ -240,15 +280,15 @@ def figures(all_rows, methods, img, fraction):
         sc = ax.scatter([r["pe_s"] for r in rs], [r["phi_s"] for r in rs],
                         c=[r["S"] for r in rs], cmap="coolwarm", norm=norm, s=140,
                         edgecolors="k")
-        pe = [0.5, 300]
+        pe = [0.1, 300]
         ax.plot(pe, [1 / ALPHA**2 / p for p in pe], "k--", lw=1,
                 label=r"$Pe_s\phi_s = 1/\alpha^2$")
         ax.plot(pe, [1 / p for p in pe], "k:", lw=1, label=r"$Pe_s\phi_s = 1$")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlim(0.6, 200)
+        ax.set_xlim(0.2, 200)
         ax.set_ylim(0.015, 0.15)
-        ax.set_xticks([1, 3, 10, 30, 100], ["1", "3", "10", "30", "100"])
+        ax.set_xticks([0.3, 1, 3, 10, 30, 100], ["0.3", "1", "3", "10", "30", "100"])
         ax.set_yticks([0.025, 0.05, 0.1], ["0.025", "0.05", "0.1"])
         ax.minorticks_off()
         ax.set_title(f"{m} ({when})", fontsize=9)
@@ -256,7 +296,7 @@ def figures(all_rows, methods, img, fraction):
     axes[0][0].set_ylabel(r"$\phi_s$ (initial)")
     axes[0][0].legend(fontsize=7, loc="lower left")
     fig.colorbar(sc, ax=axes[0].tolist(),
-                 label=r"$S = \Delta - \Delta_{eq}$ ($>0$: small-on-top)")
+                 label=r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
     fig.savefig(os.path.join(img, f"stratification-diagram-{tag}.png"), dpi=130)
     plt.close(fig)
 
@@ -277,7 +317,7 @@ def figures(all_rows, methods, img, fraction):
     ax.axvline(1.0, color="k", ls=":", lw=0.8)
     ax.set_xscale("log")
     ax.set_xlabel(r"$Pe_s \phi_s$")
-    ax.set_ylabel(r"$S = \Delta - \Delta_{eq}$")
+    ax.set_ylabel(r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
     ax.set_title(when, fontsize=9)
     ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
@@ -292,7 +332,7 @@ def main():
     ap.add_argument("--data", default="docs/data")
     ap.add_argument("--img", default="docs/img")
     ap.add_argument("--methods", default="eq,ddft-fd,ddft-rpy,bd-fd")
-    ap.add_argument("--peclet", default="1,3,10,30,100")
+    ap.add_argument("--peclet", default="0.3,1,3,10,30,100")
     ap.add_argument("--phi0", default="0.05,0.1,0.2")
     ap.add_argument("--replicas", type=int, default=4)
     ap.add_argument("--particles", type=int, default=900)
@@ -316,13 +356,15 @@ def main():
     write_csv(os.path.join(args.data, "stratification_thresholds.csv"), th)
     for fraction in FRACTIONS:
         figures(rows, args.methods, args.img, fraction)
-    print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_eq | S | wall (s) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
+          "S_eq | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         err = f" ± {r['delta_err']:.3f}" if r["delta_err"] is not None else ""
         fmt = lambda x: "n/a" if x is None else f"{x:.3f}"
         print(f"| {r['method']} | {r['fraction']:g} | {r['phi0']:g} | {r['pe_s']:g} | {r['pe_phi_s']:.3g} | "
-              f"{r['delta']:.3f}{err} | {fmt(r['delta_eq'])} | {fmt(r['S'])} | "
+              f"{r['delta']:.3f}{err} | {r['delta_ideal']:.3f} | {r['S']:.3f} | "
+              f"{fmt(r['delta_eq'])} | {fmt(r['S_eq'])} | "
               f"{fmt(r['wall_s'])} |")
     for t in th:
         v = t["threshold_pe_phi_s"]
