@@ -51,6 +51,7 @@ use colloidsim_core::ParamError;
 use colloidsim_core::param::{positive, show};
 use colloidsim_core::resources::ensure_fits;
 use colloidsim_core::rng::{Purpose, stream};
+pub use colloidsim_particles::Mixture;
 use rand::Rng;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -106,34 +107,10 @@ pub struct McParams {
     pub seed: u32,
     /// Initial half-width of the trial displacement cube.
     pub delta: f64,
-    /// The species of an additive mixture (`None`: one species, every sphere of `diameter`).
+    /// The species of an additive mixture (`None`: one species, every sphere of `diameter`):
+    /// spheres `i` and `j` overlap when their centre distance is below `(d_ti + d_tj) / 2`; the
+    /// positions are species by species (the first `counts[0]` of species 0, and so on).
     pub mixture: Option<Mixture>,
-}
-
-/// The species of an additive hard-sphere mixture: spheres `i` and `j` overlap when their
-/// centre distance is below `(d_ti + d_tj) / 2`.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
-pub struct Mixture {
-    /// Diameter of each species (at least one).
-    pub diameters: Vec<f64>,
-    /// Species of each sphere, in the order of the positions (each below `diameters.len()`).
-    pub types: Vec<u32>,
-}
-
-impl Mixture {
-    /// `counts[s]` spheres of species `s` (of diameter `diameters[s]`), species after species:
-    /// the first `counts[0]` spheres are of species 0, and so on.
-    pub fn from_counts(diameters: &[f64], counts: &[usize]) -> Self {
-        let types = counts
-            .iter()
-            .enumerate()
-            .flat_map(|(s, &c)| std::iter::repeat_n(s as u32, c))
-            .collect();
-        Self {
-            diameters: diameters.to_vec(),
-            types,
-        }
-    }
 }
 
 /// Counts of one or more sweeps.
@@ -613,7 +590,7 @@ impl HardSphereMc {
     /// species of `params.mixture` (or all of `params.diameter`). Errors: parameters out of
     /// range, overlaps (centre distance below the pair's mean diameter), centres outside the
     /// container, a cell grid larger than the memory (`key` names where the positions came from
-    /// in messages; other errors name the parameter: `diameter`, `diameters`, `types`, `delta`,
+    /// in messages; other errors name the parameter: `diameter`, `diameters`, `counts`, `delta`,
     /// `radius`, `box`).
     pub fn new(params: &McParams, positions: &[[f64; 3]], key: &str) -> Result<Self, McError> {
         Self::new_scaled(params, positions, key, 1.0)
@@ -648,32 +625,19 @@ impl HardSphereMc {
                         .into());
                     }
                 }
-                if m.types.len() != n {
+                let total: usize = m.counts.iter().sum();
+                if m.counts.len() != m.diameters.len() || total != n {
                     return Err(ParamError::new(
-                        "types",
+                        "counts",
                         format!(
-                            "names {} spheres' species, there are {n} spheres",
-                            m.types.len()
-                        ),
-                    )
-                    .into());
-                }
-                if let Some(i) = m
-                    .types
-                    .iter()
-                    .position(|&t| t as usize >= m.diameters.len())
-                {
-                    return Err(ParamError::new(
-                        "types",
-                        format!(
-                            "sphere {i} is of species {}, there are {} species",
-                            m.types[i],
+                            "{} counts summing to {total} for {} species and {n} spheres",
+                            m.counts.len(),
                             m.diameters.len()
                         ),
                     )
                     .into());
                 }
-                (m.diameters.clone(), m.types.clone())
+                (m.diameters.clone(), m.typeids())
             }
         };
         let d_max = diameters.iter().fold(0.0f64, |a, &b| a.max(b));

@@ -3,7 +3,7 @@
 //! - [`geometry`]: the periodic cube (bulk), the hard spherical wall of radius R (the droplet;
 //!   centres within `R - d/2`) and the BD droplet's harmonic interface (Metropolis on the
 //!   `HarmonicInterface` energy of `colloidsim-particles`, the one BD uses).
-//! - [`engine`]: [`HardSphereMc`] (one species, or an additive mixture: [`engine::Mixture`],
+//! - [`engine`]: [`HardSphereMc`] (one species, or an additive mixture of `colloidsim_particles::Mixture`,
 //!   overlap below the pair's mean diameter), checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
 //!   254, 27 (2013)) with counter-based random streams keyed by (seed, sweep, cell), so that a
 //!   run is fixed by its seed whatever the number of threads; move-size tuning in the warm-up.

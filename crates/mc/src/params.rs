@@ -19,17 +19,6 @@ pub const NSELECT_MAX: usize = 1000;
 /// Most sweeps [`HardSphereMc::grow`] may take to inflate a mixture's compressed lattice.
 pub const GROW_SWEEPS: u64 = 100_000;
 
-/// The species of a mixture run: `counts[s]` spheres of diameter `diameters[s]`, the first
-/// `counts[0]` spheres (in the order of `system.initial`, or of the shuffled lattice) of
-/// species 0, and so on.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct McMixture {
-    /// Diameter of each species.
-    pub diameters: Vec<f64>,
-    /// Spheres of each species (summing to [`McRun::particles`]).
-    pub counts: Vec<usize>,
-}
-
 /// A validated hard-sphere Monte Carlo run.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct McRun {
@@ -40,9 +29,11 @@ pub struct McRun {
     /// Diameter d; with a mixture, the reference diameter the interface's offset was given for
     /// (see [`Geometry::confinement_of`]).
     pub diameter: f64,
-    /// The species (`None`: one species, every sphere of `diameter`; not serialised then).
+    /// The species (`None`: one species, every sphere of `diameter`; not serialised then):
+    /// `counts[s]` spheres of diameter `diameters[s]`, the first `counts[0]` spheres (in the
+    /// order of `system.initial`, or of the shuffled lattice) of species 0, and so on.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub mixture: Option<McMixture>,
+    pub mixture: Option<Mixture>,
     /// `bulk`, `hard-wall` or `interface`.
     pub geometry: String,
     /// Volume fraction (bulk: of the box; droplet: `N d^3 / (8 R^3)`; a mixture: the sum over
@@ -128,25 +119,7 @@ impl McRun {
         let d = self.diameter;
         let diameters = self.diameters();
         let d_max = diameters.iter().fold(0.0f64, |a, &b| a.max(b));
-        let mixture = match &self.mixture {
-            None => None,
-            Some(m) => {
-                let total: usize = m.counts.iter().sum();
-                if m.counts.len() != m.diameters.len() || total != self.particles {
-                    return Err(ParamError::new(
-                        "counts",
-                        format!(
-                            "{} counts summing to {total} for {} species and {} spheres",
-                            m.counts.len(),
-                            m.diameters.len(),
-                            self.particles
-                        ),
-                    )
-                    .into());
-                }
-                Some(Mixture::from_counts(&m.diameters, &m.counts))
-            }
-        };
+        let mixture = self.mixture.clone();
         if diameters.iter().all(|d| d.is_finite() && *d > 0.0) && d.is_finite() && d > 0.0 {
             crate::engine::check_cell_count(
                 geometry.box_edge_of(d, &diameters),

@@ -6,21 +6,30 @@ use colloidsim_mc::engine::{HardSphereMc, McError, McParams, Mixture};
 use colloidsim_mc::geometry::Geometry;
 use colloidsim_mc::init::fcc_in_box;
 use colloidsim_mc::observe::{PartialContacts, RadialHistogram, bmcsl, mean_and_error};
-use colloidsim_mc::params::{McMixture, McRun};
+use colloidsim_mc::params::McRun;
 use std::f64::consts::PI;
 
-/// Two species, d = 1 and 2, in `geometry`, with `types` in the order of the positions.
-fn binary(geometry: Geometry, types: &[u32]) -> McParams {
+/// Two species, d = 1 and 2, in `geometry`, `counts` of each (positions species by species).
+fn binary(geometry: Geometry, counts: [usize; 2]) -> McParams {
     McParams {
         diameter: 1.0,
         geometry,
         seed: 7,
         delta: 0.1,
-        mixture: Some(Mixture {
-            diameters: vec![1.0, 2.0],
-            types: types.to_vec(),
-        }),
+        mixture: Some(Mixture::new(vec![1.0, 2.0], counts.to_vec())),
     }
+}
+
+/// Spheres of species `a` and `b` (0 or 1) at `p` and `q`: the parameters and the positions
+/// species by species.
+fn two(
+    geometry: Geometry,
+    (a, p): (u32, [f64; 3]),
+    (b, q): (u32, [f64; 3]),
+) -> (McParams, Vec<[f64; 3]>) {
+    let small = [a, b].iter().filter(|&&t| t == 0).count();
+    let pos = if a <= b { vec![p, q] } else { vec![q, p] };
+    (binary(geometry, [small, 2 - small]), pos)
 }
 
 /// Hand-built pairs of spheres of diameters 1 and 2: they overlap exactly when the centre
@@ -42,8 +51,8 @@ fn hand_built_pairs_overlap_below_their_mean_diameter() {
         (1, 1, 2.5, false),
     ];
     for (a, b, r, overlaps) in cases {
-        let p = binary(bulk, &[a, b]);
-        let got = HardSphereMc::new(&p, &[[0.0; 3], [r, 0.0, 0.0]], "start");
+        let (p, pos) = two(bulk, (a, [0.0; 3]), (b, [r, 0.0, 0.0]));
+        let got = HardSphereMc::new(&p, &pos, "start");
         match got {
             Err(McError::Overlap { diameter, .. }) => {
                 assert!(overlaps, "{a}-{b} at {r}: refused");
@@ -54,21 +63,21 @@ fn hand_built_pairs_overlap_below_their_mean_diameter() {
         }
     }
     // Across the periodic boundary: a small and a large sphere 1.4 apart through the faces.
-    let p = binary(bulk, &[0, 1]);
+    let p = binary(bulk, [1, 1]);
     let e = HardSphereMc::new(&p, &[[-4.7, 0.0, 0.0], [4.3, 0.0, 0.0]], "start");
     assert!(matches!(e, Err(McError::Overlap { .. })), "{e:?}");
     // A hard wall of R = 5: centres within R - d_i/2 (4.5 small, 4.0 large).
     let wall = Geometry::HardWall { radius: 5.0 };
-    let p = binary(wall, &[0, 1]);
+    let p = binary(wall, [1, 1]);
     assert!(HardSphereMc::new(&p, &[[4.49, 0.0, 0.0], [-3.99, 0.0, 0.0]], "s").is_ok());
     let e = HardSphereMc::new(&p, &[[0.0, 0.0, 0.0], [0.0, 4.01, 0.0]], "s").unwrap_err();
     assert!(matches!(e, McError::OutsideWall { i: 1, .. }), "{e}");
     // Bad species are refused naming the parameter.
-    let mut bad = binary(bulk, &[0, 2]);
+    let mut bad = binary(bulk, [1, 2]);
     let e = HardSphereMc::new(&bad, &[[0.0; 3], [3.0, 0.0, 0.0]], "s").unwrap_err();
-    assert!(e.to_string().starts_with("types: "), "{e}");
+    assert!(e.to_string().starts_with("counts: "), "{e}");
     bad.mixture.as_mut().unwrap().diameters[1] = -2.0;
-    bad.mixture.as_mut().unwrap().types[1] = 1;
+    bad.mixture.as_mut().unwrap().counts[1] = 1;
     let e = HardSphereMc::new(&bad, &[[0.0; 3], [3.0, 0.0, 0.0]], "s").unwrap_err();
     assert!(e.to_string().starts_with("diameters: "), "{e}");
 }
@@ -104,10 +113,7 @@ fn bulk_run(n: usize, xl: f64, phi: f64, seed: u32) -> McRun {
         seed,
         particles: n,
         diameter: 1.0,
-        mixture: Some(McMixture {
-            diameters: vec![1.0, 2.0],
-            counts: vec![n - nl, nl],
-        }),
+        mixture: Some(Mixture::new(vec![1.0, 2.0], vec![n - nl, nl])),
         geometry: "bulk".into(),
         volume_fraction: phi,
         radius: None,
@@ -197,7 +203,6 @@ fn sweeps_of_a_binary_mixture_keep_every_pair_beyond_its_mean_diameter() {
 #[test]
 fn a_hard_wall_confines_each_species_at_its_own_radius() {
     let (ns, nl) = (60usize, 12usize);
-    let types: Vec<u32> = (0..ns + nl).map(|i| u32::from(i >= ns)).collect();
     // Large spheres on an inner lattice, small ones on an outer shell (3.8 to 4.4).
     let large = colloidsim_mc::init::fcc_in_sphere(nl, 2.0, 2.2).unwrap();
     let mut pos = large.clone();
@@ -210,7 +215,7 @@ fn a_hard_wall_confines_each_species_at_its_own_radius() {
             .take(ns),
     );
     assert_eq!(pos.len(), ns + nl);
-    let p = binary(Geometry::HardWall { radius: 5.0 }, &types);
+    let p = binary(Geometry::HardWall { radius: 5.0 }, [ns, nl]);
     let mut mc = HardSphereMc::new(&p, &pos, "start").unwrap();
     mc.warm_up(200, 20, 0.3);
     let mut far = [0.0f64; 2];
@@ -265,17 +270,11 @@ fn one_species_in_any_dress_is_the_monodisperse_run_bitwise() {
             mixture: None,
         };
         let one = McParams {
-            mixture: Some(Mixture {
-                diameters: vec![1.0],
-                types: vec![0; n],
-            }),
+            mixture: Some(Mixture::one(1.0, n)),
             ..plain.clone()
         };
         let two = McParams {
-            mixture: Some(Mixture {
-                diameters: vec![1.0, 1.0],
-                types: (0..n as u32).map(|i| i % 2).collect(),
-            }),
+            mixture: Some(Mixture::new(vec![1.0, 1.0], vec![n / 2, n - n / 2])),
             ..plain.clone()
         };
         let run = |p: &McParams| {
@@ -358,10 +357,7 @@ fn a_mixture_run_starts_in_each_droplet_geometry_and_bad_counts_are_refused() {
     for (n, nl, radius) in [(40usize, 10usize, 4.0f64), (100, 25, 5.0)] {
         for interface in [None, Some([50.0, 0.5, -0.5])] {
             let mut run = bulk_run(n, 0.0, 0.3, 9);
-            run.mixture = Some(McMixture {
-                diameters: vec![1.0, 2.0],
-                counts: vec![n - nl, nl],
-            });
+            run.mixture = Some(Mixture::new(vec![1.0, 2.0], vec![n - nl, nl]));
             run.geometry = if interface.is_some() {
                 "interface"
             } else {

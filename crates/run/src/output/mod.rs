@@ -1,10 +1,11 @@
 //! The writers every session shares: the GSD trajectory (its opener, frame digest and trim on
-//! restart: [`trajectory`]), pictures ([`plot`]) and the drying droplet's profile names (of
+//! restart: [`trajectory`]), pictures ([`plot`]), the per-species profiles of a mixture ([`species`]) and the drying droplet's profile names (of
 //! droplet-bd, its theory and droplet-mpcd). Tables, thermo logs (`CsvLog`), JSON and the
 //! atomic writes under them, with the rule that every number is finite or empty with its
 //! reason, are `colloidsim_core::output`'s, which the engine crates use too.
 
 pub mod plot;
+pub mod species;
 pub mod trajectory;
 
 /// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,

@@ -5,6 +5,7 @@
 
 use crate::output::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::output::profile_name;
+use crate::output::species::{draw_species_profiles, write_species_profile};
 use anyhow::Result;
 use colloidsim_analysis::stratification;
 use colloidsim_core::output::OutputDir;
@@ -98,9 +99,9 @@ impl SpeciesAccum {
         for &j in drawn {
             let m = counts[j] as f64;
             let name = format!("species_{}", profile_name(p.fractions[j]));
-            let mut cols: Vec<(String, Vec<f64>)> = vec![("r".into(), r_axes[j].clone())];
+            let (mut phi, mut err) = (Vec::new(), Vec::new());
             for (sp, sname) in names.iter().enumerate() {
-                let (mean, err): (Vec<f64>, Vec<f64>) = self.sums[j][sp]
+                let (mean, e): (Vec<f64>, Vec<f64>) = self.sums[j][sp]
                     .iter()
                     .zip(&self.squares[j][sp])
                     .map(|(s, q)| mean_err(*s, *q, m))
@@ -113,20 +114,11 @@ impl SpeciesAccum {
                         mean.clone(),
                     ));
                 }
-                cols.push((format!("phi_{sname}"), mean));
-                cols.push((format!("err_{sname}"), err));
+                phi.push(mean);
+                err.push(e);
             }
-            let refs: Vec<(&str, &[f64])> = cols
-                .iter()
-                .map(|(n, v)| (n.as_str(), v.as_slice()))
-                .collect();
-            out.write_table(&name, &refs)?;
-            if m < 2.0 {
-                for sname in names {
-                    out.explain(&name, &format!("err_{sname}"), ONE_REPLICA);
-                }
-            }
-            files.push(name);
+            let no_error = (m < 2.0).then_some(ONE_REPLICA);
+            write_species_profile(out, &name, &r_axes[j], names, &phi, &err, no_error, files)?;
         }
         // The measures: mean and standard error over the replicas (those that are finite).
         let n = names.len();
@@ -185,31 +177,17 @@ impl SpeciesAccum {
         }
         files.push("stratification.csv".into());
         // Pictures: the species' profiles at the first and last times, the measures in time.
-        let series: Vec<Series> = shown
-            .iter()
-            .map(|(label, x, y)| Series {
-                label,
-                x,
-                y,
-                points: false,
-            })
-            .collect();
-        picture(
-            line_plot_with_errors(
-                &out.join("species_profiles.png"),
-                &format!(
-                    "Species profiles: {} (diameters {:?}), {} replica(s)",
-                    names.join(", "),
-                    p.species.diameters,
-                    p.replicas
-                ),
-                "r / R(t)",
-                "volume fraction phi_k(r)",
-                &series,
-                &[],
-                Scale::Linear,
+        draw_species_profiles(
+            out,
+            &format!(
+                "Species profiles: {} (diameters {:?}), {} replica(s)",
+                names.join(", "),
+                p.species.diameters,
+                p.replicas
             ),
-            "species_profiles.png",
+            "r / R(t)",
+            &shown,
+            &[],
             files,
             warnings,
         );

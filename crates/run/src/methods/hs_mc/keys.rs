@@ -7,6 +7,7 @@
 use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS};
+use crate::keys::species::{SPECIES, SPECIES_COUNTS, SPECIES_DIAMETERS, SPECIES_VOLUME_FRACTIONS};
 use crate::keys::{COUNT, SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["hs-mc"]),
@@ -21,13 +22,16 @@ pub const SYSTEM_GEOMETRY: Spec = key("system.geometry", "-",
 pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-",
     Means("from the other two"), Integer(1, 100_000_000),
     "number of spheres N")
-    .also("give exactly two of particles, volume_fraction and box (bulk) or radius (droplet); at least 2 in bulk");
+    .also("give exactly two of particles, volume_fraction and box (bulk) or radius (droplet); at least 2 in bulk; required with system.species");
 
 pub const SYSTEM_VOLUME_FRACTION: Spec = key("system.volume_fraction", "-",
     Means("from the other two"), LeftOpen(0.0, colloidsim_mc::params::MAX_PHI),
-    "N pi d^3 / (6 L^3) in bulk, N d^3 / (8 R^3) in a droplet; at most random close packing");
+    "N pi d^3 / (6 L^3) in bulk, N d^3 / (8 R^3) in a droplet (a mixture: summed over species); at most random close packing");
 
-pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length", Value("1"), Positive,
+pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length",
+    Derived("1; with system.species, the smallest of its diameters",
+        |r| Ok(crate::keys::species::smallest_diameter(r)?.unwrap_or(1.0))),
+    Positive,
     "sphere diameter d");
 
 pub const SYSTEM_RADIUS: Spec = key("system.radius", "length",
@@ -97,7 +101,7 @@ pub const OUTPUT_TRAJECTORY_EVERY: Spec = key("output.trajectory_every", "sweeps
 
 pub const OUTPUT_RHO2_R_BINS: Spec = key("output.rho2_r_bins", "-", Value("0"), Integer(0, 10_000),
     "radial bins over [0, R] of the two-body density rho2(r1, r2, cos theta) and g2 (g2.csv; all pairs, O(N^2) per sample; 0: none)")
-    .also("droplets only");
+    .also("droplets of one species only");
 
 pub const OUTPUT_RHO2_COS_BINS: Spec = key("output.rho2_cos_bins", "-",
     Value("20"), Integer(1, 10_000),
@@ -112,6 +116,10 @@ pub static KEYS: &[Spec] = &[
     SYSTEM_PARTICLES,
     SYSTEM_VOLUME_FRACTION,
     SYSTEM_DIAMETER,
+    SPECIES,
+    SPECIES_DIAMETERS,
+    SPECIES_COUNTS,
+    SPECIES_VOLUME_FRACTIONS,
     SYSTEM_RADIUS,
     SYSTEM_BOX,
     SYSTEM_KT,

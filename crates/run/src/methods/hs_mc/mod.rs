@@ -2,7 +2,9 @@
 //! the move size, then sampling sweeps with delta frozen; in bulk g(r), the contact value and
 //! the compressibility factor with block-average errors; in a droplet the radial volume-fraction
 //! profile on droplet-bd's file names (and, with a hard wall, the exact virial sum rule at the
-//! wall). Checkpoints hold the positions exactly: a restart continues bitwise.
+//! wall). A mixture (`[system.species]`) adds each species' profile, its partial contact values
+//! and the virial Z beside BMCSL (docs/mc.md, "Mixtures"). Checkpoints hold the positions
+//! exactly: a restart continues bitwise.
 
 use crate::checkpoint::Envelope;
 #[rustfmt::skip] // declarations laid out as a table, one key to a line or three
@@ -19,9 +21,9 @@ use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::{
-    CONTACT_BINS, CONTACT_WINDOW, PairDensity, PairHistogram, RadialHistogram, bulk_contact,
-    carnahan_starling, carnahan_starling_contact, compressibility, contact_pairs, mean_and_error,
-    wall_contact_density,
+    CONTACT_BINS, CONTACT_WINDOW, PairDensity, PairHistogram, PartialContacts, RadialHistogram,
+    bmcsl, bulk_contact, carnahan_starling, carnahan_starling_contact, compressibility,
+    contact_pairs, mean_and_error, wall_contact_density,
 };
 use colloidsim_mc::params::McRun;
 use colloidsim_mc::{HardSphereMc, McError, SweepStats};
@@ -49,6 +51,18 @@ fn build(p: &McRun) -> Result<HardSphereMc> {
         Some(path) => {
             let f = gsd::read_frame(path, None)
                 .with_context(|| format!("{}: {}", keys::SYSTEM_INITIAL.path, path.display()))?;
+            if let Some(m) = &p.mixture
+                && f.particles.typeid != m.typeids()
+            {
+                bail!(colloidsim_core::ParamError::new(
+                    keys::SYSTEM_INITIAL.path,
+                    format!(
+                        "{}: its typeids must be the species of system.species in order, {:?} spheres of typeid 0, 1, ... (the particles stored species by species)",
+                        path.display(),
+                        m.counts
+                    ),
+                ));
+            }
             Some(f.particles.pos)
         }
         None => None,
@@ -143,6 +157,15 @@ struct Block {
     wall: Option<RadialHistogram>,
     /// The two-body density and the one-body density on its radial bins (droplets, optional).
     rho2: Option<(PairDensity, RadialHistogram)>,
+    /// Each species' centre distances over [0, R] (droplets of a mixture).
+    #[serde(default)]
+    species: Option<Vec<RadialHistogram>>,
+    /// Pair distances next to contact of every pair of species (mixtures).
+    #[serde(default)]
+    partial: Option<PartialContacts>,
+    /// Each species' centre distances next to its own wall `R - d_s/2` (hard wall, mixtures).
+    #[serde(default)]
+    species_wall: Option<Vec<RadialHistogram>>,
 }
 
 /// Everything a run accumulates, saved in every checkpoint.
@@ -184,6 +207,25 @@ impl Accum {
                     RadialHistogram::new(0.0, r, nr),
                 )
             }),
+            species: p
+                .mixture
+                .as_ref()
+                .zip(p.radius)
+                .map(|(m, r)| vec![RadialHistogram::new(0.0, r, p.profile_bins); m.len()]),
+            partial: p.mixture.as_ref().map(|_| PartialContacts::new(mc)),
+            species_wall: p
+                .mixture
+                .as_ref()
+                .filter(|_| p.geometry == "hard-wall")
+                .map(|m| {
+                    m.diameters
+                        .iter()
+                        .map(|&ds| {
+                            let c = mc.geometry().confinement_of(ds, d).unwrap_or(0.0);
+                            RadialHistogram::new(c - CONTACT_WINDOW * ds, c, CONTACT_BINS)
+                        })
+                        .collect()
+                }),
         };
         Self {
             window: SweepStats::default(),
@@ -251,15 +293,28 @@ impl McSession {
                 h.sample(&self.mc);
                 rho.sample(&self.mc);
             }
+            for (s, h) in block.species.iter_mut().flatten().enumerate() {
+                h.sample_species(&self.mc, s as u32);
+            }
+            for (s, h) in block.species_wall.iter_mut().flatten().enumerate() {
+                h.sample_species(&self.mc, s as u32);
+            }
+            if let Some(h) = block.partial.as_mut() {
+                h.sample(&self.mc);
+            }
         }
         if let Some(w) = self.gsd.as_mut()
             && sweep.is_multiple_of(p.trajectory_every)
         {
             let pos: Vec<[f64; 3]> = (0..self.mc.len()).map(|i| self.mc.position(i)).collect();
+            let particles = match &p.mixture {
+                Some(m) => m.particles(pos),
+                None => Particles::monodisperse(pos, p.diameter),
+            };
             w.write_frame(
                 sweep,
                 &SimBox::cube(self.mc.box_edge()),
-                &Particles::monodisperse(pos, p.diameter),
+                &particles,
                 false,
                 &[],
             )?;
@@ -298,6 +353,8 @@ impl Session for McSession {
             "g_r.png",
             "g2.csv",
             "trajectory.gsd",
+            "species_profile_mean.csv",
+            "species_profiles.png",
         ]
         .contains(&name)
     }
@@ -410,20 +467,24 @@ impl Session for McSession {
         };
         if p.is_bulk() {
             let volume = self.mc.box_edge().powi(3);
-            let contact: Vec<f64> = blocks
-                .iter()
-                .map(|b| bulk_contact(&b.contact, n, volume, d))
-                .collect();
-            let z: Vec<f64> = contact
-                .iter()
-                .map(|&g| compressibility(p.volume_fraction, n, g))
-                .collect();
-            summary["contact_value"] = value_error(&contact);
-            summary["compressibility"] = value_error(&z);
-            summary["carnahan_starling"] = json!({
-                "compressibility": carnahan_starling(p.volume_fraction),
-                "contact_value": carnahan_starling_contact(p.volume_fraction),
-            });
+            if let Some(m) = &p.mixture {
+                mixture_bulk(m, &blocks, volume, &mut summary, out);
+            } else {
+                let contact: Vec<f64> = blocks
+                    .iter()
+                    .map(|b| bulk_contact(&b.contact, n, volume, d))
+                    .collect();
+                let z: Vec<f64> = contact
+                    .iter()
+                    .map(|&g| compressibility(p.volume_fraction, n, g))
+                    .collect();
+                summary["contact_value"] = value_error(&contact);
+                summary["compressibility"] = value_error(&z);
+                summary["carnahan_starling"] = json!({
+                    "compressibility": carnahan_starling(p.volume_fraction),
+                    "contact_value": carnahan_starling_contact(p.volume_fraction),
+                });
+            }
             let per_block: Vec<Vec<f64>> = blocks
                 .iter()
                 .filter_map(|b| b.gr.as_ref().map(|h| h.pair_correlation(n, volume)))
@@ -433,8 +494,13 @@ impl Session for McSession {
                 let (g, err) = columns(&per_block, r.len());
                 out.write_table("g_r.csv", &[("r", &r), ("g", &g), ("err", &err)])?;
                 files.push("g_r.csv".into());
+                let all = if p.mixture.is_some() {
+                    " (all pairs)"
+                } else {
+                    ""
+                };
                 let title = format!(
-                    "Hard spheres, Monte Carlo: N = {n}, phi = {:.3}, Z = {:.4}",
+                    "Hard spheres{all}, Monte Carlo: N = {n}, phi = {:.3}, Z = {:.4}",
                     p.volume_fraction,
                     summary["compressibility"]["value"]
                         .as_f64()
@@ -462,14 +528,28 @@ impl Session for McSession {
             }
         } else {
             let vol = PI / 6.0 * d.powi(3);
-            let per_block: Vec<Vec<f64>> = blocks
-                .iter()
-                .filter_map(|b| {
-                    b.profile
-                        .as_ref()
-                        .map(|h| h.density().iter().map(|rho| rho * vol).collect())
-                })
-                .collect();
+            // A mixture's total volume fraction is the sum of its species'.
+            let per_block: Vec<Vec<f64>> = match &p.mixture {
+                Some(m) => blocks
+                    .iter()
+                    .filter_map(|b| b.species.as_ref())
+                    .map(|hs| {
+                        species_phi(hs, &m.diameters)
+                            .iter()
+                            .fold(vec![0.0; p.profile_bins], |acc, phi| {
+                                acc.iter().zip(phi).map(|(a, b)| a + b).collect()
+                            })
+                    })
+                    .collect(),
+                None => blocks
+                    .iter()
+                    .filter_map(|b| {
+                        b.profile
+                            .as_ref()
+                            .map(|h| h.density().iter().map(|rho| rho * vol).collect())
+                    })
+                    .collect(),
+            };
             if let Some(h) = blocks.first().and_then(|b| b.profile.as_ref()) {
                 let r = h.centres();
                 let (phi, err) = columns(&per_block, r.len());
@@ -565,11 +645,14 @@ impl Session for McSession {
                     &mut warnings,
                 );
             }
+            if let Some(m) = &p.mixture {
+                mixture_droplet(p, m, &blocks, out, &mut summary, &mut files, &mut warnings)?;
+            }
             if let Some(rc) = self
                 .mc
                 .geometry()
                 .confinement(d)
-                .filter(|_| p.geometry == "hard-wall")
+                .filter(|_| p.geometry == "hard-wall" && p.mixture.is_none())
             {
                 // 4 pi Rc^3 rho(Rc) = 3 N + d n_c (docs/mc.md), per block.
                 let wall: Vec<f64> = blocks
@@ -614,6 +697,195 @@ impl Session for McSession {
             warnings,
         })
     }
+}
+
+/// Each species' volume fraction `pi d_s^3 rho_s(r) / 6` per bin of one block.
+fn species_phi(hs: &[RadialHistogram], diameters: &[f64]) -> Vec<Vec<f64>> {
+    hs.iter()
+        .zip(diameters)
+        .map(|(h, ds)| {
+            let v = PI / 6.0 * ds.powi(3);
+            h.density().iter().map(|rho| rho * v).collect()
+        })
+        .collect()
+}
+
+/// `{"value", "standard_error"}` over blocks, each `null` with a reason (recorded as `path`
+/// in summary.json) when it is not a finite number.
+fn value_error_or(out: &OutputDir, path: &str, v: &[f64], why: &str) -> serde_json::Value {
+    let (m, e) = mean_and_error(v);
+    for (x, k) in [(m, "value"), (e, "standard_error")] {
+        if !x.is_finite() {
+            out.explain("summary.json", &format!("{path}.{k}"), why);
+        }
+    }
+    json!({ "value": m, "standard_error": e })
+}
+
+/// Why a partial contact value is missing.
+const NO_CONTACT: &str = "no pair of this species pair (a species of one sphere), or a block without pairs in some bin within 10 % of contact: nothing to extrapolate to contact (sample longer or more spheres)";
+
+/// A bulk mixture's summary: the partial contact values `g_ab(d_ab+)` and the virial Z per
+/// block (mean and standard error), beside BMCSL at the same number densities.
+fn mixture_bulk(
+    m: &colloidsim_particles::Mixture,
+    blocks: &[&Block],
+    volume: f64,
+    summary: &mut serde_json::Value,
+    out: &OutputDir,
+) {
+    let partial: Vec<&PartialContacts> = blocks.iter().filter_map(|b| b.partial.as_ref()).collect();
+    let per_block: Vec<Vec<Vec<f64>>> = partial.iter().map(|h| h.contact_values(volume)).collect();
+    let z: Vec<f64> = partial.iter().map(|h| h.compressibility(volume)).collect();
+    let rho: Vec<f64> = m.counts.iter().map(|&c| c as f64 / volume).collect();
+    let (z_bmcsl, g_bmcsl) = bmcsl(&rho, &m.diameters);
+    let (mut contact, mut reference) = (serde_json::Map::new(), serde_json::Map::new());
+    for a in 0..m.len() {
+        for b in a..m.len() {
+            let name = m.pair_name(a, b);
+            let v: Vec<f64> = per_block.iter().map(|g| g[a][b]).collect();
+            let path = format!("contact_values.{name}");
+            contact.insert(name.clone(), value_error_or(out, &path, &v, NO_CONTACT));
+            reference.insert(name, json!(g_bmcsl[a][b]));
+        }
+    }
+    summary["contact_values"] = serde_json::Value::Object(contact);
+    summary["compressibility"] = value_error_or(out, "compressibility", &z, NO_CONTACT);
+    summary["bmcsl"] = json!({
+        "compressibility": z_bmcsl,
+        "contact_values": reference,
+    });
+}
+
+/// A droplet of a mixture: `species_profile_mean.csv` and `species_profiles.png` (each
+/// species' volume-fraction profile, mean and standard error over the blocks), each
+/// species' mean centre distance in summary.json, and with a hard wall the sum rule
+/// `sum_s 4 pi Rc_s^3 rho_s(Rc_s) = 3 N + sum_{a <= b} d_ab n_c,ab` (docs/mc.md).
+fn mixture_droplet(
+    p: &McRun,
+    m: &colloidsim_particles::Mixture,
+    blocks: &[&Block],
+    out: &OutputDir,
+    summary: &mut serde_json::Value,
+    files: &mut Vec<String>,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    let per_block: Vec<Vec<Vec<f64>>> = blocks
+        .iter()
+        .filter_map(|b| b.species.as_ref())
+        .map(|hs| species_phi(hs, &m.diameters))
+        .collect();
+    let Some(h0) = blocks.first().and_then(|b| b.species.as_ref()) else {
+        return Ok(());
+    };
+    let r = h0[0].centres();
+    let (mut phi, mut err) = (Vec::new(), Vec::new());
+    for s in 0..m.len() {
+        let one: Vec<Vec<f64>> = per_block.iter().map(|b| b[s].clone()).collect();
+        let (a, e) = columns(&one, r.len());
+        phi.push(a);
+        err.push(e);
+    }
+    crate::output::species::write_species_profile(
+        out,
+        "species_profile_mean.csv",
+        &r,
+        &m.names,
+        &phi,
+        &err,
+        None,
+        files,
+    )?;
+    let radius = p.radius.unwrap_or(1.0);
+    let x: Vec<f64> = r.iter().map(|v| v / radius).collect();
+    let shown: Vec<(String, Vec<f64>, Vec<f64>)> = m
+        .names
+        .iter()
+        .zip(&m.diameters)
+        .zip(&phi)
+        .map(|((name, ds), y)| (format!("{name} (d = {ds})"), x.clone(), y.clone()))
+        .collect();
+    let bars: Vec<Option<&[f64]>> = err.iter().map(|e| Some(e.as_slice())).collect();
+    crate::output::species::draw_species_profiles(
+        out,
+        &format!(
+            "Static droplet, hard-sphere MC ({}): species {}, N = {:?}, phi = {:.3} (bars: standard error over the blocks)",
+            p.geometry,
+            m.names.join(", "),
+            m.counts,
+            p.volume_fraction
+        ),
+        "r / R",
+        &shown,
+        &bars,
+        files,
+        warnings,
+    );
+    // Mean centre distance of each species over R, per block.
+    let mut mean_radius = serde_json::Map::new();
+    for s in 0..m.len() {
+        let v: Vec<f64> = blocks
+            .iter()
+            .filter_map(|b| b.species.as_ref())
+            .map(|hs| {
+                let (c, r) = (hs[s].counts(), hs[s].centres());
+                let total: u64 = c.iter().sum();
+                c.iter().zip(&r).map(|(&k, r)| k as f64 * r).sum::<f64>()
+                    / total.max(1) as f64
+                    / radius
+            })
+            .collect();
+        mean_radius.insert(m.names[s].clone(), {
+            let (a, e) = mean_and_error(&v);
+            json!({ "value": a, "standard_error": e })
+        });
+    }
+    summary["mean_radius_over_r"] = serde_json::Value::Object(mean_radius);
+    if p.geometry == "hard-wall" {
+        let geometry = p.geometry();
+        let n = m.total() as f64;
+        let (mut wall, mut virial) = (Vec::new(), Vec::new());
+        let mut contact = vec![Vec::new(); m.len()];
+        for b in blocks {
+            let (Some(hs), Some(pc)) = (b.species_wall.as_ref(), b.partial.as_ref()) else {
+                continue;
+            };
+            let mut w = 0.0;
+            for (s, h) in hs.iter().enumerate() {
+                let rc = geometry
+                    .confinement_of(m.diameters[s], p.diameter)
+                    .unwrap_or(0.0);
+                let rho = wall_contact_density(h, rc);
+                contact[s].push(rho);
+                w += 4.0 * PI * rc.powi(3) * rho;
+            }
+            let mut v = 3.0 * n;
+            for a in 0..m.len() {
+                for c in a..m.len() {
+                    let dab = 0.5 * (m.diameters[a] + m.diameters[c]);
+                    if pc.pair(a, c).counts().iter().any(|&k| k > 0) {
+                        v += dab * contact_pairs(pc.pair(a, c), dab);
+                    }
+                }
+            }
+            wall.push(w);
+            virial.push(v);
+        }
+        let ratio: Vec<f64> = wall.iter().zip(&virial).map(|(a, b)| a / b - 1.0).collect();
+        let why = "a block without centres in some bin within 0.1 d_s of a species' wall, or without pairs next to contact: nothing to extrapolate (sample longer)";
+        let mut per = serde_json::Map::new();
+        for (s, v) in contact.iter().enumerate() {
+            let path = format!("wall_contact_density.{}", m.names[s]);
+            per.insert(m.names[s].clone(), value_error_or(out, &path, v, why));
+        }
+        summary["wall_contact_density"] = serde_json::Value::Object(per);
+        summary["wall_sum_rule"] = json!({
+            "wall": value_error_or(out, "wall_sum_rule.wall", &wall, why),
+            "virial": value_error_or(out, "wall_sum_rule.virial", &virial, why),
+            "relative_difference": value_error_or(out, "wall_sum_rule.relative_difference", &ratio, why),
+        });
+    }
+    Ok(())
 }
 
 /// Mean and standard error per bin over blocks.

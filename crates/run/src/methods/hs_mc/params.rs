@@ -6,6 +6,7 @@ use super::keys::*;
 use crate::keys::shared::{
     self, INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
 };
+use crate::keys::species::{SPECIES, SPECIES_COUNTS, SPECIES_DIAMETERS};
 use crate::keys::{Reader, SEED_KEY, rekey};
 use anyhow::{Result, bail};
 use colloidsim_core::ParamError;
@@ -25,6 +26,8 @@ const ENGINE_NAMES: &[(&str, &crate::keys::Spec)] = &[
     ("range", &INTERFACE_RANGE),
     ("offset", &INTERFACE_OFFSET),
     ("n", &SYSTEM_VOLUME_FRACTION),
+    ("diameters", &SPECIES_DIAMETERS),
+    ("counts", &SPECIES_COUNTS),
 ];
 
 /// An engine's error about one of its parameters, naming the scenario key instead.
@@ -68,12 +71,28 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             "must be at least 2 in bulk, got 1"
         ));
     }
+    // The species (one of diameter d without [system.species]); a mixture needs N given.
+    let species = match particles {
+        Some(n) => Some(crate::keys::species::species(r, n, d, &SYSTEM_DIAMETER)?),
+        None if r.has(&SPECIES) => bail!(ParamError::new(
+            SYSTEM_PARTICLES.path,
+            "required with [system.species] (the counts or volume fractions share it out)",
+        )),
+        None => None,
+    };
+    // Spheres of diameter d with the volume of all spheres (N for one species).
+    let n_eq = |n: usize| {
+        species
+            .as_ref()
+            .map_or(n as f64, |m| m.equivalent_number(d))
+    };
+    let d_max = species.as_ref().map_or(d, |m| m.d_max());
     let volume_fraction = r.opt_number(&SYSTEM_VOLUME_FRACTION)?;
     // phi of N spheres in a size, and its inverses.
     let unit = if bulk { PI / 6.0 } else { 1.0 / 8.0 };
     let (particles, size) = match (particles, volume_fraction, size) {
         (Some(n), None, Some(l)) => (n, l),
-        (Some(n), Some(phi), None) => (n, (n as f64 * unit * d.powi(3) / phi).cbrt()),
+        (Some(n), Some(phi), None) => (n, (n_eq(n) * unit * d.powi(3) / phi).cbrt()),
         (None, Some(phi), Some(l)) => {
             let n = (phi * l.powi(3) / (unit * d.powi(3))).round();
             if !(1.0..=1e8).contains(&n) {
@@ -97,7 +116,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             ),
         )),
     };
-    let phi = particles as f64 * unit * d.powi(3) / size.powi(3);
+    let phi = n_eq(particles) * unit * d.powi(3) / size.powi(3);
     if phi > MAX_PHI {
         bail!(ParamError::new(
             SYSTEM_VOLUME_FRACTION.path,
@@ -126,21 +145,26 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
     } else if let Some([k, range, offset]) = interface {
         Geometry::interface(size, k, range, offset, kt).map_err(keyed)?
     } else {
-        if size <= 0.5 * d {
+        if size <= 0.5 * d_max {
             bail!(ParamError::new(
                 SYSTEM_RADIUS.path,
-                format!("must exceed d/2 = {}, got {}", show(0.5 * d), show(size)),
+                format!(
+                    "must exceed d/2 = {} (the largest diameter), got {}",
+                    show(0.5 * d_max),
+                    show(size)
+                ),
             ));
         }
         Geometry::HardWall { radius: size }
     };
-    let box_edge = shape.box_edge(d);
-    if bulk && box_edge < 2.0 * d {
+    let diameters = species.as_ref().map_or(vec![d], |m| m.diameters.clone());
+    let box_edge = shape.box_edge_of(d, &diameters);
+    if bulk && box_edge < 2.0 * d_max {
         bail!(ParamError::new(
             SYSTEM_BOX.path,
             format!(
-                "must be at least 2 d = {} (the cells need two per edge), got {}",
-                show(2.0 * d),
+                "must be at least 2 d = {} (the cells need two per edge; d the largest diameter), got {}",
+                show(2.0 * d_max),
                 show(box_edge)
             ),
         ));
@@ -214,10 +238,25 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             "applies to the droplet geometries only (give 0 or leave it out in bulk)",
         ));
     }
+    let species = species.filter(|m| !m.is_single());
+    if let Some(m) = &species
+        && rho2_bins.is_some()
+    {
+        bail!(ParamError::new(
+            OUTPUT_RHO2_R_BINS.path,
+            format!(
+                "the two-body density and g2 have no support for mixtures yet ({} species in system.species): give 0 or leave it out",
+                m.len()
+            ),
+        ));
+    }
     let rho2_cells = rho2_bins.map_or(0.0, |(r, c)| (r * r * c) as f64);
     // Positions (particle order, scratch and slots), histograms of every block.
+    let kinds = species.as_ref().map_or(1, |m| m.len());
     let bytes = particles as f64 * 200.0
-        + blocks as f64 * 8.0 * ((profile_bins + gr_bins + 100) as f64 + rho2_cells);
+        + blocks as f64
+            * 8.0
+            * (((kinds + 1) * profile_bins + gr_bins + 100 * kinds * kinds) as f64 + rho2_cells);
     ensure_fits(
         SYSTEM_PARTICLES.path,
         &format!("{particles} spheres"),
@@ -226,8 +265,9 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
     Ok(McRun {
         seed,
         particles,
-        diameter: d,
-        mixture: None,
+        // One species declared is the plain run: its diameter, no mixture.
+        diameter: if species.is_none() { diameters[0] } else { d },
+        mixture: species,
         geometry,
         volume_fraction: phi,
         radius: (!bulk).then_some(size),
@@ -280,7 +320,14 @@ rho2_r_bins = 4
         let t = table(FULL);
         let r = Reader::new(&t, KEYS).unwrap();
         resolve(&r, Path::new("."), None).unwrap();
-        assert_eq!(r.unread(), Vec::<&str>::new());
+        // The species keys are read by kind (counts or volume fractions): tests/hs_mc_species.rs
+        // reads each.
+        let unread: Vec<&str> = r
+            .unread()
+            .into_iter()
+            .filter(|k| !k.starts_with("system.species."))
+            .collect();
+        assert_eq!(unread, Vec::<&str>::new());
     }
 
     #[test]
