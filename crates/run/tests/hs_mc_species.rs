@@ -519,8 +519,8 @@ fn a_static_bidisperse_droplet_matches_the_binary_fmt() {
 /// The long form: R = 5, 144 small and 18 large spheres (mean volume fraction 0.288), 20 blocks
 /// of 10,000 sweeps; the integrated test and the chi-square of every bin (block error and 2 % of
 /// the FMT in quadrature) within its p ~ 1e-4 limit. With `COLLOIDSIM_FIGURE=<png>` it draws
-/// the comparison (docs/figures/hs_mc_bidisperse_fmt.png):
-/// `COLLOIDSIM_FIGURE=docs/figures/hs_mc_bidisperse_fmt.png cargo test --release -p colloidsim-run --test hs_mc_species -- --ignored --nocapture`
+/// the comparison (docs/img/hs-mc-bidisperse-fmt.png):
+/// `COLLOIDSIM_FIGURE=docs/img/hs-mc-bidisperse-fmt.png cargo test --release -p colloidsim-run --test hs_mc_species -- --ignored --nocapture`
 #[test]
 #[ignore = "release: about 30 s"]
 fn a_static_bidisperse_droplet_matches_the_binary_fmt_long() {
