@@ -55,6 +55,8 @@ ALPHA = 2.0
 EQ_PECLET = 0.01
 # The profile times compared (fractions of the drying time): half way, and the end.
 FRACTIONS = (0.5, 1.0)
+# As droplet-bd's warning: a droplet with more of its centres beyond R at the end did not compact.
+LEFT_BEHIND = 0.01
 BASE = "examples/droplet/bidisperse-bd.toml"
 DDFT_DX = "0.05"
 
@@ -206,6 +208,9 @@ def analyse(args):
                 with open(f + ".wall") as w:
                     wall = float(w.read())
             got, params = measures(f)
+            with open(os.path.join(f, "summary.json")) as fs:
+                beyond = json.load(fs).get("centres_beyond_R_at_end")
+            left = None if beyond is None else beyond / (params["particles"] * params["replicas"])
             for fraction, (delta, err, radius) in sorted(got.items()):
                 if fraction not in FRACTIONS or delta is None:
                     continue
@@ -216,9 +221,15 @@ def analyse(args):
                     "pe_s": pe, "pe_phi_s": pe * phi0 / 2, "R": radius, "delta": delta,
                     "delta_err": err, "delta_ideal": ideal, "S": delta - ideal,
                     "delta_eq": base, "S_eq": None if base is None else delta - base,
-                    "wall_s": wall,
+                    "left_behind": left if fraction == 1.0 else None, "wall_s": wall,
                 })
     return rows, eq
+
+
+def held_badly(row):
+    """More than LEFT_BEHIND of the centres beyond R at the end: the interface did not hold
+    the colloids (droplet-bd warns), so the droplet did not compact and its end is no measure."""
+    return (row["left_behind"] or 0.0) > LEFT_BEHIND
 
 
 def thresholds(rows, methods, phi0s):
@@ -230,7 +241,8 @@ def thresholds(rows, methods, phi0s):
             for phi0 in phi0s:
                 pts = sorted((r["pe_s"], r["S"]) for r in rows
                              if r["method"] == method and r["phi0"] == phi0
-                             and r["fraction"] == fraction and r["S"] is not None)
+                             and r["fraction"] == fraction and r["S"] is not None
+                             and not held_badly(r))
                 if not pts:
                     continue
                 value, note = None, ""
@@ -277,9 +289,15 @@ def figures(all_rows, methods, img, fraction):
                              sharey=True, squeeze=False, layout="constrained")
     for ax, m in zip(axes[0], shown):
         rs = [r for r in rows if r["method"] == m and r["S"] is not None]
-        sc = ax.scatter([r["pe_s"] for r in rs], [r["phi_s"] for r in rs],
-                        c=[r["S"] for r in rs], cmap="coolwarm", norm=norm, s=140,
+        good = [r for r in rs if not held_badly(r)]
+        bad = [r for r in rs if held_badly(r)]
+        sc = ax.scatter([r["pe_s"] for r in good], [r["phi_s"] for r in good],
+                        c=[r["S"] for r in good], cmap="coolwarm", norm=norm, s=140,
                         edgecolors="k")
+        if bad:
+            ax.scatter([r["pe_s"] for r in bad], [r["phi_s"] for r in bad], s=140,
+                       facecolors="none", edgecolors="0.5", linestyles="--",
+                       label="interface did not hold")
         pe = [0.1, 300]
         ax.plot(pe, [1 / ALPHA**2 / p for p in pe], "k--", lw=1,
                 label=r"$Pe_s\phi_s = 1/\alpha^2$")
@@ -305,7 +323,8 @@ def figures(all_rows, methods, img, fraction):
     for k, m in enumerate(shown):
         for phi0 in sorted({r["phi0"] for r in rows}):
             rs = sorted((r for r in rows if r["method"] == m and r["phi0"] == phi0
-                         and r["S"] is not None), key=lambda r: r["pe_s"])
+                         and r["S"] is not None and not held_badly(r)),
+                        key=lambda r: r["pe_s"])
             if not rs:
                 continue
             ax.errorbar([r["pe_phi_s"] for r in rs], [r["S"] for r in rs],

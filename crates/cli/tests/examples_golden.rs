@@ -29,6 +29,15 @@ const EXAMPLES: &[(&str, &[&str])] = &[
         &["replicas=2", "drying.final_volume_fraction=0.06"],
     ),
     (
+        "droplet/bidisperse-rpy.toml",
+        &[
+            "replicas=1",
+            "system.particles=90",
+            "system.species.counts=[80, 10]",
+            "drying.final_volume_fraction=0.06",
+        ],
+    ),
+    (
         "bcd/channel-trap.toml",
         &[
             "run.equilibrate=0.05",

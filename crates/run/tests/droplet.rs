@@ -159,3 +159,42 @@ fn droplet_error(text: &str) -> colloidsim_core::ParamError {
     .downcast()
     .unwrap()
 }
+
+/// The warnings of `text` run through the run path (droplets dried to phi = 0.5).
+fn run_warnings(text: &str) -> Vec<String> {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = colloidsim_run::Scenario::from_toml(text, dir.path()).unwrap();
+    let opts = colloidsim_run::RunOptions {
+        out: Some(dir.path().join("run")),
+        ..Default::default()
+    };
+    let r = colloidsim_run::run(&sc, &opts, &colloidsim_run::Control::default()).unwrap();
+    r.summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn a_droplet_whose_interface_left_colloids_behind_says_so() {
+    // 100 spheres dried to phi = 0.5 at Pe = 300 in a 20 kT/d^2 interface: the interface
+    // outruns them and most end beyond R.
+    let fast = |pe: f64, k: f64| {
+        format!(
+            "method = \"droplet-bd\"\nseed = 5\n[system]\nparticles = 100\nphi0 = 0.1\n\
+             [drying]\npeclet = {pe}\nfinal_volume_fraction = 0.5\n\
+             [interface]\nstiffness = {k}\n"
+        )
+    };
+    let w = run_warnings(&fast(300.0, 20.0));
+    assert!(
+        w.iter()
+            .any(|w| w.contains("beyond R at the end") && w.contains("interface.stiffness")),
+        "{w:?}"
+    );
+    // Dried slowly in a stiff interface the droplet compacts: no such warning.
+    let w = run_warnings(&fast(3.0, 100.0));
+    assert!(!w.iter().any(|w| w.contains("beyond R")), "{w:?}");
+}
