@@ -181,7 +181,7 @@ impl External for BodyForce {
 /// `P = N kT / V + (1 / 3V) sum_{i<j} r_ij . F_ij`,
 ///
 /// the pairs within the cut-off found by a cell list over the wrapped positions (every pair
-/// once, with its minimum image; Allen & Tildesley, Computer Simulation of Liquids, eq. 2.60).
+/// once, with its minimum image; Allen & Tildesley, Computer Simulation of Liquids).
 /// The positions must lie in the box (e.g. [`Brownian::snapshot`]); the box must be at least
 /// twice the cut-off ([`BoxTooSmall`] otherwise).
 pub fn virial_pressure<P: Pair>(

@@ -87,8 +87,9 @@ pub fn jzg_pressure(rho: f64, t: f64) -> f64 {
 ///
 /// `P_tail = (16/3) pi rho^2 [(2/3) rc^-9 - rc^-3]`
 ///
-/// (Allen & Tildesley, eq. 2.144). The same mean-field estimate gives this for the shift: the
-/// constant `u(rc)` removed inside `rc` and the virial tail add up to it.
+/// (Allen & Tildesley, Computer Simulation of Liquids). The same mean field gives this for
+/// the cut-and-shifted fluid: the constant `u(rc)` removed inside `rc` adds
+/// `(2/3) pi rho^2 rc^3 u(rc)` to the energy route's tail, and the two make this.
 pub fn lj_tail_pressure(rho: f64, rc: f64) -> f64 {
     16.0 / 3.0 * std::f64::consts::PI * rho * rho * (2.0 / 3.0 * rc.powi(-9) - rc.powi(-3))
 }

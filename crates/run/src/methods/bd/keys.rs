@@ -55,7 +55,7 @@ pub const OBSERVE_BLOCKS: Spec = key("observe.blocks", "-", Value("8"), Integer(
 
 pub const OBSERVE_MSD: Spec = key("observe.msd", "-",
     Means("30 lags up to a quarter of a block"), Table,
-    "mean-square displacement of the unwrapped positions (about the centre of mass under a body force): msd.csv, msd.png");
+    "mean-square displacement of the unwrapped positions (about the centre of mass under a body force), and of each species: msd.csv, msd.png");
 
 pub const OBSERVE_MSD_POINTS: Spec = key("observe.msd.points", "-", Value("30"), Integer(2, 1000),
     "log-spaced lags from one step to max_lag");

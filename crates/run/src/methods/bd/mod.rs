@@ -128,7 +128,7 @@ impl Method for BulkBd {
     }
 
     fn about(&self) -> &'static str {
-        "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE): MSD, self-diffusion and sedimentation under a body force beside Hasimoto"
+        "Brownian dynamics of spheres (one or more species, any pair interaction) in a periodic cube, free draining or with RPY (PSE): MSD, self-diffusion, sedimentation under a body force and the virial pressure, per species, beside Hasimoto and the LJ equation of state"
     }
 
     fn docs(&self) -> &'static str {
