@@ -215,3 +215,32 @@ fn bad_input_is_refused_before_anything_is_written() {
         assert!(!out.exists(), "{to}: the output folder was created");
     }
 }
+
+/// A mixture (diameters 1 and 1.5) under a body force, with RPY (PSE for unequal radii) and
+/// free draining: interrupted and killed, it restarts to the same files (each sphere keeps its
+/// species' diameter), and on one thread too.
+#[test]
+fn bulk_mixtures_restart_bitwise_with_their_diameters() {
+    let species = "[system.species]\ndiameters = [1.0, 1.5]\ncounts = [14, 6]\n[run]";
+    let rpy = RPY.replace("[run]", species);
+    let (tmp, sc, a) = complete("mix-rpy", &rpy);
+    restarts_and_threads(
+        tmp.path(),
+        &sc,
+        &a,
+        &[("COLLOIDSIM_INTERRUPT_AT_STEP", "77")],
+    );
+    let free = RPY
+        .replace("[run]", species)
+        .replace("[hydrodynamics]\nmodel = \"rpy\"\n", "");
+    let (tmp, sc, a) = complete("mix-free", &free);
+    restarts_and_threads(
+        tmp.path(),
+        &sc,
+        &a,
+        &[
+            ("COLLOIDSIM_INTERRUPT_AT_STEP", "123"),
+            ("COLLOIDSIM_KILL_AT_STEP", "301"),
+        ],
+    );
+}

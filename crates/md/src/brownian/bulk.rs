@@ -1,6 +1,14 @@
-//! Bulk Brownian dynamics in a periodic cube (`method = "bd"`): WCA spheres, an optional
-//! constant body force (sedimentation), free draining or with the RPY mobility of the periodic
-//! box by positively split Ewald (docs/bd.md).
+//! Bulk Brownian dynamics in a periodic cube (`method = "bd"`): spheres of one or more species
+//! (WCA or any pair interaction of [`PairSpec`]), an optional constant body force
+//! (sedimentation), free draining or with the RPY mobility of the periodic box by positively
+//! split Ewald (docs/bd.md).
+//!
+//! **Species.** Particles are stored species by species ([`Mixture`]); each has its Stokes
+//! mobility `1 / (3 pi eta d_i)`, and the body force on a sphere is proportional to its volume,
+//! `F_i = F (d_i / d)^3` with `d` the smallest diameter ([`BodyForce`]): spheres of one material
+//! in one solvent (the same density difference), so that a free sphere sediments at
+//! `U_i = mu_i F_i = F d_i^2 / (3 pi eta d^3)`, Stokes' law. With RPY the mobility is PSE for
+//! unequal radii ([`Pse::with_radii`]). One species is the monodisperse run, bit for bit.
 //!
 //! [`BulkParams`] are a bulk run's resolved parameters, plain data: the run layer reads a
 //! `method = "bd"` scenario into them. The engines are those of the droplet: [`Brownian`] (free
@@ -12,17 +20,18 @@
 //! `d^2 / D0 = 9.42`.
 
 use super::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};
-use super::scenario::{one_species, read_initial};
+use super::scenario::{read_initial, species_from_file};
 use super::{BdError, BdParams, Brownian, Integrator};
-use crate::init::{PackingError, random_in_box};
-use crate::potential::ConstantForce;
+use crate::init::{PackingError, random_mixture_in_box};
+use crate::neighbor::{BoxTooSmall, NeighborList};
+use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_core::trigger::log_spaced;
 use colloidsim_hydro::ewald::hasimoto;
 use colloidsim_hydro::{AnyMobility, HydroModel, HydroParams, Pse, PseGeometry};
-use colloidsim_particles::{Interaction, PairSpec};
+use colloidsim_particles::{Interaction, Mixture, PairSpec};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -38,28 +47,31 @@ pub struct BulkParams {
     pub seed: u32,
     /// Independent replicas.
     pub replicas: usize,
-    /// Number of spheres N.
+    /// Number of spheres N (of all species).
     pub particles: usize,
     /// Box edge L.
     pub box_length: f64,
-    /// Sphere diameter d.
+    /// Sphere diameter d: the smallest species' (the length of the defaults).
     pub diameter: f64,
-    /// The pair interaction (`None`: WCA with eps = kT at the diameter).
+    /// The species and their numbers (absent from the resolved parameters when one).
+    #[serde(skip_serializing_if = "Mixture::is_single")]
+    pub species: Mixture,
+    /// The pair interaction (`None`: WCA with eps = kT at each pair's mean diameter).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pair: Option<PairSpec>,
     /// Thermal energy kT.
     pub kt: f64,
     /// Solvent viscosity eta.
     pub viscosity: f64,
-    /// Stokes friction `3 pi eta d` (`1 / mu0`).
+    /// Stokes friction `3 pi eta d` (`1 / mu0`, of the smallest species).
     pub friction: f64,
-    /// Free diffusivity `D0 = kT / (3 pi eta d)`.
+    /// Free diffusivity `D0 = kT / (3 pi eta d)` (of the smallest species).
     pub d0: f64,
     /// Diffusion time `d^2 / D0`.
     pub diffusion_time: f64,
-    /// Volume fraction `N pi d^3 / (6 L^3)`.
+    /// Volume fraction `sum_s N_s pi d_s^3 / (6 L^3)`.
     pub phi: f64,
-    /// Body force on every sphere.
+    /// Body force on a sphere of diameter d (on one of diameter `d_i`: `F (d_i / d)^3`).
     pub body_force: [f64; 3],
     /// Its magnitude `F`.
     pub force: f64,
@@ -117,6 +129,96 @@ pub fn dilute_sedimentation(phi: f64, n: usize, a: f64, l: f64) -> f64 {
     mu - 5.0 * phi_n - 8.0 * phi_n * (mu - 1.0)
 }
 
+/// A constant body force proportional to each sphere's volume: `F (d_i / d_ref)^3` on a sphere
+/// of diameter `d_i` (spheres of one material in one solvent: gravity less buoyancy, the same
+/// density difference for every size). On spheres of the reference diameter it is exactly
+/// `force` (one species: a constant force on every sphere).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyForce {
+    /// The force on a sphere of the reference diameter.
+    pub force: [f64; 3],
+    /// The reference diameter (the smallest species').
+    pub reference_diameter: f64,
+}
+
+impl BodyForce {
+    /// The factor `(d / d_ref)^3` of a sphere of diameter `d` (exactly 1 at the reference).
+    #[inline(always)]
+    pub fn scale(&self, d: f64) -> f64 {
+        if d == self.reference_diameter {
+            1.0
+        } else {
+            (d / self.reference_diameter).powi(3)
+        }
+    }
+}
+
+impl External for BodyForce {
+    #[inline(always)]
+    fn force(&self, _: [f64; 3], _: f64) -> [f64; 3] {
+        self.force
+    }
+    #[inline]
+    fn energy(&self, p: [f64; 3], _: f64) -> f64 {
+        -(self.force[0] * p[0] + self.force[1] * p[1] + self.force[2] * p[2])
+    }
+    #[inline(always)]
+    fn force_on(&self, _: [f64; 3], _: f64, d: f64) -> [f64; 3] {
+        if d == self.reference_diameter {
+            return self.force;
+        }
+        let s = self.scale(d);
+        [self.force[0] * s, self.force[1] * s, self.force[2] * s]
+    }
+    #[inline]
+    fn energy_of(&self, p: [f64; 3], t: f64, d: f64) -> f64 {
+        self.scale(d) * self.energy(p, t)
+    }
+}
+
+/// The virial pressure of a configuration with pair interaction `pair` at temperature `kt`:
+///
+/// `P = N kT / V + (1 / 3V) sum_{i<j} r_ij . F_ij`,
+///
+/// the pairs within the cut-off found by a cell list over the wrapped positions (every pair
+/// once, with its minimum image; Allen & Tildesley, Computer Simulation of Liquids).
+/// The positions must lie in the box (e.g. [`Brownian::snapshot`]); the box must be at least
+/// twice the cut-off ([`BoxTooSmall`] otherwise).
+pub fn virial_pressure<P: Pair>(
+    particles: &Particles,
+    sbox: &SimBox,
+    pair: &P,
+    kt: f64,
+) -> Result<f64, BoxTooSmall> {
+    let n = particles.len();
+    let volume = sbox.volume();
+    let r_cut = pair.r_cut_max();
+    let mut w = 0.0;
+    if n > 1 && r_cut > 0.0 {
+        let mut list = NeighborList::new(r_cut, 0.0);
+        let key: Vec<u32> = (0..n as u32).collect();
+        list.build(sbox, &particles.pos, &key)?;
+        let (pos, t, d) = (&particles.pos, &particles.typeid, &particles.diameter);
+        for i in 0..n {
+            for &j in list.neighbors(i) {
+                let j = j as usize;
+                if j <= i {
+                    continue;
+                }
+                let v = sbox.min_image([
+                    pos[i][0] - pos[j][0],
+                    pos[i][1] - pos[j][1],
+                    pos[i][2] - pos[j][2],
+                ]);
+                let r2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+                // r . F = r^2 (F / r).
+                w += r2 * pair.force_over_r(r2, t[i], t[j], d[i], d[j]);
+            }
+        }
+    }
+    Ok((n as f64 * kt + w / 3.0) / volume)
+}
+
 /// Errors while setting up a replica (the run layer names the scenario keys).
 #[derive(Debug, thiserror::Error)]
 pub enum BulkError {
@@ -138,9 +240,9 @@ pub enum BulkError {
 }
 
 /// The free-draining engine of a bulk run.
-pub type BulkSim = Brownian<Interaction, ConstantForce>;
+pub type BulkSim = Brownian<Interaction, BodyForce>;
 /// The engine of a bulk run with RPY (PSE).
-pub type HydroBulkSim = HydroBrownian<Interaction, ConstantForce, AnyMobility>;
+pub type HydroBulkSim = HydroBrownian<Interaction, BodyForce, AnyMobility>;
 
 impl BulkParams {
     /// Does a replica run with RPY ([`Self::build_hydro_replica`]) rather than free draining
@@ -156,23 +258,48 @@ impl BulkParams {
         SimBox::cube(self.box_length)
     }
 
-    /// The pair interaction ([`Self::pair`]; WCA with `epsilon = kT`, `sigma = d` by default).
+    /// The pair interaction of the species ([`Self::pair`]; WCA with `epsilon = kT` at each
+    /// pair's mean diameter by default).
     pub fn pair(&self) -> Result<Interaction, ParamError> {
-        let d = [self.diameter];
+        let d = &self.species.diameters;
         match &self.pair {
-            Some(p) => p.build(&d, self.kt),
-            None => PairSpec::wca(self.kt, 1).build(&d, self.kt),
+            Some(p) => p.build(d, self.kt),
+            None => PairSpec::wca(self.kt, self.species.len()).build(d, self.kt),
         }
     }
 
-    /// The body force.
-    pub fn body(&self) -> ConstantForce {
-        ConstantForce(self.body_force)
+    /// The body force: `body_force` on a sphere of diameter d, `(d_i / d)^3` times it on one
+    /// of diameter `d_i`.
+    pub fn body(&self) -> BodyForce {
+        BodyForce {
+            force: self.body_force,
+            reference_diameter: self.diameter,
+        }
     }
 
     /// Stokes self-mobility `mu0 = 1 / (3 pi eta d)`.
     pub fn mu0(&self) -> f64 {
         1.0 / self.friction
+    }
+
+    /// Stokes self-mobility of species `s`, `1 / (3 pi eta d_s)`.
+    pub fn species_mobility(&self, s: usize) -> f64 {
+        1.0 / (3.0 * std::f64::consts::PI * self.viscosity * self.species.diameters[s])
+    }
+
+    /// Free diffusivity of species `s`, `D0_s = kT / (3 pi eta d_s)`.
+    pub fn species_d0(&self, s: usize) -> f64 {
+        self.kt * self.species_mobility(s)
+    }
+
+    /// Magnitude of the body force on a sphere of species `s`, `F (d_s / d)^3`.
+    pub fn species_force(&self, s: usize) -> f64 {
+        self.force * self.body().scale(self.species.diameters[s])
+    }
+
+    /// The virial pressure of the configuration `particles` ([`virial_pressure`]).
+    pub fn pressure(&self, particles: &Particles, pair: &Interaction) -> Result<f64, BoxTooSmall> {
+        virial_pressure(particles, &self.sbox(), pair, self.kt)
     }
 
     /// Hasimoto's `mu(L) / mu0` of this box ([`hasimoto`]).
@@ -213,6 +340,11 @@ impl BulkParams {
         h.pse_params(0.5 * self.diameter, self.viscosity, self.box_length)
     }
 
+    /// The radius of each species (half its diameter).
+    pub fn species_radii(&self) -> Vec<f64> {
+        self.species.diameters.iter().map(|d| 0.5 * d).collect()
+    }
+
     /// The free-draining engine's parameters of replica `replica`.
     pub fn bd_params(&self, replica: u32) -> BdParams {
         super::scenario::free_draining(
@@ -231,21 +363,18 @@ impl BulkParams {
         super::scenario::hydrodynamic(self.kt, self.dt, self.seed, replica, self.skin)
     }
 
-    /// The initial spheres of replica `replica`: random insertion (stream index `replica`)
-    /// or the last frame of `system.initial` (the same for every replica).
+    /// The initial spheres of replica `replica`: random insertion (stream index `replica`;
+    /// species by species) or the last frame of `system.initial` (the same for every replica;
+    /// its typeids must be the species', with their counts).
     pub fn initial_particles(&self, replica: u32) -> Result<Particles, BulkError> {
         let sbox = self.sbox();
         Ok(match &self.initial {
-            None => Particles::monodisperse(
-                random_in_box(
-                    self.particles,
-                    self.diameter,
-                    &sbox,
-                    self.seed,
-                    replica as u64,
-                )?,
-                self.diameter,
-            ),
+            None => self.species.particles(random_mixture_in_box(
+                &self.species.particle_diameters(),
+                &sbox,
+                self.seed,
+                replica as u64,
+            )?),
             Some(path) => {
                 let f = read_initial(path, self.particles).map_err(BulkError::Initial)?;
                 let mut p = f.particles;
@@ -264,7 +393,8 @@ impl BulkParams {
                 if let Some(i) = p.pos.iter().flatten().position(|x| !x.is_finite()) {
                     return Err(bad(format!("particle {} has a non-finite position", i / 3)));
                 }
-                one_species(path, &mut p, "bulk run", self.diameter).map_err(BulkError::Initial)?;
+                species_from_file(path, &mut p, "bulk run", &self.species)
+                    .map_err(BulkError::Initial)?;
                 p
             }
         })
@@ -292,8 +422,8 @@ impl BulkParams {
     }
 
     /// A replica with RPY at `step` from its particles (positions and image counts, in input
-    /// order: the whole state of [`HydroBrownian`]) and integrator parameters; it continues
-    /// bitwise as the run that saved them.
+    /// order: the whole state of [`HydroBrownian`]; each sphere keeps its diameter, PSE its
+    /// radius) and integrator parameters; it continues bitwise as the run that saved them.
     pub fn restart_hydro_replica(
         &self,
         particles: Particles,
@@ -305,8 +435,10 @@ impl BulkParams {
             .as_ref()
             .filter(|_| self.has_hydrodynamics())
             .ok_or_else(|| HydroBdError::Invalid("no RPY hydrodynamics in the scenario".into()))?;
+        // Equal radii: exactly `Pse::new` with that radius.
+        let radii: Vec<f64> = particles.diameter.iter().map(|d| 0.5 * d).collect();
         let mobility = AnyMobility::Pse(Box::new(
-            Pse::new(particles.len(), self.pse_params(h)).map_err(HydroBdError::from)?,
+            Pse::with_radii(&radii, self.pse_params(h)).map_err(HydroBdError::from)?,
         ));
         Ok(HydroBrownian::new(
             particles,
@@ -317,5 +449,195 @@ impl BulkParams {
             params,
             step,
         )?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::init::random_in_box;
+    use crate::potential::{ConstantForce, NoExternal};
+    use colloidsim_hydro::HydroMethod;
+    use std::f64::consts::PI;
+
+    /// A bulk run of `species` in a cube of edge `l` under `body_force` (free draining unless
+    /// `rpy`).
+    fn params(species: Mixture, l: f64, body_force: [f64; 3], rpy: bool) -> BulkParams {
+        let d = species.d_min();
+        let friction = 3.0 * PI * d;
+        let force = body_force.iter().map(|f| f * f).sum::<f64>().sqrt();
+        BulkParams {
+            seed: 7,
+            replicas: 1,
+            particles: species.total(),
+            box_length: l,
+            diameter: d,
+            pair: None,
+            kt: 1.0,
+            viscosity: 1.0,
+            friction,
+            d0: 1.0 / friction,
+            diffusion_time: d * d * friction,
+            phi: species.particle_volume() / l.powi(3),
+            species,
+            body_force,
+            force,
+            peclet: force * d,
+            dt: 0.002,
+            integrator: Integrator::Euler,
+            skin: 0.4,
+            equilibrate_steps: 0,
+            sampled_steps: 100,
+            steps: 100,
+            blocks: 1,
+            block_steps: 100,
+            msd_points: 4,
+            msd_max_lag: 25,
+            msd_origin_every: 3,
+            trajectory_every: 0,
+            initial: None,
+            hydrodynamics: rpy.then_some(HydroParams {
+                model: HydroModel::Rpy,
+                method: Some(HydroMethod::Pse),
+                tolerance: 1e-3,
+                splitting: 0.5 / (0.5 * d),
+                box_factor: 2.0,
+                max_iterations: 100,
+            }),
+            pse: None,
+        }
+    }
+
+    /// One species runs as the monodisperse bulk run did before species: random insertion of
+    /// one size, a constant force on every sphere, `Pse::new`; bit for bit, free draining and
+    /// with RPY.
+    #[test]
+    fn one_species_is_the_monodisperse_run_bit_for_bit() {
+        let p = params(Mixture::one(1.0, 60), 8.0, [0.0, 0.5, -3.0], false);
+        let start =
+            || Particles::monodisperse(random_in_box(60, 1.0, &p.sbox(), 7, 0).unwrap(), 1.0);
+        let mut before = Brownian::new(
+            start(),
+            p.sbox(),
+            p.pair().unwrap(),
+            ConstantForce(p.body_force),
+            p.bd_params(0),
+            0,
+        )
+        .unwrap();
+        let mut now = p.build_replica(0).unwrap();
+        before.run(300).unwrap();
+        now.run(300).unwrap();
+        assert_eq!(before.snapshot(), now.snapshot());
+
+        let p = params(Mixture::one(1.0, 30), 8.0, [0.0, 0.0, -3.0], true);
+        let h = p.hydrodynamics.clone().unwrap();
+        let mut before = HydroBrownian::new(
+            Particles::monodisperse(start().pos[..30].to_vec(), 1.0),
+            p.sbox(),
+            p.pair().unwrap(),
+            ConstantForce(p.body_force),
+            AnyMobility::Pse(Box::new(Pse::new(30, p.pse_params(&h)).unwrap())),
+            p.hydro_bd_params(0),
+            0,
+        )
+        .unwrap();
+        let mut now = p
+            .restart_hydro_replica(
+                Particles::monodisperse(start().pos[..30].to_vec(), 1.0),
+                p.hydro_bd_params(0),
+                0,
+            )
+            .unwrap();
+        before.run(20).unwrap();
+        now.run(20).unwrap();
+        assert_eq!(before.particles(), now.particles());
+    }
+
+    /// A mixture starts species by species with its typeids, names and diameters, every pair
+    /// apart by at least its mean diameter; the body force on each sphere is `F (d_i / d)^3`;
+    /// with RPY, PSE takes each sphere's radius.
+    #[test]
+    fn a_mixture_starts_with_its_species_and_pushes_by_volume() {
+        let p = params(
+            Mixture::new(vec![1.0, 2.0], vec![40, 10]),
+            10.0,
+            [0.0, 0.0, -2.0],
+            false,
+        );
+        let x = p.initial_particles(3).unwrap();
+        assert_eq!(x.typeid, p.species.typeids());
+        assert_eq!(x.diameter, p.species.particle_diameters());
+        assert_eq!(x.type_names, vec!["A".to_string(), "B".to_string()]);
+        let sbox = p.sbox();
+        for i in 0..x.len() {
+            for j in 0..i {
+                let v = sbox.min_image([
+                    x.pos[i][0] - x.pos[j][0],
+                    x.pos[i][1] - x.pos[j][1],
+                    x.pos[i][2] - x.pos[j][2],
+                ]);
+                let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                assert!(r >= 0.5 * (x.diameter[i] + x.diameter[j]), "{i} {j}: {r}");
+            }
+        }
+        let body = p.body();
+        assert_eq!(body.force_on([0.0; 3], 0.0, 1.0), [0.0, 0.0, -2.0]);
+        assert_eq!(body.force_on([0.0; 3], 0.0, 2.0), [0.0, 0.0, -16.0]);
+        assert_eq!(p.species_force(1), 16.0);
+        assert_eq!(body.energy_of([0.0, 0.0, 1.0], 0.0, 2.0), 16.0);
+        // Stokes: U_B = mu_B F_B = 16 / (6 pi) = 4 U_A.
+        let u = |s: usize| p.species_mobility(s) * p.species_force(s);
+        assert!((u(1) / u(0) - 4.0).abs() < 1e-14);
+        assert!((p.species_d0(1) - 0.5 * p.d0).abs() < 1e-16);
+        let mut sim = p.build_replica(0).unwrap();
+        sim.run(100).unwrap();
+        let mut rpy = params(p.species.clone(), 10.0, [0.0, 0.0, -2.0], true);
+        rpy.pse = None;
+        let mut h = rpy.build_hydro_replica(0).unwrap();
+        h.run(5).unwrap();
+        assert_eq!(h.particles().diameter, p.species.particle_diameters());
+    }
+
+    /// The virial pressure: an ideal gas (no pair within range) gives `N kT / V`; two spheres
+    /// at distance r across the periodic boundary add `r F(r) / (3V)`.
+    #[test]
+    fn the_virial_pressure_of_an_ideal_gas_and_of_one_pair() {
+        let p = params(Mixture::one(1.0, 2), 8.0, [0.0; 3], false);
+        let lj = PairSpec::Lj {
+            epsilon: vec![1.5],
+            cutoff: 2.5,
+        }
+        .build(&[1.0], 2.0)
+        .unwrap();
+        let v = 512.0;
+        let mut x = Particles::monodisperse(vec![[0.0, 0.0, 0.0], [3.0, 3.0, 3.0]], 1.0);
+        assert_eq!(
+            virial_pressure(&x, &p.sbox(), &lj, 2.0).unwrap(),
+            2.0 * 2.0 / v
+        );
+        // r = 1.1 through the face at x = +-4.
+        x.pos = vec![[-3.95, 0.2, 0.0], [2.95, 0.2, 0.0]];
+        let r: f64 = 0.55 + 0.55;
+        let f = 24.0 * 1.5 * (2.0 * r.powi(-13) - r.powi(-7));
+        let want = (2.0 * 2.0 + r * f / 3.0) / v;
+        let got = virial_pressure(&x, &p.sbox(), &lj, 2.0).unwrap();
+        assert!((got - want).abs() < 1e-14 * want.abs(), "{got} vs {want}");
+        // The engine's own snapshot: the same sum.
+        let sim = Brownian::new(
+            x.clone(),
+            p.sbox(),
+            lj.clone(),
+            NoExternal,
+            p.bd_params(0),
+            0,
+        )
+        .unwrap();
+        let again = p.pressure(&sim.snapshot(), &lj).unwrap();
+        let want = (2.0 * p.kt + r * f / 3.0) / v;
+        assert!(
+            (again - want).abs() < 1e-14 * want.abs(),
+            "{again} vs {want}"
+        );
     }
 }

@@ -40,6 +40,7 @@
 pub mod bulk;
 pub mod droplet;
 pub mod hydrodynamic;
+pub mod lj_eos;
 mod ranks;
 mod scenario;
 

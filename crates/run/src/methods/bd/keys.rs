@@ -15,7 +15,7 @@ use crate::keys::species::*;
 use crate::keys::{SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["bd"]),
-    "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE)");
+    "Brownian dynamics of spheres (one or more species, WCA or [pair]) in a periodic cube, free draining or with RPY (PSE)");
 
 pub const REPLICAS: Spec = key("replicas", "-", Value("1"), Integer(1, 1_000_000),
     "independent systems run one after the other, their blocks pooled (replica r: initial stream r, noise keyed by (seed, step, r, block))");
@@ -24,20 +24,20 @@ pub const SYSTEM: Spec = key("system", "-", Required, Table,
     "spheres, solvent, the periodic cube and the body force");
 
 pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-", Required, Integer(1, 100_000_000),
-    "number of spheres N");
+    "number of spheres N (of all species)");
 
 pub const SYSTEM_BOX_LENGTH: Spec = key("system.box_length", "length", Required, Positive,
     "edge L of the periodic cube")
-    .also("phi = N pi d^3 / (6 L^3) at most 0.3 (random insertion; 0.64 with system.initial); L > 2 (2^(1/6) d + run.skin); with RPY the PSE cut-off below L/2");
+    .also("phi = sum_s N_s pi d_s^3 / (6 L^3) at most 0.3 (random insertion; 0.64 with system.initial); L > 2 (2^(1/6) d + run.skin); with RPY the PSE cut-off below L/2");
 
 pub const SYSTEM_BODY_FORCE: Spec = key("system.body_force", "energy / length",
     Value("[0, 0, 0]"), Numbers(f64::MIN, f64::MAX, Some(3)),
-    "constant force F on every sphere (gravity less buoyancy): the mean velocity along it gives K = U / (mu0 F)")
-    .also("its drift F dt / (3 pi eta d) at most 0.1 d per step");
+    "constant force F on a sphere of diameter d (gravity less buoyancy), F (d_s / d)^3 on one of species s (the same density): the mean velocity along it gives K = U / (mu0 F), each species' U_s / (mu_s F_s)")
+    .also("its drift F dt / (3 pi eta d) at most 0.1 d per step (of the largest species, relative to its diameter)");
 
 pub const SYSTEM_INITIAL: Spec = key("system.initial", "-", Means("random insertion"), Path,
     "start every replica from the last frame of this GSD file (HOOMD schema) instead of random insertion")
-    .also("must hold system.particles spheres of typeid 0 in a cube of edge system.box_length");
+    .also("must hold system.particles spheres, with the typeids and counts of system.species (typeid 0 for one), in a cube of edge system.box_length");
 
 pub const RUN: Spec = key("run", "-", Required, Table, "time stepping");
 
@@ -55,7 +55,7 @@ pub const OBSERVE_BLOCKS: Spec = key("observe.blocks", "-", Value("8"), Integer(
 
 pub const OBSERVE_MSD: Spec = key("observe.msd", "-",
     Means("30 lags up to a quarter of a block"), Table,
-    "mean-square displacement of the unwrapped positions (about the centre of mass under a body force): msd.csv, msd.png");
+    "mean-square displacement of the unwrapped positions (about the centre of mass under a body force), and of each species: msd.csv, msd.png");
 
 pub const OBSERVE_MSD_POINTS: Spec = key("observe.msd.points", "-", Value("30"), Integer(2, 1000),
     "log-spaced lags from one step to max_lag");
@@ -78,6 +78,10 @@ pub static KEYS: &[Spec] = &[
     SYSTEM_PARTICLES,
     SYSTEM_BOX_LENGTH,
     DIAMETER,
+    SPECIES,
+    SPECIES_DIAMETERS,
+    SPECIES_COUNTS,
+    SPECIES_VOLUME_FRACTIONS,
     KT,
     VISCOSITY,
     SYSTEM_BODY_FORCE,

@@ -38,14 +38,19 @@ use colloidsim_core::msd::Msd;
 use colloidsim_core::output::OutputDir;
 use colloidsim_mc::observe::mean_and_error;
 use colloidsim_md::Brownian;
-use colloidsim_md::brownian::bulk::{BulkError, BulkParams};
-use colloidsim_particles::ConstantForce;
+use colloidsim_md::brownian::bulk::{BodyForce, BulkError, BulkParams};
+use colloidsim_md::brownian::lj_eos::{jzg_pressure, lj_tail_pressure};
+use colloidsim_particles::Interaction;
+use colloidsim_particles::PairSpec;
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use std::f64::consts::PI;
 
 /// Fewest blocks (over all replicas) from whose scatter an error is given.
 pub const MIN_BLOCKS: usize = 8;
+
+/// Virial-pressure samples per block (every `block_steps / 32` steps, at least every step).
+pub const PRESSURE_SAMPLES: u64 = 32;
 
 /// The bulk family of scenarios.
 pub struct BulkBd;
@@ -54,7 +59,7 @@ pub struct BulkBd;
 pub mod keys;
 pub mod params;
 
-type Replica = AnyReplica<ConstantForce>;
+type Replica = AnyReplica<BodyForce>;
 
 /// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
 /// replacing the scenario's.
@@ -123,7 +128,7 @@ impl Method for BulkBd {
     }
 
     fn about(&self) -> &'static str {
-        "Brownian dynamics of WCA spheres in a periodic cube, free draining or with RPY (PSE): MSD, self-diffusion and sedimentation under a body force beside Hasimoto"
+        "Brownian dynamics of spheres (one or more species, any pair interaction) in a periodic cube, free draining or with RPY (PSE): MSD, self-diffusion, sedimentation under a body force and the virial pressure, per species, beside Hasimoto and the LJ equation of state"
     }
 
     fn docs(&self) -> &'static str {
@@ -200,6 +205,14 @@ fn restore(
     if saved.replica >= p.replicas
         || saved.acc.velocities.len() > p.replicas * p.blocks
         || saved.acc.msd.iter().any(|m| m.len() != lags)
+        || saved
+            .acc
+            .species_velocities
+            .iter()
+            .any(|v| v.len() != p.species.len())
+        || saved.acc.species_msd.iter().any(|b| {
+            b.len() != p.species.len() || b.iter().any(|m| !m.is_empty() && m.len() != lags)
+        })
     {
         bail!(
             "checkpoint: replica {} with {} blocks does not fit the scenario",
@@ -239,7 +252,14 @@ fn restore_replica(
     state: &ReplicaState,
 ) -> Result<(Replica, u64)> {
     let hydro = p.has_hydrodynamics();
-    let f = read_replica_checkpoint(out, state, saved.step, saved.replica, hydro, &[p.diameter])?;
+    let f = read_replica_checkpoint(
+        out,
+        state,
+        saved.step,
+        saved.replica,
+        hydro,
+        &p.species.diameters,
+    )?;
     let path = out.join(&state.0);
     let engine = &state.2;
     let sim = if hydro {
@@ -275,6 +295,16 @@ struct Block {
     com: [f64; 3],
     /// MSD over the block's origins, per coordinate (`None` when no MSD is taken).
     msd: Option<Msd>,
+    /// Two or more species: each species' centre of mass (unwrapped) at the start.
+    #[serde(default)]
+    species_com: Vec<[f64; 3]>,
+    /// Two or more species: each species' MSD (about its own centre of mass under a body
+    /// force; none for a species of one sphere under a force).
+    #[serde(default)]
+    species_msd: Vec<Option<Msd>>,
+    /// The sum of the virial pressures sampled in the block, and their number.
+    #[serde(default)]
+    pressure: (f64, u64),
 }
 
 /// Everything a bulk run accumulates across replicas, saved in every checkpoint.
@@ -284,6 +314,16 @@ struct Accum {
     velocities: Vec<[f64; 3]>,
     /// Per finished block: the 3D MSD at each lag of [`BulkParams::msd_lags`].
     msd: Vec<Vec<f64>>,
+    /// Two or more species, per finished block: the velocity of each species' centre of mass.
+    #[serde(default)]
+    species_velocities: Vec<Vec<[f64; 3]>>,
+    /// Two or more species, per finished block: each species' 3D MSD at each lag (empty for
+    /// a species without an MSD).
+    #[serde(default)]
+    species_msd: Vec<Vec<Vec<f64>>>,
+    /// Per finished block: the mean virial pressure of its samples.
+    #[serde(default)]
+    pressures: Vec<f64>,
     /// The block under way.
     block: Option<Block>,
     /// Neighbour-list builds of the finished replicas.
@@ -302,6 +342,9 @@ impl Accum {
         Self {
             velocities: Vec::with_capacity(blocks),
             msd: Vec::with_capacity(blocks),
+            species_velocities: Vec::new(),
+            species_msd: Vec::new(),
+            pressures: Vec::with_capacity(blocks),
             block: None,
             builds: 0,
             frames: 0,
@@ -312,7 +355,7 @@ impl Accum {
 }
 
 /// A bulk run: replicas one after the other.
-type BulkSession = BdSession<ConstantForce, BulkObs>;
+type BulkSession = BdSession<BodyForce, BulkObs>;
 
 /// What a bulk run observes: blocks (the centre of mass, the MSD), trajectory frames.
 struct BulkObs {
@@ -327,6 +370,11 @@ struct BulkObs {
     unwrapped: Vec<[f64; 3]>,
     /// The MSD's coordinates (reused).
     coords: Vec<f64>,
+    /// The pair interaction (for the virial pressure).
+    pair: Interaction,
+    /// Two or more species: the input indices of each (particles are stored species by
+    /// species); empty for one.
+    ranges: Vec<std::ops::Range<usize>>,
 }
 
 impl BulkObs {
@@ -340,6 +388,8 @@ impl BulkObs {
     ) -> Result<BulkSession> {
         let lags = p.msd_lags();
         let msd_on = !(p.force > 0.0 && p.particles == 1);
+        let pair = p.pair()?;
+        let ranges = species_ranges(&p);
         Ok(BdSession::new(
             Replicas::new(p.steps, p.replicas, p.trajectory_every, rep, sim, comm)?,
             BulkObs {
@@ -349,8 +399,37 @@ impl BulkObs {
                 msd_on,
                 unwrapped: Vec::new(),
                 coords: Vec::new(),
+                pair,
+                ranges,
             },
         ))
+    }
+
+    /// Offer each species' MSD of the block the configuration in `self.unwrapped` at step
+    /// `s` (relative to the species' centre of mass `com[k]` when a body force acts).
+    fn sample_species_msd(&mut self, s: u64, com: &[[f64; 3]]) {
+        let relative = self.p.force > 0.0;
+        let Some(b) = self.acc.block.as_mut() else {
+            return;
+        };
+        for (k, m) in b.species_msd.iter_mut().enumerate() {
+            let Some(m) = m.as_mut() else {
+                continue;
+            };
+            self.coords.clear();
+            for u in &self.unwrapped[self.ranges[k].clone()] {
+                for a in 0..3 {
+                    self.coords
+                        .push(if relative { u[a] - com[k][a] } else { u[a] });
+                }
+            }
+            m.sample(s - b.start, &self.coords);
+        }
+    }
+
+    /// Steps between the virial-pressure samples of a block ([`PRESSURE_SAMPLES`] a block).
+    fn pressure_every(&self) -> u64 {
+        (self.p.block_steps / PRESSURE_SAMPLES).max(1)
     }
 
     /// Offer the block's MSD the configuration in `self.unwrapped` at step `s` (relative to
@@ -374,14 +453,14 @@ impl BulkObs {
     }
 }
 
-impl Observe<ConstantForce> for BulkObs {
+impl Observe<BodyForce> for BulkObs {
     fn build(&self, replica: u32) -> Result<Replica> {
         build_replica(&self.p, replica)
     }
 
     /// The start of sampling, the block's next MSD sample or its end, a trajectory frame, the
     /// end of the replica.
-    fn next_event(&self, run: &Replicas<ConstantForce>, s: u64) -> u64 {
+    fn next_event(&self, run: &Replicas<BodyForce>, s: u64) -> u64 {
         let p = &self.p;
         let mut next = p.steps;
         if s < p.equilibrate_steps {
@@ -392,6 +471,8 @@ impl Observe<ConstantForce> for BulkObs {
             if let Some(m) = &b.msd {
                 next = next.min(b.start + m.next_due(s + 1 - b.start));
             }
+            // The species' MSDs are due with the whole system's (the same lags and origins).
+            next = next.min(b.start + (s + 1 - b.start).next_multiple_of(self.pressure_every()));
         }
         if run.rep == 0 && p.trajectory_every > 0 {
             next = next.min((s / p.trajectory_every + 1) * p.trajectory_every);
@@ -401,7 +482,7 @@ impl Observe<ConstantForce> for BulkObs {
 
     /// Record what is due at step `s`: a trajectory frame, the block's MSD sample, the end of
     /// a block, the start of the next.
-    fn record(&mut self, run: &mut Replicas<ConstantForce>, s: u64) -> Result<()> {
+    fn record(&mut self, run: &mut Replicas<BodyForce>, s: u64) -> Result<()> {
         let Some((sim, _)) = &run.sim else {
             return Ok(());
         };
@@ -426,13 +507,32 @@ impl Observe<ConstantForce> for BulkObs {
                 .as_ref()
                 .is_some_and(|m| m.next_due(s - b.start) == s - b.start)
         });
-        if !boundary && !due {
+        let every = self.pressure_every();
+        // A pressure sample: at every `every` steps of the block under way, and at the start
+        // of the next.
+        let pressure_due = self.acc.block.as_ref().is_some_and(|b| {
+            let o = s - b.start;
+            o < block_steps && o.is_multiple_of(every)
+        }) || (boundary && k < sampled_steps);
+        if !boundary && !due && !pressure_due {
             return Ok(());
         }
+        let pressure = if pressure_due {
+            p.pressure(&sim.snapshot(), &self.pair)
+                .map_err(|e| anyhow::anyhow!("the virial pressure: {e}"))?
+        } else {
+            f64::NAN
+        };
         sim.unwrapped_into(&mut self.unwrapped);
         let com = centre(&self.unwrapped);
+        let species_com: Vec<[f64; 3]> = self
+            .ranges
+            .iter()
+            .map(|r| centre(&self.unwrapped[r.clone()]))
+            .collect();
         if due {
             self.sample_msd(s, com);
+            self.sample_species_msd(s, &species_com);
         }
         if boundary && k > 0 {
             // The block ends.
@@ -440,37 +540,101 @@ impl Observe<ConstantForce> for BulkObs {
             self.acc
                 .velocities
                 .push(std::array::from_fn(|i| (com[i] - b.com[i]) / block_time));
-            if let Some(m) = &b.msd {
-                let rows = m.rows();
-                let per_lag = self
-                    .lags
+            self.acc.pressures.push(if b.pressure.1 > 0 {
+                b.pressure.0 / b.pressure.1 as f64
+            } else {
+                f64::NAN
+            });
+            if !self.ranges.is_empty() {
+                self.acc.species_velocities.push(
+                    species_com
+                        .iter()
+                        .zip(&b.species_com)
+                        .map(|(c, c0)| std::array::from_fn(|i| (c[i] - c0[i]) / block_time))
+                        .collect(),
+                );
+                let per_species = b
+                    .species_msd
                     .iter()
-                    .map(|&lag| {
-                        rows.iter()
-                            .find(|r| r.0 == lag)
-                            .map_or(f64::NAN, |r| 3.0 * r.1)
-                    })
+                    .map(|m| m.as_ref().map_or_else(Vec::new, |m| self.per_lag(m)))
                     .collect();
+                self.acc.species_msd.push(per_species);
+            }
+            if let Some(m) = &b.msd {
+                let per_lag = self.per_lag(m);
                 self.acc.msd.push(per_lag);
             }
         }
         if boundary && k < sampled_steps {
             // The next block starts.
+            let force = self.p.force > 0.0;
             self.acc.block = Some(Block {
                 start: s,
                 com,
                 msd: self
                     .msd_on
                     .then(|| Msd::new(self.lags.clone(), origin_every)),
+                species_msd: self
+                    .ranges
+                    .iter()
+                    .map(|r| {
+                        (!(force && r.len() == 1))
+                            .then(|| Msd::new(self.lags.clone(), origin_every))
+                    })
+                    .collect(),
+                species_com,
+                pressure: (0.0, 0),
             });
             self.sample_msd(s, com);
+            let species_com = self
+                .acc
+                .block
+                .as_ref()
+                .map_or_else(Vec::new, |b| b.species_com.clone());
+            self.sample_species_msd(s, &species_com);
+        }
+        if pressure_due && let Some(b) = self.acc.block.as_mut() {
+            b.pressure.0 += pressure;
+            b.pressure.1 += 1;
         }
         Ok(())
     }
 
-    fn replica_done(&mut self, _run: &Replicas<ConstantForce>, builds: u64) -> Result<()> {
+    fn replica_done(&mut self, _run: &Replicas<BodyForce>, builds: u64) -> Result<()> {
         self.acc.builds += builds;
         Ok(())
+    }
+}
+
+/// The input indices of each species when there are two or more (stored species by species);
+/// none for one.
+fn species_ranges(p: &BulkParams) -> Vec<std::ops::Range<usize>> {
+    if p.species.is_single() {
+        return Vec::new();
+    }
+    let mut start = 0;
+    p.species
+        .counts
+        .iter()
+        .map(|&c| {
+            start += c;
+            start - c..start
+        })
+        .collect()
+}
+
+impl BulkObs {
+    /// The 3D MSD of `m` at each of the run's lags (NaN at a lag without samples).
+    fn per_lag(&self, m: &Msd) -> Vec<f64> {
+        let rows = m.rows();
+        self.lags
+            .iter()
+            .map(|&lag| {
+                rows.iter()
+                    .find(|r| r.0 == lag)
+                    .map_or(f64::NAN, |r| 3.0 * r.1)
+            })
+            .collect()
     }
 }
 
@@ -486,7 +650,7 @@ fn centre(x: &[[f64; 3]]) -> [f64; 3] {
     c.map(|s| s / n)
 }
 
-impl BdMethod<ConstantForce> for BulkObs {
+impl BdMethod<BodyForce> for BulkObs {
     type Acc = Accum;
 
     fn acc(&self) -> &Accum {
@@ -527,10 +691,19 @@ impl BdMethod<ConstantForce> for BulkObs {
         let r = Results::of(p, acc, lags, *msd_on);
         if let Some(m) = &r.msd {
             let t: Vec<f64> = lags.iter().map(|&l| l as f64 * p.dt).collect();
-            let mut cols: Vec<(&str, &[f64])> = vec![("t", &t), ("msd", &m.mean)];
+            let mut cols: Vec<(String, &[f64])> = vec![("t".into(), &t), ("msd".into(), &m.mean)];
             if let Some(e) = &m.err {
-                cols.push(("err", e));
+                cols.push(("err".into(), e));
             }
+            for (name, sm) in p.species.names.iter().zip(&r.species_msd) {
+                if let Some(sm) = sm {
+                    cols.push((format!("msd_{name}"), &sm.mean));
+                    if let Some(e) = &sm.err {
+                        cols.push((format!("err_{name}"), e));
+                    }
+                }
+            }
+            let cols: Vec<(&str, &[f64])> = cols.iter().map(|(n, c)| (n.as_str(), *c)).collect();
             out.write_table("msd.csv", &cols)?;
             files.push("msd.csv".into());
             msd_picture(out, p, &t, m, &mut files, &mut warnings);
@@ -548,7 +721,7 @@ impl BdMethod<ConstantForce> for BulkObs {
                 );
             }
         }
-        let summary = json!({
+        let mut summary = json!({
             "software": crate::software(),
             "method": "bd",
             "seed": p.seed,
@@ -560,6 +733,7 @@ impl BdMethod<ConstantForce> for BulkObs {
             "mean_velocity": r.velocity,
             "sedimentation_coefficient": r.sedimentation,
             "self_diffusion": r.diffusion,
+            "pressure": r.pressure,
             "references": references(p),
             "neighbor_list_builds": acc.builds,
             "wall_seconds": wall_s,
@@ -568,6 +742,9 @@ impl BdMethod<ConstantForce> for BulkObs {
             "trajectory_frames": acc.frames,
             "warnings": warnings,
         });
+        if let Some(species) = r.species {
+            summary["species"] = species;
+        }
         let message = format!(
             "{} replica(s) x {} steps of {} spheres in {wall_s:.1} s; {}; outputs in {}",
             p.replicas,
@@ -592,12 +769,179 @@ struct MsdTable {
     err: Option<Vec<f64>>,
 }
 
+impl MsdTable {
+    /// The mean over `blocks` (each the MSD at `lags` lags) and its error with two or more.
+    fn of(blocks: &[Vec<f64>], lags: usize) -> Self {
+        let m = blocks.len();
+        let mean: Vec<f64> = (0..lags)
+            .map(|j| blocks.iter().map(|b| b[j]).sum::<f64>() / m as f64)
+            .collect();
+        let err = (m >= 2).then(|| {
+            (0..lags)
+                .map(|j| {
+                    let v: Vec<f64> = blocks.iter().map(|b| b[j]).collect();
+                    mean_and_error(&v).1
+                })
+                .collect()
+        });
+        Self { mean, err }
+    }
+}
+
+/// The virial pressure `P = rho kT + (1/3V) sum_{i<j} r_ij . F_ij` ([`PRESSURE_SAMPLES`] a
+/// block), its block error, and for Lennard-Jones spheres of one species the equation of state
+/// of Johnson, Zollweg and Gubbins beside it with the tail correction of the cut-off.
+fn pressure_figure(p: &BulkParams, acc: &Accum, few: Option<&str>, coupled: bool) -> Value {
+    let v = p.box_length.powi(3);
+    let ideal = p.particles as f64 * p.kt / v;
+    let finite = acc.pressures.iter().all(|x| x.is_finite());
+    let why = few
+        .map(str::to_string)
+        .or_else(|| (!finite).then(|| "a block without a pressure sample".to_string()));
+    let pe = why.is_none().then(|| mean_and_error(&acc.pressures));
+    let note = (p.force > 0.0 && (coupled || !p.species.is_single())).then_some(
+        "under a body force with RPY or with species of different sizes the configurations are          not those of equilibrium: the pressure is that of the driven suspension",
+    );
+    let lj = match &p.pair {
+        Some(PairSpec::Lj { epsilon, cutoff }) if p.species.is_single() => {
+            let (eps, sigma) = (epsilon[0], p.diameter);
+            let rho = p.particles as f64 / v * sigma.powi(3);
+            let t = p.kt / eps;
+            let unit = eps / sigma.powi(3);
+            let jzg = jzg_pressure(rho, t) * unit;
+            let tail = lj_tail_pressure(rho, *cutoff) * unit;
+            json!({
+                "T_star": t,
+                "rho_star": rho,
+                "jzg_pressure": jzg,
+                "tail_correction": tail,
+                "pressure_with_tail": pe.map(|x| x.0 + tail),
+                "within_fit": (0.7..=6.0).contains(&t),
+                "definition": "the full LJ fluid's pressure by the equation of state of Johnson, Zollweg & Gubbins (Mol. Phys. 78, 591, 1993) at T* = kT/eps, rho* = rho d^3; the run's cut-and-shifted fluid plus the mean-field tail (16/3) pi rho^2 eps d^3 [(2/3)(d/rc)^9 - (d/rc)^3] compares with it",
+            })
+        }
+        _ => Value::Null,
+    };
+    json!({
+        "value": pe.map(|x| x.0),
+        "error": pe.map(|x| x.1),
+        "ideal": ideal,
+        "unit": "energy / length^3",
+        "samples_per_block": p.block_steps.div_ceil((p.block_steps / PRESSURE_SAMPLES).max(1)),
+        "definition": "P = N kT / V + (1/3V) sum_{i<j} r_ij . F_ij over the pairs within the cut-off, averaged over each block",
+        "note": note,
+        "lennard_jones": lj,
+        "why_null": why,
+    })
+}
+
+/// Each species' long-time self-diffusion (`D_s / D0_s`, `D0_s = kT / (3 pi eta d_s)`) from its
+/// MSD, and its mean velocity along the body force against Stokes' `mu_s F_s`.
+fn species_figures(p: &BulkParams, acc: &Accum, lags: &[u64], few: Option<&str>) -> Value {
+    let (lo, hi) = p.slope_lags();
+    let (ilo, ihi) = (
+        lags.iter().position(|&l| l == lo),
+        lags.iter().position(|&l| l == hi),
+    );
+    let interacting = p.particles > 1;
+    let list: Vec<Value> = (0..p.species.len())
+        .map(|k| {
+            let (n, dk) = (p.species.counts[k], p.species.diameters[k]);
+            let d0 = p.species_d0(k);
+            let tau = dk * dk / d0;
+            let nf = n as f64;
+            let com_factor = if p.force > 0.0 { nf / (nf - 1.0) } else { 1.0 };
+            let d_blocks: Vec<f64> = match (ilo, ihi) {
+                (Some(a), Some(b)) => acc
+                    .species_msd
+                    .iter()
+                    .filter_map(|m| m.get(k).filter(|m| !m.is_empty()))
+                    .map(|m| com_factor * (m[b] - m[a]) / (6.0 * (hi - lo) as f64 * p.dt) / d0)
+                    .collect(),
+                _ => Vec::new(),
+            };
+            let why_d = if p.force > 0.0 && n == 1 {
+                Some("one sphere of this species under a body force: its MSD about its species' centre of mass is zero".to_string())
+            } else if interacting && (lo as f64 * p.dt) < 0.25 * tau {
+                Some(format!(
+                    "the slope is taken between lags {:.4} and {:.4}; the long-time self-diffusion                      needs the shorter one at least a^2 / D0 = {:.4} of this species                      (observe.msd.max_lag at least d^2 / D0 = {tau:.4})",
+                    lo as f64 * p.dt,
+                    hi as f64 * p.dt,
+                    0.25 * tau
+                ))
+            } else if d_blocks.is_empty() {
+                Some("no block with an MSD".to_string())
+            } else {
+                few.map(str::to_string)
+            };
+            let d = why_d.is_none().then(|| mean_and_error(&d_blocks));
+            let why_u = few.map(str::to_string);
+            let comps: Option<Vec<(f64, f64)>> = why_u.is_none().then(|| {
+                (0..3)
+                    .map(|a| {
+                        let v: Vec<f64> = acc.species_velocities.iter().map(|u| u[k][a]).collect();
+                        mean_and_error(&v)
+                    })
+                    .collect()
+            });
+            let (mu, fk) = (p.species_mobility(k), p.species_force(k));
+            let why_k = if p.force == 0.0 {
+                Some("no body force (system.body_force)".to_string())
+            } else {
+                why_u.clone()
+            };
+            let along = why_k.is_none().then(|| {
+                let v: Vec<f64> = acc
+                    .species_velocities
+                    .iter()
+                    .map(|u| (0..3).map(|a| u[k][a] * p.body_force[a]).sum::<f64>() / p.force)
+                    .collect();
+                mean_and_error(&v)
+            });
+            let stokes = mu * fk;
+            json!({
+                "name": p.species.names[k],
+                "diameter": dk,
+                "count": n,
+                "self_diffusion": {
+                    "D_over_D0": d.map(|d| d.0),
+                    "error": d.map(|d| d.1),
+                    "D": d.map(|d| d.0 * d0),
+                    "D0": d0,
+                    "definition": "D0 = kT / (3 pi eta d_s); D from this species' MSD as the whole system's (about its own centre of mass under a body force, times N_s / (N_s - 1))",
+                    "why_null": why_d,
+                },
+                "velocity": {
+                    "value": comps.as_ref().map(|c| c.iter().map(|x| x.0).collect::<Vec<_>>()),
+                    "error": comps.as_ref().map(|c| c.iter().map(|x| x.1).collect::<Vec<_>>()),
+                    "along_force": along.map(|a| a.0),
+                    "along_force_error": along.map(|a| a.1),
+                    "stokes": (p.force > 0.0).then_some(stokes),
+                    "K": along.map(|a| a.0 / stokes),
+                    "K_error": along.map(|a| a.1 / stokes),
+                    "force": fk,
+                    "definition": "the mean velocity of this species' centre of mass; along the force against Stokes' U0 = mu_s F_s = F (d_s/d)^3 / (3 pi eta d_s), K = U / U0 (1 for free spheres free draining)",
+                    "why_null": why_u,
+                    "why_null_along_force": why_k,
+                },
+            })
+        })
+        .collect();
+    Value::Array(list)
+}
+
 /// The figures of a run with their errors and the reasons for any left out.
 struct Results {
     velocity: Value,
     sedimentation: Value,
     diffusion: Value,
+    /// The virial pressure.
+    pressure: Value,
+    /// Two or more species: each one's diffusion and sedimentation.
+    species: Option<Value>,
     msd: Option<MsdTable>,
+    /// Two or more species: each one's MSD table (`None` for a species without one).
+    species_msd: Vec<Option<MsdTable>>,
     /// One line for the message.
     headline: String,
 }
@@ -665,7 +1009,7 @@ impl Results {
             "K": k.map(|k| k.0),
             "error": k.map(|k| k.1),
             "definition": "K = U / (mu0 F): the mean velocity along the force over the Stokes velocity of one sphere",
-            "dilute_reference": p.dilute_sedimentation(),
+            "dilute_reference": p.species.is_single().then(|| p.dilute_sedimentation()),
             "why_null": why_k,
         });
 
@@ -688,7 +1032,12 @@ impl Results {
             _ => Vec::new(),
         };
         let interacting = p.particles > 1;
-        let why_d = if !msd_on {
+        let why_d = if !p.species.is_single() && p.force > 0.0 {
+            Some(
+                "species of different sizes drift apart under the body force: the MSD about the common centre of mass grows with their relative drift; each species' D is in species[]"
+                    .to_string(),
+            )
+        } else if !msd_on {
             Some(
                 "one sphere under a body force: its displacement is the mean velocity, its MSD about the centre of mass is zero"
                     .to_string(),
@@ -727,21 +1076,20 @@ impl Results {
             "why_null": why_d,
         });
 
-        let msd = (msd_on && !acc.msd.is_empty()).then(|| {
-            let m = acc.msd.len();
-            let mean: Vec<f64> = (0..lags.len())
-                .map(|j| acc.msd.iter().map(|b| b[j]).sum::<f64>() / m as f64)
-                .collect();
-            let err = (m >= 2).then(|| {
-                (0..lags.len())
-                    .map(|j| {
-                        let v: Vec<f64> = acc.msd.iter().map(|b| b[j]).collect();
-                        mean_and_error(&v).1
-                    })
-                    .collect()
-            });
-            MsdTable { mean, err }
-        });
+        let msd = (msd_on && !acc.msd.is_empty()).then(|| MsdTable::of(&acc.msd, lags.len()));
+        let species_msd: Vec<Option<MsdTable>> = (0..p.species.len())
+            .map(|k| {
+                let blocks: Vec<Vec<f64>> = acc
+                    .species_msd
+                    .iter()
+                    .filter_map(|b| b.get(k).filter(|m| !m.is_empty()).cloned())
+                    .collect();
+                (!blocks.is_empty()).then(|| MsdTable::of(&blocks, lags.len()))
+            })
+            .collect();
+        let pressure = pressure_figure(p, acc, few.as_deref(), coupled);
+        let species =
+            (!p.species.is_single()).then(|| species_figures(p, acc, lags, few.as_deref()));
         let mut parts = Vec::new();
         if let Some((k, e)) = k {
             parts.push(if p.has_hydrodynamics() {
@@ -764,6 +1112,9 @@ impl Results {
                 format!("D/D0 = {d:.4} +- {e:.4} (free draining, one sphere: 1)")
             });
         }
+        if let Some((v, e)) = pressure["value"].as_f64().zip(pressure["error"].as_f64()) {
+            parts.push(format!("P = {v:.4} +- {e:.4}"));
+        }
         if parts.is_empty() {
             parts.push("no figure long enough to report (summary.json says why)".into());
         }
@@ -771,7 +1122,10 @@ impl Results {
             velocity: velocity_json,
             sedimentation,
             diffusion,
+            pressure,
+            species,
             msd,
+            species_msd,
             headline: parts.join(", "),
         }
     }

@@ -14,7 +14,7 @@ use colloidsim_core::param::show;
 use colloidsim_md::brownian::bulk::{BulkParams, MAX_BODY_DRIFT, WCA_RANGE};
 use colloidsim_md::brownian::droplet::{MAX_PHI_FINAL, MAX_PHI0};
 use colloidsim_md::hydro::{HydroError, HydroModel, PseGeometry};
-use colloidsim_particles::{Mixture, Pair};
+use colloidsim_particles::Pair;
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -53,10 +53,13 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         friction,
         d0,
     } = shared::spheres(r)?;
+    let species = crate::keys::species::species(r, particles, d, &shared::DIAMETER)?;
     let l = r.number(&SYSTEM_BOX_LENGTH)?;
     let initial = r.file(&SYSTEM_INITIAL).map(|f| base.join(f));
     let n = particles as f64;
-    let phi = n * PI * d.powi(3) / (6.0 * l.powi(3));
+    // Spheres of diameter d with the particles' volume (N for one species).
+    let n_equivalent = species.equivalent_number(d);
+    let phi = n_equivalent * PI * d.powi(3) / (6.0 * l.powi(3));
     // Random insertion packs to MAX_PHI0; a configuration read from a file may be denser.
     let (max_phi, how) = if initial.is_some() {
         (MAX_PHI_FINAL, "random close packing")
@@ -70,11 +73,15 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         bail!(ParamError::new(
             SYSTEM_BOX_LENGTH.path,
             format!(
-                "{particles} spheres of diameter {} in a cube of edge {} give phi = {phi:.4}, \
+                "{particles} spheres of {} in a cube of edge {} give phi = {phi:.4}, \
                  above {max_phi} ({how}); the edge must be at least {:.4}",
-                show(d),
+                if species.is_single() {
+                    format!("diameter {}", show(d))
+                } else {
+                    format!("diameters {:?}", species.diameters)
+                },
                 show(l),
-                d * (n * PI / (6.0 * max_phi)).cbrt()
+                d * (n_equivalent * PI / (6.0 * max_phi)).cbrt()
             ),
         ));
     }
@@ -83,10 +90,11 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
     let time = r.number(&RUN_TIME)?;
     let equilibrate = r.number(&RUN_EQUILIBRATE)?;
     let skin = within(&RUN_SKIN, r.number(&RUN_SKIN)?, 1e-3 * d, 5.0 * d)?;
-    let pair = crate::keys::species::pair(r, &Mixture::one(d, particles), kt, base)?;
+    let pair = crate::keys::species::pair(r, &species, kt, base)?;
+    let d_max = species.d_max();
     let r_cut = match &pair {
-        Some(spec) => spec.build(&[d], kt)?.r_cut_max(),
-        None => WCA_RANGE * d,
+        Some(spec) => spec.build(&species.diameters, kt)?.r_cut_max(),
+        None => WCA_RANGE * d_max,
     };
     let range = r_cut + skin;
     if l <= 2.0 * range {
@@ -139,17 +147,39 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         ));
     }
     let force = body_force.iter().map(|f| f * f).sum::<f64>().sqrt();
-    let drift = force * dt / friction;
-    if drift > MAX_BODY_DRIFT * d {
+    // The largest spheres move the most for their size: F (D/d)^3 dt / (3 pi eta D) against
+    // 0.1 D (one species: F dt / (3 pi eta d) against 0.1 d).
+    let ratio = d_max / d;
+    let scale = if species.is_single() {
+        1.0
+    } else {
+        ratio * ratio
+    };
+    let drift = force * scale * dt / friction;
+    if drift > MAX_BODY_DRIFT * d_max {
+        let (what, limit) = if species.is_single() {
+            (
+                "F dt / (3 pi eta d)".to_string(),
+                format!("{MAX_BODY_DRIFT} d"),
+            )
+        } else {
+            (
+                format!(
+                    "F (D/d)^3 dt / (3 pi eta D) for the largest spheres, D = {}",
+                    show(d_max)
+                ),
+                format!("{MAX_BODY_DRIFT} D"),
+            )
+        };
         bail!(ParamError::new(
             SYSTEM_BODY_FORCE.path,
             format!(
-                "a force of magnitude {} moves a sphere {} per step of run.dt = {} (F dt / (3 pi eta d)), \
-                 more than {MAX_BODY_DRIFT} d: at most {:.4e} at this time step, or a smaller run.dt",
+                "a force of magnitude {} moves a sphere {} per step of run.dt = {} ({what}), \
+                 more than {limit}: at most {:.4e} at this time step, or a smaller run.dt",
                 show(force),
                 show(drift),
                 show(dt),
-                MAX_BODY_DRIFT * d * friction / dt
+                MAX_BODY_DRIFT * d_max * friction / (scale * dt)
             ),
         ));
     }
@@ -185,6 +215,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         particles,
         box_length: l,
         diameter: d,
+        species,
         pair,
         kt,
         viscosity: eta,
@@ -218,17 +249,25 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
             &SYSTEM_BOX_LENGTH
         };
         h.check_pse_extent(l, key.path)?;
-        let g = PseGeometry::new(&p.pse_params(h)).map_err(|e| match e {
-            HydroError::Param(e) => rekey(e, ENGINE_NAMES),
-            other => ParamError::new(HYDRODYNAMICS.path, other.to_string()),
-        })?;
+        // PSE's radii are the species' when there are several.
+        let single = p.species.is_single();
+        let g =
+            PseGeometry::with_radii(&p.pse_params(h), &p.species_radii()).map_err(|e| match e {
+                HydroError::Param(e) if e.key == "radius" && !single => {
+                    rekey(e, &[("radius", &crate::keys::species::SPECIES_DIAMETERS)])
+                }
+                HydroError::Param(e) => rekey(e, ENGINE_NAMES),
+                other => ParamError::new(HYDRODYNAMICS.path, other.to_string()),
+            })?;
         p.pse = Some(g);
     }
     // Memory before anything is allocated: about 400 B per particle (state, lists,
     // copies), 24 B per neighbour cell, the stored MSD origins, the PSE grids and lists.
     let cells = (l / range).powi(3);
     let origins = (msd_max_lag / msd_origin_every + 2) as f64;
-    let pse = p.pse.map_or(0.0, |g| g.grid_bytes() as f64 + 4.1e3 * n);
+    let pse = p.pse.map_or(0.0, |g| {
+        g.grid_bytes() as f64 + g.species_bytes(p.species.len()) as f64 + 4.1e3 * n
+    });
     colloidsim_core::resources::ensure_fits(
         SYSTEM_PARTICLES.path,
         &format!(
