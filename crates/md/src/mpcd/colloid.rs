@@ -2165,6 +2165,221 @@ mod tests {
     /// [`one_species_reproduces_the_single_size_model_bitwise`] on the code before species.
     const DIGEST_BEFORE_SPECIES: u64 = 0x1b96_f31b_df16_6364;
 
+    /// Geodesic shells of every frequency: `10 f^2 + 2` unit vertices (12 of degree 5, the
+    /// rest 6), `30 f^2` edges between nearest neighbours; scaled to `d = f d_min / 2` their
+    /// shortest and longest edges stay near the smallest shell's (the net is as fine).
+    #[test]
+    fn geodesic_shells_keep_the_vertex_spacing_of_the_smallest() {
+        let small = Geometry::geodesic(2);
+        let lengths = |g: &Geometry| -> (f64, f64) {
+            g.edges
+                .iter()
+                .map(|&[i, j]| dist(g.vertices[i], g.vertices[j]))
+                .fold((f64::INFINITY, 0f64), |(a, b), r| (a.min(r), b.max(r)))
+        };
+        let (lo2, hi2) = lengths(&small);
+        for f in 1..=MAX_FREQUENCY {
+            let g = Geometry::geodesic(f);
+            assert_eq!(g.vertices.len(), Geometry::vertex_count(f), "{f}");
+            assert_eq!(g.edges.len(), 30 * f * f, "{f}");
+            let mut degree = vec![0usize; g.vertices.len()];
+            for &[i, j] in &g.edges {
+                assert!(i < j);
+                degree[i] += 1;
+                degree[j] += 1;
+            }
+            assert_eq!(degree.iter().filter(|&&k| k == 5).count(), 12, "{f}");
+            assert!(degree.iter().all(|&k| k == 5 || k == 6), "{f}");
+            assert!(
+                g.vertices
+                    .iter()
+                    .all(|v| (dist(*v, [0.0; 3]) - 1.0).abs() < 1e-14)
+            );
+            // On a shell of diameter f/2 times the smallest's: edges within 25 % of its.
+            let (lo, hi) = lengths(&g);
+            let scale = f as f64 / 2.0;
+            assert!(
+                lo * scale > 0.75 * lo2 && hi * scale < 1.25 * hi2,
+                "{f}: {lo} {hi}"
+            );
+        }
+        assert_eq!(Geometry::frequency_for(4.0, 4.0), 2);
+        assert_eq!(Geometry::frequency_for(8.0, 4.0), 4);
+        assert_eq!(Geometry::frequency_for(6.0, 4.0), 3);
+        assert_eq!(Geometry::frequency_for(16.0, 4.0), 8);
+    }
+
+    /// Two species, A (d = 2) and B (d = 4), in a drying droplet with a slip or a no-slip
+    /// wall: the B shells have 162 vertices; placement and the run keep every pair apart at
+    /// its contact distance (d_a + d_b) / 2 (to within the WCA's soft core at eps = kT) and
+    /// every colloid's surface inside the interface (the SpeciesInterface shift); the shape
+    /// holds.
+    #[test]
+    fn a_bidisperse_droplet_keeps_contacts_and_surfaces_inside() {
+        use crate::mpcd::WallKind;
+        use crate::potential::SphereAreaLaw;
+        let r0 = 7.0;
+        let mix = Mixture::new(vec![2.0, 4.0], vec![16, 4]);
+        let law = SphereAreaLaw { r0, alpha: 30.0 };
+        for kind in [WallKind::Slip, WallKind::NoSlip] {
+            let conf = Confinement::Sphere { law, kind };
+            let p = SrdParams::standard(31);
+            let sbox = SimBox::cube(18.0);
+            let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
+            let c = DiscreteColloids::random_mixture(
+                ColloidParams::standard(2.0, p.kt),
+                &mix,
+                sbox,
+                Region::Sphere { radius: r0 },
+                p.kt,
+                31,
+            )
+            .unwrap();
+            assert_eq!(c.vertices_of_species(1), 162);
+            assert_eq!(c.particle_count(), 16 * 43 + 4 * 163);
+            let interface = HarmonicInterface {
+                centre: [0.0; 3],
+                radius: law,
+                stiffness: 100.0,
+                range: 1.0,
+                offset: -1.0,
+            };
+            let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+            // The closest pair over its contact distance, the farthest surface beyond R(t).
+            let check = |sys: &MpcdSystem| -> (f64, f64) {
+                let c = &sys.colloids;
+                let (x, d) = (c.centre_positions(), c.diameters());
+                let r = law.radius(sys.time());
+                let (mut closest, mut beyond) = (f64::INFINITY, f64::NEG_INFINITY);
+                for i in 0..x.len() {
+                    beyond = beyond.max(dist(x[i], [0.0; 3]) + 0.5 * d[i] - r);
+                    for j in i + 1..x.len() {
+                        closest = closest.min(dist(x[i], x[j]) / (0.5 * (d[i] + d[j])));
+                    }
+                }
+                (closest, beyond)
+            };
+            let (mut closest, mut beyond) = check(&sys);
+            assert!(closest >= 1.0 && beyond <= 0.0, "{closest} {beyond}");
+            for _ in 0..100 {
+                sys.step(&Acceleration::None).unwrap();
+                let (c, b) = check(&sys);
+                (closest, beyond) = (closest.min(c), beyond.max(b));
+            }
+            let r = law.radius(sys.time());
+            assert!(r < 0.75 * r0, "{r}");
+            eprintln!(
+                "{kind:?}: closest pair / contact {closest:.3}, surface beyond R {beyond:.3}"
+            );
+            assert!(closest > 0.8, "{kind:?}: {closest}");
+            // The spring lets a surface out by a fraction of d_min (the fast drying presses).
+            assert!(beyond < 0.4 * 2.0, "{kind:?}: {beyond}");
+            assert!(sys.colloids.bond_strain_rms() < 0.03);
+        }
+    }
+
+    /// The forces of a mixture at rest in its ideal shapes: the WCA of an A-B pair reaches to
+    /// `2^(1/6) (d_A + d_B) / 2` and no further; the interface pulls each centre back as soon
+    /// as its colloid's SURFACE passes the wall (`k s` with `s` the surface's excursion).
+    #[test]
+    fn mixture_forces_act_at_the_pairs_contact_and_at_each_surface() {
+        let mix = Mixture::new(vec![2.0, 4.0], vec![1, 1]);
+        let cp = ColloidParams::standard(2.0, 1.0);
+        let sbox = SimBox::cube(30.0);
+        let rc = 2f64.powf(1.0 / 6.0) * 3.0;
+        for (gap, acting) in [(0.999, true), (1.001, false)] {
+            let x = [[0.0; 3], [rc * gap, 0.0, 0.0]];
+            let c = DiscreteColloids::new_mixture(cp, &mix, sbox, &x, 1.0, 3).unwrap();
+            let f = c.forces_at(0.0, &NoExternal);
+            assert_eq!(f[0][0] < -1e-6, acting, "{gap}: {:?}", f[0]);
+        }
+        // The wall for the small ones at R - d_A/2 (offset -1), shifted to R - d_B/2 for B.
+        let interface = SpeciesInterface {
+            interface: HarmonicInterface {
+                centre: [0.0; 3],
+                radius: crate::potential::SphereAreaLaw {
+                    r0: 12.0,
+                    alpha: 0.0,
+                },
+                stiffness: 100.0,
+                range: 1.0,
+                offset: -1.0,
+            },
+            reference_diameter: 2.0,
+        };
+        let x = [[0.0, 0.0, 12.0 - 1.0 + 0.3], [12.0 - 2.0 + 0.3, 0.0, 0.0]];
+        let c = DiscreteColloids::new_mixture(cp, &mix, sbox, &x, 1.0, 3).unwrap();
+        let f = c.forces_at(0.0, &interface);
+        assert!((f[0][2] + 30.0).abs() < 1e-6, "{:?}", f[0]);
+        assert!((f[1][0] + 30.0).abs() < 1e-6, "{:?}", f[1]);
+    }
+
+    /// A mixture restarts bitwise from its state; a state of other species counts is refused;
+    /// so are a shell beyond MAX_FREQUENCY and a reference diameter that is not the smallest.
+    #[test]
+    fn mixtures_restart_bitwise_and_unsupported_ones_are_refused() {
+        let mix = Mixture::new(vec![2.0, 3.0], vec![5, 3]);
+        let sbox = SimBox::cube(14.0);
+        let p = SrdParams::standard(9);
+        let cp = ColloidParams::standard(2.0, p.kt);
+        let build = || {
+            let srd = Srd::new(p, sbox, &Confinement::None, 0.0).unwrap();
+            let c = DiscreteColloids::random_mixture(cp, &mix, sbox, Region::Box, p.kt, 9).unwrap();
+            MpcdSystem::new(srd, c, Confinement::None, None).unwrap()
+        };
+        let mut one = build();
+        for _ in 0..10 {
+            one.step(&Acceleration::None).unwrap();
+        }
+        let mut first = build();
+        for _ in 0..5 {
+            first.step(&Acceleration::None).unwrap();
+        }
+        let state = first.colloids.state();
+        assert_eq!(state.species_counts, vec![5, 3]);
+        let srd = Srd::from_raw(
+            p,
+            sbox,
+            &first.srd.raw_positions(),
+            &first.srd.velocities(),
+            first.srd.step(),
+        )
+        .unwrap();
+        let c = DiscreteColloids::from_state_mixture(cp, &mix, sbox, &state).unwrap();
+        let mut two = MpcdSystem::new(srd, c, Confinement::None, None).unwrap();
+        for _ in 0..5 {
+            two.step(&Acceleration::None).unwrap();
+        }
+        assert_eq!(one.colloids.state(), two.colloids.state());
+        assert_eq!(bits(&one.srd.velocities()), bits(&two.srd.velocities()));
+        let other = Mixture::new(vec![2.0, 3.0], vec![4, 4]);
+        let e = DiscreteColloids::from_state_mixture(cp, &other, sbox, &state).unwrap_err();
+        assert!(e.to_string().contains("species of [5, 3]"), "{e}");
+        let big = Mixture::new(vec![2.0, 8.6], vec![1, 1]);
+        let e = DiscreteColloids::new_mixture(
+            cp,
+            &big,
+            SimBox::cube(30.0),
+            &[[0.0; 3], [10.0, 0.0, 0.0]],
+            1.0,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("frequency 9, at most 8"), "{e}");
+        let e = DiscreteColloids::new_mixture(
+            ColloidParams::standard(3.0, 1.0),
+            &mix,
+            sbox,
+            &[[0.0; 3]; 8],
+            1.0,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("smallest species diameter 2"), "{e}");
+    }
+
     /// Mean and standard error of a correlated series from `blocks` block means.
     fn block_mean(x: &[f64], blocks: usize) -> (f64, f64) {
         let len = x.len() / blocks;
