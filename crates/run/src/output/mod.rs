@@ -5,6 +5,7 @@
 //! reason, are `colloidsim_core::output`'s, which the engine crates use too.
 
 pub mod plot;
+pub mod species;
 pub mod trajectory;
 
 /// File name of the profile at `fraction` of the drying time: `profile_0.25.csv` (two decimals,

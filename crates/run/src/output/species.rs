@@ -1,20 +1,40 @@
-//! What a droplet of two or more species adds to a `droplet-bd` run: per-species profiles with
-//! their errors over the replicas (`species_profile_<fraction>.csv`, `species_profiles.png`)
-//! and the stratification measures of [`colloidsim_analysis::stratification`] at every profile
-//! time (`stratification.csv`, `stratification.png`, `stratification` in summary.json).
+//! What a droplet of two or more species adds to a drying run (`droplet-bd`, `droplet-mpcd`):
+//! per-species profiles with their errors over the replicas (`species_profile_<fraction>.csv`,
+//! `species_profiles.png`) and the stratification measures of
+//! [`colloidsim_analysis::stratification`] at every profile time (`stratification.csv`,
+//! `stratification.png`, `stratification` in summary.json).
 
 use crate::output::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::output::profile_name;
 use anyhow::Result;
 use colloidsim_analysis::stratification;
 use colloidsim_core::output::OutputDir;
-use colloidsim_md::DropletParams;
-use colloidsim_particles::Particles;
+use colloidsim_particles::Mixture;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
-/// Why an error over the replicas is missing.
-const ONE_REPLICA: &str = "one replica: no spread to estimate an error from (set replicas >= 2)";
+/// Why an error over the replicas is missing (droplet-bd).
+pub const ONE_REPLICA: &str =
+    "one replica: no spread to estimate an error from (set replicas >= 2)";
+
+/// What the species outputs need to know of a drying run.
+#[derive(Debug, Clone)]
+pub struct SpeciesRun<'a> {
+    /// The species.
+    pub mixture: &'a Mixture,
+    /// Radial bins of the profiles.
+    pub bins: usize,
+    /// Fractions of the drying time at which profiles are taken.
+    pub fractions: &'a [f64],
+    /// Time of each profile.
+    pub times: Vec<f64>,
+    /// Droplet radius at each of those times.
+    pub radii: Vec<f64>,
+    /// Replicas of the run.
+    pub replicas: usize,
+    /// Why an error over the replicas is missing with one (the method's advice).
+    pub one_replica: &'static str,
+}
 /// Why a shell enrichment is missing.
 const EMPTY_SHELL: &str =
     "no centre in the outer shell R - d_large < r, or no small sphere in the droplet";
@@ -25,7 +45,7 @@ const FEW_SHELLS: &str =
 
 /// Per profile fraction, what the replicas that reached it gave (saved in checkpoints).
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
-pub(super) struct SpeciesAccum {
+pub struct SpeciesAccum {
     /// `[fraction][species][bin]`: sum over replicas of the species' volume fraction.
     sums: Vec<Vec<Vec<f64>>>,
     /// The same, of its square.
@@ -36,9 +56,18 @@ pub(super) struct SpeciesAccum {
 }
 
 impl SpeciesAccum {
-    /// Record the configuration `part` at profile `j` (radius `radius`).
-    pub(super) fn record(&mut self, p: &DropletParams, j: usize, part: &Particles, radius: f64) {
-        let n = p.species.len();
+    /// Record the spheres at `pos` (diameters `diameter`, species `typeid`) at profile `j`
+    /// (radius `radius`).
+    pub fn record(
+        &mut self,
+        p: &SpeciesRun,
+        j: usize,
+        pos: &[[f64; 3]],
+        diameter: &[f64],
+        typeid: &[u32],
+        radius: f64,
+    ) {
+        let n = p.mixture.len();
         if n < 2 {
             return;
         }
@@ -48,14 +77,7 @@ impl SpeciesAccum {
             self.squares = self.sums.clone();
             self.measures = vec![Vec::new(); k];
         }
-        let s = stratification(
-            &part.pos,
-            &part.diameter,
-            &part.typeid,
-            &p.species.diameters,
-            radius,
-            p.bins,
-        );
+        let s = stratification(pos, diameter, typeid, &p.mixture.diameters, radius, p.bins);
         for (sp, phi) in s.phi.iter().enumerate() {
             for (b, x) in phi.iter().enumerate() {
                 self.sums[j][sp][b] += x;
@@ -74,10 +96,10 @@ impl SpeciesAccum {
     /// Write the files of the profiles `drawn` (indices of fractions reached by `counts[j]`
     /// replicas, at droplet radii `radii`, on shells `r_axes`); the final stratification for
     /// summary.json (`Null` with one species).
-    pub(super) fn write(
+    pub fn write(
         &self,
         out: &OutputDir,
-        p: &DropletParams,
+        p: &SpeciesRun,
         drawn: &[usize],
         counts: &[u64],
         radii: &[f64],
@@ -85,10 +107,10 @@ impl SpeciesAccum {
         files: &mut Vec<String>,
         warnings: &mut Vec<String>,
     ) -> Result<serde_json::Value> {
-        if p.species.len() < 2 || self.sums.is_empty() || drawn.is_empty() {
+        if p.mixture.len() < 2 || self.sums.is_empty() || drawn.is_empty() {
             return Ok(serde_json::Value::Null);
         }
-        let names = &p.species.names;
+        let names = &p.mixture.names;
         let mean_err = |sum: f64, sq: f64, m: f64| {
             let mean = sum / m;
             let var = (sq / m - mean * mean).max(0.0) * m / (m - 1.0);
@@ -123,7 +145,7 @@ impl SpeciesAccum {
             out.write_table(&name, &refs)?;
             if m < 2.0 {
                 for sname in names {
-                    out.explain(&name, &format!("err_{sname}"), ONE_REPLICA);
+                    out.explain(&name, &format!("err_{sname}"), p.one_replica);
                 }
             }
             files.push(name);
@@ -146,8 +168,7 @@ impl SpeciesAccum {
         let mut rows = Vec::new();
         let mut last = Vec::new();
         for &j in drawn {
-            let t = (p.fractions[j] * p.steps as f64).round() * p.dt;
-            let mut row = vec![p.fractions[j], t, p.radius_at(t)];
+            let mut row = vec![p.fractions[j], p.times[j], p.radii[j]];
             last.clear();
             for k in 0..n + 3 {
                 let v: Vec<f64> = self.measures[j]
@@ -178,7 +199,7 @@ impl SpeciesAccum {
                 let why = match (h.starts_with("shell_enrichment"), h.ends_with("_err")) {
                     (true, false) => EMPTY_SHELL,
                     (true, true) => FEW_SHELLS,
-                    _ => ONE_REPLICA,
+                    _ => p.one_replica,
                 };
                 out.explain("stratification.csv", h, why);
             }
@@ -200,7 +221,7 @@ impl SpeciesAccum {
                 &format!(
                     "Species profiles: {} (diameters {:?}), {} replica(s)",
                     names.join(", "),
-                    p.species.diameters,
+                    p.mixture.diameters,
                     p.replicas
                 ),
                 "r / R(t)",
