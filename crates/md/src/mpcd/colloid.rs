@@ -23,9 +23,12 @@
 use super::boundary::Confinement;
 use super::srd::{Acceleration, CollisionStats, Embedded, Srd, StreamStats};
 use super::{Draw, MpcdError, draw};
-use crate::potential::{External, HarmonicInterface, LennardJones, NoExternal, Pair};
+use crate::potential::{
+    External, HarmonicInterface, LennardJones, LjParams, NoExternal, Pair, SpeciesInterface,
+};
 use crate::state::SimBox;
 use colloidsim_core::rng::Ziggurat;
+use colloidsim_particles::Mixture;
 use rand::RngExt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -119,6 +122,108 @@ impl Geometry {
     }
 }
 
+/// Highest subdivision frequency of a shell ([`Geometry::geodesic`]): 642 vertices, a size
+/// ratio up to 4.25 against the smallest species.
+pub const MAX_FREQUENCY: usize = 8;
+
+impl Geometry {
+    /// The icosahedron's faces cut into `frequency^2` triangles (class-I geodesic sphere): on
+    /// each face the points `A + (a (B - A) + b (C - A)) / frequency` (`a, b >= 0`,
+    /// `a + b <= frequency`) projected onto the unit sphere, neighbours on the triangular grid
+    /// bonded: `10 f^2 + 2` vertices (the 12 of the icosahedron first) and `30 f^2` edges.
+    /// Frequency 2 is [`Self::subdivided_icosahedron`] itself (the single-size model, bit for
+    /// bit).
+    pub fn geodesic(frequency: usize) -> Self {
+        assert!(
+            (1..=MAX_FREQUENCY).contains(&frequency),
+            "frequency 1..={MAX_FREQUENCY}"
+        );
+        if frequency == 2 {
+            return Self::subdivided_icosahedron();
+        }
+        let base = Self::subdivided_icosahedron();
+        let ico = &base.vertices[..12];
+        let dist2 = |a: [f64; 3], b: [f64; 3]| {
+            (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+        };
+        // Unit-sphere icosahedron edges: the 12 corners' nearest neighbours.
+        let edge2 = (0..12)
+            .flat_map(|i| (i + 1..12).map(move |j| (i, j)))
+            .map(|(i, j)| dist2(ico[i], ico[j]))
+            .fold(f64::INFINITY, f64::min);
+        let adjacent = |i: usize, j: usize| (dist2(ico[i], ico[j]) - edge2).abs() < 1e-9;
+        let f = frequency as f64;
+        let mut vertices: Vec<[f64; 3]> = ico.to_vec();
+        // Points met on several faces (edges, corners) are found again by their rounded position.
+        let key = |v: [f64; 3]| v.map(|x| (x * 1e9).round() as i64);
+        let mut index: std::collections::BTreeMap<[i64; 3], usize> = vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (key(*v), i))
+            .collect();
+        let mut edges = std::collections::BTreeSet::new();
+        for i in 0..12 {
+            for j in i + 1..12 {
+                for k in j + 1..12 {
+                    if !(adjacent(i, j) && adjacent(j, k) && adjacent(i, k)) {
+                        continue;
+                    }
+                    let (a, b, c) = (ico[i], ico[j], ico[k]);
+                    let mut point = |u: usize, w: usize| -> usize {
+                        let (x, y) = (u as f64 / f, w as f64 / f);
+                        let p: [f64; 3] =
+                            std::array::from_fn(|q| a[q] + x * (b[q] - a[q]) + y * (c[q] - a[q]));
+                        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                        let p = p.map(|x| x / r);
+                        *index.entry(key(p)).or_insert_with(|| {
+                            vertices.push(p);
+                            vertices.len() - 1
+                        })
+                    };
+                    for u in 0..frequency {
+                        for w in 0..frequency - u {
+                            let (p, q, s) = (point(u, w), point(u + 1, w), point(u, w + 1));
+                            for (m, n) in [(p, q), (p, s), (q, s)] {
+                                edges.insert([m.min(n), m.max(n)]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Self {
+            vertices,
+            edges: edges.into_iter().collect(),
+        }
+    }
+
+    /// The frequency of the shell of diameter `diameter` beside the smallest species'
+    /// (`reference`, frequency 2): `round(2 d / d_min)`, so that neighbouring vertices stay as
+    /// far apart as on the smallest shell (about `0.55 d_min / 2`) and a larger shell is as
+    /// dense a net in the solvent's collision cells as the smallest.
+    pub fn frequency_for(diameter: f64, reference: f64) -> usize {
+        let f = (2.0 * diameter / reference).round();
+        if f.is_finite() {
+            (f as usize).max(2)
+        } else {
+            usize::MAX
+        }
+    }
+
+    /// Vertices of the shell of `frequency`: `10 f^2 + 2`.
+    pub fn vertex_count(frequency: usize) -> usize {
+        10 * frequency * frequency + 2
+    }
+
+    /// The shortest edge on the unit sphere.
+    fn shortest_edge(&self) -> f64 {
+        self.edges
+            .iter()
+            .map(|&[i, j]| dist(self.vertices[i], self.vertices[j]))
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
 /// Largest thermal bond strain [`ColloidParams::thermal_bond_strain`] accepted: 10 % of the
 /// shortest bond (the default `k = 5000 kT / a^2` keeps it at 10 % down to `d = 0.52 a`).
 pub const MAX_BOND_STRAIN: f64 = 0.1;
@@ -191,17 +296,13 @@ impl ColloidParams {
     /// the colloid's shape fluctuates. Above [`MAX_BOND_STRAIN`] the bonds no longer hold a sphere
     /// of diameter `d` (a tiny `d` or a soft `k`).
     pub fn thermal_bond_strain(&self, kt: f64) -> f64 {
-        let geo = Geometry::subdivided_icosahedron();
-        let shortest = geo
-            .edges
-            .iter()
-            .map(|&[i, j]| {
-                let (a, b) = (geo.vertices[i], geo.vertices[j]);
-                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-            })
-            .fold(f64::INFINITY, f64::min)
-            * 0.5
-            * self.diameter;
+        self.thermal_bond_strain_of(kt, self.diameter, 2)
+    }
+
+    /// [`Self::thermal_bond_strain`] of a shell of diameter `diameter` and `frequency`
+    /// ([`Geometry::geodesic`]).
+    pub fn thermal_bond_strain_of(&self, kt: f64, diameter: f64, frequency: usize) -> f64 {
+        let shortest = Geometry::geodesic(frequency).shortest_edge() * 0.5 * diameter;
         (kt / self.bond_k).sqrt() / shortest
     }
 
@@ -212,15 +313,21 @@ impl ColloidParams {
     /// start (500 products, converged to 1e-6 for every mass ratio tried against a full
     /// diagonalisation). It does not depend on `d`. Velocity Verlet is stable for `omega dt < 2`.
     pub fn highest_bond_frequency(&self) -> f64 {
-        let geo = Geometry::subdivided_icosahedron();
-        let n = VERTICES + 1;
+        self.highest_bond_frequency_of(2)
+    }
+
+    /// [`Self::highest_bond_frequency`] of the shell of `frequency` ([`Geometry::geodesic`]).
+    pub fn highest_bond_frequency_of(&self, frequency: usize) -> f64 {
+        let geo = Geometry::geodesic(frequency);
+        let nv = geo.vertices.len();
+        let n = nv + 1;
         let mut pos = geo.vertices.clone();
         pos.push([0.0; 3]);
         let bonds: Vec<(usize, usize, [f64; 3])> = geo
             .edges
             .iter()
             .map(|&[i, j]| (i, j))
-            .chain((0..VERTICES).map(|i| (i, VERTICES)))
+            .chain((0..nv).map(|i| (i, nv)))
             .map(|(i, j)| {
                 let e = [0, 1, 2].map(|c| pos[i][c] - pos[j][c]);
                 let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
@@ -228,7 +335,7 @@ impl ColloidParams {
             })
             .collect();
         let inv_sqrt_m: Vec<f64> = (0..n)
-            .map(|i| match i < VERTICES {
+            .map(|i| match i < nv {
                 true => 1.0 / self.vertex_mass.sqrt(),
                 false => 1.0 / self.centre_mass.sqrt(),
             })
@@ -290,8 +397,8 @@ pub enum Region {
     },
 }
 
-/// The exact state of the colloids (for checkpoints): with the same [`ColloidParams`] and box,
-/// [`DiscreteColloids::from_state`] continues bitwise.
+/// The exact state of the colloids (for checkpoints): with the same [`ColloidParams`], species
+/// and box, [`DiscreteColloids::from_state_mixture`] continues bitwise.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ColloidState {
     /// Centre positions (in the box).
@@ -300,12 +407,15 @@ pub struct ColloidState {
     pub centre_vel: Vec<[f64; 3]>,
     /// Box crossings of each centre.
     pub centre_image: Vec<[i32; 3]>,
-    /// Vertex positions, 42 per colloid, unwrapped about their centre.
+    /// Vertex positions, colloid by colloid (42 for the smallest species), unwrapped about
+    /// their centre.
     pub vertex_pos: Vec<[f64; 3]>,
     /// Vertex velocities.
     pub vertex_vel: Vec<[f64; 3]>,
     /// MD blocks (collision times) done.
     pub step: u64,
+    /// Colloids of each species, stored species by species (the species of every colloid).
+    pub species_counts: Vec<usize>,
 }
 
 /// A bond of the ideal shape: vertex indices (or the centre for spokes) and rest length.
@@ -333,17 +443,48 @@ fn grid_cells(l: [f64; 3], width: f64, n: usize, min: usize) -> [usize; 3] {
     })
 }
 
-/// `N` discrete-particle colloids in the periodic box of the solvent (see the module docs).
+/// The shell of one species: its mesh scaled to its diameter, and where its colloids lie.
 #[derive(Debug, Clone)]
-pub struct DiscreteColloids {
-    params: ColloidParams,
-    sbox: SimBox,
-    /// The ideal shape scaled to diameter `d` (offsets of the vertices from the centre).
+struct Shell {
+    diameter: f64,
+    /// Vertices per colloid.
+    vertices: usize,
+    /// The ideal shape (offsets of the vertices from the centre).
     shape: Vec<[f64; 3]>,
     edges: Vec<Edge>,
     /// Rest length of the spokes (`d/2`).
     spoke: f64,
+    /// First colloid of the species and its count (colloids are stored species by species).
+    first: usize,
+    count: usize,
+    /// First vertex of the species.
+    first_vertex: usize,
+}
+
+impl Shell {
+    /// Mass of one colloid of this shell.
+    fn mass(&self, p: &ColloidParams) -> f64 {
+        p.centre_mass + self.vertices as f64 * p.vertex_mass
+    }
+}
+
+/// `N` discrete-particle colloids in the periodic box of the solvent (see the module docs),
+/// of one or more species stored species by species.
+#[derive(Debug, Clone)]
+pub struct DiscreteColloids {
+    params: ColloidParams,
+    mixture: Mixture,
+    sbox: SimBox,
+    /// One per species.
+    shells: Vec<Shell>,
+    /// Species of each colloid.
+    species: Vec<u32>,
+    /// First vertex of each colloid (and the total at the end).
+    vertex_start: Vec<usize>,
+    /// WCA of each species pair at the pair's mean diameter.
     wca: LennardJones,
+    /// Largest WCA cut-off.
+    cut_max: f64,
     centre_pos: Vec<[f64; 3]>,
     centre_vel: Vec<[f64; 3]>,
     centre_image: Vec<[i32; 3]>,
@@ -362,13 +503,28 @@ pub struct DiscreteColloids {
 }
 
 impl DiscreteColloids {
-    /// Colloids centred at `centres` (any periodic image) with random orientations and
-    /// Maxwell–Boltzmann velocities at `kt` for all 43 particles of each, from the stream
-    /// `(seed, 0, Colloid, i)` of colloid `i`; the total momentum of all colloid particles is
-    /// then removed (the solvent of [`Srd::new`] has none either, so the whole system starts at
-    /// rest). Overlaps are not checked here.
+    /// Colloids of one species (diameter `params.diameter`) centred at `centres`; see
+    /// [`Self::new_mixture`].
     pub fn new(
         params: ColloidParams,
+        sbox: SimBox,
+        centres: &[[f64; 3]],
+        kt: f64,
+        seed: u32,
+    ) -> Result<Self, MpcdError> {
+        let one = Mixture::one(params.diameter, centres.len());
+        Self::new_mixture(params, &one, sbox, centres, kt, seed)
+    }
+
+    /// Colloids of the species of `mixture` (stored species by species, `centres` in that
+    /// order; `params.diameter` the smallest diameter) centred at `centres` (any periodic
+    /// image) with random orientations and Maxwell–Boltzmann velocities at `kt` for every
+    /// particle of each, from the stream `(seed, 0, Colloid, i)` of colloid `i`; the total
+    /// momentum of all colloid particles is then removed (the solvent of [`Srd::new`] has none
+    /// either, so the whole system starts at rest). Overlaps are not checked here.
+    pub fn new_mixture(
+        params: ColloidParams,
+        mixture: &Mixture,
         sbox: SimBox,
         centres: &[[f64; 3]],
         kt: f64,
@@ -378,6 +534,13 @@ impl DiscreteColloids {
         if !(kt.is_finite() && kt > 0.0) {
             return Err(MpcdError::Invalid(format!(
                 "colloid kT = {kt} must be a finite number > 0"
+            )));
+        }
+        if centres.len() != mixture.total() {
+            return Err(MpcdError::Invalid(format!(
+                "{} colloid centres for species of {:?} colloids",
+                centres.len(),
+                mixture.counts
             )));
         }
         if let Some(i) = centres
@@ -390,13 +553,15 @@ impl DiscreteColloids {
                 index: i,
             });
         }
-        let mut me = Self::empty(params, sbox, centres.len())?;
+        let mut me = Self::empty(params, mixture, sbox)?;
         let zig = Ziggurat::get();
         let n = centres.len();
-        let shape = me.shape.clone();
+        let shells = me.shells.clone();
         let (mp, mc) = (params.vertex_mass, params.centre_mass);
         let (sd_c, sd_v) = ((kt / mc).sqrt(), (kt / mp).sqrt());
         for (i, c) in centres.iter().enumerate() {
+            let shell = &shells[me.species[i] as usize];
+            let v0 = me.vertex_start[i];
             let mut rng = draw(seed, 0, Draw::Colloid, i as u64);
             // A uniform random rotation: the unit quaternion of four normal deviates.
             let rot = loop {
@@ -411,16 +576,18 @@ impl DiscreteColloids {
             sbox.wrap(&mut x, &mut image);
             me.centre_pos[i] = x;
             me.centre_vel[i] = std::array::from_fn(|_| sd_c * zig.sample(&mut rng));
-            for (k, s) in shape.iter().enumerate() {
+            for (k, s) in shell.shape.iter().enumerate() {
                 let r = apply(&rot, *s);
-                me.vertex_pos[i * VERTICES + k] = [x[0] + r[0], x[1] + r[1], x[2] + r[2]];
-                me.vertex_vel[i * VERTICES + k] =
-                    std::array::from_fn(|_| sd_v * zig.sample(&mut rng));
+                me.vertex_pos[v0 + k] = [x[0] + r[0], x[1] + r[1], x[2] + r[2]];
+                me.vertex_vel[v0 + k] = std::array::from_fn(|_| sd_v * zig.sample(&mut rng));
             }
         }
         if n > 0 {
             let p = me.momentum();
-            let m = n as f64 * params.colloid_mass();
+            let m = shells
+                .iter()
+                .map(|s| s.count as f64 * s.mass(&params))
+                .sum::<f64>();
             let u = p.map(|x| x / m);
             for v in me.centre_vel.iter_mut().chain(me.vertex_vel.iter_mut()) {
                 for k in 0..3 {
@@ -432,10 +599,8 @@ impl DiscreteColloids {
         Ok(me)
     }
 
-    /// `n` colloids at random non-overlapping positions (centres at least `d` apart, periodic)
-    /// in `region`, by random sequential addition: colloid `i` tries positions from the stream
-    /// `(seed, 0, Colloid, 2^48 + i)` until one fits (at most [`MAX_PLACEMENT_TRIALS`]);
-    /// orientations and velocities as [`Self::new`].
+    /// `n` colloids of one species at random non-overlapping positions; see
+    /// [`Self::random_mixture`].
     pub fn random(
         params: ColloidParams,
         sbox: SimBox,
@@ -444,43 +609,79 @@ impl DiscreteColloids {
         kt: f64,
         seed: u32,
     ) -> Result<Self, MpcdError> {
+        let one = Mixture::one(params.diameter, n);
+        Self::random_mixture(params, &one, sbox, region, kt, seed)
+    }
+
+    /// The colloids of `mixture` at random non-overlapping positions (centres of species `a`
+    /// and `b` at least `(d_a + d_b) / 2` apart, periodic) in `region` (each colloid wholly
+    /// inside a sphere), by random sequential addition, the largest species first: colloid `i`
+    /// (storage index) tries positions from the stream `(seed, 0, Colloid, 2^48 + i)` until one
+    /// fits (at most [`MAX_PLACEMENT_TRIALS`]); orientations and velocities as
+    /// [`Self::new_mixture`].
+    pub fn random_mixture(
+        params: ColloidParams,
+        mixture: &Mixture,
+        sbox: SimBox,
+        region: Region,
+        kt: f64,
+        seed: u32,
+    ) -> Result<Self, MpcdError> {
         params.check()?;
-        let d = params.diameter;
+        let n = mixture.total();
+        let d_max = mixture.d_max();
         let l = sbox.l;
-        let reach = match region {
+        let reach = |d: f64| match region {
             Region::Box => None,
-            Region::Sphere { radius } => {
-                let half = 0.5 * l.iter().cloned().fold(f64::INFINITY, f64::min);
-                if !(radius.is_finite() && radius > 0.5 * d && radius <= half) {
-                    return Err(MpcdError::Invalid(format!(
-                        "colloid placement radius = {radius} must lie in (d/2, L/2] = ({}, {half}]",
-                        0.5 * d
-                    )));
-                }
-                Some(radius - 0.5 * d)
-            }
+            Region::Sphere { radius } => Some(radius - 0.5 * d),
         };
+        if let Region::Sphere { radius } = region {
+            let half = 0.5 * l.iter().cloned().fold(f64::INFINITY, f64::min);
+            if !(radius.is_finite() && radius > 0.5 * d_max && radius <= half) {
+                return Err(MpcdError::Invalid(format!(
+                    "colloid placement radius = {radius} must lie in (d/2, L/2] = ({}, {half}]",
+                    0.5 * d_max
+                )));
+            }
+        }
         if n >= 1 << 40 {
             return Err(MpcdError::Invalid(format!(
                 "{n} colloids: at most 2^40 are supported"
             )));
         }
-        // A grid of cells at least d wide over the box for the overlap checks (no more cells
-        // than the colloids need: a tiny d must not make a grid of 1024^3 empty cells).
-        let nc = grid_cells(l, d, n, 1);
+        let diameter: Vec<f64> = mixture.particle_diameters();
+        // A grid of cells at least d_max wide over the box for the overlap checks (no more
+        // cells than the colloids need: a tiny d must not make a grid of 1024^3 empty cells).
+        let nc = grid_cells(l, d_max, n, 1);
         let cell = |x: [f64; 3]| -> [usize; 3] {
             std::array::from_fn(|k| {
                 (((x[k] / l[k] + 0.5) * nc[k] as f64).floor() as usize).min(nc[k] - 1)
             })
         };
         let mut grid: Vec<Vec<u32>> = vec![Vec::new(); nc[0] * nc[1] * nc[2]];
-        let mut centres: Vec<[f64; 3]> = Vec::with_capacity(n);
-        for i in 0..n {
+        let mut centres: Vec<[f64; 3]> = vec![[0.0; 3]; n];
+        // The largest species first (stable: one species in storage order).
+        let mut order: Vec<usize> = (0..mixture.len()).collect();
+        order.sort_by(|&a, &b| mixture.diameters[b].total_cmp(&mixture.diameters[a]));
+        let starts: Vec<usize> = mixture
+            .counts
+            .iter()
+            .scan(0, |acc, &c| {
+                let s = *acc;
+                *acc += c;
+                Some(s)
+            })
+            .collect();
+        for i in order
+            .iter()
+            .flat_map(|&s| starts[s]..starts[s] + mixture.counts[s])
+        {
+            let di = diameter[i];
             let mut rng = draw(seed, 0, Draw::Colloid, (1 << 48) + i as u64);
             let mut placed = false;
             for _ in 0..MAX_PLACEMENT_TRIALS {
                 let mut x: [f64; 3] = std::array::from_fn(|k| (rng.random::<f64>() - 0.5) * l[k]);
-                if let Some(rmax) = reach {
+                if let Some(rmax) = reach(di) {
                     // Uniform in the ball: rejection from the cube of edge 2 rmax.
                     x = std::array::from_fn(|k| (2.0 * x[k] / l[k]) * rmax);
                     if x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > rmax * rmax {
@@ -501,7 +702,8 @@ impl DiscreteColloids {
                             for &j in &grid[(cc[2] * nc[1] + cc[1]) * nc[0] + cc[0]] {
                                 let y = centres[j as usize];
                                 let r = sbox.min_image([x[0] - y[0], x[1] - y[1], x[2] - y[2]]);
-                                if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < d * d {
+                                let contact = 0.5 * (di + diameter[j as usize]);
+                                if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < contact * contact {
                                     free = false;
                                     break 'search;
                                 }
@@ -511,7 +713,7 @@ impl DiscreteColloids {
                 }
                 if free {
                     grid[(c[2] * nc[1] + c[1]) * nc[0] + c[0]].push(i as u32);
-                    centres.push(x);
+                    centres[i] = x;
                     placed = true;
                     break;
                 }
@@ -522,32 +724,52 @@ impl DiscreteColloids {
                 )));
             }
         }
-        Self::new(params, sbox, &centres, kt, seed)
+        Self::new_mixture(params, mixture, sbox, &centres, kt, seed)
     }
 
-    /// Colloids in a saved state (see [`ColloidState`]).
+    /// Colloids of one species in a saved state; see [`Self::from_state_mixture`].
     pub fn from_state(
         params: ColloidParams,
         sbox: SimBox,
         state: &ColloidState,
     ) -> Result<Self, MpcdError> {
+        let one = Mixture::one(params.diameter, state.centre_pos.len());
+        Self::from_state_mixture(params, &one, sbox, state)
+    }
+
+    /// Colloids of `mixture` in a saved state (see [`ColloidState`]); its species counts must
+    /// be the mixture's.
+    pub fn from_state_mixture(
+        params: ColloidParams,
+        mixture: &Mixture,
+        sbox: SimBox,
+        state: &ColloidState,
+    ) -> Result<Self, MpcdError> {
         params.check()?;
-        let n = state.centre_pos.len();
-        if state.centre_vel.len() != n
+        if state.species_counts != mixture.counts {
+            return Err(MpcdError::Invalid(format!(
+                "colloid state: species of {:?} colloids, but the run has {:?}",
+                state.species_counts, mixture.counts
+            )));
+        }
+        let mut me = Self::empty(params, mixture, sbox)?;
+        let n = me.len();
+        let nv = me.vertex_pos.len();
+        if state.centre_pos.len() != n
+            || state.centre_vel.len() != n
             || state.centre_image.len() != n
-            || state.vertex_pos.len() != n * VERTICES
-            || state.vertex_vel.len() != n * VERTICES
+            || state.vertex_pos.len() != nv
+            || state.vertex_vel.len() != nv
         {
             return Err(MpcdError::Invalid(format!(
-                "colloid state: {n} centres need {n} velocities and images and {} vertex positions and velocities (got {}, {}, {}, {})",
-                n * VERTICES,
+                "colloid state: {n} centres need {n} positions, velocities and images and {nv} vertex positions and velocities (got {}, {}, {}, {}, {})",
+                state.centre_pos.len(),
                 state.centre_vel.len(),
                 state.centre_image.len(),
                 state.vertex_pos.len(),
                 state.vertex_vel.len()
             )));
         }
-        let mut me = Self::empty(params, sbox, n)?;
         me.centre_pos.copy_from_slice(&state.centre_pos);
         me.centre_vel.copy_from_slice(&state.centre_vel);
         me.centre_image.copy_from_slice(&state.centre_image);
@@ -573,28 +795,100 @@ impl DiscreteColloids {
             vertex_pos: self.vertex_pos.clone(),
             vertex_vel: self.vertex_vel.clone(),
             step: self.step,
+            species_counts: self.mixture.counts.clone(),
         }
     }
 
-    fn empty(params: ColloidParams, sbox: SimBox, n: usize) -> Result<Self, MpcdError> {
-        let cut = params.wca_cut();
+    /// The shells and storage of `mixture`'s colloids; `params.diameter` must be its smallest
+    /// diameter (the species of frequency 2, [`Geometry::frequency_for`]).
+    fn empty(params: ColloidParams, mixture: &Mixture, sbox: SimBox) -> Result<Self, MpcdError> {
+        if mixture
+            .diameters
+            .iter()
+            .any(|d| !(d.is_finite() && *d > 0.0))
+        {
+            return Err(MpcdError::Invalid(format!(
+                "colloid diameters {:?} must be finite numbers > 0",
+                mixture.diameters
+            )));
+        }
+        if params.diameter != mixture.d_min() {
+            return Err(MpcdError::Invalid(format!(
+                "colloid diameter {} must be the smallest species diameter {}",
+                params.diameter,
+                mixture.d_min()
+            )));
+        }
+        let cut = 2f64.powf(1.0 / 6.0) * mixture.d_max();
         if let Some(k) = (0..3).find(|&k| sbox.l[k] <= 2.0 * cut) {
             return Err(MpcdError::Invalid(format!(
                 "box edge {} must exceed twice the WCA cut-off 2^(1/6) d = {cut} (colloid diameter {})",
-                sbox.l[k], params.diameter
+                sbox.l[k],
+                mixture.d_max()
             )));
         }
-        let geo = Geometry::subdivided_icosahedron();
-        let r = 0.5 * params.diameter;
-        let shape: Vec<[f64; 3]> = geo.vertices.iter().map(|v| v.map(|x| r * x)).collect();
-        let edges = geo
-            .edges
-            .iter()
-            .map(|&[i, j]| {
-                let (a, b) = (shape[i], shape[j]);
-                let r0 =
-                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-                Edge { i, j, r0 }
+        let mut shells = Vec::with_capacity(mixture.len());
+        let (mut first, mut first_vertex) = (0, 0);
+        for (s, (&d, &count)) in mixture.diameters.iter().zip(&mixture.counts).enumerate() {
+            let frequency = Geometry::frequency_for(d, params.diameter);
+            if frequency > MAX_FREQUENCY {
+                return Err(MpcdError::Invalid(format!(
+                    "colloid species {} of diameter {d} is {:.4} times the smallest ({}): its shell would need frequency {frequency}, at most {MAX_FREQUENCY} ({} vertices; a size ratio up to {})",
+                    mixture.names[s],
+                    d / params.diameter,
+                    params.diameter,
+                    Geometry::vertex_count(MAX_FREQUENCY),
+                    (MAX_FREQUENCY as f64 + 0.5) / 2.0
+                )));
+            }
+            let geo = Geometry::geodesic(frequency);
+            let r = 0.5 * d;
+            let shape: Vec<[f64; 3]> = geo.vertices.iter().map(|v| v.map(|x| r * x)).collect();
+            let edges = geo
+                .edges
+                .iter()
+                .map(|&[i, j]| {
+                    let (a, b) = (shape[i], shape[j]);
+                    let r0 =
+                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2))
+                            .sqrt();
+                    Edge { i, j, r0 }
+                })
+                .collect();
+            let vertices = shape.len();
+            shells.push(Shell {
+                diameter: d,
+                vertices,
+                shape,
+                edges,
+                spoke: r,
+                first,
+                count,
+                first_vertex,
+            });
+            first += count;
+            first_vertex += count * vertices;
+        }
+        let n = first;
+        let mut species = Vec::with_capacity(n);
+        let mut vertex_start = Vec::with_capacity(n + 1);
+        for (s, sh) in shells.iter().enumerate() {
+            for k in 0..sh.count {
+                species.push(s as u32);
+                vertex_start.push(sh.first_vertex + k * sh.vertices);
+            }
+        }
+        vertex_start.push(first_vertex);
+        let ns = mixture.len();
+        let pairs: Vec<LjParams> = (0..ns)
+            .flat_map(|a| (a..ns).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let sigma = 0.5 * (mixture.diameters[a] + mixture.diameters[b]);
+                LjParams {
+                    epsilon: params.wca_epsilon,
+                    sigma,
+                    r_cut: 2f64.powf(1.0 / 6.0) * sigma,
+                }
             })
             .collect();
         // Cells at least the cut-off wide; fewer than 3 per axis: all pairs.
@@ -607,19 +901,21 @@ impl DiscreteColloids {
         let n_cells = cells[0] * cells[1] * cells[2];
         Ok(Self {
             params,
+            mixture: mixture.clone(),
             sbox,
-            shape,
-            edges,
-            spoke: r,
-            wca: LennardJones::wca(params.wca_epsilon, params.diameter),
+            shells,
+            species,
+            vertex_start,
+            wca: LennardJones::new(ns, &pairs),
+            cut_max: cut,
             centre_pos: vec![[0.0; 3]; n],
             centre_vel: vec![[0.0; 3]; n],
             centre_image: vec![[0; 3]; n],
             centre_force: vec![[0.0; 3]; n],
-            vertex_pos: vec![[0.0; 3]; n * VERTICES],
-            vertex_vel: vec![[0.0; 3]; n * VERTICES],
-            vertex_force: vec![[0.0; 3]; n * VERTICES],
-            vertex_mass: vec![params.vertex_mass; n * VERTICES],
+            vertex_pos: vec![[0.0; 3]; first_vertex],
+            vertex_vel: vec![[0.0; 3]; first_vertex],
+            vertex_force: vec![[0.0; 3]; first_vertex],
+            vertex_mass: vec![params.vertex_mass; first_vertex],
             cells,
             cell_start: vec![0; n_cells + 1],
             cell_members: vec![0; if n_cells > 0 { n } else { 0 }],
@@ -631,6 +927,36 @@ impl DiscreteColloids {
     /// Parameters.
     pub fn params(&self) -> &ColloidParams {
         &self.params
+    }
+
+    /// The species (diameters and counts).
+    pub fn mixture(&self) -> &Mixture {
+        &self.mixture
+    }
+
+    /// Species of each colloid.
+    pub fn species(&self) -> &[u32] {
+        &self.species
+    }
+
+    /// Diameter of each colloid.
+    pub fn diameters(&self) -> Vec<f64> {
+        self.mixture.particle_diameters()
+    }
+
+    /// Vertices of a colloid of species `s`.
+    pub fn vertices_of_species(&self, s: usize) -> usize {
+        self.shells[s].vertices
+    }
+
+    /// The vertices of colloid `i` (indices into [`Self::vertex_positions`]).
+    pub fn vertex_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.vertex_start[i]..self.vertex_start[i + 1]
+    }
+
+    /// Every particle of the colloids (centres and vertices).
+    pub fn particle_count(&self) -> usize {
+        self.len() + self.vertex_pos.len()
     }
 
     /// Number of colloids.
@@ -648,9 +974,10 @@ impl DiscreteColloids {
         self.step
     }
 
-    /// Rest lengths of the 120 mesh bonds (the spokes have `d/2`).
+    /// Rest lengths of the mesh bonds of the first species (120 for its 42 vertices; the
+    /// spokes have `d/2`).
     pub fn rest_lengths(&self) -> Vec<f64> {
-        self.edges.iter().map(|e| e.r0).collect()
+        self.shells[0].edges.iter().map(|e| e.r0).collect()
     }
 
     /// Centre positions in the box.
@@ -672,13 +999,13 @@ impl DiscreteColloids {
         &self.centre_vel
     }
 
-    /// Vertex positions (42 per colloid, unwrapped about their centre).
+    /// Vertex positions (colloid by colloid, unwrapped about their centre).
     pub fn vertex_positions(&self) -> &[[f64; 3]] {
         &self.vertex_pos
     }
 
     /// The forces at the current positions at time `t` (bonds on all particles, WCA and
-    /// `external` on the centres), the centres' then the vertices' (colloid-major, 42 each);
+    /// `external` on the centres), the centres' then the vertices' (colloid by colloid);
     /// computed on a copy, for readers (Python's engines), not in the time step.
     pub fn forces_at<E: External>(&self, t: f64, external: &E) -> Vec<[f64; 3]> {
         let mut copy = self.clone();
@@ -711,22 +1038,24 @@ impl DiscreteColloids {
         out
     }
 
+    /// Mass of colloid `i`.
+    fn mass_of(&self, i: usize) -> f64 {
+        self.shells[self.species[i] as usize].mass(&self.params)
+    }
+
     /// [`Self::com_velocities`] into `out` (cleared first), for callers that sample every
     /// collision without allocating.
     pub fn com_velocities_into(&self, out: &mut Vec<[f64; 3]>) {
-        let (mc, mv, m) = (
-            self.params.centre_mass,
-            self.params.vertex_mass,
-            self.params.colloid_mass(),
-        );
+        let (mc, mv) = (self.params.centre_mass, self.params.vertex_mass);
         out.clear();
         out.extend((0..self.len()).map(|i| {
             let mut p = self.centre_vel[i].map(|x| mc * x);
-            for v in &self.vertex_vel[i * VERTICES..(i + 1) * VERTICES] {
+            for v in &self.vertex_vel[self.vertex_range(i)] {
                 for k in 0..3 {
                     p[k] += mv * v[k];
                 }
             }
+            let m = self.mass_of(i);
             p.map(|x| x / m)
         }));
     }
@@ -761,66 +1090,68 @@ impl DiscreteColloids {
         let k = self.params.bond_k;
         let mut u = 0.0;
         for i in 0..self.len() {
-            let (c, vs) = (
-                self.centre_pos[i],
-                &self.vertex_pos[i * VERTICES..][..VERTICES],
-            );
-            for e in &self.edges {
+            let sh = &self.shells[self.species[i] as usize];
+            let (c, vs) = (self.centre_pos[i], &self.vertex_pos[self.vertex_range(i)]);
+            for e in &sh.edges {
                 let r = dist(vs[e.i], vs[e.j]);
                 u += 0.5 * k * (r - e.r0).powi(2);
             }
             for v in vs {
-                u += 0.5 * k * (dist(*v, c) - self.spoke).powi(2);
+                u += 0.5 * k * (dist(*v, c) - sh.spoke).powi(2);
             }
             for j in i + 1..self.len() {
                 let y = self.centre_pos[j];
                 let d = self.sbox.min_image([c[0] - y[0], c[1] - y[1], c[2] - y[2]]);
-                u += self
-                    .wca
-                    .energy(d[0] * d[0] + d[1] * d[1] + d[2] * d[2], 0, 0, 0.0, 0.0);
+                u += self.wca.energy(
+                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2],
+                    self.species[i],
+                    self.species[j],
+                    0.0,
+                    0.0,
+                );
             }
         }
         u
     }
 
-    /// Kinetic temperature of all colloid particles, `sum m v^2 / (3 * 43 N)`.
+    /// Kinetic temperature of all colloid particles, `sum m v^2 / (3 N_particles)`.
     pub fn temperature(&self) -> f64 {
-        2.0 * self.kinetic_energy() / (3.0 * (VERTICES + 1) as f64 * self.len() as f64)
+        2.0 * self.kinetic_energy() / (3.0 * self.particle_count() as f64)
     }
 
     /// Kinetic temperature of the colloids' centre-of-mass velocities, `sum M V^2 / (3 N)`.
     pub fn com_temperature(&self) -> f64 {
-        let m = self.params.colloid_mass();
         let v = self.com_velocities();
         v.iter()
-            .map(|v| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+            .enumerate()
+            .map(|(i, v)| self.mass_of(i) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
             .sum::<f64>()
             / (3.0 * self.len() as f64)
     }
 
     /// Root-mean-square relative deviation `(r - r0) / r0` over all bonds (mesh and spokes).
     pub fn bond_strain_rms(&self) -> f64 {
-        let mut s = 0.0;
+        let (mut s, mut bonds) = (0.0, 0usize);
         for i in 0..self.len() {
-            let (c, vs) = (
-                self.centre_pos[i],
-                &self.vertex_pos[i * VERTICES..][..VERTICES],
-            );
-            for e in &self.edges {
+            let sh = &self.shells[self.species[i] as usize];
+            let (c, vs) = (self.centre_pos[i], &self.vertex_pos[self.vertex_range(i)]);
+            for e in &sh.edges {
                 s += (dist(vs[e.i], vs[e.j]) / e.r0 - 1.0).powi(2);
             }
             for v in vs {
-                s += (dist(*v, c) / self.spoke - 1.0).powi(2);
+                s += (dist(*v, c) / sh.spoke - 1.0).powi(2);
             }
+            bonds += sh.edges.len() + sh.vertices;
         }
-        (s / ((EDGES + VERTICES) * self.len()) as f64).sqrt()
+        (s / bonds as f64).sqrt()
     }
 
     /// Velocity Verlet over one collision time: `md_steps` steps of `dt = tau / md_steps` from
     /// time `t0`, forces from the bonds, WCA between centres and `external` on the centres
-    /// (e.g. the droplet's [`HarmonicInterface`], evaluated at the time of each force
-    /// evaluation). The forces at `t0` are recomputed from the positions, so the state is the
-    /// positions and velocities alone. Advances the step counter.
+    /// (e.g. the droplet's [`HarmonicInterface`] or, for several sizes, its
+    /// [`SpeciesInterface`]: `External::force_on` with each colloid's diameter, evaluated at
+    /// the time of each force evaluation). The forces at `t0` are recomputed from the
+    /// positions, so the state is the positions and velocities alone. Advances the step counter.
     pub fn advance<E: External>(
         &mut self,
         t0: f64,
@@ -840,43 +1171,55 @@ impl DiscreteColloids {
         self.compute_forces(t0, external);
         for s in 0..steps {
             let sbox = self.sbox;
-            self.centre_pos
-                .par_iter_mut()
-                .zip(self.centre_vel.par_iter_mut())
-                .zip(self.centre_image.par_iter_mut())
-                .zip(self.centre_force.par_iter())
-                .zip(self.vertex_pos.par_chunks_mut(VERTICES))
-                .zip(self.vertex_vel.par_chunks_mut(VERTICES))
-                .zip(self.vertex_force.par_chunks(VERTICES))
-                .for_each(|((((((x, v), image), f), xs), vs), fs)| {
-                    kick_drift(x, v, f, hc, dt);
-                    for ((x, v), f) in xs.iter_mut().zip(vs.iter_mut()).zip(fs) {
-                        kick_drift(x, v, f, hv, dt);
-                    }
-                    // Wrap the whole colloid with its centre.
-                    let before = *x;
-                    sbox.wrap(x, image);
-                    let shift = [x[0] - before[0], x[1] - before[1], x[2] - before[2]];
-                    if shift != [0.0; 3] {
-                        for y in xs.iter_mut() {
-                            for k in 0..3 {
-                                y[k] += shift[k];
+            for sh in &self.shells {
+                let (c, v) = (
+                    sh.first..sh.first + sh.count,
+                    sh.first_vertex..sh.first_vertex + sh.count * sh.vertices,
+                );
+                self.centre_pos[c.clone()]
+                    .par_iter_mut()
+                    .zip(self.centre_vel[c.clone()].par_iter_mut())
+                    .zip(self.centre_image[c.clone()].par_iter_mut())
+                    .zip(self.centre_force[c].par_iter())
+                    .zip(self.vertex_pos[v.clone()].par_chunks_mut(sh.vertices))
+                    .zip(self.vertex_vel[v.clone()].par_chunks_mut(sh.vertices))
+                    .zip(self.vertex_force[v].par_chunks(sh.vertices))
+                    .for_each(|((((((x, v), image), f), xs), vs), fs)| {
+                        kick_drift(x, v, f, hc, dt);
+                        for ((x, v), f) in xs.iter_mut().zip(vs.iter_mut()).zip(fs) {
+                            kick_drift(x, v, f, hv, dt);
+                        }
+                        // Wrap the whole colloid with its centre.
+                        let before = *x;
+                        sbox.wrap(x, image);
+                        let shift = [x[0] - before[0], x[1] - before[1], x[2] - before[2]];
+                        if shift != [0.0; 3] {
+                            for y in xs.iter_mut() {
+                                for k in 0..3 {
+                                    y[k] += shift[k];
+                                }
                             }
                         }
-                    }
-                });
+                    });
+            }
             self.compute_forces(t0 + (s + 1) as f64 * dt, external);
-            self.centre_vel
-                .par_iter_mut()
-                .zip(self.centre_force.par_iter())
-                .zip(self.vertex_vel.par_chunks_mut(VERTICES))
-                .zip(self.vertex_force.par_chunks(VERTICES))
-                .for_each(|(((v, f), vs), fs)| {
-                    kick(v, f, hc);
-                    for (v, f) in vs.iter_mut().zip(fs) {
-                        kick(v, f, hv);
-                    }
-                });
+            for sh in &self.shells {
+                let (c, v) = (
+                    sh.first..sh.first + sh.count,
+                    sh.first_vertex..sh.first_vertex + sh.count * sh.vertices,
+                );
+                self.centre_vel[c.clone()]
+                    .par_iter_mut()
+                    .zip(self.centre_force[c].par_iter())
+                    .zip(self.vertex_vel[v.clone()].par_chunks_mut(sh.vertices))
+                    .zip(self.vertex_force[v].par_chunks(sh.vertices))
+                    .for_each(|(((v, f), vs), fs)| {
+                        kick(v, f, hc);
+                        for (v, f) in vs.iter_mut().zip(fs) {
+                            kick(v, f, hv);
+                        }
+                    });
+            }
         }
         self.step += 1;
         if let Some(i) = self.first_non_finite() {
@@ -893,11 +1236,12 @@ impl DiscreteColloids {
     fn first_non_finite(&self) -> Option<usize> {
         let bad = |x: &[f64; 3]| !(x[0].is_finite() && x[1].is_finite() && x[2].is_finite());
         (0..self.len()).into_par_iter().find_first(|&i| {
+            let v = self.vertex_range(i);
             bad(&self.centre_pos[i])
                 || bad(&self.centre_vel[i])
-                || self.vertex_pos[i * VERTICES..][..VERTICES]
+                || self.vertex_pos[v.clone()]
                     .iter()
-                    .chain(&self.vertex_vel[i * VERTICES..][..VERTICES])
+                    .chain(&self.vertex_vel[v])
                     .any(bad)
         })
     }
@@ -937,94 +1281,105 @@ impl DiscreteColloids {
         self.cell_start[0] = 0;
     }
 
-    /// Forces at time `t`: bonds on all particles, WCA and `external` on the centres.
+    /// Forces at time `t`: bonds on all particles, WCA and `external` on the centres (each
+    /// with its colloid's diameter, `External::force_on`).
     fn compute_forces<E: External>(&mut self, t: f64, external: &E) {
         let wca_on = self.params.wca_epsilon > 0.0 && self.len() > 1;
         if wca_on && self.cells[0] > 0 {
             self.build_cells();
         }
         let k = self.params.bond_k;
-        let (sbox, wca, rc2) = (self.sbox, &self.wca, self.params.wca_cut().powi(2));
-        let (centres, edges, spoke) = (&self.centre_pos, &self.edges, self.spoke);
+        let (sbox, wca, rc2) = (self.sbox, &self.wca, self.cut_max.powi(2));
+        let (centres, species) = (&self.centre_pos, &self.species);
         let (nc, start, members) = (self.cells, &self.cell_start, &self.cell_members);
         let n = centres.len();
-        self.centre_force
-            .par_iter_mut()
-            .zip(self.vertex_force.par_chunks_mut(VERTICES))
-            .zip(self.vertex_pos.par_chunks(VERTICES))
-            .enumerate()
-            .for_each(|(i, ((fc, fs), xs))| {
-                let c = centres[i];
-                fs.fill([0.0; 3]);
-                let mut f = external.force(c, t);
-                for e in edges {
-                    let (a, b) = (xs[e.i], xs[e.j]);
-                    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    // Force on a: k (r - r0) d / r (pulled towards b when stretched).
-                    let g = k * (r - e.r0) / r;
-                    for q in 0..3 {
-                        fs[e.i][q] += g * d[q];
-                        fs[e.j][q] -= g * d[q];
-                    }
-                }
-                for (fv, x) in fs.iter_mut().zip(xs) {
-                    let d = [c[0] - x[0], c[1] - x[1], c[2] - x[2]];
-                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    let g = k * (r - spoke) / r;
-                    for q in 0..3 {
-                        fv[q] += g * d[q];
-                        f[q] -= g * d[q];
-                    }
-                }
-                if wca_on {
-                    let mut pair = |j: usize| {
-                        if j == i {
-                            return;
+        for sh in &self.shells {
+            let (c, v) = (
+                sh.first..sh.first + sh.count,
+                sh.first_vertex..sh.first_vertex + sh.count * sh.vertices,
+            );
+            let (edges, spoke, diameter) = (&sh.edges, sh.spoke, sh.diameter);
+            self.centre_force[c]
+                .par_iter_mut()
+                .zip(self.vertex_force[v.clone()].par_chunks_mut(sh.vertices))
+                .zip(self.vertex_pos[v].par_chunks(sh.vertices))
+                .enumerate()
+                .for_each(|(m, ((fc, fs), xs))| {
+                    let i = sh.first + m;
+                    let c = centres[i];
+                    let ti = species[i];
+                    fs.fill([0.0; 3]);
+                    let mut f = external.force_on(c, t, diameter);
+                    for e in edges {
+                        let (a, b) = (xs[e.i], xs[e.j]);
+                        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                        // Force on a: k (r - r0) d / r (pulled towards b when stretched).
+                        let g = k * (r - e.r0) / r;
+                        for q in 0..3 {
+                            fs[e.i][q] += g * d[q];
+                            fs[e.j][q] -= g * d[q];
                         }
-                        let y = centres[j];
-                        let d = sbox.min_image([c[0] - y[0], c[1] - y[1], c[2] - y[2]]);
-                        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        if r2 < rc2 {
-                            let g = wca.force_over_r(r2, 0, 0, 0.0, 0.0);
-                            for q in 0..3 {
-                                f[q] += g * d[q];
+                    }
+                    for (fv, x) in fs.iter_mut().zip(xs) {
+                        let d = [c[0] - x[0], c[1] - x[1], c[2] - x[2]];
+                        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                        let g = k * (r - spoke) / r;
+                        for q in 0..3 {
+                            fv[q] += g * d[q];
+                            f[q] -= g * d[q];
+                        }
+                    }
+                    if wca_on {
+                        let mut pair = |j: usize| {
+                            if j == i {
+                                return;
                             }
-                        }
-                    };
-                    if nc[0] == 0 {
-                        (0..n).for_each(&mut pair);
-                    } else {
-                        let l = sbox.l;
-                        let own: [i64; 3] = std::array::from_fn(|q| {
-                            let u = (c[q] / l[q] + 0.5) * nc[q] as f64;
-                            (if u.is_finite() {
-                                u.max(0.0) as usize
-                            } else {
-                                0
-                            })
-                            .min(nc[q] - 1) as i64
-                        });
-                        for dz in -1..=1 {
-                            for dy in -1..=1 {
-                                for dx in -1..=1 {
-                                    let o = [dx, dy, dz];
-                                    let cc: [usize; 3] = std::array::from_fn(|q| {
-                                        (own[q] + o[q]).rem_euclid(nc[q] as i64) as usize
-                                    });
-                                    let cell = (cc[2] * nc[1] + cc[1]) * nc[0] + cc[0];
-                                    for &j in
-                                        &members[start[cell] as usize..start[cell + 1] as usize]
-                                    {
-                                        pair(j as usize);
+                            let y = centres[j];
+                            let d = sbox.min_image([c[0] - y[0], c[1] - y[1], c[2] - y[2]]);
+                            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                            if r2 < rc2 {
+                                // Zero beyond the pair's own cut-off.
+                                let g = wca.force_over_r(r2, ti, species[j], 0.0, 0.0);
+                                for q in 0..3 {
+                                    f[q] += g * d[q];
+                                }
+                            }
+                        };
+                        if nc[0] == 0 {
+                            (0..n).for_each(&mut pair);
+                        } else {
+                            let l = sbox.l;
+                            let own: [i64; 3] = std::array::from_fn(|q| {
+                                let u = (c[q] / l[q] + 0.5) * nc[q] as f64;
+                                (if u.is_finite() {
+                                    u.max(0.0) as usize
+                                } else {
+                                    0
+                                })
+                                .min(nc[q] - 1) as i64
+                            });
+                            for dz in -1..=1 {
+                                for dy in -1..=1 {
+                                    for dx in -1..=1 {
+                                        let o = [dx, dy, dz];
+                                        let cc: [usize; 3] = std::array::from_fn(|q| {
+                                            (own[q] + o[q]).rem_euclid(nc[q] as i64) as usize
+                                        });
+                                        let cell = (cc[2] * nc[1] + cc[1]) * nc[0] + cc[0];
+                                        for &j in
+                                            &members[start[cell] as usize..start[cell + 1] as usize]
+                                        {
+                                            pair(j as usize);
+                                        }
                                     }
                                 }
                             }
                         }
                     }
-                }
-                *fc = f;
-            });
+                    *fc = f;
+                });
+        }
     }
 }
 
@@ -1142,7 +1497,14 @@ impl MpcdSystem {
         let t0 = self.time();
         let st = self.srd.stream(t0 + tau, &self.confinement, accel)?;
         match &self.interface {
-            Some(h) => self.colloids.advance(t0, tau, h)?,
+            // The interface placed for the smallest colloids, met by each at its own size.
+            Some(h) => {
+                let w = SpeciesInterface {
+                    interface: *h,
+                    reference_diameter: self.colloids.mixture.d_min(),
+                };
+                self.colloids.advance(t0, tau, &w)?
+            }
             None => self.colloids.advance(t0, tau, &NoExternal)?,
         }
         Ok(st)
@@ -1743,6 +2105,279 @@ mod tests {
             // Within the interface (the spring lets them in by a fraction of d).
             assert!(dist(*x, [0.0; 3]) < r - 0.5 * d + 0.25 * d, "{x:?} {r}");
         }
+    }
+
+    /// FNV-1a over the bits of the rows.
+    fn digest(h: &mut u64, rows: &[[f64; 3]]) {
+        for x in rows.iter().flatten() {
+            for b in x.to_bits().to_le_bytes() {
+                *h = (*h ^ b as u64).wrapping_mul(0x100_0000_01b3);
+            }
+        }
+    }
+
+    /// A short drying droplet with colloids (slip wall, interface, WCA contacts): the digest of
+    /// its final state, the same bits as the single-size model before species existed (the
+    /// constant was printed by this test on that code, commit 59068cd).
+    #[test]
+    fn one_species_reproduces_the_single_size_model_bitwise() {
+        use crate::mpcd::WallKind;
+        use crate::potential::SphereAreaLaw;
+        let (d, r0) = (2.0, 6.0);
+        let law = SphereAreaLaw { r0, alpha: 10.0 };
+        let conf = Confinement::Sphere {
+            law,
+            kind: WallKind::Slip,
+        };
+        let p = SrdParams::standard(5);
+        let sbox = SimBox::cube(16.0);
+        let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
+        let c = DiscreteColloids::random(
+            ColloidParams::standard(d, p.kt),
+            sbox,
+            25,
+            Region::Sphere { radius: r0 },
+            p.kt,
+            5,
+        )
+        .unwrap();
+        let interface = HarmonicInterface {
+            centre: [0.0; 3],
+            radius: law,
+            stiffness: 100.0,
+            range: 0.5 * d,
+            offset: -0.5 * d,
+        };
+        let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+        for _ in 0..8 {
+            sys.step(&Acceleration::None).unwrap();
+        }
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        digest(&mut h, &sys.srd.velocities());
+        let s = sys.colloids.state();
+        for rows in [&s.centre_pos, &s.centre_vel, &s.vertex_pos, &s.vertex_vel] {
+            digest(&mut h, rows);
+        }
+        eprintln!("digest {h:#018x}");
+        assert_eq!(h, DIGEST_BEFORE_SPECIES, "{h:#018x}");
+    }
+
+    /// [`one_species_reproduces_the_single_size_model_bitwise`] on the code before species.
+    const DIGEST_BEFORE_SPECIES: u64 = 0x1b96_f31b_df16_6364;
+
+    /// Geodesic shells of every frequency: `10 f^2 + 2` unit vertices (12 of degree 5, the
+    /// rest 6), `30 f^2` edges between nearest neighbours; scaled to `d = f d_min / 2` their
+    /// shortest and longest edges stay near the smallest shell's (the net is as fine).
+    #[test]
+    fn geodesic_shells_keep_the_vertex_spacing_of_the_smallest() {
+        let small = Geometry::geodesic(2);
+        let lengths = |g: &Geometry| -> (f64, f64) {
+            g.edges
+                .iter()
+                .map(|&[i, j]| dist(g.vertices[i], g.vertices[j]))
+                .fold((f64::INFINITY, 0f64), |(a, b), r| (a.min(r), b.max(r)))
+        };
+        let (lo2, hi2) = lengths(&small);
+        for f in 1..=MAX_FREQUENCY {
+            let g = Geometry::geodesic(f);
+            assert_eq!(g.vertices.len(), Geometry::vertex_count(f), "{f}");
+            assert_eq!(g.edges.len(), 30 * f * f, "{f}");
+            let mut degree = vec![0usize; g.vertices.len()];
+            for &[i, j] in &g.edges {
+                assert!(i < j);
+                degree[i] += 1;
+                degree[j] += 1;
+            }
+            assert_eq!(degree.iter().filter(|&&k| k == 5).count(), 12, "{f}");
+            assert!(degree.iter().all(|&k| k == 5 || k == 6), "{f}");
+            assert!(
+                g.vertices
+                    .iter()
+                    .all(|v| (dist(*v, [0.0; 3]) - 1.0).abs() < 1e-14)
+            );
+            // On a shell of diameter f/2 times the smallest's: edges within 25 % of its.
+            let (lo, hi) = lengths(&g);
+            let scale = f as f64 / 2.0;
+            assert!(
+                lo * scale > 0.75 * lo2 && hi * scale < 1.25 * hi2,
+                "{f}: {lo} {hi}"
+            );
+        }
+        assert_eq!(Geometry::frequency_for(4.0, 4.0), 2);
+        assert_eq!(Geometry::frequency_for(8.0, 4.0), 4);
+        assert_eq!(Geometry::frequency_for(6.0, 4.0), 3);
+        assert_eq!(Geometry::frequency_for(16.0, 4.0), 8);
+    }
+
+    /// Two species, A (d = 2) and B (d = 4), in a drying droplet with a slip or a no-slip
+    /// wall: the B shells have 162 vertices; placement and the run keep every pair apart at
+    /// its contact distance (d_a + d_b) / 2 (to within the WCA's soft core at eps = kT) and
+    /// every colloid's surface inside the interface (the SpeciesInterface shift); the shape
+    /// holds.
+    #[test]
+    fn a_bidisperse_droplet_keeps_contacts_and_surfaces_inside() {
+        use crate::mpcd::WallKind;
+        use crate::potential::SphereAreaLaw;
+        let r0 = 7.0;
+        let mix = Mixture::new(vec![2.0, 4.0], vec![16, 4]);
+        let law = SphereAreaLaw { r0, alpha: 30.0 };
+        for kind in [WallKind::Slip, WallKind::NoSlip] {
+            let conf = Confinement::Sphere { law, kind };
+            let p = SrdParams::standard(31);
+            let sbox = SimBox::cube(18.0);
+            let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
+            let c = DiscreteColloids::random_mixture(
+                ColloidParams::standard(2.0, p.kt),
+                &mix,
+                sbox,
+                Region::Sphere { radius: r0 },
+                p.kt,
+                31,
+            )
+            .unwrap();
+            assert_eq!(c.vertices_of_species(1), 162);
+            assert_eq!(c.particle_count(), 16 * 43 + 4 * 163);
+            let interface = HarmonicInterface {
+                centre: [0.0; 3],
+                radius: law,
+                stiffness: 100.0,
+                range: 1.0,
+                offset: -1.0,
+            };
+            let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+            // The closest pair over its contact distance, the farthest surface beyond R(t).
+            let check = |sys: &MpcdSystem| -> (f64, f64) {
+                let c = &sys.colloids;
+                let (x, d) = (c.centre_positions(), c.diameters());
+                let r = law.radius(sys.time());
+                let (mut closest, mut beyond) = (f64::INFINITY, f64::NEG_INFINITY);
+                for i in 0..x.len() {
+                    beyond = beyond.max(dist(x[i], [0.0; 3]) + 0.5 * d[i] - r);
+                    for j in i + 1..x.len() {
+                        closest = closest.min(dist(x[i], x[j]) / (0.5 * (d[i] + d[j])));
+                    }
+                }
+                (closest, beyond)
+            };
+            let (mut closest, mut beyond) = check(&sys);
+            assert!(closest >= 1.0 && beyond <= 0.0, "{closest} {beyond}");
+            for _ in 0..100 {
+                sys.step(&Acceleration::None).unwrap();
+                let (c, b) = check(&sys);
+                (closest, beyond) = (closest.min(c), beyond.max(b));
+            }
+            let r = law.radius(sys.time());
+            assert!(r < 0.75 * r0, "{r}");
+            eprintln!(
+                "{kind:?}: closest pair / contact {closest:.3}, surface beyond R {beyond:.3}"
+            );
+            assert!(closest > 0.8, "{kind:?}: {closest}");
+            // The spring lets a surface out by a fraction of d_min (the fast drying presses).
+            assert!(beyond < 0.4 * 2.0, "{kind:?}: {beyond}");
+            assert!(sys.colloids.bond_strain_rms() < 0.03);
+        }
+    }
+
+    /// The forces of a mixture at rest in its ideal shapes: the WCA of an A-B pair reaches to
+    /// `2^(1/6) (d_A + d_B) / 2` and no further; the interface pulls each centre back as soon
+    /// as its colloid's SURFACE passes the wall (`k s` with `s` the surface's excursion).
+    #[test]
+    fn mixture_forces_act_at_the_pairs_contact_and_at_each_surface() {
+        let mix = Mixture::new(vec![2.0, 4.0], vec![1, 1]);
+        let cp = ColloidParams::standard(2.0, 1.0);
+        let sbox = SimBox::cube(30.0);
+        let rc = 2f64.powf(1.0 / 6.0) * 3.0;
+        for (gap, acting) in [(0.999, true), (1.001, false)] {
+            let x = [[0.0; 3], [rc * gap, 0.0, 0.0]];
+            let c = DiscreteColloids::new_mixture(cp, &mix, sbox, &x, 1.0, 3).unwrap();
+            let f = c.forces_at(0.0, &NoExternal);
+            assert_eq!(f[0][0] < -1e-6, acting, "{gap}: {:?}", f[0]);
+        }
+        // The wall for the small ones at R - d_A/2 (offset -1), shifted to R - d_B/2 for B.
+        let interface = SpeciesInterface {
+            interface: HarmonicInterface {
+                centre: [0.0; 3],
+                radius: crate::potential::SphereAreaLaw {
+                    r0: 12.0,
+                    alpha: 0.0,
+                },
+                stiffness: 100.0,
+                range: 1.0,
+                offset: -1.0,
+            },
+            reference_diameter: 2.0,
+        };
+        let x = [[0.0, 0.0, 12.0 - 1.0 + 0.3], [12.0 - 2.0 + 0.3, 0.0, 0.0]];
+        let c = DiscreteColloids::new_mixture(cp, &mix, sbox, &x, 1.0, 3).unwrap();
+        let f = c.forces_at(0.0, &interface);
+        assert!((f[0][2] + 30.0).abs() < 1e-6, "{:?}", f[0]);
+        assert!((f[1][0] + 30.0).abs() < 1e-6, "{:?}", f[1]);
+    }
+
+    /// A mixture restarts bitwise from its state; a state of other species counts is refused;
+    /// so are a shell beyond MAX_FREQUENCY and a reference diameter that is not the smallest.
+    #[test]
+    fn mixtures_restart_bitwise_and_unsupported_ones_are_refused() {
+        let mix = Mixture::new(vec![2.0, 3.0], vec![5, 3]);
+        let sbox = SimBox::cube(14.0);
+        let p = SrdParams::standard(9);
+        let cp = ColloidParams::standard(2.0, p.kt);
+        let build = || {
+            let srd = Srd::new(p, sbox, &Confinement::None, 0.0).unwrap();
+            let c = DiscreteColloids::random_mixture(cp, &mix, sbox, Region::Box, p.kt, 9).unwrap();
+            MpcdSystem::new(srd, c, Confinement::None, None).unwrap()
+        };
+        let mut one = build();
+        for _ in 0..10 {
+            one.step(&Acceleration::None).unwrap();
+        }
+        let mut first = build();
+        for _ in 0..5 {
+            first.step(&Acceleration::None).unwrap();
+        }
+        let state = first.colloids.state();
+        assert_eq!(state.species_counts, vec![5, 3]);
+        let srd = Srd::from_raw(
+            p,
+            sbox,
+            &first.srd.raw_positions(),
+            &first.srd.velocities(),
+            first.srd.step(),
+        )
+        .unwrap();
+        let c = DiscreteColloids::from_state_mixture(cp, &mix, sbox, &state).unwrap();
+        let mut two = MpcdSystem::new(srd, c, Confinement::None, None).unwrap();
+        for _ in 0..5 {
+            two.step(&Acceleration::None).unwrap();
+        }
+        assert_eq!(one.colloids.state(), two.colloids.state());
+        assert_eq!(bits(&one.srd.velocities()), bits(&two.srd.velocities()));
+        let other = Mixture::new(vec![2.0, 3.0], vec![4, 4]);
+        let e = DiscreteColloids::from_state_mixture(cp, &other, sbox, &state).unwrap_err();
+        assert!(e.to_string().contains("species of [5, 3]"), "{e}");
+        let big = Mixture::new(vec![2.0, 8.6], vec![1, 1]);
+        let e = DiscreteColloids::new_mixture(
+            cp,
+            &big,
+            SimBox::cube(30.0),
+            &[[0.0; 3], [10.0, 0.0, 0.0]],
+            1.0,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("frequency 9, at most 8"), "{e}");
+        let e = DiscreteColloids::new_mixture(
+            ColloidParams::standard(3.0, 1.0),
+            &mix,
+            sbox,
+            &[[0.0; 3]; 8],
+            1.0,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("smallest species diameter 2"), "{e}");
     }
 
     /// Mean and standard error of a correlated series from `blocks` block means.

@@ -40,9 +40,27 @@ const LEFT_BEHIND: f64 = 0.01;
 #[rustfmt::skip] // declarations laid out as a table, one key to a line or three
 pub mod keys;
 pub mod params;
-mod species;
+
 pub mod theory;
 mod theory_mixture;
+
+/// What the species outputs need of a droplet-bd run.
+fn species_run(p: &DropletParams) -> crate::output::species::SpeciesRun<'_> {
+    let times: Vec<f64> = p
+        .fractions
+        .iter()
+        .map(|f| (f * p.steps as f64).round() * p.dt)
+        .collect();
+    crate::output::species::SpeciesRun {
+        mixture: &p.species,
+        bins: p.bins,
+        fractions: &p.fractions,
+        radii: times.iter().map(|&t| p.radius_at(t)).collect(),
+        times,
+        replicas: p.replicas,
+        one_replica: crate::output::species::ONE_REPLICA,
+    }
+}
 
 /// Read and check a scenario (`system.initial` relative to the scenario's folder), with `seed`
 /// replacing the scenario's.
@@ -199,7 +217,7 @@ struct Accum {
     checkpoints: u64,
     /// Two or more species: their profiles and the stratification.
     #[serde(default)]
-    species: species::SpeciesAccum,
+    species: crate::output::species::SpeciesAccum,
 }
 
 impl Accum {
@@ -380,7 +398,14 @@ impl Observe<SpeciesInterface> for DropletObs {
                 acc.counts[j] += 1;
                 acc.radii[j] = radius;
                 acc.r_axes[j] = prof.r;
-                acc.species.record(p, j, &part, radius);
+                acc.species.record(
+                    &species_run(p),
+                    j,
+                    &part.pos,
+                    &part.diameter,
+                    &part.typeid,
+                    radius,
+                );
                 if ev == p.steps {
                     acc.outside_final += prof.outside as u64;
                 }
@@ -562,7 +587,7 @@ impl BdMethod<SpeciesInterface> for DropletObs {
         }
         let stratification = species.write(
             out,
-            p,
+            &species_run(p),
             &drawn,
             &counts,
             &radii,

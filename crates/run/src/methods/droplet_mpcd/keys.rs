@@ -4,6 +4,7 @@ use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{self, *};
 use crate::keys::{COUNT, SEED_KEY, Spec, key};
+pub use crate::keys::species::{SPECIES, SPECIES_COUNTS, SPECIES_DIAMETERS, SPECIES_VOLUME_FRACTIONS};
 
 /// `method`.
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-mpcd"]),
@@ -27,7 +28,9 @@ pub const SYSTEM_PARTICLES: Spec = key("system.particles", "-", Value("0"), Inte
 
 /// `system.diameter`.
 pub const SYSTEM_DIAMETER: Spec = key("system.diameter", "length",
-    Derived("4 solvent.cell", |r| Ok(4.0 * r.number(&SOLVENT_CELL)?)), Positive,
+    Derived("4 solvent.cell; with system.species, the smallest of its diameters", |r| {
+        Ok(crate::keys::species::smallest_diameter(r)?.unwrap_or(4.0 * r.number(&SOLVENT_CELL)?))
+    }), Positive,
     "colloid diameter d; sets D0 = kT / (3 pi eta d) with Kikuchi's viscosity, and so Pe")
     .also("held in shape: sqrt(kT / colloid.bond_k) at most 0.1 of the shortest bond 0.273 d");
 
@@ -130,6 +133,10 @@ pub static KEYS: &[Spec] = &[
     SYSTEM,
     SYSTEM_PARTICLES,
     SYSTEM_DIAMETER,
+    SPECIES,
+    SPECIES_DIAMETERS,
+    SPECIES_COUNTS,
+    SPECIES_VOLUME_FRACTIONS,
     SYSTEM_RADIUS,
     SYSTEM_PHI0,
     SYSTEM_BOX,

@@ -10,6 +10,7 @@ use crate::methods::mpcd::common::*;
 use crate::output::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
 };
+use crate::output::species::{SpeciesAccum, SpeciesRun};
 use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_core::exchange::Exchange;
@@ -35,6 +36,29 @@ fn resolve_droplet(src: &Source, seed: Option<u64>) -> Result<DropletRun> {
     params::read(&src.table()?, seed).with_context(|| src.label())
 }
 
+/// Why an error over replicas is missing: a droplet-mpcd run is one replica.
+const ONE_RUN: &str =
+    "one run: droplet-mpcd has one replica; compare runs of several seeds for the spread";
+
+/// What the species outputs need of a droplet-mpcd run.
+fn species_run(p: &DropletRun) -> SpeciesRun<'_> {
+    let tau = p.solvent.srd.tau;
+    let times: Vec<f64> = p
+        .profile_collisions
+        .iter()
+        .map(|&c| c as f64 * tau)
+        .collect();
+    SpeciesRun {
+        mixture: &p.species,
+        bins: p.profile.bins,
+        fractions: &p.profile.fractions,
+        radii: times.iter().map(|&t| p.law().radius(t)).collect(),
+        times,
+        replicas: 1,
+        one_replica: ONE_RUN,
+    }
+}
+
 /// Where the solvent streams (the sphere, or nothing for `boundary = "none"`).
 fn confinement(p: &DropletRun) -> Confinement {
     let law = p.law();
@@ -55,17 +79,32 @@ fn build_droplet(p: &DropletRun, comm: Option<Box<dyn Exchange>>) -> Result<Srd>
     new_solvent(p.solvent.srd, p.box_edge, &confinement(p), comm)
 }
 
-/// The colloids at the start: random sequential addition with centres within `R0 - d/2`.
+/// The colloids at the start: random sequential addition with centres within `R0 - d_s/2`
+/// (one species: `place_colloids`, as always).
 fn build_colloids(p: &DropletRun) -> Result<Option<DiscreteColloids>> {
-    place_colloids(
-        p.particles,
-        p.colloid,
-        p.box_edge,
-        Region::Sphere { radius: p.r0 },
-        p.solvent.srd.kt,
-        p.seed,
-    )
-    .context("system.particles")
+    let region = Region::Sphere { radius: p.r0 };
+    if p.species.is_single() || p.particles == 0 {
+        return place_colloids(
+            p.particles,
+            p.colloid,
+            p.box_edge,
+            region,
+            p.solvent.srd.kt,
+            p.seed,
+        )
+        .context("system.particles");
+    }
+    Ok(Some(
+        DiscreteColloids::random_mixture(
+            p.colloid,
+            &p.species,
+            SimBox::cube(p.box_edge),
+            region,
+            p.solvent.srd.kt,
+            p.seed,
+        )
+        .context("system.particles")?,
+    ))
 }
 
 impl Method for DropletMpcd {
@@ -130,8 +169,18 @@ impl Method for DropletMpcd {
             .engine(p.solvent.srd, SimBox::cube(p.box_edge))?;
         let writer = comm.as_ref().is_none_or(|c| c.rank() == 0);
         let srd = decompose(srd, comm)?;
-        let colloids =
-            restore_colloids(saved.colloids.as_ref(), p.particles, p.colloid, p.box_edge)?;
+        let colloids = match (&saved.colloids, p.species.is_single()) {
+            (Some(state), false) => Some(
+                DiscreteColloids::from_state_mixture(
+                    p.colloid,
+                    &p.species,
+                    SimBox::cube(p.box_edge),
+                    state,
+                )
+                .context("checkpoint.bin: the colloids")?,
+            ),
+            (saved, _) => restore_colloids(saved.as_ref(), p.particles, p.colloid, p.box_edge)?,
+        };
         if p.trajectory_every > 0 && writer {
             saved
                 .acc
@@ -160,7 +209,7 @@ impl Method for DropletMpcd {
         Ok(Box::new(SolventEngine {
             srd: build_droplet(&p, None)?,
             colloids: build_colloids(&p)?,
-            interface: Some(p.harmonic()),
+            interface: Some(p.species_interface()),
             method: "droplet-mpcd",
             conf: confinement(&p),
             drive: Acceleration::None,
@@ -213,6 +262,8 @@ struct DropletAccum {
     stuck: u64,
     virtual_particles: u64,
     colloid_profiles: ColloidProfiles,
+    /// Two or more species: their profiles and the stratification.
+    species: SpeciesAccum,
     frames: u64,
     digest: FrameDigest,
 }
@@ -246,6 +297,7 @@ impl DropletAccum {
                     outside_final: 0,
                 }
             },
+            species: SpeciesAccum::default(),
             frames: 0,
             digest: FrameDigest::default(),
         }
@@ -287,7 +339,7 @@ impl DropletSession {
                 Err(e) => return Ok(Some(e.to_string())),
             };
             if let Some(col) = self.colloids.as_mut()
-                && let Err(e) = col.advance(step as f64 * tau, tau, &self.p.harmonic())
+                && let Err(e) = col.advance(step as f64 * tau, tau, &self.p.species_interface())
             {
                 return Ok(Some(e.to_string()));
             }
@@ -328,21 +380,26 @@ impl DropletSession {
         let p = &self.p;
         if let Some(col) = &self.colloids {
             let cp = &mut self.acc.colloid_profiles;
+            // Each species meets the wall (d_s - d) / 2 further in (its surface at R + offset).
             let wall = r + p.interface[2];
-            for x in col.centre_positions() {
+            let diameters = col.diameters();
+            for (x, ds) in col.centre_positions().iter().zip(&diameters) {
                 let d = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                cp.max_excursion = cp.max_excursion.max(d - wall);
+                cp.max_excursion = cp.max_excursion.max(d - (wall - 0.5 * (ds - p.diameter)));
             }
             for (j, &cf) in p.profile_collisions.iter().enumerate() {
                 if cf == c {
                     let pos = col.centre_positions();
                     let prof = colloidsim_analysis::radial_profile(
                         pos,
-                        &vec![p.diameter; pos.len()],
+                        &diameters,
                         [0.0; 3],
                         r,
                         p.profile.bins,
                     );
+                    self.acc
+                        .species
+                        .record(&species_run(p), j, pos, &diameters, col.species(), r);
                     cp.phi[j] = prof.phi;
                     cp.r[j] = prof.r;
                     cp.radius[j] = r;
@@ -467,9 +524,14 @@ impl Session for DropletSession {
             "solvent_velocity.png",
             "profiles.png",
             "trajectory.gsd",
+            "species_profiles.png",
+            "stratification.csv",
+            "stratification.png",
         ]
         .contains(&name)
             || name
+                .strip_prefix("species_")
+                .unwrap_or(name)
                 .strip_prefix("profile_")
                 .and_then(|r| r.strip_suffix(".csv"))
                 .is_some_and(|f| f.parse::<f64>().is_ok())
@@ -616,6 +678,18 @@ impl Session for DropletSession {
                 &mut warnings,
             );
         }
+        // Two or more species: their profiles and the stratification (droplet-bd's files).
+        let taken: Vec<usize> = (0..cp.taken.len()).filter(|&j| cp.taken[j]).collect();
+        let stratification = self.acc.species.write(
+            out,
+            &species_run(p),
+            &taken,
+            &vec![1; cp.taken.len()],
+            &cp.radius,
+            &cp.r,
+            &mut files,
+            &mut warnings,
+        )?;
         // The solvent profiles taken (complete windows only).
         let mut cols: [Vec<f64>; 9] = Default::default();
         let mut curves: Vec<Curve> = Vec::new();
@@ -752,7 +826,7 @@ impl Session for DropletSession {
         let colloids = self.colloids.as_ref().map(|c| {
             json!({
                 "particles": c.len(),
-                "final_mean_volume_fraction": p.particles as f64 * p.diameter.powi(3) / (8.0 * r.powi(3)),
+                "final_mean_volume_fraction": p.species.sum_n_d3() / (8.0 * r.powi(3)),
                 "max_excursion_beyond_wall": cp.max_excursion,
                 "centres_beyond_R_at_end": cp.outside_final,
                 "temperature_centre_of_mass": c.com_temperature(),
@@ -794,6 +868,9 @@ impl Session for DropletSession {
         });
         if self.srd.rank().1 > 1 {
             summary["ranks"] = json!(self.srd.rank().1);
+        }
+        if !stratification.is_null() {
+            summary["stratification"] = stratification;
         }
         let message = match failure {
             Some(f) => format!("droplet-mpcd stopped at collision {collisions}: {f}"),

@@ -13,7 +13,9 @@ use anyhow::Result;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_md::mpcd::ColloidParams;
-use colloidsim_particles::potential::{HarmonicInterface, SphereAreaLaw};
+use colloidsim_md::mpcd::colloid::{Geometry, MAX_BOND_STRAIN, MAX_FREQUENCY};
+use colloidsim_particles::Mixture;
+use colloidsim_particles::potential::{HarmonicInterface, SpeciesInterface, SphereAreaLaw};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -49,8 +51,11 @@ pub struct DropletRun {
     pub solvent: SolventParams,
     /// Colloids.
     pub particles: usize,
-    /// Colloid diameter d.
+    /// Colloid diameter d (the smallest species').
     pub diameter: f64,
+    /// The species (written only when there are several).
+    #[serde(skip_serializing_if = "Mixture::is_single")]
+    pub species: Mixture,
     /// Stokes–Einstein diffusivity `kT / (3 pi eta d)` with the theory's viscosity (the
     /// paper's estimate at infinite dilution).
     pub d0: f64,
@@ -106,6 +111,16 @@ impl DropletRun {
         }
     }
 
+    /// The interface as each species meets it: placed for the smallest colloids, a colloid
+    /// of diameter `d_s` meets it `(d_s - d) / 2` further in (its surface, not its centre, at
+    /// the same place).
+    pub fn species_interface(&self) -> SpeciesInterface {
+        SpeciesInterface {
+            interface: self.harmonic(),
+            reference_diameter: self.diameter,
+        }
+    }
+
     /// The radius law.
     pub fn law(&self) -> SphereAreaLaw {
         SphereAreaLaw {
@@ -117,6 +132,66 @@ impl DropletRun {
 
 fn refuse(k: &Spec, message: impl Into<String>) -> anyhow::Error {
     ParamError::new(k.path, message).into()
+}
+
+/// The shells of the species beside the smallest ([`Geometry::frequency_for`]): each must be
+/// supported (at most [`MAX_FREQUENCY`]), held in shape and resolved by the Verlet step like
+/// the smallest (`shared::colloid`); the highest bond frequency of them all.
+fn shells(
+    species: &Mixture,
+    colloid: &ColloidParams,
+    kt: f64,
+    tau: f64,
+    colloids: bool,
+) -> Result<f64> {
+    let mut omega = colloid.highest_bond_frequency();
+    if species.is_single() || !colloids {
+        return Ok(omega);
+    }
+    let d = colloid.diameter;
+    let dt = tau / colloid.md_steps as f64;
+    for (name, &ds) in species.names.iter().zip(&species.diameters) {
+        let f = Geometry::frequency_for(ds, d);
+        if f > MAX_FREQUENCY {
+            return Err(refuse(
+                &SPECIES_DIAMETERS,
+                format!(
+                    "species {name} of diameter {} is {:.4} times the smallest ({}): its shell would need {} vertices \
+                     (frequency {f}), at most {} (frequency {MAX_FREQUENCY}): a size ratio of at most {}",
+                    show(ds),
+                    ds / d,
+                    show(d),
+                    Geometry::vertex_count(f.min(1000)),
+                    Geometry::vertex_count(MAX_FREQUENCY),
+                    (MAX_FREQUENCY as f64 + 0.5) / 2.0
+                ),
+            ));
+        }
+        let strain = colloid.thermal_bond_strain_of(kt, ds, f);
+        if strain > MAX_BOND_STRAIN || strain.is_nan() {
+            return Err(refuse(
+                &SPECIES_DIAMETERS,
+                format!(
+                    "the shell of species {name} (diameter {}, {} vertices) is not held in shape: its bonds stretch by {strain:.3e} of the shortest (at most {MAX_BOND_STRAIN}); stiffer colloid.bond_k",
+                    show(ds),
+                    Geometry::vertex_count(f)
+                ),
+            ));
+        }
+        let w = colloid.highest_bond_frequency_of(f);
+        if w * dt > 1.0 {
+            return Err(refuse(
+                &SPECIES_DIAMETERS,
+                format!(
+                    "the shell of species {name} ({} vertices) vibrates at omega = {w:.4e}: omega dt = {:.4e} with dt = solvent.tau / colloid.md_steps, at most 1; more colloid.md_steps",
+                    Geometry::vertex_count(f),
+                    w * dt
+                ),
+            ));
+        }
+        omega = omega.max(w);
+    }
+    Ok(omega)
 }
 
 /// Read `table` (a `droplet-mpcd` scenario) through [`KEYS`]; `seed` overrides the scenario's.
@@ -141,7 +216,11 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
     let d = r.number(&SYSTEM_DIAMETER)?;
     let kt = srd.kt;
     let colloid = shared::colloid(r, &SYSTEM_DIAMETER, d, particles > 0)?;
-    let n = particles as f64;
+    let species = crate::keys::species::species(r, particles, d, &SYSTEM_DIAMETER)?;
+    // The shells' highest bond frequency (the smallest's when alone).
+    let omega_bonds = shells(&species, &colloid, kt, srd.tau, particles > 0)?;
+    // Spheres of diameter d with the colloids' volume (N for one species).
+    let n = species.equivalent_number(d);
     // system.radius is required unless system.phi0 gives it.
     let radius = match r.has(&SYSTEM_RADIUS) {
         true => Some(r.number(&SYSTEM_RADIUS)?),
@@ -195,13 +274,13 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
             ),
         ));
     }
-    if r0 < d && particles > 0 {
+    if r0 < species.d_max() && particles > 0 {
         return Err(refuse(
             &SYSTEM_RADIUS,
             format!(
                 "the initial droplet radius {} is smaller than a colloid diameter {}",
                 show(r0),
-                show(d)
+                show(species.d_max())
             ),
         ));
     }
@@ -209,8 +288,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
     // The interface's spring on each centre adds at most stiffness / m_centre to the bonds'
     // omega^2 (Weyl): velocity Verlet must still resolve it (as the bonds, `shared::colloid`).
     let dt = srd.tau / colloid.md_steps as f64;
-    let omega =
-        (colloid.highest_bond_frequency().powi(2) + it.stiffness / colloid.centre_mass).sqrt();
+    let omega = (omega_bonds.powi(2) + it.stiffness / colloid.centre_mass).sqrt();
     if particles > 0 && omega * dt > 1.0 {
         return Err(refuse(
             &INTERFACE_STIFFNESS,
@@ -222,7 +300,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
                 show(colloid.centre_mass),
                 omega * dt,
                 show(dt),
-                (dt.powi(-2) - colloid.highest_bond_frequency().powi(2)) * colloid.centre_mass,
+                (dt.powi(-2) - omega_bonds.powi(2)) * colloid.centre_mass,
             ),
         ));
     }
@@ -263,6 +341,17 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         }
         None => box_edge(&SYSTEM_BOX, (min_box / a).ceil() * a, a, 2)?,
     };
+    // The WCA between the largest centres must not reach round the box.
+    let cut = 2f64.powf(1.0 / 6.0) * species.d_max();
+    if particles > 0 && l <= 2.0 * cut {
+        return Err(refuse(
+            &SYSTEM_BOX,
+            format!(
+                "{} must exceed twice the WCA cut-off 2^(1/6) d_max = {cut:.4} of the largest colloids",
+                show(l)
+            ),
+        ));
+    }
     let d0 = srd.kt / (3.0 * PI * solvent.viscosity_theory * d);
     let (peclet, alpha) = shared::drying_rate(r, d0)?;
     let final_fraction = r.if_given(&DRYING_FINAL_VOLUME_FRACTION, Reader::number)?;
@@ -352,6 +441,12 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
     ensure_colloids_fit(
         &SYSTEM_PARTICLES,
         particles,
+        species
+            .diameters
+            .iter()
+            .zip(&species.counts)
+            .map(|(&ds, &c)| c * (1 + Geometry::vertex_count(Geometry::frequency_for(ds, d))))
+            .sum(),
         solvent_bytes(solvent_particles, (l / a).powi(3)),
     )?;
     let profile = Profile {
@@ -400,6 +495,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         solvent,
         particles,
         diameter: d,
+        species,
         d0,
         r0,
         phi0,
@@ -450,8 +546,33 @@ mod tests {
         let table: toml::Table = toml::from_str(FULL).unwrap();
         let r = Reader::new(&table, KEYS).unwrap();
         resolve(&r, None).unwrap();
-        // system.phi0 is read (and refused beside system.radius) but absent here.
-        assert_eq!(r.unread(), Vec::<&str>::new());
+        // system.phi0 is read (and refused beside system.radius) but absent here; the species
+        // keys are read by `species_keys_are_read` (counts and volume_fractions exclude each other).
+        let unread: Vec<&str> = r
+            .unread()
+            .into_iter()
+            .filter(|k| !k.starts_with("system.species."))
+            .collect();
+        assert_eq!(unread, Vec::<&str>::new());
+    }
+
+    #[test]
+    fn species_keys_are_read() {
+        for share in ["counts = [48, 6]", "volume_fractions = [0.5, 0.5]"] {
+            let text = format!(
+                "method = \"droplet-mpcd\"\n[system]\nparticles = 54\nradius = 10\n\
+                 [system.species]\ndiameters = [2.0, 4.0]\n{share}\n[drying]\nduration = 20\n"
+            );
+            let r = match read(&toml::from_str(&text).unwrap(), None) {
+                Ok(r) => r,
+                Err(e) => panic!("{share}: {e:#}"),
+            };
+            // The smallest is system.diameter; phi0 from sum N d^3.
+            assert_eq!(r.species.counts, vec![48, 6], "{share}");
+            assert_eq!(r.diameter, 2.0);
+            let phi = (48.0 * 8.0 + 6.0 * 64.0) / (8.0 * 1000.0);
+            assert!((r.phi0 - phi).abs() < 1e-12, "{} vs {phi}", r.phi0);
+        }
     }
 
     #[test]

@@ -72,8 +72,8 @@ pub(crate) fn solvent_frame(
 /// The positions and velocities of the solvent in a frame.
 pub(crate) type SolventFrame = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
-/// A GSD frame with colloids: the centres (type `A`, diameter d), the vertices (type `V`) and,
-/// when given, the solvent (type `S`).
+/// A GSD frame with colloids: the centres (types `A`, `B`, ... of the species, their
+/// diameters), the vertices (type `V`) and, when given, the solvent (type `S`).
 pub(crate) fn colloid_frame(
     w: &mut GsdWriter,
     srd: &Srd,
@@ -83,10 +83,11 @@ pub(crate) fn colloid_frame(
 ) -> Result<()> {
     let sbox = *srd.sbox();
     let cp = col.params();
+    let ns = col.mixture().len() as u32;
     let mut pos: Vec<[f64; 3]> = col.centre_positions().to_vec();
     let mut vel: Vec<[f64; 3]> = col.centre_velocities().to_vec();
-    let mut typeid = vec![0u32; pos.len()];
-    let mut diameter = vec![cp.diameter; pos.len()];
+    let mut typeid = col.species().to_vec();
+    let mut diameter = col.diameters();
     let mut mass = vec![cp.centre_mass; pos.len()];
     for (x, v) in col.vertex_positions().iter().zip(col.vertex_velocities()) {
         let mut x = *x;
@@ -94,7 +95,7 @@ pub(crate) fn colloid_frame(
         sbox.wrap(&mut x, &mut image);
         pos.push(x);
         vel.push(*v);
-        typeid.push(1);
+        typeid.push(ns);
         diameter.push(0.25 * srd.params().cell);
         mass.push(cp.vertex_mass);
     }
@@ -102,11 +103,13 @@ pub(crate) fn colloid_frame(
         let n = sp.len();
         pos.extend(sp);
         vel.extend(sv);
-        typeid.extend(std::iter::repeat_n(2, n));
+        typeid.extend(std::iter::repeat_n(ns + 1, n));
         diameter.extend(std::iter::repeat_n(0.2 * srd.params().cell, n));
         mass.extend(std::iter::repeat_n(srd.params().mass, n));
     }
     let n = pos.len();
+    let mut type_names = col.mixture().names.clone();
+    type_names.extend(["V".into(), "S".into()]);
     let frame = Particles {
         pos,
         image: vec![[0; 3]; n],
@@ -114,7 +117,7 @@ pub(crate) fn colloid_frame(
         diameter,
         vel,
         mass,
-        type_names: vec!["A".into(), "V".into(), "S".into()],
+        type_names,
     };
     w.write_frame(srd.step(), &sbox, &frame, false, log)?;
     Ok(())
@@ -225,7 +228,7 @@ pub(crate) struct SolventEngine {
     /// The discrete-particle colloids, if any.
     pub(crate) colloids: Option<DiscreteColloids>,
     /// The droplet's interface on the colloid centres (droplet-mpcd).
-    pub(crate) interface: Option<colloidsim_particles::potential::HarmonicInterface>,
+    pub(crate) interface: Option<colloidsim_particles::potential::SpeciesInterface>,
     pub(crate) method: &'static str,
     pub(crate) conf: Confinement,
     pub(crate) drive: Acceleration,
@@ -240,11 +243,7 @@ impl crate::Engine for SolventEngine {
         3
     }
     fn particles(&self) -> usize {
-        self.srd.len()
-            + self
-                .colloids
-                .as_ref()
-                .map_or(0, |c| c.len() * (1 + VERTICES))
+        self.srd.len() + self.colloids.as_ref().map_or(0, |c| c.particle_count())
     }
     fn step(&mut self, steps: u64) -> Result<()> {
         let tau = self.srd.params().tau;
@@ -284,9 +283,11 @@ impl crate::Engine for SolventEngine {
         if let Some(c) = &self.colloids {
             x.extend(c.unwrapped_centres());
             let (centres, unwrapped) = (c.centre_positions(), c.unwrapped_centres());
-            for (k, v) in c.vertex_positions().iter().enumerate() {
-                let (a, b) = (centres[k / VERTICES], unwrapped[k / VERTICES]);
-                x.push(std::array::from_fn(|i| v[i] - a[i] + b[i]));
+            for i in 0..c.len() {
+                let (a, b) = (centres[i], unwrapped[i]);
+                for v in &c.vertex_positions()[c.vertex_range(i)] {
+                    x.push(std::array::from_fn(|k| v[k] - a[k] + b[k]));
+                }
             }
         }
         crate::engine::flat(&x)
@@ -380,15 +381,24 @@ pub(crate) fn colloid_bytes(n: f64) -> f64 {
     n * (1 + VERTICES) as f64 * 200.0
 }
 
-/// Refuse `n` colloids (key `key`) beside a solvent of `solvent` bytes when both do not fit.
-pub(crate) fn ensure_colloids_fit(key: &Spec, n: usize, solvent: f64) -> Result<()> {
+/// Refuse `n` colloids of `particles` particles in all (key `key`) beside a solvent of
+/// `solvent` bytes when both do not fit.
+pub(crate) fn ensure_colloids_fit(
+    key: &Spec,
+    n: usize,
+    particles: usize,
+    solvent: f64,
+) -> Result<()> {
     colloidsim_core::resources::ensure_fits(
         key.path,
-        &format!(
-            "{n} colloids of {} particles beside the solvent",
-            1 + VERTICES
-        ),
-        solvent + colloid_bytes(n as f64),
+        &match particles == n * (1 + VERTICES) {
+            true => format!(
+                "{n} colloids of {} particles beside the solvent",
+                1 + VERTICES
+            ),
+            false => format!("{n} colloids of {particles} particles in all beside the solvent"),
+        },
+        solvent + colloid_bytes(particles as f64 / (1 + VERTICES) as f64),
     )?;
     Ok(())
 }

@@ -12,6 +12,7 @@ use anyhow::Result;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_md::mpcd::ColloidParams;
+use colloidsim_md::mpcd::colloid::VERTICES;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -191,7 +192,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<BulkRun> {
     }
     if nc > 0 {
         let solvent = solvent_bytes(particles, (l / srd.cell).powi(3));
-        ensure_colloids_fit(&SYSTEM_COLLOIDS, nc, solvent)?;
+        ensure_colloids_fit(&SYSTEM_COLLOIDS, nc, nc * (1 + VERTICES), solvent)?;
         // The autocorrelation's ring of lags + 1 velocity sets and its sums per block.
         let vacf = (vacf_lags as f64 + 1.0) * (24.0 * nc as f64 + 40.0 + 16.0 * blocks as f64);
         colloidsim_core::resources::ensure_fits(
