@@ -13,8 +13,8 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
              enough that every profile is the static one at its radius
 
 The measure is the difference of the species' mean centre distances over R, Delta =
-<r>_s / R - <r>_l / R (colloidsim_analysis::stratification), half way through drying and at
-its end. A mixed droplet has Delta > 0 already, because a small centre reaches (d_l - d_s) / 2
+<r>_s / R - <r>_l / R (colloidsim_analysis::stratification), at 50, 75 and 100 % of the drying
+time. A mixed droplet has Delta > 0 already, because a small centre reaches (d_l - d_s) / 2
 closer to the surface; so each run is compared with the uniform mixture at the same radius
 (Delta_ideal: each species' centres distributed as exp(-beta V_k) in its own interface, no
 correlations): S = Delta - Delta_ideal > 0 is small-on-top, S < 0 large-on-top. The threshold
@@ -27,20 +27,22 @@ Each point is one folder RUNS/<method>/phi<phi0>-pe<Pe_s>; a folder whose summar
 run completed (or the theory stopped) is skipped, so the script can be stopped and started
 again.
 
-Outputs: DATA/stratification_study.csv (one row per method, point and profile time, half way
-and at the end: R, Delta and its standard error over the droplets, Delta_ideal, S, Delta_eq,
-S_eq, wall seconds),
-DATA/stratification_thresholds.csv, IMG/stratification-diagram-t050.png and -t100.png (S on the
+Outputs: DATA/stratification_study.csv (one row per method, point and profile time, at 50, 75
+and 100 % of the drying time: R, Delta and its standard error over the droplets, Delta_ideal,
+S, Delta_eq, S_eq, the fraction of centres left beyond R at the end, wall seconds),
+DATA/stratification_thresholds.csv, IMG/stratification-diagram-t075.png and -t100.png (S on the
 Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
-IMG/stratification-vs-pephi-t050.png and -t100.png (S against Pe_s phi_s), and a markdown table
-on stdout. A theory run that stopped early (particles ejected through the interface: the DDFT
+IMG/stratification-vs-pephi-t075.png and -t100.png (S against Pe_s phi_s), and a markdown table
+on stdout. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond R (the
+interface let them behind: droplet-bd warns) did not compact; its end is drawn hollow and left
+out of the thresholds. A theory run that stopped early (particles ejected through the interface: the DDFT
 with the RPY flux and the dilute pair correlation does, as the paper's did) is kept, and its
 profile times up to the stop are used.
 
 Usage (from the repository root):
   python3 scripts/stratification_study.py --bin target/release/colloidsim --runs /tmp/strat \\
       [--methods bd-fd,ddft-fd,ddft-rpy,eq] [--peclet 0.3,1,3,10,30,100] [--phi0 0.05,0.1,0.2] \\
-      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only]
+      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only] [--tag -n450]
 """
 import argparse
 import csv
@@ -53,8 +55,9 @@ import time
 
 ALPHA = 2.0
 EQ_PECLET = 0.01
-# The profile times compared (fractions of the drying time): half way, and the end.
-FRACTIONS = (0.5, 1.0)
+# The profile times compared (fractions of the drying time), and those drawn.
+FRACTIONS = (0.5, 0.75, 1.0)
+DRAWN = (0.75, 1.0)
 # As droplet-bd's warning: a droplet with more of its centres beyond R at the end did not compact.
 LEFT_BEHIND = 0.01
 BASE = "examples/droplet/bidisperse-bd.toml"
@@ -271,7 +274,7 @@ def write_csv(path, rows):
             w.writerow({k: ("" if v is None else v) for k, v in r.items()})
 
 
-def figures(all_rows, methods, img, fraction):
+def figures(all_rows, methods, img, fraction, tag=""):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -279,11 +282,12 @@ def figures(all_rows, methods, img, fraction):
 
     rows = [r for r in all_rows if r["fraction"] == fraction]
     when = "end of drying" if fraction == 1.0 else f"{fraction:.0%} of the drying time"
-    tag = f"t{int(round(100 * fraction)):03d}"
+    tag = f"t{int(round(100 * fraction)):03d}{tag}"
     shown = [m for m in methods if m != "eq" and any(r["method"] == m for r in rows)]
     if not shown or all(r["S"] is None for r in rows):
         return
-    smax = max(abs(r["S"]) for r in rows if r["S"] is not None) or 1.0
+    smax = max((abs(r["S"]) for r in rows if r["S"] is not None and not held_badly(r)),
+               default=0.0) or 1.0
     norm = TwoSlopeNorm(vmin=-smax, vcenter=0.0, vmax=smax)
     fig, axes = plt.subplots(1, len(shown), figsize=(3.4 * len(shown) + 1.4, 3.6),
                              sharey=True, squeeze=False, layout="constrained")
@@ -312,7 +316,9 @@ def figures(all_rows, methods, img, fraction):
         ax.set_title(f"{m} ({when})", fontsize=9)
         ax.set_xlabel(r"$Pe_s$")
     axes[0][0].set_ylabel(r"$\phi_s$ (initial)")
-    axes[0][0].legend(fontsize=7, loc="lower left")
+    for ax in axes[0]:
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="lower left")
     fig.colorbar(sc, ax=axes[0].tolist(),
                  label=r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
     fig.savefig(os.path.join(img, f"stratification-diagram-{tag}.png"), dpi=130)
@@ -357,6 +363,7 @@ def main():
     ap.add_argument("--particles", type=int, default=900)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--analyse-only", action="store_true")
+    ap.add_argument("--tag", default="", help="appended to the names of the data and figures")
     args = ap.parse_args()
     args.methods = args.methods.split(",")
     args.peclet = [float(x) for x in args.peclet.split(",")]
@@ -370,11 +377,11 @@ def main():
     rows, eq = analyse(args)
     os.makedirs(args.data, exist_ok=True)
     os.makedirs(args.img, exist_ok=True)
-    write_csv(os.path.join(args.data, "stratification_study.csv"), rows)
+    write_csv(os.path.join(args.data, f"stratification_study{args.tag}.csv"), rows)
     th = thresholds(rows, [m for m in args.methods if m != "eq"], args.phi0)
-    write_csv(os.path.join(args.data, "stratification_thresholds.csv"), th)
-    for fraction in FRACTIONS:
-        figures(rows, args.methods, args.img, fraction)
+    write_csv(os.path.join(args.data, f"stratification_thresholds{args.tag}.csv"), th)
+    for fraction in DRAWN:
+        figures(rows, args.methods, args.img, fraction, args.tag)
     print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
           "S_eq | wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")

@@ -33,6 +33,36 @@
 use crate::rpy::{PairTensor, rpy, rpy_far, rpy_unequal};
 use std::f64::consts::PI;
 
+/// The wave vectors `k = 2 pi m / l` (m != 0) of a cube of edge `l` with `|k| <= k_cut`, each
+/// with `k^2` and Beenakker's factor `g(k) = 6 pi (1 + q + 2 q^2) e^-q / (k^2 V)`,
+/// `q = k^2 / (4 xi^2)`, which the RPY wave sum multiplies by `1 - s k^2 / 3` (`s` the pair's).
+fn ewald_waves(l: f64, xi: f64, k_cut: f64) -> Vec<([f64; 3], f64, f64)> {
+    let vol = l * l * l;
+    let m_max = (k_cut * l / (2.0 * PI)).ceil() as i32;
+    let mut waves = Vec::new();
+    for mx in -m_max..=m_max {
+        for my in -m_max..=m_max {
+            for mz in -m_max..=m_max {
+                if mx == 0 && my == 0 && mz == 0 {
+                    continue;
+                }
+                let k = [mx, my, mz].map(|m| 2.0 * PI * m as f64 / l);
+                let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+                if k2 > k_cut * k_cut {
+                    continue;
+                }
+                let q = k2 / (4.0 * xi * xi);
+                waves.push((
+                    k,
+                    k2,
+                    (1.0 + q + 2.0 * q * q) * 6.0 * PI / (k2 * vol) * (-q).exp(),
+                ));
+            }
+        }
+    }
+    waves
+}
+
 /// Dense periodic RPY matrix (row-major, entry `(3 i + p, 3 j + q)`) of spheres of radius `a`
 /// at `pos` in a cube of edge `l`, viscosity `eta`, by Beenakker's Ewald sum with parameter
 /// `xi` (real and wave sums each converged to about 1e-16 relative).
@@ -41,12 +71,10 @@ pub fn beenakker_matrix(pos: &[[f64; 3]], a: f64, eta: f64, l: f64, xi: f64) -> 
     let n = pos.len();
     let mu0 = 1.0 / (6.0 * PI * eta * a);
     let sp = PI.sqrt();
-    let vol = l * l * l;
     // exp(-x^2) and erfc(x) below 1e-17 beyond x = 6.2.
     let r_cut = 6.2 / xi;
     let n_img = (r_cut / l).ceil() as i32 + 1;
     let k_cut = 2.0 * xi * 6.2;
-    let m_max = (k_cut * l / (2.0 * PI)).ceil() as i32;
     let real = |r: f64| -> (f64, f64) {
         let (x2, e, c) = (
             xi * xi * r * r,
@@ -70,27 +98,11 @@ pub fn beenakker_matrix(pos: &[[f64; 3]], a: f64, eta: f64, l: f64, xi: f64) -> 
         let _ = x2;
         (a1, b1)
     };
-    // Wave vectors and their scalar factors.
-    let mut waves = Vec::new();
-    for mx in -m_max..=m_max {
-        for my in -m_max..=m_max {
-            for mz in -m_max..=m_max {
-                if mx == 0 && my == 0 && mz == 0 {
-                    continue;
-                }
-                let k = [mx, my, mz].map(|m| 2.0 * PI * m as f64 / l);
-                let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-                if k2 > k_cut * k_cut {
-                    continue;
-                }
-                let q = k2 / (4.0 * xi * xi);
-                let s = (a - a * a * a * k2 / 3.0) * (1.0 + q + 2.0 * q * q) * 6.0 * PI
-                    / (k2 * vol)
-                    * (-q).exp();
-                waves.push((k, k2, s));
-            }
-        }
-    }
+    // Wave vectors and their scalar factors (a - a^3 k^2 / 3) g(k).
+    let waves: Vec<_> = ewald_waves(l, xi, k_cut)
+        .into_iter()
+        .map(|(k, k2, g)| (k, k2, (a - a * a * a * k2 / 3.0) * g))
+        .collect();
     let self_term = 1.0 - 6.0 * xi * a / sp + 40.0 / 3.0 * xi.powi(3) * a.powi(3) / sp;
     let mut m = vec![0.0; 9 * n * n];
     for i in 0..n {
@@ -184,11 +196,9 @@ pub fn beenakker_matrix_radii(
     );
     let c6 = 1.0 / (6.0 * PI * eta);
     let sp = PI.sqrt();
-    let vol = l * l * l;
     let r_cut = 6.2 / xi;
     let n_img = (r_cut / l).ceil() as i32 + 1;
     let k_cut = 2.0 * xi * 6.2;
-    let m_max = (k_cut * l / (2.0 * PI)).ceil() as i32;
     // Real-space functions of a pair with s = (a_i^2 + a_j^2)/2, in units of 1/(6 pi eta).
     let real = |r: f64, s: f64| -> (f64, f64) {
         let (e, c) = ((-(xi * xi * r * r)).exp() / sp, libm::erfc(xi * r));
@@ -208,24 +218,7 @@ pub fn beenakker_matrix_radii(
         (a1, b1)
     };
     // Wave vectors, k^2 and the factor g(k) of (1 − s k^2 / 3) g(k).
-    let mut waves = Vec::new();
-    for mx in -m_max..=m_max {
-        for my in -m_max..=m_max {
-            for mz in -m_max..=m_max {
-                if mx == 0 && my == 0 && mz == 0 {
-                    continue;
-                }
-                let k = [mx, my, mz].map(|m| 2.0 * PI * m as f64 / l);
-                let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-                if k2 > k_cut * k_cut {
-                    continue;
-                }
-                let q = k2 / (4.0 * xi * xi);
-                let g = (1.0 + q + 2.0 * q * q) * 6.0 * PI / (k2 * vol) * (-q).exp();
-                waves.push((k, k2, g));
-            }
-        }
-    }
+    let waves = ewald_waves(l, xi, k_cut);
     let mut m = vec![0.0; 9 * n * n];
     for i in 0..n {
         for j in 0..n {

@@ -23,8 +23,8 @@ use colloidsim_md::DropletParams;
 use serde_json::json;
 
 use crate::control::Control;
-use crate::output::plot::{self, Scale, Series};
 use crate::output::profile_name;
+use crate::output::species::draw_species_profiles;
 use crate::{Report, Scenario as Source, TheoryOptions};
 
 /// The mixture DDFT of the droplet `p` up to `t_end` (grid spacing `dr`, fluxes `hydro`): each
@@ -169,31 +169,17 @@ pub(super) fn theory(
     });
     dir.write_json("summary.json", &summary)?;
     let mut warnings = Vec::new();
-    let series: Vec<Series> = shown
-        .iter()
-        .map(|(label, x, y)| Series {
-            label,
-            x,
-            y,
-            points: false,
-        })
-        .collect();
-    if !series.is_empty() {
-        plot::picture(
-            plot::line_plot_with_errors(
-                &dir.join("species_profiles.png"),
-                &format!(
-                    "Mixture DDFT: species {} (diameters {:?})",
-                    m.names.join(", "),
-                    m.diameters
-                ),
-                "r / R(t)",
-                "volume fraction phi_k(r)",
-                &series,
-                &[],
-                Scale::Linear,
+    if !shown.is_empty() {
+        draw_species_profiles(
+            &dir,
+            &format!(
+                "Mixture DDFT: species {} (diameters {:?})",
+                m.names.join(", "),
+                m.diameters
             ),
-            "species_profiles.png",
+            "r / R(t)",
+            &shown,
+            &[],
             &mut files,
             &mut warnings,
         );
