@@ -12,6 +12,9 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
   eq         the binary FMT equilibrium reference: the DDFT dried at Pe_s = EQ_PECLET, slow
              enough that every profile is the static one at its radius
 
+and any of them with `-k<stiffness>` appended (`bd-rpy-k500`): the same in an interface of that
+stiffness (kT/d^2) instead of the example's 100, to see whether the interface held the colloids.
+
 The measure is the difference of the species' mean centre distances over R, Delta =
 <r>_s / R - <r>_l / R (colloidsim_analysis::stratification), at 50, 75 and 100 % of the drying
 time. A mixed droplet has Delta > 0 already, because a small centre reaches (d_l - d_s) / 2
@@ -33,16 +36,17 @@ S, Delta_eq, S_eq, the fraction of centres left beyond R at the end, wall second
 DATA/stratification_thresholds.csv, IMG/stratification-diagram-t075.png and -t100.png (S on the
 Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
 IMG/stratification-vs-pephi-t075.png and -t100.png (S against Pe_s phi_s), and a markdown table
-on stdout. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond R (the
-interface let them behind: droplet-bd warns) did not compact; its end is drawn hollow and left
-out of the thresholds. A theory run that stopped early (particles ejected through the interface: the DDFT
-with the RPY flux and the dilute pair correlation does, as the paper's did) is kept, and its
-profile times up to the stop are used.
+on stdout; IMG/stratification-profiles-pe10-phi0.1.png: both species' profiles at the end, every
+method side by side. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond
+R (the interface left them behind: droplet-bd warns) did not compact; its end is drawn hollow
+and left out of the thresholds. A theory run that stopped early (particles ejected through the
+interface: the DDFT with the RPY flux and the dilute pair correlation does, as the paper's did)
+is kept, and its profile times up to the stop are used. --tag is appended to every file name.
 
 Usage (from the repository root):
   python3 scripts/stratification_study.py --bin target/release/colloidsim --runs /tmp/strat \\
       [--methods bd-fd,ddft-fd,ddft-rpy,eq] [--peclet 0.3,1,3,10,30,100] [--phi0 0.05,0.1,0.2] \\
-      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only] [--tag -n450]
+      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only] [--tag=-n450]
 """
 import argparse
 import csv
@@ -58,15 +62,26 @@ EQ_PECLET = 0.01
 # The profile times compared (fractions of the drying time), and those drawn.
 FRACTIONS = (0.5, 0.75, 1.0)
 DRAWN = (0.75, 1.0)
+# The grid points whose profiles are drawn method by method.
+PROFILES_AT = ((10.0, 0.1),)
 # As droplet-bd's warning: a droplet with more of its centres beyond R at the end did not compact.
 LEFT_BEHIND = 0.01
 BASE = "examples/droplet/bidisperse-bd.toml"
 DDFT_DX = "0.05"
 
 
+def split(method):
+    """A method name and its interface stiffness: `bd-rpy-k500` is bd-rpy in an interface of
+    500 kT/d^2 (None: the example's 100)."""
+    base, _, k = method.rpartition("-k")
+    return (base, float(k)) if base and k.isdigit() else (method, None)
+
+
 def scenario(pe, phi0, replicas, method, particles=900):
-    """The example with this Peclet number, initial volume fraction, replicas, mobility and
-    number of spheres (8 small per large: equal volumes at alpha = 2)."""
+    """The example with this Peclet number, initial volume fraction, replicas, mobility,
+    interface stiffness and number of spheres (8 small per large: equal volumes at
+    alpha = 2)."""
+    method, stiffness = split(method)
     with open(BASE) as f:
         lines = f.read().splitlines()
     out = []
@@ -83,6 +98,8 @@ def scenario(pe, phi0, replicas, method, particles=900):
         elif key == "counts":
             large = particles // 9
             line = f"counts = [{particles - large}, {large}]"
+        elif key == "stiffness" and stiffness is not None:
+            line = f"stiffness = {stiffness}"
         out.append(line)
     text = "\n".join(out) + "\n"
     if method == "bd-rpy":
@@ -121,12 +138,12 @@ def run_point(args, method, pe, phi0, log):
     scen = folder + ".toml"
     with open(scen, "w") as f:
         f.write(scenario(pe, phi0, args.replicas, method, args.particles))
-    if method.startswith("bd"):
+    if split(method)[0].startswith("bd"):
         cmd = [args.bin, "run", scen, "--out", folder, "--force", "--quiet",
                "--threads", str(args.threads)]
     else:
         cmd = [args.bin, "theory", scen, "--out", folder, "--force", "--dx", DDFT_DX]
-        if method == "ddft-rpy":
+        if split(method)[0] == "ddft-rpy":
             cmd += ["--hydrodynamics", "rpy"]
     t0 = time.time()
     res = subprocess.run(cmd, capture_output=True, text=True)
@@ -235,32 +252,43 @@ def held_badly(row):
     return (row["left_behind"] or 0.0) > LEFT_BEHIND
 
 
+def crossing(pts, phi0):
+    """Pe_s phi_s where S turns positive along (Pe_s, S) points sorted by Pe_s: interpolated in
+    log Pe_s at the last sign change from <= 0 to > 0; or a bound with the reason."""
+    if not pts:
+        return None, "no points"
+    if pts[0][1] > 0:
+        return None, f"small-on-top at every Pe_s: below {pts[0][0] * phi0 / 2:g}"
+    if all(s <= 0 for _, s in pts):
+        return None, f"never small-on-top: above {pts[-1][0] * phi0 / 2:g}"
+    value = None
+    for (p0, s0), (p1, s1) in zip(pts, pts[1:]):
+        if s0 <= 0 < s1:
+            x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
+            value = math.exp(x) * phi0 / 2
+    return value, ""
+
+
 def thresholds(rows, methods, phi0s):
-    """Pe_s phi_s where S turns positive, per method, profile time and phi0 (log-linear
-    interpolation in Pe_s between grid points)."""
+    """Pe_s phi_s where S turns positive, per method, profile time and phi0, with the range
+    that S - err and S + err give (the crossing's uncertainty from the droplets' scatter)."""
     out = []
     for method in methods:
         for fraction in FRACTIONS:
             for phi0 in phi0s:
-                pts = sorted((r["pe_s"], r["S"]) for r in rows
-                             if r["method"] == method and r["phi0"] == phi0
-                             and r["fraction"] == fraction and r["S"] is not None
-                             and not held_badly(r))
-                if not pts:
+                sel = sorted((r for r in rows
+                              if r["method"] == method and r["phi0"] == phi0
+                              and r["fraction"] == fraction and r["S"] is not None
+                              and not held_badly(r)), key=lambda r: r["pe_s"])
+                if not sel:
                     continue
-                value, note = None, ""
-                if pts[0][1] > 0:
-                    note = f"small-on-top at every Pe_s: below {pts[0][0] * phi0 / 2:g}"
-                elif all(s <= 0 for _, s in pts):
-                    note = f"never small-on-top: above {pts[-1][0] * phi0 / 2:g}"
-                else:
-                    for (p0, s0), (p1, s1) in zip(pts, pts[1:]):
-                        if s0 <= 0 < s1:
-                            x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
-                            value = math.exp(x) * phi0 / 2
-                            break
+                value, note = crossing([(r["pe_s"], r["S"]) for r in sel], phi0)
+                err = [r["delta_err"] or 0.0 for r in sel]
+                late, _ = crossing([(r["pe_s"], r["S"] - e) for r, e in zip(sel, err)], phi0)
+                early, _ = crossing([(r["pe_s"], r["S"] + e) for r, e in zip(sel, err)], phi0)
                 out.append({"method": method, "fraction": fraction, "phi0": phi0,
-                            "threshold_pe_phi_s": value, "note": note})
+                            "threshold_pe_phi_s": value, "from": early, "to": late,
+                            "note": note})
     return out
 
 
@@ -350,6 +378,44 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
+def profile_figure(args, pe, phi0, fraction, path):
+    """Both species' volume-fraction profiles against r/R at one point of the grid, every
+    method side by side (species_profile_<f>.csv of each run, errors where there are)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6), sharey=True, layout="constrained")
+    name = f"species_profile_{fraction:.2f}.csv"
+    drawn = False
+    for k, method in enumerate(m for m in args.methods if m != "eq"):
+        f = os.path.join(folder_of(args.runs, method, pe, phi0), name)
+        if not os.path.exists(f):
+            continue
+        with open(f) as fh:
+            rows = [r for r in csv.DictReader(fh)]
+        radius = measures(os.path.dirname(f))[0].get(round(fraction, 6), (0, 0, None))[2]
+        if not rows or not radius:
+            continue
+        x = [float(r["r"]) / radius for r in rows]
+        for ax, sp in zip(axes, ("A", "B")):
+            y = [float(r[f"phi_{sp}"]) for r in rows]
+            e = [float(r[f"err_{sp}"]) if r.get(f"err_{sp}") not in (None, "") else 0.0
+                 for r in rows]
+            ax.errorbar(x, y, yerr=e, color=f"C{k}", lw=1.2, capsize=1.5, label=method)
+            drawn = True
+    if not drawn:
+        plt.close(fig)
+        return
+    for ax, what in zip(axes, ("small spheres (A, d)", "large spheres (B, 2d)")):
+        ax.set_title(f"{what}: Pe_s = {pe:g}, phi0 = {phi0:g}, t = {fraction:.0%}", fontsize=9)
+        ax.set_xlabel("r / R(t)")
+    axes[0].set_ylabel("volume fraction of centres")
+    axes[0].legend(fontsize=8)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default="target/release/colloidsim")
@@ -382,20 +448,26 @@ def main():
     write_csv(os.path.join(args.data, f"stratification_thresholds{args.tag}.csv"), th)
     for fraction in DRAWN:
         figures(rows, args.methods, args.img, fraction, args.tag)
+    for pe, phi0 in PROFILES_AT:
+        profile_figure(args, pe, phi0, 1.0, os.path.join(
+            args.img, f"stratification-profiles-pe{pe:g}-phi{phi0:g}{args.tag}.png"))
     print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
           "S_eq | wall (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         err = f" ± {r['delta_err']:.3f}" if r["delta_err"] is not None else ""
         fmt = lambda x: "n/a" if x is None else f"{x:.3f}"
-        print(f"| {r['method']} | {r['fraction']:g} | {r['phi0']:g} | {r['pe_s']:g} | {r['pe_phi_s']:.3g} | "
+        print(f"| {r['method']} | {r['fraction']:g} | {r['phi0']:g} | {r['pe_s']:g} | "
+              f"{r['pe_phi_s']:.3g} | "
               f"{r['delta']:.3f}{err} | {r['delta_ideal']:.3f} | {r['S']:.3f} | "
               f"{fmt(r['delta_eq'])} | {fmt(r['S_eq'])} | "
               f"{fmt(r['wall_s'])} |")
     for t in th:
         v = t["threshold_pe_phi_s"]
+        rng = lambda x: "?" if x is None else "%.3g" % x
         print(f"threshold {t['method']} t/t_end={t['fraction']:g} phi0={t['phi0']:g}: "
-              f"{'%.3g' % v if v is not None else t['note']}")
+              f"{'%.3g' % v if v is not None else t['note']} "
+              f"(S -/+ err: {rng(t['from'])} .. {rng(t['to'])})")
 
 
 if __name__ == "__main__":
