@@ -21,7 +21,7 @@ time. A mixed droplet has Delta > 0 already, because a small centre reaches (d_l
 closer to the surface; so each run is compared with the uniform mixture at the same radius
 (Delta_ideal: each species' centres distributed as exp(-beta V_k) in its own interface, no
 correlations): S = Delta - Delta_ideal > 0 is small-on-top, S < 0 large-on-top. The threshold
-of small-on-top is the Pe_s phi_s at which S turns positive (interpolated in log Pe_s between
+of small-on-top is the Pe_s phi_s from which S stays positive (interpolated in log Pe_s between
 grid points at each phi0). The binary FMT equilibrium at the same radius (Delta_eq, from the
 `eq` runs) is the second reference: S_eq = Delta - Delta_eq says how far from equilibrium the
 droplet is (at phi = 0.5 the equilibrium has the large spheres layered at the wall).
@@ -253,24 +253,22 @@ def held_badly(row):
 
 
 def crossing(pts, phi0):
-    """Pe_s phi_s where S turns positive along (Pe_s, S) points sorted by Pe_s: interpolated in
-    log Pe_s at the last sign change from <= 0 to > 0; or a bound with the reason."""
+    """Pe_s phi_s from which S stays positive along (Pe_s, S) points sorted by Pe_s:
+    interpolated in log Pe_s after the last point with S <= 0; or a bound with the reason."""
     if not pts:
         return None, "no points"
-    if pts[0][1] > 0:
+    if all(s > 0 for _, s in pts):
         return None, f"small-on-top at every Pe_s: below {pts[0][0] * phi0 / 2:g}"
-    if all(s <= 0 for _, s in pts):
-        return None, f"never small-on-top: above {pts[-1][0] * phi0 / 2:g}"
-    value = None
-    for (p0, s0), (p1, s1) in zip(pts, pts[1:]):
-        if s0 <= 0 < s1:
-            x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
-            value = math.exp(x) * phi0 / 2
-    return value, ""
+    if pts[-1][1] <= 0:
+        return None, f"not small-on-top at the largest Pe_s: above {pts[-1][0] * phi0 / 2:g}"
+    k = max(i for i, (_, s) in enumerate(pts) if s <= 0)
+    (p0, s0), (p1, s1) = pts[k], pts[k + 1]
+    x = math.log(p0) + (math.log(p1) - math.log(p0)) * (-s0) / (s1 - s0)
+    return math.exp(x) * phi0 / 2, ""
 
 
 def thresholds(rows, methods, phi0s):
-    """Pe_s phi_s where S turns positive, per method, profile time and phi0, with the range
+    """Pe_s phi_s from which S stays positive, per method, profile time and phi0, with the range
     that S - err and S + err give (the crossing's uncertainty from the droplets' scatter)."""
     out = []
     for method in methods:
@@ -352,7 +350,7 @@ def figures(all_rows, methods, img, fraction, tag=""):
     fig.savefig(os.path.join(img, f"stratification-diagram-{tag}.png"), dpi=130)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    fig, ax = plt.subplots(figsize=(8.0, 4.0), layout="constrained")
     marks = {0.05: "o", 0.1: "s", 0.2: "^"}
     for k, m in enumerate(shown):
         for phi0 in sorted({r["phi0"] for r in rows}):
@@ -372,8 +370,7 @@ def figures(all_rows, methods, img, fraction, tag=""):
     ax.set_xlabel(r"$Pe_s \phi_s$")
     ax.set_ylabel(r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
     ax.set_title(when, fontsize=9)
-    ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.savefig(os.path.join(img, f"stratification-vs-pephi-{tag}.png"), dpi=130)
     plt.close(fig)
 
