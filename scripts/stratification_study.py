@@ -36,7 +36,7 @@ S, Delta_eq, S_eq, the fraction of centres left beyond R at the end, wall second
 DATA/stratification_thresholds.csv, IMG/stratification-diagram-t075.png and -t100.png (S on the
 Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
 IMG/stratification-vs-pephi-t075.png and -t100.png (S against Pe_s phi_s), and a markdown table
-on stdout; IMG/stratification-profiles-pe10-phi0.1.png: both species' profiles at the end, every
+on stdout; IMG/stratification-profiles-pe30-phi0.2.png: both species' profiles at the end, every
 method side by side. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond
 R (the interface left them behind: droplet-bd warns) did not compact; its end is drawn hollow
 and left out of the thresholds. A theory run that stopped early (particles ejected through the
@@ -46,7 +46,8 @@ is kept, and its profile times up to the stop are used. --tag is appended to eve
 Usage (from the repository root):
   python3 scripts/stratification_study.py --bin target/release/colloidsim --runs /tmp/strat \\
       [--methods bd-fd,ddft-fd,ddft-rpy,eq] [--peclet 0.3,1,3,10,30,100] [--phi0 0.05,0.1,0.2] \\
-      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only] [--tag=-n450]
+      [--replicas 4] [--particles 900] [--threads 2] [--analyse-only] [--tag=-n450] \
+      [--panels ddft-fd,bd-fd]
 """
 import argparse
 import csv
@@ -63,7 +64,7 @@ EQ_PECLET = 0.01
 FRACTIONS = (0.5, 0.75, 1.0)
 DRAWN = (0.75, 1.0)
 # The grid points whose profiles are drawn method by method.
-PROFILES_AT = ((10.0, 0.1),)
+PROFILES_AT = ((30.0, 0.2),)
 # As droplet-bd's warning: a droplet with more of its centres beyond R at the end did not compact.
 LEFT_BEHIND = 0.01
 BASE = "examples/droplet/bidisperse-bd.toml"
@@ -306,7 +307,7 @@ def figures(all_rows, methods, img, fraction, tag=""):
     import matplotlib.pyplot as plt
     from matplotlib.colors import TwoSlopeNorm
 
-    rows = [r for r in all_rows if r["fraction"] == fraction]
+    rows = [r for r in all_rows if r["fraction"] == fraction and r["method"] in methods]
     when = "end of drying" if fraction == 1.0 else f"{fraction:.0%} of the drying time"
     tag = f"t{int(round(100 * fraction)):03d}{tag}"
     shown = [m for m in methods if m != "eq" and any(r["method"] == m for r in rows)]
@@ -375,7 +376,7 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
-def profile_figure(args, pe, phi0, fraction, path):
+def profile_figure(args, methods, pe, phi0, fraction, path):
     """Both species' volume-fraction profiles against r/R at one point of the grid, every
     method side by side (species_profile_<f>.csv of each run, errors where there are)."""
     import matplotlib
@@ -385,7 +386,7 @@ def profile_figure(args, pe, phi0, fraction, path):
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6), sharey=True, layout="constrained")
     name = f"species_profile_{fraction:.2f}.csv"
     drawn = False
-    for k, method in enumerate(m for m in args.methods if m != "eq"):
+    for k, method in enumerate(m for m in methods if m != "eq"):
         f = os.path.join(folder_of(args.runs, method, pe, phi0), name)
         if not os.path.exists(f):
             continue
@@ -407,6 +408,8 @@ def profile_figure(args, pe, phi0, fraction, path):
     for ax, what in zip(axes, ("small spheres (A, d)", "large spheres (B, 2d)")):
         ax.set_title(f"{what}: Pe_s = {pe:g}, phi0 = {phi0:g}, t = {fraction:.0%}", fontsize=9)
         ax.set_xlabel("r / R(t)")
+        # The inner shells hold a sphere or two: their profile is noise.
+        ax.set_xlim(0.4, 1.0)
     axes[0].set_ylabel("volume fraction of centres")
     axes[0].legend(fontsize=8)
     fig.savefig(path, dpi=130)
@@ -427,6 +430,7 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--tag", default="", help="appended to the names of the data and figures")
+    ap.add_argument("--panels", help="the methods the figures show (default: --methods)")
     args = ap.parse_args()
     args.methods = args.methods.split(",")
     args.peclet = [float(x) for x in args.peclet.split(",")]
@@ -443,10 +447,11 @@ def main():
     write_csv(os.path.join(args.data, f"stratification_study{args.tag}.csv"), rows)
     th = thresholds(rows, [m for m in args.methods if m != "eq"], args.phi0)
     write_csv(os.path.join(args.data, f"stratification_thresholds{args.tag}.csv"), th)
+    shown = args.panels.split(",") if args.panels else args.methods
     for fraction in DRAWN:
-        figures(rows, args.methods, args.img, fraction, args.tag)
+        figures(rows, shown, args.img, fraction, args.tag)
     for pe, phi0 in PROFILES_AT:
-        profile_figure(args, pe, phi0, 1.0, os.path.join(
+        profile_figure(args, shown, pe, phi0, 1.0, os.path.join(
             args.img, f"stratification-profiles-pe{pe:g}-phi{phi0:g}{args.tag}.png"))
     print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
           "S_eq | wall (s) |")
