@@ -2057,29 +2057,33 @@ mod tests {
         }
     }
 
-    /// A drying droplet with colloids: solvent in the sphere (slip wall, virtual particles),
-    /// colloids placed inside and held by the harmonic interface on their centres at R(t);
-    /// they stay inside while the sphere shrinks.
-    #[test]
-    fn colloids_in_a_drying_droplet_stay_inside_the_interface() {
+    /// A drying droplet of `n` colloids of diameter `d` in a sphere of initial radius `r0`
+    /// (slip wall, `alpha = 10`) in a cubic box of edge `edge`, solvent and colloids seeded by
+    /// `seed`, held by a harmonic interface (100 kT/d^2, range d/2, offset -d/2) on their centres.
+    fn drying_droplet(
+        d: f64,
+        r0: f64,
+        edge: f64,
+        n: usize,
+        seed: u32,
+    ) -> (MpcdSystem, crate::potential::SphereAreaLaw) {
         use crate::mpcd::WallKind;
         use crate::potential::SphereAreaLaw;
-        let (d, r0) = (2.0, 7.0);
         let law = SphereAreaLaw { r0, alpha: 10.0 };
         let conf = Confinement::Sphere {
             law,
             kind: WallKind::Slip,
         };
-        let p = SrdParams::standard(12);
-        let sbox = SimBox::cube(18.0);
+        let p = SrdParams::standard(seed);
+        let sbox = SimBox::cube(edge);
         let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
         let c = DiscreteColloids::random(
             ColloidParams::standard(d, p.kt),
             sbox,
-            20,
+            n,
             Region::Sphere { radius: r0 },
             p.kt,
-            12,
+            seed,
         )
         .unwrap();
         let interface = HarmonicInterface {
@@ -2089,7 +2093,16 @@ mod tests {
             range: 0.5 * d,
             offset: -0.5 * d,
         };
-        let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+        (MpcdSystem::new(srd, c, conf, Some(interface)).unwrap(), law)
+    }
+
+    /// A drying droplet with colloids: solvent in the sphere (slip wall, virtual particles),
+    /// colloids placed inside and held by the harmonic interface on their centres at R(t);
+    /// they stay inside while the sphere shrinks.
+    #[test]
+    fn colloids_in_a_drying_droplet_stay_inside_the_interface() {
+        let (d, r0) = (2.0, 7.0);
+        let (mut sys, law) = drying_droplet(d, r0, 18.0, 20, 12);
         let mut virt = 0;
         for _ in 0..100 {
             virt += sys
@@ -2121,34 +2134,7 @@ mod tests {
     /// constant was printed by this test on that code, commit 59068cd).
     #[test]
     fn one_species_reproduces_the_single_size_model_bitwise() {
-        use crate::mpcd::WallKind;
-        use crate::potential::SphereAreaLaw;
-        let (d, r0) = (2.0, 6.0);
-        let law = SphereAreaLaw { r0, alpha: 10.0 };
-        let conf = Confinement::Sphere {
-            law,
-            kind: WallKind::Slip,
-        };
-        let p = SrdParams::standard(5);
-        let sbox = SimBox::cube(16.0);
-        let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
-        let c = DiscreteColloids::random(
-            ColloidParams::standard(d, p.kt),
-            sbox,
-            25,
-            Region::Sphere { radius: r0 },
-            p.kt,
-            5,
-        )
-        .unwrap();
-        let interface = HarmonicInterface {
-            centre: [0.0; 3],
-            radius: law,
-            stiffness: 100.0,
-            range: 0.5 * d,
-            offset: -0.5 * d,
-        };
-        let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+        let (mut sys, _) = drying_droplet(2.0, 6.0, 16.0, 25, 5);
         for _ in 0..8 {
             sys.step(&Acceleration::None).unwrap();
         }
