@@ -154,10 +154,20 @@ fn draw_line_plot(
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
+            let (xres, yres) = match scale {
+                Scale::Linear => (1e-6 * (xr.1 - xr.0), 1e-6 * (yr.1 - yr.0)),
+                Scale::LogLog => (f64::NAN, f64::NAN),
+            };
+            let tick =
+                |v: &f64, res: f64| tick_label(*v, if res.is_nan() { 1e-6 * v.abs() } else { res });
+            let xfmt = |v: &f64| tick(v, xres);
+            let yfmt = |v: &f64| tick(v, yres);
             chart
                 .configure_mesh()
                 .x_desc(xlabel)
                 .y_desc(ylabel)
+                .x_label_formatter(&xfmt)
+                .y_label_formatter(&yfmt)
                 .label_style(("sans-serif", 16))
                 .draw()
                 .map_err(|e| anyhow!("plot: {e}"))?;
@@ -257,6 +267,42 @@ fn draw_line_plot(
     }
     whole.present().map_err(|e| anyhow!("plot: {e}"))?;
     Ok(())
+}
+
+/// A tick label: `v` rounded to the fewest significant digits (at most 15) that keep it within
+/// `resolution` of itself, printed as the shortest decimal of that rounded value (so a tick at
+/// 0.1 + 0.2 reads "0.3", not "0.30000000000000004"); a value within `resolution / 2` of zero
+/// reads "0"; magnitudes below 1e-4 or from 1e6 up in scientific notation ("2.5e-5").
+/// `resolution` is a millionth of the axis' span on a linear axis, of the value on a log one.
+pub fn tick_label(v: f64, resolution: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let res = if resolution.is_finite() && resolution > 0.0 {
+        resolution
+    } else {
+        v.abs() * 1e-12
+    };
+    if v.abs() <= 0.5 * res {
+        return "0".into();
+    }
+    let mut digits = 15;
+    let mut rounded = v;
+    for p in 1..=15 {
+        // Rounding to p significant digits through the decimal text is exact to the last bit.
+        let r: f64 = format!("{:.*e}", p - 1, v).parse().unwrap_or(v);
+        if (r - v).abs() <= res {
+            digits = p;
+            rounded = r;
+            break;
+        }
+    }
+    let m = rounded.abs();
+    if !(1e-4..1e6).contains(&m) {
+        format!("{:.*e}", digits - 1, rounded)
+    } else {
+        format!("{rounded}")
+    }
 }
 
 /// The width in px of a legend beside the axes: its longest label at about 7 px a character
@@ -406,11 +452,14 @@ fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) ->
         .y_label_area_size(50)
         .build_cartesian_2d(-lim..lim, -lim..lim)
         .map_err(e)?;
+    let fmt = |v: &f64| tick_label(*v, 2e-6 * lim);
     chart
         .configure_mesh()
         .disable_mesh()
         .x_desc("x")
         .y_desc("y")
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(e)?;
@@ -504,7 +553,7 @@ fn flat_range(y: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::{Scale, Series, data_ranges, flat_range, merged_shells};
+    use super::{Scale, Series, data_ranges, flat_range, merged_shells, tick_label};
 
     /// The y axis holds the error bars, not only the points; a series without errors and the
     /// lower ends on a log axis that would reach zero leave it as the points make it.
@@ -555,5 +604,26 @@ mod tests {
         assert!(flat_range(1e-6).0 > 0.0);
         assert_eq!(flat_range(0.0), (-1.0, 1.0));
         assert!(flat_range(-2.0).1 < 0.0);
+    }
+
+    /// Tick labels are the shortest decimals of the ticks at the axis' resolution.
+    #[test]
+    fn tick_labels_are_short_decimals() {
+        let res = 1e-6;
+        assert_eq!(tick_label(0.1 + 0.2, res), "0.3");
+        assert_eq!(tick_label(0.30000000000000004, res), "0.3");
+        assert_eq!(tick_label(3.0 * 0.1, res), "0.3");
+        assert_eq!(tick_label(1.0, res), "1");
+        assert_eq!(tick_label(-0.7000000000000001, res), "-0.7");
+        assert_eq!(tick_label(2.5, res), "2.5");
+        assert_eq!(tick_label(120.0, 1e-4), "120");
+        // A tick at zero computed as a tiny remainder.
+        assert_eq!(tick_label(5.551115123125783e-17, res), "0");
+        // Small and large magnitudes in scientific notation, still short.
+        assert_eq!(tick_label(2.5e-5 + 1e-21, 1e-11), "2.5e-5");
+        assert_eq!(tick_label(3.0e7 * 1.0000000000000002, 10.0), "3e7");
+        // A fine axis keeps the digits it needs.
+        assert_eq!(tick_label(1.0001, 1e-7), "1.0001");
+        assert_eq!(tick_label(f64::NAN, res), "NaN");
     }
 }
