@@ -415,16 +415,36 @@ pub struct Disc {
     pub colour: usize,
 }
 
+/// What the marks of a [`cross_section`] mean: one legend entry per disc colour (by index),
+/// one for the outline, and the axes' labels with their unit.
+pub struct SectionLabels<'a> {
+    /// Legend entry of the discs of colour `k`.
+    pub colours: &'a [&'a str],
+    /// Legend entry of the outline circle.
+    pub outline: &'a str,
+    /// x axis, with its unit.
+    pub x: &'a str,
+    /// y axis, with its unit.
+    pub y: &'a str,
+}
+
 /// Draw `discs` (e.g. the sections of spheres cut by a slab) inside a circle of radius `outline`
-/// centred on the origin, with equal scales on both axes, into a square PNG at `path`
-/// (600x600 px; drawn under a temporary name and renamed into place).
-pub fn cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
+/// centred on the origin, with equal scales on both axes, into a PNG at `path` (a 600x600 px
+/// square of axes and a legend column right of it, as `labels` say; drawn under a temporary
+/// name and renamed into place).
+pub fn cross_section(
+    path: &Path,
+    title: &str,
+    discs: &[Disc],
+    outline: f64,
+    labels: &SectionLabels,
+) -> Result<()> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_cross_section(&tmp, title, discs, outline)
+    let drawn = draw_cross_section(&tmp, title, discs, outline, labels)
         .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
     if drawn.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -432,7 +452,13 @@ pub fn cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> 
     drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
 }
 
-fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
+fn draw_cross_section(
+    path: &Path,
+    title: &str,
+    discs: &[Disc],
+    outline: f64,
+    labels: &SectionLabels,
+) -> Result<()> {
     register_font();
     let reach = discs
         .iter()
@@ -443,21 +469,30 @@ fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) ->
     }
     let e = |e| anyhow!("plot: {e}");
     let lim = 1.05 * reach;
-    let root = BitMapBackend::new(path, (600, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
+    let chars = labels
+        .colours
+        .iter()
+        .chain([&labels.outline])
+        .map(|l| l.chars().count())
+        .max()
+        .unwrap_or(0);
+    let side_width = (48 + 7 * chars as u32).max(160);
+    let whole = BitMapBackend::new(path, (600 + side_width, 600)).into_drawing_area();
+    whole.fill(&WHITE).map_err(e)?;
+    let (root, side) = whole.split_horizontally(600);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
         .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
         .build_cartesian_2d(-lim..lim, -lim..lim)
         .map_err(e)?;
     let fmt = |v: &f64| tick_label(*v, 2e-6 * lim);
     chart
         .configure_mesh()
         .disable_mesh()
-        .x_desc("x")
-        .y_desc("y")
+        .x_desc(labels.x)
+        .y_desc(labels.y)
         .x_label_formatter(&fmt)
         .y_label_formatter(&fmt)
         .label_style(("sans-serif", 14))
@@ -485,7 +520,31 @@ fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) ->
             BLACK.stroke_width(2),
         )))
         .map_err(e)?;
-    root.present().map_err(e)?;
+    // The legend beside the axes: a disc per colour, a line for the outline.
+    for (k, label) in labels.colours.iter().enumerate() {
+        let (c, y) = (COLOURS[k % COLOURS.len()], 60 + 24 * k as i32);
+        side.draw(&Circle::new((18, y), 7, c.mix(0.85).filled()))
+            .map_err(e)?;
+        side.draw(&Text::new(
+            label.to_string(),
+            (36, y - 9),
+            ("sans-serif", 15),
+        ))
+        .map_err(e)?;
+    }
+    let y = 60 + 24 * labels.colours.len() as i32;
+    side.draw(&PathElement::new(
+        vec![(8, y), (28, y)],
+        BLACK.stroke_width(2),
+    ))
+    .map_err(e)?;
+    side.draw(&Text::new(
+        labels.outline.to_string(),
+        (36, y - 9),
+        ("sans-serif", 15),
+    ))
+    .map_err(e)?;
+    whole.present().map_err(e)?;
     Ok(())
 }
 
@@ -625,5 +684,52 @@ mod tests {
         // A fine axis keeps the digits it needs.
         assert_eq!(tick_label(1.0001, 1e-7), "1.0001");
         assert_eq!(tick_label(f64::NAN, res), "NaN");
+    }
+
+    /// A cross-section carries its legend in a column beside the square axes: the picture is
+    /// wider than the 600 px square by the column, which grows with the longest label.
+    #[test]
+    fn a_cross_section_has_a_legend_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let discs = [
+            super::Disc {
+                x: 0.0,
+                y: 0.0,
+                r: 0.5,
+                colour: 0,
+            },
+            super::Disc {
+                x: 2.0,
+                y: 0.0,
+                r: 0.5,
+                colour: 1,
+            },
+        ];
+        let width = |labels: &super::SectionLabels| {
+            let path = dir.path().join("s.png");
+            super::cross_section(&path, "t", &discs, 2.6, labels).unwrap();
+            let png = std::fs::read(&path).unwrap();
+            // IHDR: width and height, big-endian, at bytes 16..24.
+            let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
+            let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
+            assert_eq!(h, 600);
+            w
+        };
+        let short = super::SectionLabels {
+            colours: &["a", "b"],
+            outline: "R",
+            x: "x / d",
+            y: "y / d",
+        };
+        let long = super::SectionLabels {
+            colours: &[
+                "a label of some sixty characters, longer than the column",
+                "b",
+            ],
+            ..short
+        };
+        let (ws, wl) = (width(&short), width(&long));
+        assert!(ws >= 760, "{ws}");
+        assert!(wl > ws, "{wl} <= {ws}");
     }
 }

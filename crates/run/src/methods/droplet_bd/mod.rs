@@ -12,8 +12,8 @@ use crate::control::Control;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::output::plot::{
-    Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
-    picture,
+    Disc, SHELL_PARTICLES, Scale, SectionLabels, Series, Style, cross_section, line_plot_styled,
+    merged_shells, picture,
 };
 use crate::output::profile_name;
 use crate::output::trajectory::FrameDigest;
@@ -706,12 +706,12 @@ fn write_cross_section(
                 c.push(v);
             }
             // The section of the sphere by z = 0 (a sphere cut off-centre by the slab still
-            // shows as a small disc).
+            // shows as a small disc), drawn in units of the diameter.
             let rc = (a * a - x[2] * x[2]).max(0.04 * a * a).sqrt();
             discs.push(Disc {
-                x: x[0],
-                y: x[1],
-                r: rc,
+                x: x[0] / p.diameter,
+                y: x[1] / p.diameter,
+                r: rc / p.diameter,
                 colour: usize::from(r > radius - p.diameter),
             });
         }
@@ -726,13 +726,25 @@ fn write_cross_section(
         ],
     )?;
     let title = format!(
-        "{}: slab |z| < {} at t = {:.1} (R = {:.2}), replica 0",
+        "{}: slab |z| < {} d at t = {:.1} (R = {:.2} d), replica 0",
         mobility_label(p).unwrap_or_else(|| "free-draining BD".into()),
-        0.5 * width,
+        0.5 * width / p.diameter,
         time,
-        radius
+        radius / p.diameter
     );
+    let labels = SectionLabels {
+        colours: &["centre deeper than d below R(t)", "centre within d of R(t)"],
+        outline: "droplet radius R(t)",
+        x: "x / d",
+        y: "y / d",
+    };
     // A picture that cannot be drawn leaves the table; the run goes on.
-    let _ = cross_section(&out.join("cross_section.png"), &title, &discs, radius);
+    let _ = cross_section(
+        &out.join("cross_section.png"),
+        &title,
+        &discs,
+        radius / p.diameter,
+        &labels,
+    );
     Ok(())
 }
