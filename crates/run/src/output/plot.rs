@@ -1,9 +1,16 @@
-//! Pictures of the main observables (PNG, text rendered with the embedded DejaVu Sans font).
+//! Pictures of the main observables (PNG, SVG or both as `observe.figure_format` says; text
+//! rendered with the embedded DejaVu Sans font).
+//!
+//! Every picture is named by the run as `NAME.png`; the format registered for its folder
+//! ([`set_figure_format`], by the driver from the scenario) decides whether `NAME.png`,
+//! `NAME.svg` or both are written, each under a temporary name renamed into place.
 
 use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
-use std::sync::Once;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, Once};
 
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
@@ -14,6 +21,124 @@ fn register_font() {
         // The font is embedded, so registration cannot fail for a missing file.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     });
+}
+
+/// The format of a run's pictures (`observe.figure_format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FigureFormat {
+    /// `NAME.png` (raster, 800 px wide).
+    #[default]
+    Png,
+    /// `NAME.svg` (vector, text as text).
+    Svg,
+    /// Both.
+    Both,
+}
+
+impl FigureFormat {
+    /// The format named `word` ("png", "svg" or "both").
+    pub fn from_word(word: &str) -> Option<Self> {
+        match word {
+            "png" => Some(Self::Png),
+            "svg" => Some(Self::Svg),
+            "both" => Some(Self::Both),
+            _ => None,
+        }
+    }
+
+    /// The extensions written.
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Self::Png => &["png"],
+            Self::Svg => &["svg"],
+            Self::Both => &["png", "svg"],
+        }
+    }
+}
+
+/// The formats of the output folders of this process, by canonical path (a folder not listed
+/// gets PNG).
+static FORMATS: Mutex<BTreeMap<PathBuf, FigureFormat>> = Mutex::new(BTreeMap::new());
+
+fn folder_key(dir: &Path) -> PathBuf {
+    dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf())
+}
+
+/// The pictures written into the folder `dir` from now on are in `format`.
+pub fn set_figure_format(dir: &Path, format: FigureFormat) {
+    let mut formats = FORMATS.lock().unwrap_or_else(|e| e.into_inner());
+    formats.insert(folder_key(dir), format);
+}
+
+/// The format of the pictures in the folder `dir` (PNG unless [`set_figure_format`] said else).
+pub fn figure_format(dir: &Path) -> FigureFormat {
+    let formats = FORMATS.lock().unwrap_or_else(|e| e.into_inner());
+    formats.get(&folder_key(dir)).copied().unwrap_or_default()
+}
+
+/// The files a picture the run names `name` (`NAME.png`) is written as in the folder `dir`:
+/// `NAME.png`, `NAME.svg` or both. Other names are themselves.
+pub fn picture_files(dir: &Path, name: &str) -> Vec<String> {
+    match name.strip_suffix(".png") {
+        Some(stem) => figure_format(dir)
+            .extensions()
+            .iter()
+            .map(|ext| format!("{stem}.{ext}"))
+            .collect(),
+        None => vec![name.to_string()],
+    }
+}
+
+/// `NAME.png` for `NAME.svg` (the name the run gives the picture), else `None`.
+pub fn png_name(name: &str) -> Option<String> {
+    name.strip_suffix(".svg").map(|stem| format!("{stem}.png"))
+}
+
+/// Draw a picture of `size` px at `path` (`NAME.png`) in the formats of its folder: `png`
+/// draws it with the bitmap backend, `svg` with the SVG one (the same generic drawing, see
+/// `save!`), each under a temporary name renamed into place, so that a failed or
+/// interrupted drawing never leaves a truncated picture under the final name.
+fn save(
+    path: &Path,
+    size: (u32, u32),
+    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let format = figure_format(dir);
+    let (mut png, mut svg) = (Some(png), Some(svg));
+    for ext in format.extensions() {
+        let target = path.with_extension(ext);
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        // The extension stays last: the bitmap encoder is chosen by it.
+        let tmp = target.with_file_name(format!(".{name}.partial.{ext}"));
+        let drawn = match *ext {
+            "svg" => svg.take().map_or(Ok(()), |draw| {
+                draw(SVGBackend::new(&tmp, size).into_drawing_area())
+            }),
+            _ => png.take().map_or(Ok(()), |draw| {
+                draw(BitMapBackend::new(&tmp, size).into_drawing_area())
+            }),
+        }
+        .and_then(|()| {
+            std::fs::rename(&tmp, &target).map_err(|e| anyhow!("{}: {e}", target.display()))
+        });
+        if drawn.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        drawn.map_err(|e| anyhow!("{}: {e:#}", target.display()))?;
+    }
+    Ok(())
+}
+
+/// [`save`] with one generic drawing `|area| draw(area, ...)` for both backends.
+macro_rules! save {
+    ($path:expr, $size:expr, |$area:ident| $draw:expr) => {
+        save($path, $size, |$area| $draw, |$area| $draw)
+    };
 }
 
 /// One curve of a line plot.
@@ -103,23 +228,19 @@ pub fn line_plot_styled(
     scale: Scale,
     style: Style,
 ) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    // The extension stays .png: the encoder is chosen by it.
-    let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_line_plot(&tmp, title, xlabel, ylabel, series, errors, scale, style)
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+    let width = if style.legend_outside {
+        800 + legend_width(series)
+    } else {
+        800
+    };
+    save!(path, (width, 500), |area| draw_line_plot(
+        area, title, xlabel, ylabel, series, errors, scale, style
+    ))
 }
 
 #[allow(clippy::too_many_arguments)]
-fn draw_line_plot(
-    path: &Path,
+fn draw_line_plot<DB: DrawingBackend>(
+    whole: DrawingArea<DB, Shift>,
     title: &str,
     xlabel: &str,
     ylabel: &str,
@@ -137,13 +258,6 @@ fn draw_line_plot(
     if yr.0 >= yr.1 {
         yr = flat_range(yr.0);
     }
-    let legend_width = legend_width(series);
-    let width = if style.legend_outside {
-        800 + legend_width
-    } else {
-        800
-    };
-    let whole = BitMapBackend::new(path, (width, 500)).into_drawing_area();
     whole.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
     let (root, side) = if style.legend_outside {
         let (l, r) = whole.split_horizontally(800);
@@ -439,21 +553,21 @@ pub fn cross_section(
     outline: f64,
     labels: &SectionLabels,
 ) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_cross_section(&tmp, title, discs, outline, labels)
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+    let chars = labels
+        .colours
+        .iter()
+        .chain([&labels.outline])
+        .map(|l| l.chars().count())
+        .max()
+        .unwrap_or(0);
+    let side_width = (48 + 7 * chars as u32).max(160);
+    save!(path, (600 + side_width, 600), |area| draw_cross_section(
+        area, title, discs, outline, labels
+    ))
 }
 
-fn draw_cross_section(
-    path: &Path,
+fn draw_cross_section<DB: DrawingBackend>(
+    whole: DrawingArea<DB, Shift>,
     title: &str,
     discs: &[Disc],
     outline: f64,
@@ -469,15 +583,6 @@ fn draw_cross_section(
     }
     let e = |e| anyhow!("plot: {e}");
     let lim = 1.05 * reach;
-    let chars = labels
-        .colours
-        .iter()
-        .chain([&labels.outline])
-        .map(|l| l.chars().count())
-        .max()
-        .unwrap_or(0);
-    let side_width = (48 + 7 * chars as u32).max(160);
-    let whole = BitMapBackend::new(path, (600 + side_width, 600)).into_drawing_area();
     whole.fill(&WHITE).map_err(e)?;
     let (root, side) = whole.split_horizontally(600);
     let mut chart = ChartBuilder::on(&root)

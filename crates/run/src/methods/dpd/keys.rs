@@ -236,6 +236,7 @@ pub static KEYS: &[Spec] = &[
     RUN_SHEAR_RATE,
     RUN_RANK_GRID,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_THERMO_EVERY,
     OBSERVE_TRAJECTORY_EVERY,
     OBSERVE_MSD_EVERY,

@@ -597,7 +597,10 @@ impl BdMethod<SpeciesInterface> for DropletObs {
         )?;
         if p.cross_section.is_some() && out.join("cross_section.csv").exists() {
             files.push("cross_section.csv".into());
-            if out.join("cross_section.png").exists() {
+            if ["png", "svg"]
+                .iter()
+                .any(|ext| out.join(&format!("cross_section.{ext}")).exists())
+            {
                 files.push("cross_section.png".into());
             }
         }
