@@ -251,13 +251,11 @@ fn draw_line_plot<DB: DrawingBackend>(
 ) -> Result<()> {
     register_font();
     let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
-    let (xr, mut yr) = data_ranges(series, errors, scale);
+    let (xr, yr) = data_ranges(series, errors, scale);
     if xr.0 >= xr.1 {
         return Err(anyhow!("no finite data to draw"));
     }
-    if yr.0 >= yr.1 {
-        yr = flat_range(yr.0);
-    }
+    let (xr, yr) = (widened(xr), widened(yr));
     whole.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
     let (root, side) = if style.legend_outside {
         let (l, r) = whole.split_horizontally(800);
@@ -315,6 +313,15 @@ fn draw_line_plot<DB: DrawingBackend>(
                         .label(s.label)
                         .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
                 } else {
+                    // A curve of one point is drawn as a dot (a line through it is nothing).
+                    let lone = data.clone().count() == 1;
+                    chart
+                        .draw_series(
+                            data.clone()
+                                .filter(|_| lone)
+                                .map(|p| Circle::new(p, 3, c.filled())),
+                        )
+                        .map_err(|e| anyhow!("plot: {e}"))?;
                     chart
                         .draw_series(LineSeries::new(data, c.stroke_width(2)))
                         .map_err(|e| anyhow!("plot: {e}"))?
@@ -704,6 +711,17 @@ fn caption_size(title: &str) -> u32 {
     if n <= 64 { 20 } else { (20 * 64 / n).max(12) }
 }
 
+/// `r` itself, or [`flat_range`] about its middle when it is empty or narrower than a
+/// billionth of its magnitude (points that differ only in their last bits would otherwise span
+/// the axis, its ticks reading 0.7490234374999999 and 0.7490234375000001).
+fn widened(r: (f64, f64)) -> (f64, f64) {
+    if r.1 - r.0 > 1e-9 * r.0.abs().max(r.1.abs()) {
+        r
+    } else {
+        flat_range(if r.0 >= r.1 { r.0 } else { 0.5 * (r.0 + r.1) })
+    }
+}
+
 /// The y range of a flat curve at `y`: 10 % of its value either side (a flat density keeps a
 /// positive axis), or [-1, 1] around zero.
 fn flat_range(y: f64) -> (f64, f64) {
@@ -717,7 +735,7 @@ fn flat_range(y: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::{Scale, Series, data_ranges, flat_range, merged_shells, tick_label};
+    use super::{Scale, Series, data_ranges, flat_range, merged_shells, tick_label, widened};
 
     /// The y axis holds the error bars, not only the points; a series without errors and the
     /// lower ends on a log axis that would reach zero leave it as the points make it.
@@ -760,6 +778,16 @@ mod tests {
         assert!(spike[0] > 3.0, "{}", spike[0]);
         let (_, y) = merged_shells(&r, &spike, v, 4.0, 10.0);
         assert!(y[0] < 0.7, "{}", y[0]);
+    }
+
+    /// A range of a few ulps is an axis about its value; a true range is kept.
+    #[test]
+    fn an_axis_a_few_ulps_wide_is_widened() {
+        let x = 0.7490234375;
+        assert_eq!(widened((x - 1e-16, x + 1e-16)), flat_range(x));
+        assert_eq!(widened((x, x)), flat_range(x));
+        assert_eq!(widened((0.0, 1e-12)), (0.0, 1e-12));
+        assert_eq!(widened((1.0, 1.001)), (1.0, 1.001));
     }
 
     #[test]
