@@ -70,6 +70,65 @@ pub fn radial_profile(
     RadialProfile { r, phi, outside }
 }
 
+/// Volume of the part of a sphere of radius `a`, centred at distance `rho` from the origin,
+/// that lies inside the ball of radius `big_r` about the origin: the whole sphere when
+/// `rho + a <= R`, the ball when `rho + R <= a`, nothing when `rho >= R + a`, else the lens of
+/// the two spheres (e.g. Weisstein, "Sphere-Sphere Intersection", MathWorld),
+/// `V = pi (R + a - rho)^2 (rho^2 + 2 rho a - 3 a^2 + 2 rho R + 6 a R - 3 R^2) / (12 rho)`.
+pub fn sphere_ball_overlap(big_r: f64, rho: f64, a: f64) -> f64 {
+    let rho = rho.abs();
+    if big_r <= 0.0 || a <= 0.0 || rho >= big_r + a {
+        0.0
+    } else if rho + a <= big_r {
+        4.0 / 3.0 * PI * a.powi(3)
+    } else if rho + big_r <= a {
+        4.0 / 3.0 * PI * big_r.powi(3)
+    } else {
+        let r = big_r;
+        PI * (r + a - rho).powi(2)
+            * (rho * rho + 2.0 * rho * a - 3.0 * a * a + 2.0 * rho * r + 6.0 * a * r - 3.0 * r * r)
+            / (12.0 * rho)
+    }
+}
+
+/// Radial volume-fraction profile around `centre` by sphere–shell overlap: each sphere's
+/// volume is shared among the shells `[b dr, (b + 1) dr)` it cuts, by the exact volume of
+/// their intersection ([`sphere_ball_overlap`] of the outer minus the inner ball), and each
+/// shell's fraction is that volume over the shell's. Unlike centre binning (the centre density
+/// times the particle volume, [`radial_profile`]) it is a true local volume fraction, at most 1
+/// and smooth where centres are few; the volume beyond `r_max` is not counted.
+pub fn overlap_profile(
+    pos: &[[f64; 3]],
+    diameter: &[f64],
+    centre: [f64; 3],
+    r_max: f64,
+    bins: usize,
+) -> Vec<f64> {
+    assert!(bins > 0 && r_max > 0.0 && pos.len() == diameter.len());
+    let dr = r_max / bins as f64;
+    let mut vol = vec![0.0; bins];
+    for (x, d) in pos.iter().zip(diameter) {
+        let v = [x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]];
+        let rho = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let a = 0.5 * d;
+        let first = (((rho - a) / dr).floor().max(0.0) as usize).min(bins);
+        let last = (((rho + a) / dr).ceil().max(0.0) as usize).min(bins);
+        let mut inner = sphere_ball_overlap(first as f64 * dr, rho, a);
+        for (b, slot) in vol.iter_mut().enumerate().take(last).skip(first) {
+            let outer = sphere_ball_overlap((b + 1) as f64 * dr, rho, a);
+            *slot += outer - inner;
+            inner = outer;
+        }
+    }
+    vol.iter()
+        .enumerate()
+        .map(|(b, v)| {
+            let (lo, hi) = (b as f64 * dr, (b + 1) as f64 * dr);
+            v / (4.0 / 3.0 * PI * (hi.powi(3) - lo.powi(3)))
+        })
+        .collect()
+}
+
 /// Pair distribution function g(r) of a periodic orthorhombic box with edges `l`, on `bins`
 /// shells up to `r_max` (at most half the shortest edge). O(N^2), parallel over particles.
 pub fn pair_distribution(
@@ -188,6 +247,96 @@ pub fn read_trajectory(path: &Path) -> Result<Vec<TrajectoryFrame>, GsdError> {
 
 #[cfg(test)]
 mod tests {
+    use super::{overlap_profile, sphere_ball_overlap};
+
+    /// The exact overlap against a quadrature of the sphere's radial density: a shell of radius
+    /// r about the origin lies inside the sphere over the fraction (1 - c) / 2 of its area,
+    /// c = (r^2 + rho^2 - a^2) / (2 r rho) clipped to [-1, 1].
+    #[test]
+    fn sphere_ball_overlap_is_the_integral_of_the_radial_density() {
+        let numeric = |big_r: f64, rho: f64, a: f64| {
+            let n = 20_000;
+            let h = big_r / n as f64;
+            let f = |r: f64| {
+                if r == 0.0 {
+                    return 0.0;
+                }
+                let c = ((r * r + rho * rho - a * a) / (2.0 * r * rho)).clamp(-1.0, 1.0);
+                4.0 * std::f64::consts::PI * r * r * 0.5 * (1.0 - c)
+            };
+            // Composite Simpson.
+            (0..=n)
+                .map(|i| {
+                    let w = if i == 0 || i == n {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
+                    w * f(i as f64 * h)
+                })
+                .sum::<f64>()
+                * h
+                / 3.0
+        };
+        let a = 0.5;
+        for (big_r, rho) in [
+            (3.0, 2.8),
+            (3.0, 3.2),
+            (3.0, 2.5),
+            (3.0, 3.49),
+            (0.3, 0.1),
+            (0.3, 0.5),
+            (1.0, 0.6),
+            (2.0, 0.2),
+        ] {
+            let exact = sphere_ball_overlap(big_r, rho, a);
+            let quad = numeric(big_r, rho, a);
+            assert!(
+                (exact - quad).abs() < 1e-6 * std::f64::consts::PI / 6.0,
+                "R {big_r}, rho {rho}: {exact} vs {quad}"
+            );
+        }
+        let v = std::f64::consts::PI / 6.0;
+        assert_eq!(sphere_ball_overlap(3.0, 1.0, a), v);
+        assert_eq!(sphere_ball_overlap(3.0, 3.5, a), 0.0);
+    }
+
+    /// The overlap profile shares each sphere's whole volume among the shells it cuts, and a
+    /// sphere at the centre fills the innermost shell completely (centre binning would read
+    /// a volume fraction of (d / 2 dr)^3 there).
+    #[test]
+    fn overlap_profile_keeps_the_volume_and_stays_below_one() {
+        let pos = [
+            [0.0, 0.0, 0.0],
+            [1.3, 0.4, -0.2],
+            [-2.0, 1.1, 0.7],
+            [0.0, 0.0, 2.95],
+        ];
+        let d = [1.0; 4];
+        let (r_max, bins) = (4.0, 40);
+        let phi = overlap_profile(&pos, &d, [0.0; 3], r_max, bins);
+        let dr = r_max / bins as f64;
+        let total: f64 = phi
+            .iter()
+            .enumerate()
+            .map(|(b, p)| {
+                let (lo, hi) = (b as f64 * dr, (b + 1) as f64 * dr);
+                p * 4.0 / 3.0 * std::f64::consts::PI * (hi.powi(3) - lo.powi(3))
+            })
+            .sum();
+        assert!(
+            (total - 4.0 * std::f64::consts::PI / 6.0).abs() < 1e-12,
+            "{total}"
+        );
+        assert!((phi[0] - 1.0).abs() < 1e-12, "{}", phi[0]);
+        assert!(
+            phi.iter().all(|&p| (0.0..=1.0 + 1e-12).contains(&p)),
+            "{phi:?}"
+        );
+    }
+
     use super::*;
     use colloidsim_core::rng::{Purpose, stream};
     use rand::RngExt;

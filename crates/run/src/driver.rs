@@ -3,7 +3,9 @@
 
 use crate::checkpoint::{self, CHECKPOINT, Envelope};
 use crate::control::{Control, Stop};
+use crate::keys::shared::figure_format;
 use crate::method::Session;
+use crate::output::plot::{picture_files, png_name, set_figure_format};
 use crate::registry;
 use crate::{Failed, Interrupted, Report, RunOptions, Scenario};
 use anyhow::{Context, Result, bail};
@@ -274,6 +276,7 @@ fn run_with(
         let created = (|| -> Result<OutputDir> {
             let input_copy = input_in_folder(sc, &out_path)?;
             let out = OutputDir::create(&out_path, opts.force)?;
+            set_figure_format(out.path(), figure_format(&sc.table()?)?);
             if opts.force {
                 let keep = input_copy.then_some("scenario.toml");
                 let (w, k) = clear_earlier_outputs(&out, &*session, keep)?;
@@ -416,7 +419,7 @@ fn clear_earlier_outputs(
             removed.push(name);
         } else {
             if Some(name.as_str()) != keep
-                && (s.writes(&name) || DRIVER_FILES.contains(&name.as_str()))
+                && (writes(s, &name) || DRIVER_FILES.contains(&name.as_str()))
             {
                 clash.push(name.clone());
             }
@@ -458,6 +461,12 @@ fn clear_earlier_outputs(
     Ok((w, kept))
 }
 
+/// Does the session write the file `name`? Its pictures, which it names `NAME.png`, may be
+/// written as `NAME.svg` too (`observe.figure_format`).
+fn writes(s: &dyn Session, name: &str) -> bool {
+    s.writes(name) || png_name(name).is_some_and(|png| s.writes(&png))
+}
+
 /// Record in [`MANIFEST`] the files of the run in `out` so far: those there now that the run
 /// writes, but not the `kept` ones it found there (the writer; atomically).
 fn record_files(out: &OutputDir, s: &dyn Session, kept: &[String]) -> Result<()> {
@@ -468,7 +477,7 @@ fn record_files(out: &OutputDir, s: &dyn Session, kept: &[String]) -> Result<()>
     for e in std::fs::read_dir(out.path()).with_context(|| out.path().display().to_string())? {
         let e = e?;
         let name = e.file_name().to_string_lossy().into_owned();
-        let ours = s.writes(&name) || DRIVER_FILES.contains(&name.as_str());
+        let ours = writes(s, &name) || DRIVER_FILES.contains(&name.as_str());
         if e.file_type()?.is_file() && ours && name != MANIFEST && !kept.contains(&name) {
             files.push(name);
         }
@@ -640,6 +649,7 @@ fn resume_with(
         crate::seed32(s)?;
     }
     let m = registry::of(&sc)?;
+    set_figure_format(out.path(), figure_format(&sc.table()?)?);
     let seed = seed.unwrap_or(envelope.seed);
     let mut session = m
         .restore(&sc, seed, &out, &envelope, comm)
@@ -899,7 +909,13 @@ fn drive(
     if !kept.iter().any(|k| k == "scenario.toml") {
         files.push("scenario.toml".to_string());
     }
-    files.extend(fin.files.into_iter().filter(|f| f != "scenario.toml"));
+    // The pictures the method names NAME.png, as the files of the folder's format.
+    files.extend(
+        fin.files
+            .into_iter()
+            .filter(|f| f != "scenario.toml")
+            .flat_map(|f| picture_files(out.path(), &f)),
+    );
     // Every number is written finite or as an empty field (JSON: null): say where and why.
     let non_finite = out.non_finite();
     for n in non_finite.iter().filter(|n| n.reason.is_none()) {

@@ -442,13 +442,15 @@ impl<'a> Reader<'a> {
         })
     }
 
-    /// The declared keys (tables, and `method`, which the registry reads, aside) not consulted
+    /// The declared keys (tables, `method`, which the registry reads, and the driver's
+    /// [`shared::DRIVER_KEYS`] aside) not consulted
     /// so far, in declaration order: a method that declares a key it never reads shows it here.
     pub fn unread(&self) -> Vec<&'static str> {
         let consulted = self.consulted.borrow();
         self.spec
             .iter()
             .filter(|s| !matches!(s.allowed, Table) && s.path != "method")
+            .filter(|s| !shared::DRIVER_KEYS.contains(&s.path))
             .filter(|s| !consulted.contains(&s.path))
             .map(|s| s.path)
             .collect()

@@ -652,6 +652,38 @@ pub fn hydrodynamics(
     Ok(Some(p))
 }
 
+/// `observe.figure_format`: declared by every method, read once by the driver
+/// ([`figure_format`]) for the pictures of the shared plotting module.
+pub const FIGURE_FORMAT: Spec = key(
+    "observe.figure_format",
+    "-",
+    Word("png"),
+    OneOf(&["png", "svg", "both"]),
+    "format of every picture: NAME.png (raster), NAME.svg (vector, for a paper) or both",
+);
+
+/// Keys every method declares that the driver, not the method's parameters, reads.
+pub const DRIVER_KEYS: &[&str] = &[FIGURE_FORMAT.path];
+
+/// `observe.figure_format` of a scenario's table (PNG when left out); a value not allowed is
+/// refused naming the key.
+pub fn figure_format(table: &toml::Table) -> Result<crate::output::plot::FigureFormat> {
+    use crate::output::plot::FigureFormat;
+    let Some(v) = table
+        .get("observe")
+        .and_then(|o| o.as_table())
+        .and_then(|o| o.get("figure_format"))
+    else {
+        return Ok(FigureFormat::default());
+    };
+    if let Err(m) = FIGURE_FORMAT.allowed.check(v) {
+        bail!("{}: {m}", FIGURE_FORMAT.path);
+    }
+    v.as_str()
+        .and_then(FigureFormat::from_word)
+        .ok_or_else(|| anyhow::anyhow!("{}: not a format", FIGURE_FORMAT.path))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,9 +1,16 @@
-//! Pictures of the main observables (PNG, text rendered with the embedded DejaVu Sans font).
+//! Pictures of the main observables (PNG, SVG or both as `observe.figure_format` says; text
+//! rendered with the embedded DejaVu Sans font).
+//!
+//! Every picture is named by the run as `NAME.png`; the format registered for its folder
+//! ([`set_figure_format`], by the driver from the scenario) decides whether `NAME.png`,
+//! `NAME.svg` or both are written, each under a temporary name renamed into place.
 
 use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
-use std::sync::Once;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, Once};
 
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
@@ -14,6 +21,124 @@ fn register_font() {
         // The font is embedded, so registration cannot fail for a missing file.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     });
+}
+
+/// The format of a run's pictures (`observe.figure_format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FigureFormat {
+    /// `NAME.png` (raster, 800 px wide).
+    #[default]
+    Png,
+    /// `NAME.svg` (vector, text as text).
+    Svg,
+    /// Both.
+    Both,
+}
+
+impl FigureFormat {
+    /// The format named `word` ("png", "svg" or "both").
+    pub fn from_word(word: &str) -> Option<Self> {
+        match word {
+            "png" => Some(Self::Png),
+            "svg" => Some(Self::Svg),
+            "both" => Some(Self::Both),
+            _ => None,
+        }
+    }
+
+    /// The extensions written.
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Self::Png => &["png"],
+            Self::Svg => &["svg"],
+            Self::Both => &["png", "svg"],
+        }
+    }
+}
+
+/// The formats of the output folders of this process, by canonical path (a folder not listed
+/// gets PNG).
+static FORMATS: Mutex<BTreeMap<PathBuf, FigureFormat>> = Mutex::new(BTreeMap::new());
+
+fn folder_key(dir: &Path) -> PathBuf {
+    dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf())
+}
+
+/// The pictures written into the folder `dir` from now on are in `format`.
+pub fn set_figure_format(dir: &Path, format: FigureFormat) {
+    let mut formats = FORMATS.lock().unwrap_or_else(|e| e.into_inner());
+    formats.insert(folder_key(dir), format);
+}
+
+/// The format of the pictures in the folder `dir` (PNG unless [`set_figure_format`] said else).
+pub fn figure_format(dir: &Path) -> FigureFormat {
+    let formats = FORMATS.lock().unwrap_or_else(|e| e.into_inner());
+    formats.get(&folder_key(dir)).copied().unwrap_or_default()
+}
+
+/// The files a picture the run names `name` (`NAME.png`) is written as in the folder `dir`:
+/// `NAME.png`, `NAME.svg` or both. Other names are themselves.
+pub fn picture_files(dir: &Path, name: &str) -> Vec<String> {
+    match name.strip_suffix(".png") {
+        Some(stem) => figure_format(dir)
+            .extensions()
+            .iter()
+            .map(|ext| format!("{stem}.{ext}"))
+            .collect(),
+        None => vec![name.to_string()],
+    }
+}
+
+/// `NAME.png` for `NAME.svg` (the name the run gives the picture), else `None`.
+pub fn png_name(name: &str) -> Option<String> {
+    name.strip_suffix(".svg").map(|stem| format!("{stem}.png"))
+}
+
+/// Draw a picture of `size` px at `path` (`NAME.png`) in the formats of its folder: `png`
+/// draws it with the bitmap backend, `svg` with the SVG one (the same generic drawing, see
+/// `save!`), each under a temporary name renamed into place, so that a failed or
+/// interrupted drawing never leaves a truncated picture under the final name.
+fn save(
+    path: &Path,
+    size: (u32, u32),
+    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let format = figure_format(dir);
+    let (mut png, mut svg) = (Some(png), Some(svg));
+    for ext in format.extensions() {
+        let target = path.with_extension(ext);
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        // The extension stays last: the bitmap encoder is chosen by it.
+        let tmp = target.with_file_name(format!(".{name}.partial.{ext}"));
+        let drawn = match *ext {
+            "svg" => svg.take().map_or(Ok(()), |draw| {
+                draw(SVGBackend::new(&tmp, size).into_drawing_area())
+            }),
+            _ => png.take().map_or(Ok(()), |draw| {
+                draw(BitMapBackend::new(&tmp, size).into_drawing_area())
+            }),
+        }
+        .and_then(|()| {
+            std::fs::rename(&tmp, &target).map_err(|e| anyhow!("{}: {e}", target.display()))
+        });
+        if drawn.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        drawn.map_err(|e| anyhow!("{}: {e:#}", target.display()))?;
+    }
+    Ok(())
+}
+
+/// [`save`] with one generic drawing `|area| draw(area, ...)` for both backends.
+macro_rules! save {
+    ($path:expr, $size:expr, |$area:ident| $draw:expr) => {
+        save($path, $size, |$area| $draw, |$area| $draw)
+    };
 }
 
 /// One curve of a line plot.
@@ -103,23 +228,19 @@ pub fn line_plot_styled(
     scale: Scale,
     style: Style,
 ) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    // The extension stays .png: the encoder is chosen by it.
-    let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_line_plot(&tmp, title, xlabel, ylabel, series, errors, scale, style)
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+    let width = if style.legend_outside {
+        800 + legend_width(series)
+    } else {
+        800
+    };
+    save!(path, (width, 500), |area| draw_line_plot(
+        area, title, xlabel, ylabel, series, errors, scale, style
+    ))
 }
 
 #[allow(clippy::too_many_arguments)]
-fn draw_line_plot(
-    path: &Path,
+fn draw_line_plot<DB: DrawingBackend>(
+    whole: DrawingArea<DB, Shift>,
     title: &str,
     xlabel: &str,
     ylabel: &str,
@@ -130,20 +251,11 @@ fn draw_line_plot(
 ) -> Result<()> {
     register_font();
     let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
-    let (xr, mut yr) = data_ranges(series, errors, scale);
+    let (xr, yr) = data_ranges(series, errors, scale);
     if xr.0 >= xr.1 {
         return Err(anyhow!("no finite data to draw"));
     }
-    if yr.0 >= yr.1 {
-        yr = flat_range(yr.0);
-    }
-    let legend_width = 240;
-    let width = if style.legend_outside {
-        800 + legend_width
-    } else {
-        800
-    };
-    let whole = BitMapBackend::new(path, (width, 500)).into_drawing_area();
+    let (xr, yr) = (widened(xr), widened(yr));
     whole.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
     let (root, side) = if style.legend_outside {
         let (l, r) = whole.split_horizontally(800);
@@ -154,10 +266,20 @@ fn draw_line_plot(
     macro_rules! draw {
         ($chart:expr) => {{
             let mut chart = $chart;
+            let (xres, yres) = match scale {
+                Scale::Linear => (1e-6 * (xr.1 - xr.0), 1e-6 * (yr.1 - yr.0)),
+                Scale::LogLog => (f64::NAN, f64::NAN),
+            };
+            let tick =
+                |v: &f64, res: f64| tick_label(*v, if res.is_nan() { 1e-6 * v.abs() } else { res });
+            let xfmt = |v: &f64| tick(v, xres);
+            let yfmt = |v: &f64| tick(v, yres);
             chart
                 .configure_mesh()
                 .x_desc(xlabel)
                 .y_desc(ylabel)
+                .x_label_formatter(&xfmt)
+                .y_label_formatter(&yfmt)
                 .label_style(("sans-serif", 16))
                 .draw()
                 .map_err(|e| anyhow!("plot: {e}"))?;
@@ -191,6 +313,15 @@ fn draw_line_plot(
                         .label(s.label)
                         .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
                 } else {
+                    // A curve of one point is drawn as a dot (a line through it is nothing).
+                    let lone = data.clone().count() == 1;
+                    chart
+                        .draw_series(
+                            data.clone()
+                                .filter(|_| lone)
+                                .map(|p| Circle::new(p, 3, c.filled())),
+                        )
+                        .map_err(|e| anyhow!("plot: {e}"))?;
                     chart
                         .draw_series(LineSeries::new(data, c.stroke_width(2)))
                         .map_err(|e| anyhow!("plot: {e}"))?
@@ -257,6 +388,53 @@ fn draw_line_plot(
     }
     whole.present().map_err(|e| anyhow!("plot: {e}"))?;
     Ok(())
+}
+
+/// A tick label: `v` rounded to the fewest significant digits (at most 15) that keep it within
+/// `resolution` of itself, printed as the shortest decimal of that rounded value (so a tick at
+/// 0.1 + 0.2 reads "0.3", not "0.30000000000000004"); a value within `resolution / 2` of zero
+/// reads "0"; magnitudes below 1e-4 or from 1e6 up in scientific notation ("2.5e-5").
+/// `resolution` is a millionth of the axis' span on a linear axis, of the value on a log one.
+pub fn tick_label(v: f64, resolution: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let res = if resolution.is_finite() && resolution > 0.0 {
+        resolution
+    } else {
+        v.abs() * 1e-12
+    };
+    if v.abs() <= 0.5 * res {
+        return "0".into();
+    }
+    let mut digits = 15;
+    let mut rounded = v;
+    for p in 1..=15 {
+        // Rounding to p significant digits through the decimal text is exact to the last bit.
+        let r: f64 = format!("{:.*e}", p - 1, v).parse().unwrap_or(v);
+        if (r - v).abs() <= res {
+            digits = p;
+            rounded = r;
+            break;
+        }
+    }
+    let m = rounded.abs();
+    if !(1e-4..1e6).contains(&m) {
+        format!("{:.*e}", digits - 1, rounded)
+    } else {
+        format!("{rounded}")
+    }
+}
+
+/// The width in px of a legend beside the axes: its longest label at about 7 px a character
+/// (15 px DejaVu Sans) after the 36 px of the mark, at least 240.
+fn legend_width(series: &[Series]) -> u32 {
+    let chars = series
+        .iter()
+        .map(|s| s.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    (48 + 7 * chars as u32).max(240)
 }
 
 /// The shells of a radial profile merged from the centre outwards until each merged shell is
@@ -358,24 +536,50 @@ pub struct Disc {
     pub colour: usize,
 }
 
-/// Draw `discs` (e.g. the sections of spheres cut by a slab) inside a circle of radius `outline`
-/// centred on the origin, with equal scales on both axes, into a square PNG at `path`
-/// (600x600 px; drawn under a temporary name and renamed into place).
-pub fn cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial.png"));
-    let drawn = draw_cross_section(&tmp, title, discs, outline)
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| anyhow!("{}: {e}", path.display())));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn.map_err(|e| anyhow!("{}: {e:#}", path.display()))
+/// What the marks of a [`cross_section`] mean: one legend entry per disc colour (by index),
+/// one for the outline, and the axes' labels with their unit.
+pub struct SectionLabels<'a> {
+    /// Legend entry of the discs of colour `k`.
+    pub colours: &'a [&'a str],
+    /// Legend entry of the outline circle.
+    pub outline: &'a str,
+    /// x axis, with its unit.
+    pub x: &'a str,
+    /// y axis, with its unit.
+    pub y: &'a str,
 }
 
-fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) -> Result<()> {
+/// Draw `discs` (e.g. the sections of spheres cut by a slab) inside a circle of radius `outline`
+/// centred on the origin, with equal scales on both axes, into a PNG at `path` (a 600x600 px
+/// square of axes and a legend column right of it, as `labels` say; drawn under a temporary
+/// name and renamed into place).
+pub fn cross_section(
+    path: &Path,
+    title: &str,
+    discs: &[Disc],
+    outline: f64,
+    labels: &SectionLabels,
+) -> Result<()> {
+    let chars = labels
+        .colours
+        .iter()
+        .chain([&labels.outline])
+        .map(|l| l.chars().count())
+        .max()
+        .unwrap_or(0);
+    let side_width = (48 + 7 * chars as u32).max(160);
+    save!(path, (600 + side_width, 600), |area| draw_cross_section(
+        area, title, discs, outline, labels
+    ))
+}
+
+fn draw_cross_section<DB: DrawingBackend>(
+    whole: DrawingArea<DB, Shift>,
+    title: &str,
+    discs: &[Disc],
+    outline: f64,
+    labels: &SectionLabels,
+) -> Result<()> {
     register_font();
     let reach = discs
         .iter()
@@ -386,20 +590,23 @@ fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) ->
     }
     let e = |e| anyhow!("plot: {e}");
     let lim = 1.05 * reach;
-    let root = BitMapBackend::new(path, (600, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
+    whole.fill(&WHITE).map_err(e)?;
+    let (root, side) = whole.split_horizontally(600);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
         .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
         .build_cartesian_2d(-lim..lim, -lim..lim)
         .map_err(e)?;
+    let fmt = |v: &f64| tick_label(*v, 2e-6 * lim);
     chart
         .configure_mesh()
         .disable_mesh()
-        .x_desc("x")
-        .y_desc("y")
+        .x_desc(labels.x)
+        .y_desc(labels.y)
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(e)?;
@@ -425,7 +632,31 @@ fn draw_cross_section(path: &Path, title: &str, discs: &[Disc], outline: f64) ->
             BLACK.stroke_width(2),
         )))
         .map_err(e)?;
-    root.present().map_err(e)?;
+    // The legend beside the axes: a disc per colour, a line for the outline.
+    for (k, label) in labels.colours.iter().enumerate() {
+        let (c, y) = (COLOURS[k % COLOURS.len()], 60 + 24 * k as i32);
+        side.draw(&Circle::new((18, y), 7, c.mix(0.85).filled()))
+            .map_err(e)?;
+        side.draw(&Text::new(
+            label.to_string(),
+            (36, y - 9),
+            ("sans-serif", 15),
+        ))
+        .map_err(e)?;
+    }
+    let y = 60 + 24 * labels.colours.len() as i32;
+    side.draw(&PathElement::new(
+        vec![(8, y), (28, y)],
+        BLACK.stroke_width(2),
+    ))
+    .map_err(e)?;
+    side.draw(&Text::new(
+        labels.outline.to_string(),
+        (36, y - 9),
+        ("sans-serif", 15),
+    ))
+    .map_err(e)?;
+    whole.present().map_err(e)?;
     Ok(())
 }
 
@@ -480,6 +711,17 @@ fn caption_size(title: &str) -> u32 {
     if n <= 64 { 20 } else { (20 * 64 / n).max(12) }
 }
 
+/// `r` itself, or [`flat_range`] about its middle when it is empty or narrower than a
+/// billionth of its magnitude (points that differ only in their last bits would otherwise span
+/// the axis, its ticks reading 0.7490234374999999 and 0.7490234375000001).
+fn widened(r: (f64, f64)) -> (f64, f64) {
+    if r.1 - r.0 > 1e-9 * r.0.abs().max(r.1.abs()) {
+        r
+    } else {
+        flat_range(if r.0 >= r.1 { r.0 } else { 0.5 * (r.0 + r.1) })
+    }
+}
+
 /// The y range of a flat curve at `y`: 10 % of its value either side (a flat density keeps a
 /// positive axis), or [-1, 1] around zero.
 fn flat_range(y: f64) -> (f64, f64) {
@@ -493,7 +735,7 @@ fn flat_range(y: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
-    use super::{Scale, Series, data_ranges, flat_range, merged_shells};
+    use super::{Scale, Series, data_ranges, flat_range, merged_shells, tick_label, widened};
 
     /// The y axis holds the error bars, not only the points; a series without errors and the
     /// lower ends on a log axis that would reach zero leave it as the points make it.
@@ -538,11 +780,89 @@ mod tests {
         assert!(y[0] < 0.7, "{}", y[0]);
     }
 
+    /// A range of a few ulps is an axis about its value; a true range is kept.
+    #[test]
+    fn an_axis_a_few_ulps_wide_is_widened() {
+        let x = 0.7490234375;
+        assert_eq!(widened((x - 1e-16, x + 1e-16)), flat_range(x));
+        assert_eq!(widened((x, x)), flat_range(x));
+        assert_eq!(widened((0.0, 1e-12)), (0.0, 1e-12));
+        assert_eq!(widened((1.0, 1.001)), (1.0, 1.001));
+    }
+
     #[test]
     fn a_flat_positive_curve_keeps_a_positive_axis() {
         assert_eq!(flat_range(0.5), (0.45, 0.55));
         assert!(flat_range(1e-6).0 > 0.0);
         assert_eq!(flat_range(0.0), (-1.0, 1.0));
         assert!(flat_range(-2.0).1 < 0.0);
+    }
+
+    /// Tick labels are the shortest decimals of the ticks at the axis' resolution.
+    #[test]
+    fn tick_labels_are_short_decimals() {
+        let res = 1e-6;
+        assert_eq!(tick_label(0.1 + 0.2, res), "0.3");
+        assert_eq!(tick_label(0.30000000000000004, res), "0.3");
+        assert_eq!(tick_label(3.0 * 0.1, res), "0.3");
+        assert_eq!(tick_label(1.0, res), "1");
+        assert_eq!(tick_label(-0.7000000000000001, res), "-0.7");
+        assert_eq!(tick_label(2.5, res), "2.5");
+        assert_eq!(tick_label(120.0, 1e-4), "120");
+        // A tick at zero computed as a tiny remainder.
+        assert_eq!(tick_label(5.551115123125783e-17, res), "0");
+        // Small and large magnitudes in scientific notation, still short.
+        assert_eq!(tick_label(2.5e-5 + 1e-21, 1e-11), "2.5e-5");
+        assert_eq!(tick_label(3.0e7 * 1.0000000000000002, 10.0), "3e7");
+        // A fine axis keeps the digits it needs.
+        assert_eq!(tick_label(1.0001, 1e-7), "1.0001");
+        assert_eq!(tick_label(f64::NAN, res), "NaN");
+    }
+
+    /// A cross-section carries its legend in a column beside the square axes: the picture is
+    /// wider than the 600 px square by the column, which grows with the longest label.
+    #[test]
+    fn a_cross_section_has_a_legend_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let discs = [
+            super::Disc {
+                x: 0.0,
+                y: 0.0,
+                r: 0.5,
+                colour: 0,
+            },
+            super::Disc {
+                x: 2.0,
+                y: 0.0,
+                r: 0.5,
+                colour: 1,
+            },
+        ];
+        let width = |labels: &super::SectionLabels| {
+            let path = dir.path().join("s.png");
+            super::cross_section(&path, "t", &discs, 2.6, labels).unwrap();
+            let png = std::fs::read(&path).unwrap();
+            // IHDR: width and height, big-endian, at bytes 16..24.
+            let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
+            let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
+            assert_eq!(h, 600);
+            w
+        };
+        let short = super::SectionLabels {
+            colours: &["a", "b"],
+            outline: "R",
+            x: "x / d",
+            y: "y / d",
+        };
+        let long = super::SectionLabels {
+            colours: &[
+                "a label of some sixty characters, longer than the column",
+                "b",
+            ],
+            ..short
+        };
+        let (ws, wl) = (width(&short), width(&long));
+        assert!(ws >= 760, "{ws}");
+        assert!(wl > ws, "{wl} <= {ws}");
     }
 }

@@ -250,6 +250,7 @@ pub static KEYS: &[Spec] = &[
     RUN_TIME,
     RUN_CHECKPOINT_EVERY,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_EVERY,
     OBSERVE_DENSITY,
     OBSERVE_DENSITY_BINS,

@@ -107,6 +107,7 @@ pub static KEYS: &[Spec] = &[
     RUN_SKIN,
     RUN_INTEGRATOR,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_BLOCKS,
     OBSERVE_MSD,
     OBSERVE_MSD_POINTS,

@@ -164,8 +164,8 @@ pub const OBSERVE_STRUCTURE_EVERY: Spec = key("observe.structure_every", "steps"
     Value("1000"), Integer(0, COUNT),
     "steps between g(r), S(q), contacts and clusters (0: none)");
 
-pub const OBSERVE_GR_BINS: Spec = key("observe.gr_bins", "-", Value("200"), Integer(1, 100_000),
-    "bins of g(r)")
+pub const OBSERVE_GR_BINS: Spec = key("observe.gr_bins", "-", Value("200"), Integer(2, 100_000),
+    "bins of g(r) (at least 2: S(q) needs two)")
     .also("at most 1e5: bins of 1e-3 rc over the widest range, finer than the contact range; S(q) takes at most 1000 wave numbers");
 
 pub const OBSERVE_GR_MAX: Spec = key("observe.gr_max", "rc",
@@ -236,6 +236,7 @@ pub static KEYS: &[Spec] = &[
     RUN_SHEAR_RATE,
     RUN_RANK_GRID,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_THERMO_EVERY,
     OBSERVE_TRAJECTORY_EVERY,
     OBSERVE_MSD_EVERY,

@@ -126,6 +126,7 @@ pub static KEYS: &[Spec] = &[
     RUN_SKIN,
     RUN_INTEGRATOR,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_PROFILE,
     OBSERVE_PROFILE_BINS,
     OBSERVE_PROFILE_FRACTIONS,

@@ -12,14 +12,14 @@ use crate::control::Control;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::output::plot::{
-    Disc, SHELL_PARTICLES, Scale, Series, Style, cross_section, line_plot_styled, merged_shells,
-    picture,
+    Disc, SHELL_PARTICLES, Scale, SectionLabels, Series, Style, cross_section, line_plot_styled,
+    merged_shells, picture,
 };
 use crate::output::profile_name;
 use crate::output::trajectory::FrameDigest;
 use crate::{Report, Scenario as Source, TheoryOptions};
 use anyhow::{Context, Result, bail};
-use colloidsim_analysis::radial_profile;
+use colloidsim_analysis::{overlap_profile, radial_profile};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_md::DropletParams;
@@ -218,6 +218,10 @@ struct Accum {
     /// Two or more species: their profiles and the stratification.
     #[serde(default)]
     species: crate::output::species::SpeciesAccum,
+    /// Per profile fraction: sum over the replicas of the volume-fraction profile by
+    /// sphere–shell overlap (empty when continued from a checkpoint written without it).
+    #[serde(default)]
+    overlap: Vec<Vec<f64>>,
 }
 
 impl Accum {
@@ -235,6 +239,7 @@ impl Accum {
             digest: FrameDigest::default(),
             checkpoints: 0,
             species: Default::default(),
+            overlap: vec![vec![0.0; p.bins]; n_frac],
         }
     }
 }
@@ -395,6 +400,12 @@ impl Observe<SpeciesInterface> for DropletObs {
                 for (a, b) in acc.sums[j].iter_mut().zip(&prof.phi) {
                     *a += b;
                 }
+                if let Some(sum) = acc.overlap.get_mut(j) {
+                    let phi = overlap_profile(&part.pos, &part.diameter, [0.0; 3], radius, p.bins);
+                    for (a, b) in sum.iter_mut().zip(&phi) {
+                        *a += b;
+                    }
+                }
                 acc.counts[j] += 1;
                 acc.radii[j] = radius;
                 acc.r_axes[j] = prof.r;
@@ -495,12 +506,14 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             builds,
             frames,
             species,
+            overlap,
             ..
         } = self.acc;
         let mut warnings = Vec::new();
         let mut files = Vec::new();
         let mut means: Vec<Vec<f64>> = Vec::new();
         let mut drawn = Vec::new();
+        let mut overlaps: Vec<Vec<f64>> = Vec::new();
         for j in 0..n_frac {
             if counts[j] == 0 {
                 continue;
@@ -508,7 +521,22 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             let reps = counts[j] as f64;
             let phi: Vec<f64> = sums[j].iter().map(|v| v / reps).collect();
             let name = profile_name(p.fractions[j]);
-            out.write_table(&name, &[("r", &r_axes[j]), ("phi", &phi)])?;
+            // phi: centres per shell volume times the particle volume (centre density, more
+            // than 1 where a shell is thinner than a sphere); phi_overlap: the volume fraction
+            // by sphere-shell overlap.
+            match overlap.get(j).filter(|o| o.len() == phi.len()) {
+                Some(o) => {
+                    let o: Vec<f64> = o.iter().map(|v| v / reps).collect();
+                    out.write_table(
+                        &name,
+                        &[("r", &r_axes[j]), ("phi", &phi), ("phi_overlap", &o)],
+                    )?;
+                    overlaps.push(o);
+                }
+                None => {
+                    out.write_table(&name, &[("r", &r_axes[j]), ("phi", &phi)])?;
+                }
+            }
             files.push(name);
             means.push(phi);
             drawn.push(j);
@@ -517,13 +545,19 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             .iter()
             .map(|&j| format!("t = {:.0} % (R = {:.2})", p.fractions[j] * 100.0, radii[j]))
             .collect();
-        // The picture merges the small inner shells (plot::merged_shells); the CSV files keep
-        // every shell.
+        // The picture shows the volume fraction by sphere-shell overlap; without it (a run
+        // continued from an older checkpoint) the centre density with the small inner shells
+        // merged (plot::merged_shells). The CSV files keep every shell.
+        let by_overlap = overlaps.len() == drawn.len();
         let vp = std::f64::consts::PI / 6.0 * p.diameter.powi(3);
         let merged: Vec<(Vec<f64>, Vec<f64>)> = drawn
             .iter()
             .enumerate()
             .map(|(k, &j)| {
+                if by_overlap {
+                    let x = r_axes[j].iter().map(|x| x / radii[j]).collect();
+                    return (x, overlaps[k].clone());
+                }
                 let (x, y) = merged_shells(
                     &r_axes[j],
                     &means[k],
@@ -597,7 +631,10 @@ impl BdMethod<SpeciesInterface> for DropletObs {
         )?;
         if p.cross_section.is_some() && out.join("cross_section.csv").exists() {
             files.push("cross_section.csv".into());
-            if out.join("cross_section.png").exists() {
+            if ["png", "svg"]
+                .iter()
+                .any(|ext| out.join(&format!("cross_section.{ext}")).exists())
+            {
                 files.push("cross_section.png".into());
             }
         }
@@ -605,8 +642,16 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             line_plot_styled(
                 &out.join("profiles.png"),
                 &title,
-                "r / R(t) (inner shells merged to >= 10 particles)",
-                "volume fraction phi(r)",
+                if by_overlap {
+                    "r / R(t)"
+                } else {
+                    "r / R(t) (inner shells merged to >= 10 particles)"
+                },
+                if by_overlap {
+                    "volume fraction phi(r) (sphere-shell overlap)"
+                } else {
+                    "centre density x particle volume"
+                },
                 &series,
                 &[],
                 Scale::Linear,
@@ -706,12 +751,12 @@ fn write_cross_section(
                 c.push(v);
             }
             // The section of the sphere by z = 0 (a sphere cut off-centre by the slab still
-            // shows as a small disc).
+            // shows as a small disc), drawn in units of the diameter.
             let rc = (a * a - x[2] * x[2]).max(0.04 * a * a).sqrt();
             discs.push(Disc {
-                x: x[0],
-                y: x[1],
-                r: rc,
+                x: x[0] / p.diameter,
+                y: x[1] / p.diameter,
+                r: rc / p.diameter,
                 colour: usize::from(r > radius - p.diameter),
             });
         }
@@ -726,13 +771,25 @@ fn write_cross_section(
         ],
     )?;
     let title = format!(
-        "{}: slab |z| < {} at t = {:.1} (R = {:.2}), replica 0",
+        "{}: slab |z| < {} d at t = {:.1} (R = {:.2} d), replica 0",
         mobility_label(p).unwrap_or_else(|| "free-draining BD".into()),
-        0.5 * width,
+        0.5 * width / p.diameter,
         time,
-        radius
+        radius / p.diameter
     );
+    let labels = SectionLabels {
+        colours: &["centre deeper than d below R(t)", "centre within d of R(t)"],
+        outline: "droplet radius R(t)",
+        x: "x / d",
+        y: "y / d",
+    };
     // A picture that cannot be drawn leaves the table; the run goes on.
-    let _ = cross_section(&out.join("cross_section.png"), &title, &discs, radius);
+    let _ = cross_section(
+        &out.join("cross_section.png"),
+        &title,
+        &discs,
+        radius / p.diameter,
+        &labels,
+    );
     Ok(())
 }

@@ -155,6 +155,7 @@ pub static KEYS: &[Spec] = &[
     COLLOID_BOND_K,
     COLLOID_MD_STEPS,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_EVERY,
     OBSERVE_PROFILE,
     OBSERVE_PROFILE_BINS,

@@ -107,6 +107,9 @@ pub const OUTPUT_RHO2_COS_BINS: Spec = key("output.rho2_cos_bins", "-",
     Value("20"), Integer(1, 10_000),
     "bins of cos theta over [-1, 1] of the two-body density");
 
+pub const OBSERVE: Spec = key("observe", "-", Means("PNG pictures"), Table,
+    "how the pictures are written (the observables are under [output])");
+
 /// The keys of `hs-mc` scenarios, in the order `colloidsim keys hs-mc` lists them.
 pub static KEYS: &[Spec] = &[
     METHOD,
@@ -144,4 +147,6 @@ pub static KEYS: &[Spec] = &[
     OUTPUT_TRAJECTORY_EVERY,
     OUTPUT_RHO2_R_BINS,
     OUTPUT_RHO2_COS_BINS,
+    OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
 ];

@@ -14,7 +14,9 @@ pub mod params;
 use crate::engine::flat;
 use crate::keys::Spec;
 use crate::method::{Checked, Finished, Method, Session};
-use crate::output::plot::{Scale, Series, line_plot, line_plot_with_errors, picture};
+use crate::output::plot::{
+    Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors, picture,
+};
 use crate::output::trajectory::FrameDigest;
 use crate::{Scenario as Source, seed32};
 use anyhow::{Context, Result, bail};
@@ -494,37 +496,35 @@ impl Session for McSession {
                 let (g, err) = columns(&per_block, r.len());
                 out.write_table("g_r.csv", &[("r", &r), ("g", &g), ("err", &err)])?;
                 files.push("g_r.csv".into());
-                let all = if p.mixture.is_some() {
-                    " (all pairs)"
-                } else {
-                    ""
-                };
-                let title = format!(
-                    "Hard spheres{all}, Monte Carlo: N = {n}, phi = {:.3}, Z = {:.4}",
-                    p.volume_fraction,
-                    summary["compressibility"]["value"]
-                        .as_f64()
-                        .unwrap_or(f64::NAN)
+                let z = &summary["compressibility"];
+                let z = (
+                    z["value"].as_f64().unwrap_or(f64::NAN),
+                    z["standard_error"].as_f64().unwrap_or(f64::NAN),
                 );
-                let series = [Series {
-                    label: "g(r)",
-                    x: &r,
-                    y: &g,
-                    points: false,
-                }];
-                picture(
-                    line_plot(
+                let drawn = if p.mixture.is_some() {
+                    // No one-component reference for the pairs of a mixture.
+                    let x: Vec<f64> = r.iter().map(|v| v / d).collect();
+                    line_plot_with_errors(
                         &out.join("g_r.png"),
-                        &title,
+                        &format!(
+                            "Hard spheres (all pairs), Monte Carlo: N = {n}, phi = {:.3}",
+                            p.volume_fraction
+                        ),
                         "r / d",
                         "g(r)",
-                        &series,
+                        &[Series {
+                            label: "Monte Carlo (bars: standard error over the blocks)",
+                            x: &x,
+                            y: &g,
+                            points: false,
+                        }],
+                        &[Some(err.as_slice())],
                         Scale::Linear,
-                    ),
-                    "g_r.png",
-                    &mut files,
-                    &mut warnings,
-                );
+                    )
+                } else {
+                    gr_picture(out, n, p.volume_fraction, d, (&r, &g, &err), z)
+                };
+                picture(drawn, "g_r.png", &mut files, &mut warnings);
             }
         } else {
             let vol = PI / 6.0 * d.powi(3);
@@ -959,6 +959,95 @@ fn draw_g2(
     )
 }
 
+/// `g_r.png` of a one-component fluid: the Monte Carlo `g(r)` with its block errors, the
+/// Percus–Yevick `g(r)` at the same packing fraction (`colloidsim_dft::oz`, solved numerically)
+/// and, inside its fitted range, Trokhymchuk et al.'s simulation-fitted `g(r)`; the title gives
+/// the measured `Z` with its error beside Carnahan–Starling's.
+fn gr_picture(
+    out: &OutputDir,
+    n: usize,
+    eta: f64,
+    d: f64,
+    (r, g, err): (&[f64], &[f64], &[f64]),
+    (z, z_err): (f64, f64),
+) -> Result<()> {
+    use colloidsim_dft::oz;
+    use colloidsim_dft::radial::pair::{ETA_FIT_MAX, ETA_FIT_MIN, Trokhymchuk};
+    let x: Vec<f64> = r.iter().map(|v| v / d).collect();
+    let x_max = x.iter().cloned().fold(0.0, f64::max);
+    let mut series = vec![Series {
+        label: "Monte Carlo (bars: standard error of the blocks)",
+        x: &x,
+        y: g,
+        points: true,
+    }];
+    let mut errors = vec![Some(err)];
+    // The PY curve from contact out to the MC's last bin (inside the core g = 0, as the MC's
+    // points show); a packing fraction PY is not solved at draws none.
+    let py = oz::solve(eta, &oz::PyOptions::default()).ok();
+    let (px, pg): (Vec<f64>, Vec<f64>) = py
+        .iter()
+        .flat_map(|s| s.r.iter().zip(&s.g))
+        .filter(|(r, _)| (1.0..=x_max).contains(*r))
+        .map(|(r, g)| (*r, *g))
+        .unzip();
+    if !px.is_empty() {
+        series.push(Series {
+            label: "Percus-Yevick (Ornstein-Zernike, numerical)",
+            x: &px,
+            y: &pg,
+            points: false,
+        });
+        errors.push(None);
+    }
+    let (tx, tg): (Vec<f64>, Vec<f64>) = match Trokhymchuk::new(eta) {
+        Ok(t) if (ETA_FIT_MIN..=ETA_FIT_MAX).contains(&eta) => {
+            let m = 400;
+            (0..=m)
+                .map(|i| 1.0 + (x_max - 1.0) * i as f64 / m as f64)
+                .map(|x| (x, t.g(x)))
+                .unzip()
+        }
+        _ => (Vec::new(), Vec::new()),
+    };
+    if !tx.is_empty() {
+        series.push(Series {
+            label: "Trokhymchuk et al. 2005 (fit to simulations)",
+            x: &tx,
+            y: &tg,
+            points: false,
+        });
+        errors.push(None);
+    }
+    let title = format!(
+        "Hard spheres, Monte Carlo: N = {n}, phi = {eta:.3}, Z = {} (Carnahan-Starling {:.3})",
+        value_with_error(z, z_err),
+        carnahan_starling(eta)
+    );
+    line_plot_styled(
+        &out.join("g_r.png"),
+        &title,
+        "r / d",
+        "g(r)",
+        &series,
+        &errors,
+        Scale::Linear,
+        Style {
+            legend_outside: true,
+        },
+    )
+}
+
+/// `v +- e` with the error to two significant digits and the value to the same decimal place
+/// (`v` alone to four significant digits when the error is not finite or zero).
+fn value_with_error(v: f64, e: f64) -> String {
+    if !(e.is_finite() && e > 0.0 && v.is_finite()) {
+        return format!("{v:.4}");
+    }
+    let decimals = (1 - e.log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$} ± {e:.decimals$}")
+}
+
 fn columns(per_block: &[Vec<f64>], bins: usize) -> (Vec<f64>, Vec<f64>) {
     (0..bins)
         .map(|b| {
@@ -1010,5 +1099,22 @@ impl crate::Engine for McEngine {
     }
     fn box_lengths(&self) -> Vec<f64> {
         vec![self.mc.box_edge(); 3]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::value_with_error;
+
+    /// The error to two significant digits, the value to the same place.
+    #[test]
+    fn a_value_is_written_with_its_error() {
+        assert_eq!(
+            value_with_error(3.968951672741633, 0.0401153),
+            "3.969 ± 0.040"
+        );
+        assert_eq!(value_with_error(12.3456, 0.5), "12.35 ± 0.50");
+        assert_eq!(value_with_error(250.0, 12.0), "250 ± 12");
+        assert_eq!(value_with_error(3.96897, f64::INFINITY), "3.9690");
     }
 }

@@ -129,6 +129,7 @@ pub static KEYS: &[Spec] = &[
     VISCOSITY_DRIVE,
     VISCOSITY_BLOCKS,
     OBSERVE,
+    crate::keys::shared::FIGURE_FORMAT,
     OBSERVE_EVERY,
     OBSERVE_VACF_LAGS,
     OBSERVE_TRAJECTORY,
