@@ -15,9 +15,7 @@ pub use network::{
     coordination_numbers,
 };
 pub use stratification::{Stratification, stratification};
-pub use structure::{
-    Window, default_q_grid, percus_yevick_g, structure_factor, structure_factor_windowed,
-};
+pub use structure::{Window, default_q_grid, structure_factor, structure_factor_windowed};
 
 use colloidsim_particles::gsd::{GsdError, frame_count, read_frame};
 use rayon::prelude::*;

@@ -91,6 +91,27 @@ impl PySolution {
         1.0 + 4.0 * self.eta * self.contact()
     }
 
+    /// `g` at the distances `x` (units of `d`), linear between nodes: 0 inside the core, the
+    /// contact value from `x = 1` on, 1 beyond the grid.
+    pub fn g_at(&self, x: &[f64]) -> Vec<f64> {
+        let dr = self.r[1] - self.r[0];
+        let m = self.contact_node();
+        x.iter()
+            .map(|&x| {
+                if x < 1.0 {
+                    return 0.0;
+                }
+                let u = x / dr;
+                let i = (u.floor() as usize).max(m);
+                if i + 1 >= self.g.len() {
+                    return 1.0;
+                }
+                let t = (u - i as f64).clamp(0.0, 1.0);
+                (1.0 - t) * self.g[i] + t * self.g[i + 1]
+            })
+            .collect()
+    }
+
     fn contact_node(&self) -> usize {
         (1.0 / (self.r[1] - self.r[0])).round() as usize
     }
@@ -400,6 +421,15 @@ mod tests {
         assert!(s.g[..256].iter().all(|&g| g == 0.0));
         let peak = s.g.iter().cloned().fold(0.0, f64::max);
         assert_eq!(peak, s.contact());
+        // Read at any distance (dpd's gr.png): 0 inside, the contact value at contact, the
+        // nodes' values on nodes and between them linearly, 1 beyond the grid.
+        let dr = s.r[1];
+        let at = s.g_at(&[0.99, 1.0, 1.5, 1.5 + 0.5 * dr, 1e3]);
+        assert_eq!(&at[..2], &[0.0, s.contact()]);
+        let i = (1.5 / dr).round() as usize;
+        assert_eq!(at[2], s.g[i]);
+        assert!((at[3] - 0.5 * (s.g[i] + s.g[i + 1])).abs() < 1e-12);
+        assert_eq!(at[4], 1.0);
     }
 
     #[test]

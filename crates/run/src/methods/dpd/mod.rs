@@ -17,10 +17,11 @@ use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
     Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
-    pair_distribution, percus_yevick_g, structure_factor_windowed,
+    pair_distribution, structure_factor_windowed,
 };
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
+use colloidsim_dft::oz;
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
 use colloidsim_particles::gsd::GsdWriter;
@@ -1253,7 +1254,10 @@ fn write_outputs(
         let phi =
             s.setup.colloids as f64 * 4.0 / 3.0 * std::f64::consts::PI * s.setup.radius.powi(3)
                 / vol;
-        let py = (phi > 0.0 && phi < 0.6).then(|| percus_yevick_g(phi, &r_over_d));
+        let py = (phi > 0.0 && phi <= oz::ETA_MAX)
+            .then(|| oz::solve(phi, &oz::PyOptions::default()).ok())
+            .flatten()
+            .map(|s| s.g_at(&r_over_d));
         let mut series = vec![Series {
             label: "colloids (bars: standard error)",
             x: &r_over_d,
