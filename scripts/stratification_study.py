@@ -11,9 +11,16 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
   ddft-rpy   the same DDFT with the pairwise unequal-radius RPY flux (--hydrodynamics rpy)
   eq         the binary FMT equilibrium reference: the DDFT dried at Pe_s = EQ_PECLET, slow
              enough that every profile is the static one at its radius
+  mpcd-slip, mpcd-noslip
+             droplet-mpcd (explicit SRD solvent, discrete-particle colloids of diameters 2 and
+             4 cells, examples/droplet/bidisperse-mpcd.toml scaled) with a slip or no-slip
+             boundary for the solvent at the moving interface; droplet-mpcd has no replicas, so
+             each point runs REPLICAS seeds (folders seed1, seed2, ... of the point)
 
 and any of them with `-k<stiffness>` appended (`bd-rpy-k500`): the same in an interface of that
-stiffness (kT/d^2) instead of the example's 100, to see whether the interface held the colloids.
+stiffness (kT/d^2, d the small diameter) instead of the example's (100 kT/d^2; the MPCD
+example's 100 kT/cell^2 = 400 kT/d^2 for the mpcd methods), to see whether the interface held
+the colloids.
 
 The measure is the difference of the species' mean centre distances over R, Delta =
 <r>_s / R - <r>_l / R (colloidsim_analysis::stratification), at 50, 75 and 100 % of the drying
@@ -36,8 +43,8 @@ S, Delta_eq, S_eq, the fraction of centres left beyond R at the end, wall second
 DATA/stratification_thresholds.csv, IMG/stratification-diagram-t075.png and -t100.png (S on the
 Pe_s x phi_s plane per method, with the lines Pe_s phi_s = 1/alpha^2 and 1),
 IMG/stratification-vs-pephi-t075.png and -t100.png (S against Pe_s phi_s), and a markdown table
-on stdout; IMG/stratification-profiles-pe30-phi0.2.png: both species' profiles at the end, every
-method side by side. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond
+on stdout; IMG/stratification-profiles-pe<Pe_s>-phi<phi0>.png (--profiles-at, default 30:0.2):
+both species' profiles at the end, every method side by side. A droplet-bd run that ends with more than LEFT_BEHIND of its centres beyond
 R (the interface left them behind: droplet-bd warns) did not compact; its end is drawn hollow
 and left out of the thresholds. A theory run that stopped early (particles ejected through the
 interface: the DDFT with the RPY flux and the dilute pair correlation does, as the paper's did)
@@ -58,16 +65,22 @@ import subprocess
 import sys
 import time
 
+# The size ratio d_l / d_s (--alpha).
 ALPHA = 2.0
 EQ_PECLET = 0.01
 # The profile times compared (fractions of the drying time), and those drawn.
 FRACTIONS = (0.5, 0.75, 1.0)
 DRAWN = (0.75, 1.0)
-# The grid points whose profiles are drawn method by method.
-PROFILES_AT = ((30.0, 0.2),)
 # As droplet-bd's warning: a droplet with more of its centres beyond R at the end did not compact.
 LEFT_BEHIND = 0.01
+# Interfaces stiffer than this (kT/d^2) get a shorter time step than droplet-bd's default.
+STIFF = 500.0
 BASE = "examples/droplet/bidisperse-bd.toml"
+MPCD_BASE = "examples/droplet/bidisperse-mpcd.toml"
+# The small colloids of the MPCD droplet are 2 cells across: a stiffness in kT/d^2 is 4 times
+# that in kT/cell^2.
+MPCD_CELLS_PER_D = 2.0
+MPCD_BOUNDARY = {"mpcd-slip": "slip", "mpcd-noslip": "no-slip"}
 DDFT_DX = "0.05"
 
 
@@ -78,10 +91,57 @@ def split(method):
     return (base, float(k)) if base and k.isdigit() else (method, None)
 
 
+def large_count(particles):
+    """Large spheres among `particles` for equal volumes of both sizes (1 per alpha^3 small)."""
+    return int(particles // (1 + ALPHA**3))
+
+
+def is_mpcd(method):
+    return split(method)[0] in MPCD_BOUNDARY
+
+
+def mpcd_scenario(pe, phi0, method, particles, seed):
+    """The MPCD example with this Peclet number, initial volume fraction, number of colloids
+    (alpha^3 small per large), boundary, seed and interface stiffness, dried to phi = 0.5 as the BD
+    droplets, with profiles at the study's times."""
+    method, stiffness = split(method)
+    with open(MPCD_BASE) as f:
+        lines = f.read().splitlines()
+    out, section = [], ""
+    for line in lines:
+        key = line.split("=")[0].strip()
+        if line.startswith("["):
+            section = line
+        if key == "peclet":
+            line = f"peclet = {pe}"
+        elif key == "phi0":
+            line = f"phi0 = {phi0}"
+        elif key == "seed":
+            line = f"seed = {seed}"
+        elif key == "boundary":
+            line = f'boundary = "{MPCD_BOUNDARY[method]}"'
+        elif key == "particles":
+            line = f"particles = {particles}"
+        elif key == "diameters":
+            line = f"diameters = [{MPCD_CELLS_PER_D}, {MPCD_CELLS_PER_D * ALPHA}]"
+        elif key == "counts":
+            line = f"counts = [{particles - large_count(particles)}, {large_count(particles)}]"
+        elif key == "final_volume_fraction":
+            line = "final_volume_fraction = 0.5"
+        elif key == "stiffness" and stiffness is not None:
+            line = f"stiffness = {stiffness / MPCD_CELLS_PER_D**2}"
+        elif key == "bins" and section == "[observe.profile]":
+            line = "bins = 20"
+        elif key == "fractions" and section == "[observe.profile]":
+            line = "fractions = [0.0, 0.25, 0.5, 0.75, 1.0]"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def scenario(pe, phi0, replicas, method, particles=900):
     """The example with this Peclet number, initial volume fraction, replicas, mobility,
-    interface stiffness and number of spheres (8 small per large: equal volumes at
-    alpha = 2)."""
+    interface stiffness, number of spheres and size ratio ALPHA (alpha^3 small per large:
+    equal volumes)."""
     method, stiffness = split(method)
     with open(BASE) as f:
         lines = f.read().splitlines()
@@ -96,21 +156,39 @@ def scenario(pe, phi0, replicas, method, particles=900):
             line = f"replicas = {replicas}"
         elif key == "particles":
             line = f"particles = {particles}"
+        elif key == "diameters":
+            line = f"diameters = [1.0, {ALPHA}]"
         elif key == "counts":
-            large = particles // 9
-            line = f"counts = [{particles - large}, {large}]"
+            line = f"counts = [{particles - large_count(particles)}, {large_count(particles)}]"
         elif key == "stiffness" and stiffness is not None:
             line = f"stiffness = {stiffness}"
         out.append(line)
     text = "\n".join(out) + "\n"
+    if stiffness is not None and stiffness > STIFF:
+        # The default step 2e-4 d^2/D0 keeps k D0 dt / kT at 0.1 up to STIFF kT/d^2; above,
+        # a step that keeps it there (D0 = kT / (3 pi eta d) with kT = eta = d = 1).
+        text += f"\n[run]\ndt = {0.1 / stiffness * 3 * math.pi:.6g}\n"
     if method == "bd-rpy":
         text += '\n[hydrodynamics]\nmodel = "rpy"\nmethod = "direct"\n'
     return text
 
 
-def state(folder):
+def seeds_of(folder):
+    """The seed folders of an MPCD point (its droplets), in order; [] for other methods."""
+    if not os.path.isdir(folder):
+        return []
+    names = [n for n in os.listdir(folder) if n.startswith("seed") and n[4:].isdigit()]
+    return [os.path.join(folder, n) for n in sorted(names, key=lambda n: int(n[4:]))]
+
+
+def state(folder, replicas=None):
     """'done' (completed), 'stopped' (the theory stopped early, e.g. on ejection, with the
-    profiles up to then: kept and used up to where it got) or None (run it)."""
+    profiles up to then: kept and used up to where it got) or None (run it). An MPCD point is
+    done when `replicas` of its seeds are (any number of them when `replicas` is None)."""
+    seeds = seeds_of(folder)
+    if seeds:
+        done = [f for f in seeds if state(f) == "done"]
+        return "done" if done and (replicas is None or len(done) >= replicas) else None
     try:
         with open(os.path.join(folder, "summary.json")) as f:
             s = json.load(f)
@@ -131,8 +209,35 @@ def folder_of(runs, method, pe, phi0):
     return os.path.join(runs, method, f"phi{phi0:g}-pe{pe:g}")
 
 
+def run_command(cmd, folder, log, what):
+    """Runs one colloidsim command into `folder`, logs it and records its wall time."""
+    t0 = time.time()
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.time() - t0
+    got = state(folder)
+    print(f"{what}: {got or 'FAILED'} {wall:.0f} s {' '.join(cmd)}", file=log, flush=True)
+    if got != "done":
+        print(res.stderr[-2000:], file=log, flush=True)
+    if got is None:
+        return
+    with open(folder + ".wall", "w") as f:
+        f.write(f"{wall:.1f}\n")
+
+
 def run_point(args, method, pe, phi0, log):
     folder = folder_of(args.runs, method, pe, phi0)
+    if is_mpcd(method):
+        for seed in range(1, args.replicas + 1):
+            one = os.path.join(folder, f"seed{seed}")
+            if state(one):
+                continue
+            os.makedirs(folder, exist_ok=True)
+            with open(one + ".toml", "w") as f:
+                f.write(mpcd_scenario(pe, phi0, method, args.particles, seed))
+            cmd = [args.bin, "run", one + ".toml", "--out", one, "--force", "--quiet",
+                   "--threads", str(args.threads)]
+            run_command(cmd, one, log, f"{method} phi0={phi0} Pe={pe} seed={seed}")
+        return
     if state(folder):
         return
     os.makedirs(os.path.dirname(folder), exist_ok=True)
@@ -146,24 +251,37 @@ def run_point(args, method, pe, phi0, log):
         cmd = [args.bin, "theory", scen, "--out", folder, "--force", "--dx", DDFT_DX]
         if split(method)[0] == "ddft-rpy":
             cmd += ["--hydrodynamics", "rpy"]
-    t0 = time.time()
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.time() - t0
-    got = state(folder)
-    print(f"{method} phi0={phi0} Pe={pe}: {got or 'FAILED'} {wall:.0f} s "
-          f"{' '.join(cmd)}", file=log, flush=True)
-    if got != "done":
-        print(res.stderr[-2000:], file=log, flush=True)
-    if got is None:
-        return
-    with open(folder + ".wall", "w") as f:
-        f.write(f"{wall:.1f}\n")
+    run_command(cmd, folder, log, f"{method} phi0={phi0} Pe={pe}")
+
+
+def mpcd_parameters(p):
+    """droplet-mpcd's parameters in the names droplet-bd's have (ideal_delta reads them)."""
+    k, rng, offset = p["interface"]
+    return {"stiffness": k, "range": rng, "offset": offset, "kt": p["solvent"]["srd"]["kt"],
+            "diameter": p["diameter"], "species": p["species"], "particles": p["particles"],
+            "replicas": 1}
 
 
 def measures(folder):
     """{fraction: (Delta, its standard error over the droplets or None, R)} at each profile
     time the run reached (stratification.csv of colloidsim run, summary.json of the theory),
-    and the run's parameters."""
+    and the run's parameters. An MPCD point: the mean over its seeds (the standard error from
+    their scatter), its parameters with `replicas` the number of seeds."""
+    seeds = [f for f in seeds_of(folder) if state(f) == "done"]
+    if seeds:
+        runs = [measures(f) for f in seeds]
+        params = dict(runs[0][1], replicas=len(runs))
+        out = {}
+        for fraction in runs[0][0]:
+            got = [r[0][fraction] for r in runs if r[0].get(fraction, (None,))[0] is not None]
+            if not got:
+                continue
+            d = [g[0] for g in got]
+            mean = sum(d) / len(d)
+            err = (math.sqrt(sum((x - mean) ** 2 for x in d) / (len(d) - 1) / len(d))
+                   if len(d) > 1 else None)
+            out[fraction] = (mean, err, got[0][2])
+        return out, params
     with open(os.path.join(folder, "summary.json")) as f:
         summary = json.load(f)
     path = os.path.join(folder, "stratification.csv")
@@ -175,7 +293,8 @@ def measures(folder):
         num = lambda x: float(x) if x not in ("", "null", "NaN", "nan") else None
         for r in rows[1:]:
             out[round(float(r[0]), 6)] = (num(r[i]), num(r[j]), float(r[head.index("R")]))
-        return out, summary["parameters"]
+        p = summary["parameters"]
+        return out, (mpcd_parameters(p) if summary.get("method") == "droplet-mpcd" else p)
     st = summary["stratification"]
     out = {round(x["fraction"], 6): (x["radius_difference"], None, x["radius"]) for x in st}
     return out, summary["parameters"]
@@ -224,13 +343,8 @@ def analyse(args):
             f = folder_of(args.runs, method, pe, phi0)
             if not state(f):
                 continue
-            wall = None
-            if os.path.exists(f + ".wall"):
-                with open(f + ".wall") as w:
-                    wall = float(w.read())
             got, params = measures(f)
-            with open(os.path.join(f, "summary.json")) as fs:
-                beyond = json.load(fs).get("centres_beyond_R_at_end")
+            wall, beyond = run_costs(f)
             left = None if beyond is None else beyond / (params["particles"] * params["replicas"])
             for fraction, (delta, err, radius) in sorted(got.items()):
                 if fraction not in FRACTIONS or delta is None:
@@ -238,13 +352,30 @@ def analyse(args):
                 base = eq.get(phi0, {}).get(fraction, (None,))[0]
                 ideal = ideal_delta(params, radius)
                 rows.append({
-                    "method": method, "fraction": fraction, "phi0": phi0, "phi_s": phi0 / 2,
+                    "method": method, "alpha": ALPHA, "fraction": fraction, "phi0": phi0,
+                    "phi_s": phi0 / 2,
                     "pe_s": pe, "pe_phi_s": pe * phi0 / 2, "R": radius, "delta": delta,
                     "delta_err": err, "delta_ideal": ideal, "S": delta - ideal,
                     "delta_eq": base, "S_eq": None if base is None else delta - base,
                     "left_behind": left if fraction == 1.0 else None, "wall_s": wall,
                 })
     return rows, eq
+
+
+def run_costs(folder):
+    """The wall seconds of a point (summed over an MPCD point's seeds) and the centres beyond R
+    at its end (summed over the droplets; None where the run does not say)."""
+    wall = beyond = None
+    for f in [g for g in seeds_of(folder) if state(g) == "done"] or [folder]:
+        if os.path.exists(f + ".wall"):
+            with open(f + ".wall") as w:
+                wall = (wall or 0.0) + float(w.read())
+        with open(os.path.join(f, "summary.json")) as fs:
+            s = json.load(fs)
+        b = s.get("centres_beyond_R_at_end", (s.get("colloids") or {}).get("centres_beyond_R_at_end"))
+        if b is not None:
+            beyond = (beyond or 0) + b
+    return wall, beyond
 
 
 def held_badly(row):
@@ -376,6 +507,42 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
+def alpha_figure(paths, path, fraction=1.0):
+    """S against Pe_s at each phi0 for the data files of several size ratios (their `alpha`
+    column; the files of --tag runs): does the threshold move as 1 / alpha^2?"""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = []
+    for p in paths:
+        with open(p) as f:
+            rows += [r for r in csv.DictReader(f) if float(r["fraction"]) == fraction]
+    fig, ax = plt.subplots(figsize=(7.5, 4.0), layout="constrained")
+    marks = {0.05: "o", 0.1: "s", 0.2: "^"}
+    groups = sorted({(r["method"], float(r.get("alpha") or 2.0)) for r in rows})
+    for k, (m, alpha) in enumerate(groups):
+        for phi0 in sorted({float(r["phi0"]) for r in rows}):
+            rs = sorted((r for r in rows if r["method"] == m
+                         and float(r.get("alpha") or 2.0) == alpha
+                         and float(r["phi0"]) == phi0), key=lambda r: float(r["pe_s"]))
+            if not rs:
+                continue
+            ax.errorbar([float(r["pe_s"]) for r in rs], [float(r["S"]) for r in rs],
+                        yerr=[float(r["delta_err"] or 0.0) for r in rs], color=f"C{k}",
+                        marker=marks.get(phi0, "o"), ms=5, lw=1, capsize=2,
+                        label=f"{m}, $\\alpha$ = {alpha:g}, $\\phi_0$ = {phi0:g}")
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel(r"$Pe_s$")
+    ax.set_ylabel(r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
+    when = "end of drying" if fraction == 1.0 else f"{fraction:.0%} of the drying time"
+    ax.set_title(f"size ratios side by side ({when})", fontsize=9)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def profile_figure(args, methods, pe, phi0, fraction, path):
     """Both species' volume-fraction profiles against r/R at one point of the grid, every
     method side by side (species_profile_<f>.csv of each run, errors where there are)."""
@@ -387,25 +554,36 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
     name = f"species_profile_{fraction:.2f}.csv"
     drawn = False
     for k, method in enumerate(m for m in methods if m != "eq"):
-        f = os.path.join(folder_of(args.runs, method, pe, phi0), name)
-        if not os.path.exists(f):
+        point = folder_of(args.runs, method, pe, phi0)
+        if not state(point):
             continue
-        with open(f) as fh:
-            rows = [r for r in csv.DictReader(fh)]
-        radius = measures(os.path.dirname(f))[0].get(round(fraction, 6), (0, 0, None))[2]
-        if not rows or not radius:
+        # An MPCD point's droplets are its seeds: their mean, the error from their scatter.
+        files = [os.path.join(f, name) for f in seeds_of(point) if state(f) == "done"]
+        files = [f for f in files or [os.path.join(point, name)] if os.path.exists(f)]
+        runs = []
+        for f in files:
+            with open(f) as fh:
+                runs.append([r for r in csv.DictReader(fh)])
+        radius = measures(point)[0].get(round(fraction, 6), (0, 0, None))[2]
+        if not runs or not runs[0] or not radius:
             continue
-        x = [float(r["r"]) / radius for r in rows]
+        x = [float(r["r"]) / radius for r in runs[0]]
         for ax, sp in zip(axes, ("A", "B")):
-            y = [float(r[f"phi_{sp}"]) for r in rows]
-            e = [float(r[f"err_{sp}"]) if r.get(f"err_{sp}") not in (None, "") else 0.0
-                 for r in rows]
+            if len(runs) > 1:
+                cols = list(zip(*[[float(r[f"phi_{sp}"]) for r in rs] for rs in runs]))
+                y = [sum(c) / len(c) for c in cols]
+                e = [math.sqrt(sum((v - m) ** 2 for v in c) / (len(c) - 1) / len(c))
+                     for c, m in zip(cols, y)]
+            else:
+                y = [float(r[f"phi_{sp}"]) for r in runs[0]]
+                e = [float(r[f"err_{sp}"]) if r.get(f"err_{sp}") not in (None, "") else 0.0
+                     for r in runs[0]]
             ax.errorbar(x, y, yerr=e, color=f"C{k}", lw=1.2, capsize=1.5, label=method)
             drawn = True
     if not drawn:
         plt.close(fig)
         return
-    for ax, what in zip(axes, ("small spheres (A, d)", "large spheres (B, 2d)")):
+    for ax, what in zip(axes, ("small spheres (A, d)", f"large spheres (B, {ALPHA:g}d)")):
         ax.set_title(f"{what}: Pe_s = {pe:g}, phi0 = {phi0:g}, t = {fraction:.0%}", fontsize=9)
         ax.set_xlabel("r / R(t)")
         # The inner shells hold a sphere or two: their profile is noise.
@@ -417,6 +595,7 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
 
 
 def main():
+    global ALPHA
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default="target/release/colloidsim")
     ap.add_argument("--runs", required=True)
@@ -427,11 +606,21 @@ def main():
     ap.add_argument("--phi0", default="0.05,0.1,0.2")
     ap.add_argument("--replicas", type=int, default=4)
     ap.add_argument("--particles", type=int, default=900)
+    ap.add_argument("--alpha", type=float, default=2.0, help="size ratio d_l / d_s")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--tag", default="", help="appended to the names of the data and figures")
     ap.add_argument("--panels", help="the methods the figures show (default: --methods)")
+    ap.add_argument("--profiles-at", default="30:0.2", metavar="PE:PHI0,...",
+                    help="the grid points whose profiles are drawn method by method")
+    ap.add_argument("--compare-alpha", metavar="CSV,CSV,...",
+                    help="only draw IMG/stratification-alpha<tag>.png from these data files")
     args = ap.parse_args()
+    ALPHA = args.alpha
+    if args.compare_alpha:
+        alpha_figure(args.compare_alpha.split(","),
+                     os.path.join(args.img, f"stratification-alpha{args.tag}.png"))
+        return
     args.methods = args.methods.split(",")
     args.peclet = [float(x) for x in args.peclet.split(",")]
     args.phi0 = [float(x) for x in args.phi0.split(",")]
@@ -450,7 +639,7 @@ def main():
     shown = args.panels.split(",") if args.panels else args.methods
     for fraction in DRAWN:
         figures(rows, shown, args.img, fraction, args.tag)
-    for pe, phi0 in PROFILES_AT:
+    for pe, phi0 in (map(float, x.split(":")) for x in args.profiles_at.split(",")):
         profile_figure(args, shown, pe, phi0, 1.0, os.path.join(
             args.img, f"stratification-profiles-pe{pe:g}-phi{phi0:g}{args.tag}.png"))
     print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
