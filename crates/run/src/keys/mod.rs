@@ -777,7 +777,7 @@ mod tests {
             ),
             (
                 "[observe]\nnonsense = 1",
-                "observe.nonsense: unknown key (the keys of [observe] are: every, density",
+                "observe.nonsense: unknown key (the keys of [observe] are: figure_format, every, density",
             ),
             (
                 "sedd = 3",
