@@ -56,6 +56,7 @@ pub(super) fn mixture_setup(
         dr,
         functional: Functional::WhiteBear,
         hydrodynamics: hydro,
+        pair: Default::default(),
     })
 }
 
