@@ -687,4 +687,37 @@ mod tests {
             last = worst;
         }
     }
+
+    /// The bulk collective mobility matrix `Lambda_ij = rho_i D0_i (delta_ij + C_ij)` (symmetric:
+    /// `D0_i C_ij rho_i` is symmetric in `i, j`) of a size-ratio-2 mixture: positive definite at
+    /// every composition and `xi3 <= 0.6` with the dense `g_ij` (so uniform bulk states are
+    /// stable, as `K > 0` for one size), while the dilute one has a negative eigenvalue from
+    /// `xi3 = 0.2` on (the mixture form of `1 - 5 phi < 0`).
+    #[test]
+    fn dense_bulk_mobility_matrix_is_positive_definite_where_the_dilute_one_is_not() {
+        let d = [1.0, 2.0];
+        let table = PairTable::default();
+        let smallest = |pair: PairCorrelation, eta: f64, fs: f64| {
+            let rho = [fs * eta / (PI / 6.0), (1.0 - fs) * eta / (PI / 6.0 * 8.0)];
+            let c = bulk_coupling(&d, &rho, pair, table).unwrap();
+            let l = |i: usize, j: usize| {
+                rho[i] / d[i] * (if i == j { 1.0 } else { 0.0 } + c[i * 2 + j])
+            };
+            assert!((l(0, 1) - l(1, 0)).abs() < 1e-14, "symmetry");
+            let (tr, det) = (l(0, 0) + l(1, 1), l(0, 0) * l(1, 1) - l(0, 1) * l(1, 0));
+            // The smaller eigenvalue over the larger (scale-free).
+            let disc = (0.25 * tr * tr - det).max(0.0).sqrt();
+            (0.5 * tr - disc) / (0.5 * tr + disc)
+        };
+        for eta in [0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6] {
+            for fs in [0.1, 0.3, 0.5, 0.7, 0.9] {
+                let dense = smallest(PairCorrelation::Trokhymchuk, eta, fs);
+                assert!(dense > 1e-3, "eta {eta}, small fraction {fs}: {dense}");
+                let dilute = smallest(PairCorrelation::Dilute, eta, fs);
+                if eta >= 0.3 {
+                    assert!(dilute < 0.0, "eta {eta}, small fraction {fs}: {dilute}");
+                }
+            }
+        }
+    }
 }
