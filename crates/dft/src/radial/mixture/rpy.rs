@@ -421,16 +421,22 @@ impl MixtureRpy {
             }
             let (dilute, tails) = block.split_at(b.bw);
             let dd = self.reduced[p];
+            let inv = 1.0 / self.d_eta;
             for (k, gk) in gj.iter().enumerate() {
                 let c = s + k;
                 let e3 = 0.5 * (f3 + xi3[c]);
-                let t = (e3 / self.d_eta).clamp(0.0, top);
+                let t = (e3 * inv).clamp(0.0, top);
                 let node = (t as usize).min(self.nodes - 2);
                 let frac = t - node as f64;
                 let (lo, hi) = (tails[node * b.bw + k], tails[(node + 1) * b.bw + k]);
                 let tail = lo + frac * (hi - lo);
+                // `amplitude(e, q)` with `q = e2 dd / e3`, numerator and denominator times
+                // `e3^2`: one division per cell.
                 let amp = if e3 > 0.0 {
-                    amplitude(e3.min(self.eta_max), 0.5 * (f2 + xi2[c]) * dd / e3)
+                    let e = e3.min(self.eta_max);
+                    let (v, w) = (1.0 - e, 0.5 * (f2 + xi2[c]) * dd);
+                    (v * e3 * (v * e3 + 3.0 * w) + 2.0 * e * w * w)
+                        / (e3 * e3 * (2.5 - 3.0 * e + e * e))
                 } else {
                     1.0
                 };
