@@ -117,8 +117,9 @@ enum Command {
         #[arg(long)]
         hydrodynamics: Option<String>,
         /// Droplet DDFT with `--hydrodynamics rpy` only: the pair correlation in the flux's
-        /// two-body density, `dilute` (default, `g = Theta(r - d)`) or `trokhymchuk`
-        /// (Trokhymchuk et al. 2005 at the mean local packing fraction).
+        /// two-body density, `dilute` (default, `g = Theta(r - d)`), `trokhymchuk`
+        /// (Trokhymchuk et al. 2005 at the mean local packing fraction; for a mixture scaled to
+        /// each pair's BMCSL contact value) or `trokhymchuk-n3` (at the weighted `n3`).
         #[arg(long)]
         pair: Option<String>,
         #[command(flatten)]

@@ -44,6 +44,7 @@ fn main() -> Result<(), RadialError> {
         dr,
         functional,
         hydrodynamics: hydro,
+        pair: Default::default(),
     };
     println!(
         "N_s = {}, N_l = {}, phi0 = {}, Pe_s = {pe}, Pe_l = {}, {hydro:?}, {functional:?}, dr = {dr}, t_end = {:.4} d_s^2/D0_s",

@@ -9,7 +9,8 @@
 //! - DDFT: numbers of each species conserved to rounding (free draining and RPY); the
 //!   equilibrium solver's profile is a stationary state; the dilute limit is Boltzmann in each
 //!   species' interface and diffuses with each species' own `D0` (`<r^2>` grows as `6 D0_s t`).
-//! - RPY: the mixture kernel's bulk drift against its closed form.
+//! - RPY: the mixture kernel's bulk drift against its closed form, dilute and dense `g_ij`; one
+//!   species with each pair correlation is the single-species run.
 //! - Bad input names the parameter.
 
 use std::f64::consts::PI;
@@ -20,7 +21,8 @@ use colloidsim_dft::radial::mixture::{
 };
 use colloidsim_dft::radial::{
     DdftOptions, DropletSetup, DryingSchedule, EquilibriumOptions, HarmonicInterface,
-    Hydrodynamics, RadialError, RadialGrid, Rosenfeld, Snapshot, run_droplet,
+    Hydrodynamics, PairCorrelation, PairTable, RadialError, RadialGrid, Rosenfeld, Snapshot,
+    run_droplet,
 };
 
 const DIAMETERS: [f64; 2] = [1.0, 2.0];
@@ -177,6 +179,7 @@ fn binary(r0: f64, phi0: [f64; 2], phi_end: f64, dr: f64, hydro: Hydrodynamics) 
         dr,
         functional: Functional::Rosenfeld,
         hydrodynamics: hydro,
+        pair: PairCorrelation::Dilute,
     }
 }
 
@@ -196,12 +199,17 @@ fn run(setup: &MixtureSetup) -> (Result<Vec<f64>, RadialError>, Vec<MixtureSnaps
 
 #[test]
 fn one_species_mixture_run_is_the_single_species_run() {
-    for hydro in [Hydrodynamics::FreeDraining, Hydrodynamics::Rpy] {
-        one_species_run(hydro);
+    for (hydro, pair) in [
+        (Hydrodynamics::FreeDraining, PairCorrelation::Dilute),
+        (Hydrodynamics::Rpy, PairCorrelation::Dilute),
+        (Hydrodynamics::Rpy, PairCorrelation::Trokhymchuk),
+        (Hydrodynamics::Rpy, PairCorrelation::TrokhymchukWeighted),
+    ] {
+        one_species_run(hydro, pair);
     }
 }
 
-fn one_species_run(hydro: Hydrodynamics) {
+fn one_species_run(hydro: Hydrodynamics, pair: PairCorrelation) {
     let (r0, phi0, phi_end): (f64, f64, f64) = (6.0, 0.1, 0.2);
     let schedule = DryingSchedule::from_peclet(r0, 10.0, 1.0).unwrap();
     let t_end = schedule.time_at_radius(r0 * (phi0 / phi_end).cbrt());
@@ -215,7 +223,7 @@ fn one_species_run(hydro: Hydrodynamics) {
         t_end,
         dr: 0.05,
         hydrodynamics: hydro,
-        pair: Default::default(),
+        pair,
     };
     let mix = MixtureSetup {
         species: vec![Species {
@@ -230,6 +238,7 @@ fn one_species_run(hydro: Hydrodynamics) {
         dr: 0.05,
         functional: Functional::Rosenfeld,
         hydrodynamics: hydro,
+        pair,
     };
     let times = [0.5 * t_end, t_end];
     let eq = EquilibriumOptions::default();
@@ -255,7 +264,7 @@ fn one_species_run(hydro: Hydrodynamics) {
             .map(|(x, y)| (x - y).abs())
             .fold(0.0, f64::max);
         eprintln!(
-            "t = {}: max |rho_one - rho_mix| / max rho = {:.3e}",
+            "{hydro:?} {pair:?} t = {}: max |rho_one - rho_mix| / max rho = {:.3e}",
             sa.time,
             diff / scale
         );
@@ -460,7 +469,7 @@ fn mixture_rpy_kernel_gives_its_bulk_drift() {
     }
     for i in 0..2 {
         let mut u = vec![0.0; n + 1];
-        k.velocities(i, &g, n, n, &mut u);
+        k.velocities(i, &g, &[], &[], n, n, &mut u);
         let at = |x: f64| u[(x / dr).round() as usize];
         let extrapolated = (4.0 * at(80.0) - at(40.0)) / 3.0;
         let ai = 0.5 * DIAMETERS[i];
@@ -473,6 +482,59 @@ fn mixture_rpy_kernel_gives_its_bulk_drift() {
             .sum::<f64>();
         eprintln!("species {i}: u/D0 {extrapolated:.8} vs {expected:.8}");
         assert!((extrapolated / expected - 1.0).abs() < 1e-4, "species {i}");
+    }
+}
+
+/// The dense kernel's bulk drift (`g_ij` of Trokhymchuk's `h` scaled to BMCSL contact values,
+/// kept to 4 `sigma_ij`) against `mixture::rpy::bulk_coupling`: uniform binary at `xi3 = 0.3`
+/// (a node of the table; small and large volumes 0.2, 0.1), forces 1 and 2.5, dr = d_s/10,
+/// faces at 40 and 80 extrapolated in 1/x^2.
+#[test]
+fn dense_mixture_rpy_kernel_gives_its_bulk_drift() {
+    let dr = 0.1;
+    let grid = RadialGrid::covering(dr, 90.0).unwrap();
+    let n = grid.len();
+    let table = PairTable {
+        range: 4.0,
+        ..PairTable::default()
+    };
+    let k = MixtureRpy::with_pair(&grid, &DIAMETERS, PairCorrelation::Trokhymchuk, table).unwrap();
+    let rho = [0.2 / (PI / 6.0), 0.1 / (PI / 6.0 * 8.0)];
+    let force = [1.0, 2.5];
+    let mut g = Vec::with_capacity(2 * n);
+    let mut all = Vec::with_capacity(2 * n);
+    for s in 0..2 {
+        g.extend(vec![-rho[s] * force[s]; n]);
+        all.extend(vec![rho[s]; n]);
+    }
+    let (mut xi2, mut xi3) = (vec![0.0; n], vec![0.0; n]);
+    colloidsim_dft::radial::mixture::rpy::point_packing(&DIAMETERS, &all, n, n, &mut xi2, &mut xi3);
+    let c = colloidsim_dft::radial::mixture::rpy::bulk_coupling(
+        &DIAMETERS,
+        &rho,
+        PairCorrelation::Trokhymchuk,
+        table,
+    )
+    .unwrap();
+    let dilute = colloidsim_dft::radial::mixture::rpy::bulk_coupling(
+        &DIAMETERS,
+        &rho,
+        PairCorrelation::Dilute,
+        table,
+    )
+    .unwrap();
+    for i in 0..2 {
+        let mut u = vec![0.0; n + 1];
+        k.velocities(i, &g, &xi2, &xi3, n, n, &mut u);
+        let at = |x: f64| u[(x / dr).round() as usize];
+        let extrapolated = (4.0 * at(80.0) - at(40.0)) / 3.0;
+        let expected: f64 = (0..2).map(|j| c[i * 2 + j] * force[j]).sum();
+        let without: f64 = (0..2).map(|j| dilute[i * 2 + j] * force[j]).sum();
+        eprintln!("species {i}: u/D0 {extrapolated:.8} vs {expected:.8} (dilute g: {without:.8})");
+        assert!(
+            (extrapolated - expected).abs() < 1e-6 * (expected - without).abs(),
+            "species {i}"
+        );
     }
 }
 

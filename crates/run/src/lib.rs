@@ -60,8 +60,8 @@ pub struct TheoryOptions {
     pub force: bool,
     /// Droplet DDFT only: `free-draining` (default) or `rpy`.
     pub hydrodynamics: Option<String>,
-    /// Droplet DDFT with RPY only: the pair correlation of the flux, `dilute` (default) or
-    /// `trokhymchuk`.
+    /// Droplet DDFT with RPY only (one size or a mixture): the pair correlation of the flux,
+    /// `dilute` (default), `trokhymchuk` or `trokhymchuk-n3`.
     pub pair: Option<String>,
 }
 

@@ -5,7 +5,8 @@
 //! - [`bulk`]: the equations of state they imply (Percus–Yevick / scaled-particle and BMCSL).
 //! - [`equilibrium`]: equilibrium at fixed numbers of each species.
 //! - [`ddft`]: [`MixtureDdft`], free-draining fluxes per species (`D0_s`) or plus the pairwise
-//!   RPY flux of [`rpy`] (unequal-radius RPY tensor, dilute `g_ij = Theta(r - (d_i + d_j)/2)`).
+//!   RPY flux of [`rpy`] (unequal-radius RPY tensor, dilute `g_ij = Theta(r - (d_i + d_j)/2)`
+//!   or Trokhymchuk's one-size `g` scaled to each pair's BMCSL contact value).
 //!
 //! Each species feels its own harmonic interface ([`Species::interface`]; the one-size droplet
 //! puts the wall at `R + offset` with `offset = -d/2`, so the colloid surface sits at `R`: give
@@ -33,6 +34,7 @@
 //!     dr: 0.05,
 //!     functional: Functional::WhiteBear,
 //!     hydrodynamics: Hydrodynamics::FreeDraining,
+//!     pair: PairCorrelation::Dilute,
 //! };
 //! let times = [0.5 * setup.t_end, setup.t_end];
 //! run_mixture_droplet(&setup, &times, &setup.ddft_options(), &EquilibriumOptions::default(),
@@ -58,8 +60,8 @@ use colloidsim_core::{ParamError, param};
 
 use super::droplet::CLOSE_PACKING;
 use super::{
-    DdftOptions, DryingSchedule, EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError,
-    RadialGrid, StepReport,
+    DdftOptions, DryingSchedule, EquilibriumOptions, HarmonicInterface, Hydrodynamics,
+    PairCorrelation, RadialError, RadialGrid, StepReport,
 };
 
 /// One species of a mixture.
@@ -116,6 +118,8 @@ pub struct MixtureSetup {
     pub functional: Functional,
     /// Free draining, or plus the pairwise RPY flux (needs Stokes `D0_s`, one viscosity).
     pub hydrodynamics: Hydrodynamics,
+    /// Pair correlations of the RPY flux ([`rpy`]; unused when free-draining).
+    pub pair: PairCorrelation,
 }
 
 /// Mean volume fraction `sum_s N_s d_s^3 / (8 R^3)` of `species` in a sphere of `radius`.
@@ -253,6 +257,7 @@ impl MixtureSetup {
             });
         let mut o = DdftOptions::new(fastest.d0, fastest.diameter);
         o.hydrodynamics = self.hydrodynamics;
+        o.pair = self.pair;
         o
     }
 
@@ -349,7 +354,7 @@ pub fn mixture_equilibrium_at(
 /// Equilibrium at `R0` (fixed `N_s`), then DDFT to each of `times` (ascending within
 /// `[0, t_end]`); `on_snapshot` receives every output, `on_step` every accepted step. `opts`:
 /// see [`MixtureSetup::ddft_options`] (its `d0`, `hydrodynamics` and `pair` are taken from the
-/// setup: `D0_s` per species, dilute pair correlation).
+/// setup: `D0_s` per species; `pair_table` from `opts`).
 ///
 /// Stops with [`RadialError::Unphysical`] (ejection, negative density) or
 /// [`RadialError::NotConverged`] after the snapshots reached so far.
@@ -381,7 +386,7 @@ pub fn run_mixture_droplet(
     let eq = solve_mixture_equilibrium(&grid, &mut fmt, &v, &numbers, None, eq_opts)?;
     let mut o = *opts;
     o.hydrodynamics = setup.hydrodynamics;
-    o.pair = super::PairCorrelation::Dilute;
+    o.pair = setup.pair;
     let d0: Vec<f64> = setup.species.iter().map(|s| s.d0).collect();
     let walls: Vec<HarmonicInterface> = setup.species.iter().map(|s| s.interface).collect();
     let mut ddft = MixtureDdft::new(grid.clone(), fmt, &d0, &walls, schedule, &eq.rho, o)?;

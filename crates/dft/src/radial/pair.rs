@@ -234,20 +234,25 @@ impl TotalCorrelation {
     }
 }
 
-/// Bulk sedimentation coefficient of the pairwise far-field RPY flux with this pair correlation
-/// kept to `range` diameters: `K = 1 - 5 eta + 12 eta int_1^range x h(x) dx` (the angular mean of
-/// the RPY pair tensor along the force is `1 / (6 pi eta_s r)`; `1 - 5 eta` is the excluded core).
-pub fn bulk_sedimentation(eta: f64, range: f64) -> Result<f64, ParamError> {
+/// `int_1^range x h(x; eta) dx` (midpoint rule on 100,000 points): the part of the bulk
+/// sedimentation coefficient beyond contact, [`bulk_sedimentation`] `= 1 - 5 eta + 12 eta` times it.
+pub fn first_moment(eta: f64, range: f64) -> Result<f64, ParamError> {
     let h = TotalCorrelation::new(eta)?;
     let n = 100_000;
     let dx = (range - 1.0) / n as f64;
-    let tail: f64 = (0..n)
+    Ok((0..n)
         .map(|k| {
             let x = 1.0 + (k as f64 + 0.5) * dx;
             x * h.h(x) * dx
         })
-        .sum();
-    Ok(1.0 - 5.0 * eta + 12.0 * eta * tail)
+        .sum())
+}
+
+/// Bulk sedimentation coefficient of the pairwise far-field RPY flux with this pair correlation
+/// kept to `range` diameters: `K = 1 - 5 eta + 12 eta int_1^range x h(x) dx` (the angular mean of
+/// the RPY pair tensor along the force is `1 / (6 pi eta_s r)`; `1 - 5 eta` is the excluded core).
+pub fn bulk_sedimentation(eta: f64, range: f64) -> Result<f64, ParamError> {
+    Ok(1.0 - 5.0 * eta + 12.0 * eta * first_moment(eta, range)?)
 }
 
 /// `h(x; eta)` (see [`TotalCorrelation`]).

@@ -59,7 +59,7 @@ impl PairCorrelation {
 }
 
 /// Packing-fraction nodes of the tabulated Trokhymchuk kernel: `eta_n = n * eta_max / 10`.
-const PAIR_NODES: usize = 11;
+pub(in crate::radial) const PAIR_NODES: usize = 11;
 /// Default [`PairTable::range`]: the tail of `h` beyond 8 d changes the bulk sedimentation
 /// coefficient `12 eta int x h dx` by less than 2.1e-3 at every `eta <= 0.471`.
 pub const PAIR_RANGE: f64 = 8.0;
@@ -84,7 +84,7 @@ impl Default for PairTable {
 }
 
 impl PairTable {
-    fn validate(&self) -> Result<(), ParamError> {
+    pub(in crate::radial) fn validate(&self) -> Result<(), ParamError> {
         if !(self.range.is_finite() && (2.0..=30.0).contains(&self.range)) {
             return Err(ParamError::new(
                 "pair_range",
@@ -107,7 +107,7 @@ impl PairTable {
 
 /// `int_from^R r^p h(r) dr` for `p = 0, 2, -2, -4` on a fine grid of `R` (cumulative Simpson,
 /// step at most `d / 2000`, ending at `to`), read back by cubic Hermite interpolation (the derivative `R^p h(R)` is known).
-struct TailMoments {
+pub(in crate::radial) struct TailMoments {
     from: f64,
     step: f64,
     integrals: Vec<[f64; 4]>,
@@ -118,7 +118,7 @@ impl TailMoments {
     const POWERS: [i32; 4] = [0, 2, -2, -4];
 
     /// Moments of `h(r)` (`r` in lengths) on `[from, to]`.
-    fn new(h: impl Fn(f64) -> f64, from: f64, to: f64, d: f64) -> Self {
+    pub(in crate::radial) fn new(h: impl Fn(f64) -> f64, from: f64, to: f64, d: f64) -> Self {
         let n = ((to - from) / (d / 2000.0)).ceil().max(1.0) as usize;
         let step = (to - from) / n as f64;
         let f = |r: f64| -> [f64; 4] {
@@ -151,7 +151,7 @@ impl TailMoments {
     }
 
     /// The four moments from `from` to `r` (`from <= r`; beyond the table the last value).
-    fn at(&self, r: f64) -> [f64; 4] {
+    pub(in crate::radial) fn at(&self, r: f64) -> [f64; 4] {
         let t = (r - self.from) / self.step;
         let last = self.integrals.len() - 1;
         if t >= last as f64 {

@@ -1,7 +1,8 @@
 //! DDFT of a hard-sphere mixture on spherical shells: per species
 //! `d rho_s / dt = -(1/r^2) d/dr (r^2 J_s)`, free-draining
 //! `J_s = -D0_s (d rho_s/dr + rho_s dw_s/dr)`, `w_s = beta mu_ex,s[rho] + beta V_s(r, t)`,
-//! optionally plus the pairwise RPY flux `rho_s u_s` of [`super::rpy`].
+//! optionally plus the pairwise RPY flux `rho_s u_s` of [`super::rpy`] (dilute or dense pair
+//! correlations, [`DdftOptions::pair`]).
 //!
 //! Numerics as [`crate::radial::Ddft`], species by species: Scharfetter–Gummel face fluxes
 //! (`D = w_s,i+1 - w_s,i - u_s dr / D0_s`), implicit Euler, each step the fixed point of "freeze
@@ -11,11 +12,11 @@
 //! over species of `max |G(rho_s) - rho_s| / max rho_s`.
 
 use super::fmt::MixtureFmt;
-use super::rpy::MixtureRpy;
+use super::rpy::{MixtureRpy, point_packing};
 use crate::anderson::{Anderson, Convention};
 use crate::radial::{
-    DdftOptions, DryingSchedule, HarmonicInterface, Hydrodynamics, PairCorrelation, RadialError,
-    RadialGrid, StepReport,
+    DdftOptions, DryingSchedule, HarmonicInterface, Hydrodynamics, RadialError, RadialGrid,
+    StepReport,
 };
 
 /// `B(z) = z / (e^z - 1)`.
@@ -52,6 +53,8 @@ pub struct MixtureDdft {
     vext: Vec<f64>,
     delta: Vec<f64>,
     gcell: Vec<f64>,
+    xi2: Vec<f64>,
+    xi3: Vec<f64>,
     u: Vec<f64>,
     lower: Vec<f64>,
     diag: Vec<f64>,
@@ -62,8 +65,9 @@ pub struct MixtureDdft {
 
 impl MixtureDdft {
     /// Start from `rho0` (species after species, cell values on `grid`) at `t = 0`. `d0[s]` and
-    /// `walls[s]` are species `s`'s bare diffusion coefficient and interface; `opts.d0` and
-    /// `opts.pair_table` are not used (the RPY flux has the dilute pair correlation only).
+    /// `walls[s]` are species `s`'s bare diffusion coefficient and interface; `opts.d0` is not
+    /// used; `opts.pair` and `opts.pair_table` choose the RPY flux's pair correlations
+    /// ([`super::rpy`]: `TrokhymchukWeighted` reads `xi3 = n3`, `xi2 = sum_s n3_s / d_s`).
     pub fn new(
         grid: RadialGrid,
         fmt: MixtureFmt,
@@ -102,18 +106,13 @@ impl MixtureDdft {
         let rpy = match opts.hydrodynamics {
             Hydrodynamics::FreeDraining => None,
             Hydrodynamics::Rpy => {
-                if opts.pair != PairCorrelation::Dilute {
-                    return Err(colloidsim_core::ParamError::new(
-                        "pair",
-                        format!(
-                            "a mixture's RPY flux has the dilute pair correlation only (got {})",
-                            opts.pair.name()
-                        ),
-                    )
-                    .into());
-                }
                 check_stokes(fmt.diameters(), d0, |s| format!("d0[{s}]"))?;
-                Some(MixtureRpy::new(&grid, fmt.diameters()))
+                Some(MixtureRpy::with_pair(
+                    &grid,
+                    fmt.diameters(),
+                    opts.pair,
+                    opts.pair_table,
+                )?)
             }
         };
         let particles = (0..ns)
@@ -140,6 +139,8 @@ impl MixtureDdft {
             vext: vec![0.0; ns * n],
             delta: vec![0.0; n + 1],
             gcell: vec![0.0; ns * n],
+            xi2: vec![0.0; n],
+            xi3: vec![0.0; n],
             u: vec![0.0; n + 1],
             lower: vec![0.0; n],
             diag: vec![0.0; n],
@@ -377,6 +378,25 @@ impl MixtureDdft {
                     prev = next;
                 }
             }
+            let dense = self.rpy.as_ref().is_some_and(|k| k.is_dense());
+            if dense && self.opts.pair.reads_n3() {
+                self.xi2[..m].iter_mut().for_each(|v| *v = 0.0);
+                for (s, d) in self.fmt.diameters().iter().enumerate() {
+                    for (x, n3) in self.xi2[..m].iter_mut().zip(self.fmt.n3_of(s)) {
+                        *x += n3 / d;
+                    }
+                }
+                self.xi3[..m].copy_from_slice(&self.fmt.n3()[..m]);
+            } else if dense {
+                point_packing(
+                    self.fmt.diameters(),
+                    &self.x,
+                    n,
+                    m,
+                    &mut self.xi2,
+                    &mut self.xi3,
+                );
+            }
         }
         let vol = self.grid.volumes();
         let area = self.grid.areas();
@@ -389,7 +409,7 @@ impl MixtureDdft {
                 self.delta[f] = (mu[f] + vs[f]) - (mu[f - 1] + vs[f - 1]);
             }
             if let Some(k) = &self.rpy {
-                k.velocities(s, &self.gcell, n, m, &mut self.u);
+                k.velocities(s, &self.gcell, &self.xi2, &self.xi3, n, m, &mut self.u);
                 for f in 1..m {
                     self.delta[f] -= self.u[f] * dr;
                 }

@@ -92,7 +92,7 @@ const THEORY_NAMES: &[&str] = &[
 
 /// A DFT error about one of its parameters, naming the scenario key that sets it (or the
 /// theory's own parameter as `theory.<name>`, and the derived `D0` as `system.d0`).
-fn relabel(e: RadialError) -> RadialError {
+pub(super) fn relabel(e: RadialError) -> RadialError {
     let RadialError::Param(p) = e else {
         return e;
     };
@@ -168,7 +168,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
     let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;
     if !p.species.is_single() {
-        return super::theory_mixture::theory(src, topts, ctl, &p, hydro, dr);
+        return super::theory_mixture::theory(src, topts, ctl, &p, hydro, pair, dr);
     }
     // Output times of the BD run (`step * dt`, the last one up to dt past t_end), in ascending
     // order (fractions may be listed in any order).

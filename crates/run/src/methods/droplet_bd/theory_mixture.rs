@@ -1,7 +1,10 @@
 //! `colloidsim theory` for a `droplet-bd` scenario of two or more species: the radial mixture
 //! FMT DDFT (White Bear mark I, whose bulk limit is BMCSL; `colloidsim_dft::radial::mixture`),
-//! free-draining or with the pairwise unequal-radius RPY flux (`--hydrodynamics rpy`, dilute
-//! pair correlation), on the BD run's bins and output times.
+//! free-draining or with the pairwise unequal-radius RPY flux (`--hydrodynamics rpy`; `--pair
+//! dilute`, `trokhymchuk` or `trokhymchuk-n3`: Trokhymchuk's one-size `g` scaled to each pair's
+//! BMCSL contact value, `colloidsim_dft::radial::mixture::rpy`), on the BD run's bins and output
+//! times. `summary.json` says how far the drying got (`reached`) and, for RPY, the pair
+//! correlation; a run stopped by ejection has status `unphysical`.
 //!
 //! Each species gets its Stokes diffusivity `kT / (3 pi eta d_s)` and the interface as the BD
 //! run's spheres meet it: the same stiffness and range, the wall `(d_s - d) / 2` further in
@@ -13,11 +16,12 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use colloidsim_core::output::OutputDir;
+use colloidsim_dft::radial::mixture::mixture_volume_fraction;
 use colloidsim_dft::radial::mixture::{Functional, MixtureSetup, Species, run_mixture_droplet};
 use colloidsim_dft::radial::{
-    EquilibriumOptions, HarmonicInterface, Hydrodynamics, RadialError, bin_average,
+    EquilibriumOptions, HarmonicInterface, Hydrodynamics, PairCorrelation, RadialError, bin_average,
 };
 use colloidsim_md::DropletParams;
 use serde_json::json;
@@ -56,29 +60,32 @@ pub(super) fn mixture_setup(
         dr,
         functional: Functional::WhiteBear,
         hydrodynamics: hydro,
+        pair: Default::default(),
     })
 }
 
-/// The mixture DDFT of the validated scenario `p` (grid spacing `dr`, fluxes `hydro`).
+/// The mixture DDFT of the validated scenario `p` (grid spacing `dr`, fluxes `hydro`, pair
+/// correlation `pair` of the RPY flux).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn theory(
     src: &Source,
     topts: &TheoryOptions,
     ctl: &Control,
     p: &DropletParams,
     hydro: Hydrodynamics,
+    pair: PairCorrelation,
     dr: f64,
 ) -> Result<Report> {
-    if topts.pair.as_deref().is_some_and(|x| x != "dilute") {
-        bail!("--pair: the mixture DDFT has the dilute pair correlation only");
-    }
     let m = &p.species;
     let mut order: Vec<usize> = (0..p.fractions.len()).collect();
     let time_of = |k: usize| p.profile_steps[k] as f64 * p.dt;
     order.sort_by(|&a, &b| time_of(a).total_cmp(&time_of(b)));
     let times: Vec<f64> = order.iter().map(|&k| time_of(k)).collect();
     let t_end = times.last().copied().unwrap_or(0.0).max(p.t_end);
-    let setup = mixture_setup(p, hydro, dr, t_end).map_err(|e| anyhow!("{}: {e}", src.label()))?;
-    setup
+    let mut setup =
+        mixture_setup(p, hydro, dr, t_end).map_err(|e| anyhow!("{}: {e}", src.label()))?;
+    setup.pair = pair;
+    let schedule = setup
         .validate()
         .map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let out = topts
@@ -95,6 +102,7 @@ pub(super) fn theory(
     let mut shown: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     let mut next = 0usize;
     let start = Instant::now();
+    let mut reached = 0.0f64;
     let result = run_mixture_droplet(
         &setup,
         &times,
@@ -140,8 +148,12 @@ pub(super) fn theory(
                 "radius_difference": mean[small] - mean[large],
             }));
         },
-        |rep| pb.advance((1000.0 * rep.time / p.t_end.max(1e-300)) as u64),
-    );
+        |rep| {
+            reached = rep.time;
+            pb.advance((1000.0 * rep.time / p.t_end.max(1e-300)) as u64)
+        },
+    )
+    .map_err(super::theory::relabel);
     pb.end();
     let wall = start.elapsed().as_secs_f64();
     if let Some(e) = write_err {
@@ -149,14 +161,23 @@ pub(super) fn theory(
     }
     let (status, message) = match &result {
         Ok(_) => ("ok", String::new()),
+        Err(e @ RadialError::Unphysical { .. }) => ("unphysical", e.to_string()),
         Err(e) => ("failed", e.to_string()),
     };
-    let summary = json!({
+    let radius_reached = schedule.radius(reached)?;
+    let mut summary = json!({
         "method": "droplet-bd",
         "engine": "theory: radial mixture FMT DDFT (White Bear mark I), implicit Euler",
         "hydrodynamics": match hydro {
             Hydrodynamics::FreeDraining => "free-draining",
-            Hydrodynamics::Rpy => "rpy (pairwise unequal-radius RPY flux, dilute pair correlation)",
+            Hydrodynamics::Rpy => match pair {
+                PairCorrelation::Dilute =>
+                    "rpy (pairwise unequal-radius RPY flux, dilute pair correlation)",
+                PairCorrelation::Trokhymchuk =>
+                    "rpy (pairwise unequal-radius RPY flux, Trokhymchuk g scaled to BMCSL contact values at the mean local packing)",
+                PairCorrelation::TrokhymchukWeighted =>
+                    "rpy (pairwise unequal-radius RPY flux, Trokhymchuk g scaled to BMCSL contact values at the mean weighted packing n3)",
+            },
         },
         "software": crate::software(),
         "status": status,
@@ -165,8 +186,17 @@ pub(super) fn theory(
         "theory": { "dr": dr },
         "stratification": snapshots,
         "particle_number_drift": result.as_ref().ok().map(|o| o.particle_drift.clone()),
+        "reached": {
+            "time": reached,
+            "fraction_of_drying_time": reached / t_end.max(1e-300),
+            "radius": radius_reached,
+            "mean_volume_fraction": mixture_volume_fraction(&setup.species, radius_reached),
+        },
         "wall_seconds": wall,
     });
+    if hydro == Hydrodynamics::Rpy {
+        summary["pair_correlation"] = pair.name().into();
+    }
     dir.write_json("summary.json", &summary)?;
     let mut warnings = Vec::new();
     if !shown.is_empty() {
