@@ -176,7 +176,7 @@ fn dpd_gr_bins_beyond_the_bound_are_refused() {
         "method = \"dpd\"\n[system]\nbox_length = 8.0\nphi = 0.1\n[observe]\ngr_bins = 100001\n";
     let e = refusal(text);
     assert!(
-        e.contains("observe.gr_bins") && e.contains("[1, 100000]"),
+        e.contains("observe.gr_bins") && e.contains("[2, 100000]"),
         "{e}"
     );
 }
