@@ -9,6 +9,10 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
   bd-rpy     Brownian dynamics with the unequal-radius RPY mobility (direct free-space sums)
   ddft-fd    the binary White Bear FMT DDFT with free-draining fluxes (colloidsim theory)
   ddft-rpy   the same DDFT with the pairwise unequal-radius RPY flux (--hydrodynamics rpy)
+             and the dilute pair correlation
+  ddft-rpy-tk
+             the same with the dense pair correlation (--pair trokhymchuk: Trokhymchuk's h
+             scaled to each pair's contact distance and BMCSL contact value)
   eq         the binary FMT equilibrium reference: the DDFT dried at Pe_s = EQ_PECLET, slow
              enough that every profile is the static one at its radius
   mpcd-slip, mpcd-noslip
@@ -196,7 +200,7 @@ def state(folder, replicas=None):
         return None
     if "completed" in s:  # colloidsim run
         return "done" if s["completed"] is True else None
-    return {"ok": "done", "failed": "stopped"}.get(s.get("status"))
+    return {"ok": "done", "failed": "stopped", "unphysical": "stopped"}.get(s.get("status"))
 
 
 def points(args, method):
@@ -251,6 +255,8 @@ def run_point(args, method, pe, phi0, log):
         cmd = [args.bin, "theory", scen, "--out", folder, "--force", "--dx", DDFT_DX]
         if split(method)[0] == "ddft-rpy":
             cmd += ["--hydrodynamics", "rpy"]
+        elif split(method)[0] == "ddft-rpy-tk":
+            cmd += ["--hydrodynamics", "rpy", "--pair", "trokhymchuk"]
     run_command(cmd, folder, log, f"{method} phi0={phi0} Pe={pe}")
 
 
@@ -543,6 +549,10 @@ def alpha_figure(paths, path, fraction=1.0):
     plt.close(fig)
 
 
+# The profiles are drawn from this r / R on.
+X_FROM = 0.4
+
+
 def profile_figure(args, methods, pe, phi0, fraction, path):
     """Both species' volume-fraction profiles against r/R at one point of the grid, every
     method side by side (species_profile_<f>.csv of each run, errors where there are)."""
@@ -552,7 +562,7 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
 
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6), sharey=True, layout="constrained")
     name = f"species_profile_{fraction:.2f}.csv"
-    drawn = False
+    drawn, top = False, 0.0
     for k, method in enumerate(m for m in methods if m != "eq"):
         point = folder_of(args.runs, method, pe, phi0)
         if not state(point):
@@ -579,6 +589,7 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
                 e = [float(r[f"err_{sp}"]) if r.get(f"err_{sp}") not in (None, "") else 0.0
                      for r in runs[0]]
             ax.errorbar(x, y, yerr=e, color=f"C{k}", lw=1.2, capsize=1.5, label=method)
+            top = max([top] + [a + b for xi, a, b in zip(x, y, e) if xi >= X_FROM])
             drawn = True
     if not drawn:
         plt.close(fig)
@@ -587,8 +598,11 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
         ax.set_title(f"{what}: Pe_s = {pe:g}, phi0 = {phi0:g}, t = {fraction:.0%}", fontsize=9)
         ax.set_xlabel("r / R(t)")
         # The inner shells hold a sphere or two: their profile is noise.
-        ax.set_xlim(0.4, 1.0)
-    axes[0].set_ylabel("volume fraction of centres")
+        ax.set_xlim(X_FROM, 1.0)
+        ax.set_ylim(0.0, 1.05 * top)
+    # A histogram of centres times the sphere's volume (not the sphere-shell overlap): it
+    # exceeds close packing in a shell thinner than the sphere where the centres layer.
+    axes[0].set_ylabel("centre density x sphere volume")
     axes[0].legend(fontsize=8)
     fig.savefig(path, dpi=130)
     plt.close(fig)
