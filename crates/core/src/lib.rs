@@ -6,13 +6,14 @@
 //! estimates checked before allocating ([`resources`]), sampling triggers ([`trigger`]),
 //! messages between the domains of a run decomposed over ranks ([`exchange`]),
 //! one-dimensional external fields ([`field1d`]) shared by Brownian cluster dynamics and the
-//! exact 1D theory, and the external tools tests check outputs with ([`tools`]).
+//! exact 1D theory, Gauss–Legendre quadrature ([`quadrature`]), and the external tools tests check outputs with ([`tools`]).
 
 pub mod exchange;
 pub mod field1d;
 pub mod msd;
 pub mod output;
 pub mod param;
+pub mod quadrature;
 pub mod resources;
 pub mod rng;
 pub mod timing;

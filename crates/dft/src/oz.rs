@@ -274,39 +274,13 @@ pub fn solve(eta: f64, opts: &PyOptions) -> Result<PySolution, ParamError> {
 /// `Z(eta) = (1 / eta) int_0^eta (1 - rho C(0))(eta') d eta'` by 8-point Gauss–Legendre
 /// quadrature in `eta'` (a solution at each node; the integrand is a smooth rational function).
 pub fn compressibility_z(eta: f64, opts: &PyOptions) -> Result<f64, ParamError> {
-    let (x, w) = gauss_legendre(8);
+    let (x, w) = colloidsim_core::quadrature::gauss_legendre(8);
     let mut sum = 0.0;
     for (xi, wi) in x.iter().zip(&w) {
         let e = 0.5 * eta * (1.0 + xi);
         sum += wi * solve(e, opts)?.inverse_compressibility;
     }
     Ok(0.5 * sum)
-}
-
-/// Nodes and weights of `n`-point Gauss–Legendre quadrature on `[-1, 1]` (Newton on `P_n`).
-fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let (mut x, mut w) = (vec![0.0; n], vec![0.0; n]);
-    for i in 0..n {
-        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-15 {
-                break;
-            }
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (x, w)
 }
 
 /// Exact PY contact value `(1 + eta/2) / (1 - eta)^2`.

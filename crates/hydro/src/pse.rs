@@ -151,31 +151,6 @@ fn hasimoto_cut(eps: f64) -> f64 {
     hi
 }
 
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre polynomial).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
-
 /// `(j0(x) − j1(x)/x, j2(x))`, by series below x = 0.3.
 fn bessel_pair(x: f64) -> (f64, f64) {
     if x < 0.3 {
@@ -224,12 +199,14 @@ impl WaveTable {
             .min(PI / (4.0 * ai.max(aj)))
             .min(xi);
         let panels = (k_max / width).ceil() as usize;
-        let gl = gauss_legendre(16);
+        let (gx, gw) = colloidsim_core::quadrature::gauss_legendre(16);
         let hw = 0.5 * k_max / panels as f64;
         let nodes: Vec<(f64, f64)> = (0..panels)
             .flat_map(|p| {
                 let mid = (2 * p + 1) as f64 * hw;
-                gl.iter().map(move |&(x, w)| (mid + hw * x, hw * w))
+                gx.iter()
+                    .zip(&gw)
+                    .map(move |(&x, &w)| (mid + hw * x, hw * w))
             })
             .map(|(k, w)| {
                 let q = k * k / (4.0 * xi * xi);

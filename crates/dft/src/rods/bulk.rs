@@ -61,7 +61,7 @@ pub fn structure_factor_zero_finite_range(
     order: f64,
     rho: f64,
 ) -> f64 {
-    let (nodes, weights) = gauss_legendre_64();
+    let (nodes, weights) = colloidsim_core::quadrature::gauss_legendre(64);
     let a = eps.powf(order + 1.0) / (order + 1.0);
     // The first three moments of r under e^{-s r} e^{-beta V(r)}, divided by e^{-s sigma}.
     let moments = |s: f64| {
@@ -110,32 +110,6 @@ pub fn structure_factor_zero_finite_range(
 /// `(2 / rho) sqrt(S(0) D t / pi)`; for hard rods `(1 - rho sigma) / rho sqrt(4 D t / pi)`.
 pub fn single_file_msd(s0: f64, rho: f64, diffusion: f64, t: f64) -> f64 {
     2.0 / rho * (s0 * diffusion * t / std::f64::consts::PI).sqrt()
-}
-
-/// Nodes and weights of 64-point Gauss–Legendre quadrature on [-1, 1] (Newton on the Legendre
-/// recurrence).
-fn gauss_legendre_64() -> ([f64; 64], [f64; 64]) {
-    const N: usize = 64;
-    let (mut x, mut w) = ([0.0; N], [0.0; N]);
-    for i in 0..N {
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (N as f64 + 0.5)).cos();
-        loop {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=N {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                (p0, p1) = (p1, p2);
-            }
-            let dp = N as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-15 {
-                x[i] = z;
-                w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-                break;
-            }
-        }
-    }
-    (x, w)
 }
 
 #[cfg(test)]
