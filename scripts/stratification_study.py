@@ -104,42 +104,34 @@ def is_mpcd(method):
     return split(method)[0] in MPCD_BOUNDARY
 
 
+def rewritten(path, new):
+    """The scenario file at `path` with the line of each key of `new` replaced by
+    `key = value` (a key `"[section] key"` only in that section; None leaves the line)."""
+    out, section = [], ""
+    with open(path) as f:
+        for line in f.read().splitlines():
+            if line.startswith("["):
+                section = line
+            key = line.split("=")[0].strip()
+            value = new.get(f"{section} {key}", new.get(key))
+            out.append(line if value is None or line.startswith(("[", "#")) else f"{key} = {value}")
+    return "\n".join(out) + "\n"
+
+
 def mpcd_scenario(pe, phi0, method, particles, seed):
     """The MPCD example with this Peclet number, initial volume fraction, number of colloids
     (alpha^3 small per large), boundary, seed and interface stiffness, dried to phi = 0.5 as the BD
     droplets, with profiles at the study's times."""
     method, stiffness = split(method)
-    with open(MPCD_BASE) as f:
-        lines = f.read().splitlines()
-    out, section = [], ""
-    for line in lines:
-        key = line.split("=")[0].strip()
-        if line.startswith("["):
-            section = line
-        if key == "peclet":
-            line = f"peclet = {pe}"
-        elif key == "phi0":
-            line = f"phi0 = {phi0}"
-        elif key == "seed":
-            line = f"seed = {seed}"
-        elif key == "boundary":
-            line = f'boundary = "{MPCD_BOUNDARY[method]}"'
-        elif key == "particles":
-            line = f"particles = {particles}"
-        elif key == "diameters":
-            line = f"diameters = [{MPCD_CELLS_PER_D}, {MPCD_CELLS_PER_D * ALPHA}]"
-        elif key == "counts":
-            line = f"counts = [{particles - large_count(particles)}, {large_count(particles)}]"
-        elif key == "final_volume_fraction":
-            line = "final_volume_fraction = 0.5"
-        elif key == "stiffness" and stiffness is not None:
-            line = f"stiffness = {stiffness / MPCD_CELLS_PER_D**2}"
-        elif key == "bins" and section == "[observe.profile]":
-            line = "bins = 20"
-        elif key == "fractions" and section == "[observe.profile]":
-            line = "fractions = [0.0, 0.25, 0.5, 0.75, 1.0]"
-        out.append(line)
-    return "\n".join(out) + "\n"
+    large = large_count(particles)
+    return rewritten(MPCD_BASE, {
+        "peclet": pe, "phi0": phi0, "seed": seed, "boundary": f'"{MPCD_BOUNDARY[method]}"',
+        "particles": particles, "diameters": f"[{MPCD_CELLS_PER_D}, {MPCD_CELLS_PER_D * ALPHA}]",
+        "counts": f"[{particles - large}, {large}]", "final_volume_fraction": 0.5,
+        "stiffness": None if stiffness is None else stiffness / MPCD_CELLS_PER_D**2,
+        "[observe.profile] bins": 20,
+        "[observe.profile] fractions": "[0.0, 0.25, 0.5, 0.75, 1.0]",
+    })
 
 
 def scenario(pe, phi0, replicas, method, particles=900):
@@ -147,27 +139,12 @@ def scenario(pe, phi0, replicas, method, particles=900):
     interface stiffness, number of spheres and size ratio ALPHA (alpha^3 small per large:
     equal volumes)."""
     method, stiffness = split(method)
-    with open(BASE) as f:
-        lines = f.read().splitlines()
-    out = []
-    for line in lines:
-        key = line.split("=")[0].strip()
-        if key == "peclet":
-            line = f"peclet = {pe}"
-        elif key == "phi0":
-            line = f"phi0 = {phi0}"
-        elif key == "replicas":
-            line = f"replicas = {replicas}"
-        elif key == "particles":
-            line = f"particles = {particles}"
-        elif key == "diameters":
-            line = f"diameters = [1.0, {ALPHA}]"
-        elif key == "counts":
-            line = f"counts = [{particles - large_count(particles)}, {large_count(particles)}]"
-        elif key == "stiffness" and stiffness is not None:
-            line = f"stiffness = {stiffness}"
-        out.append(line)
-    text = "\n".join(out) + "\n"
+    large = large_count(particles)
+    text = rewritten(BASE, {
+        "peclet": pe, "phi0": phi0, "replicas": replicas, "particles": particles,
+        "diameters": f"[1.0, {ALPHA}]", "counts": f"[{particles - large}, {large}]",
+        "stiffness": stiffness,
+    })
     if stiffness is not None and stiffness > STIFF:
         # The default step 2e-4 d^2/D0 keeps k D0 dt / kT at 0.1 up to STIFF kT/d^2; above,
         # a step that keeps it there (D0 = kT / (3 pi eta d) with kT = eta = d = 1).
