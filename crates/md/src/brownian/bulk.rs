@@ -24,6 +24,7 @@ use super::scenario::{read_initial, species_from_file};
 use super::{BdError, BdParams, Brownian, Integrator};
 use crate::init::{PackingError, random_mixture_in_box};
 use crate::neighbor::{BoxTooSmall, NeighborList};
+use crate::tune::{SkinTuning, TunePlan, candidate_skins, tune_skin};
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
 use colloidsim_core::ParamError;
@@ -39,6 +40,19 @@ use std::path::PathBuf;
 pub const MAX_BODY_DRIFT: f64 = 0.1;
 /// The WCA cut-off `2^(1/6) d`, in diameters.
 pub const WCA_RANGE: f64 = 1.122_462_048_309_373;
+
+/// Candidate skins of [`BulkParams::measure_skins`], in diameters of the smallest species (the
+/// best of WCA at phi 0.1, dt 1e-4 d^2 / D0 lies near 0.7-0.9: docs/performance.md).
+pub const SKIN_FACTORS: [f64; 6] = [0.2, 0.35, 0.5, 0.7, 0.9, 1.2];
+
+/// How [`BulkParams::measure_skins`] times each candidate: 100 steps to settle, then 500 (the
+/// engine's forced re-sort period, so that the largest skins pay their builds too), three
+/// interleaved rounds.
+pub const SKIN_TUNE_PLAN: TunePlan = TunePlan {
+    warmup: 100,
+    steps: 500,
+    rounds: 3,
+};
 
 /// Resolved, validated parameters of a bulk run.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -83,6 +97,11 @@ pub struct BulkParams {
     pub integrator: Integrator,
     /// Verlet skin.
     pub skin: f64,
+    /// Choose the skin from measured step times before the run ([`crate::tune`]).
+    pub tune_skin: bool,
+    /// The tuning that chose `skin`, once made.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skin_tuning: Option<SkinTuning>,
     /// Steps before sampling (per replica).
     pub equilibrate_steps: u64,
     /// Sampled steps per replica (`blocks * block_steps`).
@@ -412,6 +431,26 @@ impl BulkParams {
         )?)
     }
 
+    /// Time the free-draining replica 0 at the candidate skins [`SKIN_FACTORS`] `x d` that fit
+    /// the box ([`crate::tune`]: [`SKIN_TUNE_PLAN`], each on its own copy from step 0) and
+    /// return what was measured; the caller sets `skin` and `skin_tuning` from it.
+    pub fn measure_skins(&self) -> Result<SkinTuning, BulkError> {
+        let r_cut = self.pair()?.r_cut_max();
+        let max_range = 0.5 * self.box_length * (1.0 - 1e-9);
+        let skins = candidate_skins(self.diameter, &SKIN_FACTORS, r_cut, max_range);
+        tune_skin(
+            &skins,
+            SKIN_TUNE_PLAN,
+            |skin| {
+                let mut p = self.clone();
+                p.skin = skin;
+                p.build_replica(0)
+            },
+            |sim, n| Ok(sim.run(n)?),
+            |sim| sim.neighbor_builds(),
+        )
+    }
+
     /// Replica `replica` at step 0 with RPY by PSE in the box.
     pub fn build_hydro_replica(&self, replica: u32) -> Result<HydroBulkSim, BulkError> {
         self.restart_hydro_replica(
@@ -486,6 +525,8 @@ mod tests {
             dt: 0.002,
             integrator: Integrator::Euler,
             skin: 0.4,
+            tune_skin: false,
+            skin_tuning: None,
             equilibrate_steps: 0,
             sampled_steps: 100,
             steps: 100,

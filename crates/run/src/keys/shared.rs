@@ -451,6 +451,15 @@ pub const RUN_SKIN: Spec = key(
 )
 .also("in [0.001 d, 5 d]");
 
+/// `run.tune_skin`.
+pub const RUN_TUNE_SKIN: Spec = key(
+    "run.tune_skin",
+    "-",
+    Value("false"),
+    Bool,
+    "choose the Verlet skin from measured step times before the run (candidates 0.2-1.2 d on copies of replica 0, discarded): run.skin is then ignored, the chosen skin and every candidate's time are in summary.json's parameters and the checkpoint (a rerun with run.skin set to it is bitwise the same run); free draining on one process",
+);
+
 /// `run.integrator`.
 pub const RUN_INTEGRATOR: Spec = key(
         "run.integrator",

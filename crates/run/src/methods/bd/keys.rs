@@ -9,7 +9,7 @@ use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{
     DIAMETER, HYDRO_MAX_ITERATIONS, HYDRO_MODEL, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS,
-    KT, RUN_DT, RUN_INTEGRATOR, RUN_SKIN, TRAJECTORY, TRAJECTORY_EVERY, VISCOSITY,
+    KT, RUN_DT, RUN_INTEGRATOR, RUN_SKIN, RUN_TUNE_SKIN, TRAJECTORY, TRAJECTORY_EVERY, VISCOSITY,
 };
 use crate::keys::species::*;
 use crate::keys::{SEED_KEY, Spec, key};
@@ -105,6 +105,7 @@ pub static KEYS: &[Spec] = &[
     RUN_DT,
     RUN_EQUILIBRATE,
     RUN_SKIN,
+    RUN_TUNE_SKIN,
     RUN_INTEGRATOR,
     OBSERVE,
     crate::keys::shared::FIGURE_FORMAT,

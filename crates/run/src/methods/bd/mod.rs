@@ -40,6 +40,8 @@ use colloidsim_mc::observe::mean_and_error;
 use colloidsim_md::Brownian;
 use colloidsim_md::brownian::bulk::{BodyForce, BulkError, BulkParams};
 use colloidsim_md::brownian::lj_eos::{jzg_pressure, lj_tail_pressure};
+use colloidsim_md::tune::SkinTuning;
+use crate::keys::shared::RUN_TUNE_SKIN;
 use colloidsim_particles::Interaction;
 use colloidsim_particles::PairSpec;
 use serde::{Deserialize, Serialize};
@@ -184,7 +186,21 @@ fn start(
     seed: Option<u64>,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let p = resolve(src, seed)?;
+    let mut p = resolve(src, seed)?;
+    if p.tune_skin {
+        if comm.as_ref().is_some_and(|c| c.size() > 1) {
+            bail!(
+                "{}: {}: the skin is tuned on one process (each rank would time its own and \
+                 choose another); tune it in a run on one process and set run.skin to the skin \
+                 it chose",
+                src.label(),
+                RUN_TUNE_SKIN.path
+            );
+        }
+        let t = p.measure_skins().map_err(keyed).with_context(|| src.label())?;
+        p.skin = t.skin;
+        p.skin_tuning = Some(t);
+    }
     // Set up replica 0 before the output folder is created: bad input leaves nothing.
     let sim = build_replica(&p, 0).with_context(|| src.label())?;
     let acc = Accum::new(&p);
@@ -199,8 +215,13 @@ fn restore(
     envelope: &Envelope,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let p = resolve(src, Some(seed))?;
+    let mut p = resolve(src, Some(seed))?;
     let saved: Saved<Accum> = crate::checkpoint::decode_payload(&envelope.payload)?;
+    // The skin the run chose when it started, not a new tuning (bitwise restarts).
+    if let Some(t) = saved.acc.skin_tuning.as_ref().filter(|_| p.tune_skin) {
+        p.skin = t.skin;
+        p.skin_tuning = Some(t.clone());
+    }
     let lags = p.msd_lags().len();
     if saved.replica >= p.replicas
         || saved.acc.velocities.len() > p.replicas * p.blocks
@@ -328,6 +349,9 @@ struct Accum {
     block: Option<Block>,
     /// Neighbour-list builds of the finished replicas.
     builds: u64,
+    /// `run.tune_skin`: the tuning that chose the run's skin.
+    #[serde(default)]
+    skin_tuning: Option<SkinTuning>,
     /// Frames in trajectory.gsd.
     frames: u64,
     /// CRC-32 of those frames, checked before a restart appends to the file.
@@ -347,6 +371,7 @@ impl Accum {
             pressures: Vec::with_capacity(blocks),
             block: None,
             builds: 0,
+            skin_tuning: p.skin_tuning.clone(),
             frames: 0,
             digest: FrameDigest::default(),
             checkpoints: 0,

@@ -5,6 +5,7 @@
 use super::keys::*;
 use crate::keys::shared::{
     self, HYDRO_MAX_ITERATIONS, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS, RUN_DT, RUN_SKIN,
+    RUN_TUNE_SKIN,
     Spheres, TRAJECTORY_EVERY,
 };
 use crate::keys::{Reader, SEED_KEY, Spec, rekey};
@@ -189,6 +190,14 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         .as_ref()
         .is_some_and(|h| h.model == HydroModel::Rpy);
     let integrator = shared::integrator(r, rpy)?;
+    let tune_skin = r.flag(&RUN_TUNE_SKIN)?;
+    if tune_skin && rpy {
+        bail!(ParamError::new(
+            RUN_TUNE_SKIN.path,
+            "applies to free-draining runs only: with RPY hydrodynamics the mobility's cost, not \
+             the neighbour list's, decides a step (set run.skin, or leave out [hydrodynamics])",
+        ));
+    }
 
     let msd_points = r.count(&OBSERVE_MSD_POINTS)? as usize;
     let msd_max_lag = match r.opt_number(&OBSERVE_MSD_MAX_LAG)? {
@@ -229,6 +238,8 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<BulkParams> {
         dt,
         integrator,
         skin,
+        tune_skin,
+        skin_tuning: None,
         equilibrate_steps,
         sampled_steps,
         steps: equilibrate_steps + sampled_steps,
