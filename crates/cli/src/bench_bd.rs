@@ -275,13 +275,18 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
 /// The skin `run.tune_skin` would choose for the benchmark's system (on the current pool).
 fn tuned_skin(n: usize, phi: f64, dt: f64) -> Result<colloidsim_md::tune::SkinTuning> {
     use colloidsim_md::brownian::bulk::{SKIN_FACTORS, SKIN_TUNE_PLAN};
-    use colloidsim_md::tune::{candidate_skins, tune_skin};
+    use colloidsim_md::tune::{candidate_skins, lists, tune_skin};
     let l = (n as f64 * std::f64::consts::PI / 6.0 / phi).cbrt();
-    let skins = candidate_skins(1.0, &SKIN_FACTORS, 2f64.powf(1.0 / 6.0), 0.5 * l * (1.0 - 1e-9));
+    let skins = candidate_skins(
+        1.0,
+        &SKIN_FACTORS,
+        2f64.powf(1.0 / 6.0),
+        0.5 * l * (1.0 - 1e-9),
+    );
     Ok(tune_skin(
-        &skins,
+        &lists(&skins),
         SKIN_TUNE_PLAN,
-        |skin| colloidsim_md::bench::wca_periodic_skin(n, phi, dt, 1, skin),
+        |c| colloidsim_md::bench::wca_periodic_skin(n, phi, dt, 1, c.skin),
         |sim, k| sim.run(k),
         |sim| sim.neighbor_builds(),
     )?)

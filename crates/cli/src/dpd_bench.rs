@@ -41,6 +41,11 @@ pub struct BenchArgs {
     /// `cells`. In cells mode the skin plays no part: each thread count is measured once.
     #[arg(long, default_value = "auto")]
     pub neighbors: String,
+    /// colloidsim chooses its neighbour search as `run.tune_skin = true` does (cells, or Verlet
+    /// lists at skins 0.1-0.8 rc; per thread count, on the relaxed state; its table is
+    /// printed) instead of being measured at every `--skin`; LAMMPS still is.
+    #[arg(long)]
+    pub tune: bool,
     /// Seed of the start and of the pair noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u32,
@@ -273,10 +278,41 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         "skin\tcode\tneighbors\tthreads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbor_builds\tsteps_per_build\tT_end"
     );
     let mut rows: Vec<Row> = Vec::new();
+    if a.tune {
+        for &t in &a.threads {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+            let tuning = pool.install(|| tuned_search(&relaxed, sbox, params0, step0))?;
+            for x in &tuning.trials {
+                println!(
+                    "# tuning on {t} thread(s): {}: {:.4e} particle-steps/s, {} list builds in {} steps",
+                    if x.cells {
+                        "cells".to_string()
+                    } else {
+                        format!("verlet, skin {}", x.skin)
+                    },
+                    n as f64 / x.seconds_per_step,
+                    x.builds,
+                    tuning.plan.steps
+                );
+            }
+            println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
+            let mut params = params0;
+            params.skin = tuning.skin;
+            params.neighbors = if tuning.cells {
+                NeighborMode::Cells
+            } else {
+                NeighborMode::Verlet
+            };
+            let mut row = measure_ours(&relaxed, sbox, params, step0, a.steps, repeats, t)?;
+            row.skin = tuning.skin;
+            row.print(a.steps);
+            rows.push(row);
+        }
+    }
     for &skin in &a.skin {
         let mut params = params0;
         params.skin = skin;
-        for &t in &a.threads {
+        for &t in a.threads.iter().filter(|_| !a.tune) {
             let cells_done = rows
                 .iter()
                 .any(|r| r.code == "colloidsim" && r.threads == t && r.neighbors == "cells");
@@ -371,6 +407,38 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
 }
 
 /// `repeats` runs of colloidsim on `threads` threads from the relaxed state.
+/// What `run.tune_skin` chooses for the relaxed water (on the current pool).
+fn tuned_search(
+    relaxed: &Particles,
+    sbox: SimBox,
+    params: DpdParams,
+    step0: u64,
+) -> Result<colloidsim_md::tune::SkinTuning> {
+    use colloidsim_md::dpd::setup::{DPD_SKIN_FACTORS, DPD_TUNE_PLAN};
+    use colloidsim_md::tune::{Candidate, lists, tune_skin};
+    let mut candidates = vec![Candidate {
+        skin: params.skin,
+        cells: true,
+    }];
+    candidates.extend(lists(&DPD_SKIN_FACTORS.map(|f| f * params.rc)));
+    Ok(tune_skin(
+        &candidates,
+        DPD_TUNE_PLAN,
+        |c| {
+            let mut p = params;
+            p.skin = c.skin;
+            p.neighbors = if c.cells {
+                NeighborMode::Cells
+            } else {
+                NeighborMode::Verlet
+            };
+            Dpd::new(relaxed.clone(), sbox, p, vec![false], step0)
+        },
+        |sim, k| sim.run(k),
+        |sim| sim.neighbor_builds(),
+    )?)
+}
+
 fn measure_ours(
     relaxed: &Particles,
     sbox: SimBox,

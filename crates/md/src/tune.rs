@@ -1,4 +1,4 @@
-//! A Verlet skin chosen from measured step times.
+//! A Verlet skin (and, for DPD, lists or cells) chosen from measured step times.
 //!
 //! A larger skin makes the neighbour list longer (pair work `~ (r_cut + skin)^3`) and its
 //! builds rarer (a build is due when a particle has moved half the skin: for diffusion after
@@ -30,6 +30,8 @@ pub struct TunePlan {
 pub struct SkinTrial {
     /// The skin.
     pub skin: f64,
+    /// No lists: cells every step (DPD's `NeighborMode::Cells`; false: Verlet lists).
+    pub cells: bool,
     /// Median wall time per step over the rounds (s).
     pub seconds_per_step: f64,
     /// Neighbour-list builds in the timed steps (of the last round).
@@ -41,6 +43,8 @@ pub struct SkinTrial {
 pub struct SkinTuning {
     /// The chosen skin: the least median time per step.
     pub skin: f64,
+    /// The chosen candidate is cells every step ([`SkinTrial::cells`]).
+    pub cells: bool,
     /// Every candidate, in increasing skin.
     pub trials: Vec<SkinTrial>,
     /// How they were timed.
@@ -63,25 +67,43 @@ pub fn candidate_skins(unit: f64, factors: &[f64], r_cut: f64, max_range: f64) -
     out
 }
 
-/// Time each of `skins` (by `build` from the same start, `run` for a number of steps) under
-/// `plan` and choose the fastest; `builds` counts a system's neighbour-list builds so far.
+/// A candidate: a skin, with Verlet lists or (`cells`) cells every step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// The skin.
+    pub skin: f64,
+    /// Cells every step instead of lists.
+    pub cells: bool,
+}
+
+/// Verlet-list candidates of `skins`.
+pub fn lists(skins: &[f64]) -> Vec<Candidate> {
+    skins
+        .iter()
+        .map(|&skin| Candidate { skin, cells: false })
+        .collect()
+}
+
+/// Time each of `candidates` (by `build` from the same start, `run` for a number of steps)
+/// under `plan` and choose the fastest; `builds` counts a system's neighbour-list builds so
+/// far.
 pub fn tune_skin<T, E>(
-    skins: &[f64],
+    candidates: &[Candidate],
     plan: TunePlan,
-    build: impl FnMut(f64) -> Result<T, E>,
+    build: impl FnMut(Candidate) -> Result<T, E>,
     run: impl FnMut(&mut T, u64) -> Result<(), E>,
     builds: impl Fn(&T) -> u64,
 ) -> Result<SkinTuning, E> {
     let origin = Instant::now();
     let clock = || origin.elapsed().as_secs_f64();
-    tune_with_clock(skins, plan, build, run, builds, clock)
+    tune_with_clock(candidates, plan, build, run, builds, clock)
 }
 
 /// [`tune_skin`] with the time read from `clock` (s).
 fn tune_with_clock<T, E>(
-    skins: &[f64],
+    skins: &[Candidate],
     plan: TunePlan,
-    mut build: impl FnMut(f64) -> Result<T, E>,
+    mut build: impl FnMut(Candidate) -> Result<T, E>,
     mut run: impl FnMut(&mut T, u64) -> Result<(), E>,
     builds: impl Fn(&T) -> u64,
     clock: impl Fn() -> f64,
@@ -89,9 +111,24 @@ fn tune_with_clock<T, E>(
     let start = clock();
     let mut times = vec![Vec::with_capacity(plan.rounds); skins.len()];
     let mut counts = vec![0; skins.len()];
-    for _ in 0..plan.rounds.max(1) {
-        for (k, &skin) in skins.iter().enumerate() {
-            let mut sim = build(skin)?;
+    // Candidates the system cannot be built with (a box too small for their range) are left
+    // out; the error is returned only when none can be built.
+    let mut usable = vec![true; skins.len()];
+    let mut first_error = None;
+    for round in 0..plan.rounds.max(1) {
+        for (k, &c) in skins.iter().enumerate() {
+            if !usable[k] {
+                continue;
+            }
+            let mut sim = match build(c) {
+                Ok(sim) => sim,
+                Err(e) if round == 0 => {
+                    usable[k] = false;
+                    first_error.get_or_insert(e);
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
             run(&mut sim, plan.warmup)?;
             let b0 = builds(&sim);
             let t0 = clock();
@@ -100,22 +137,30 @@ fn tune_with_clock<T, E>(
             counts[k] = builds(&sim) - b0;
         }
     }
+    if !usable.contains(&true)
+        && let Some(e) = first_error
+    {
+        return Err(e);
+    }
     let trials: Vec<SkinTrial> = skins
         .iter()
         .zip(times.iter_mut())
         .zip(counts)
-        .map(|((&skin, t), builds)| SkinTrial {
-            skin,
+        .zip(&usable)
+        .filter(|(_, ok)| **ok)
+        .map(|(((c, t), builds), _)| SkinTrial {
+            skin: c.skin,
+            cells: c.cells,
             seconds_per_step: median(t),
             builds,
         })
         .collect();
-    let skin = trials
+    let best = trials
         .iter()
-        .min_by(|a, b| a.seconds_per_step.total_cmp(&b.seconds_per_step))
-        .map_or(f64::NAN, |t| t.skin);
+        .min_by(|a, b| a.seconds_per_step.total_cmp(&b.seconds_per_step));
     Ok(SkinTuning {
-        skin,
+        skin: best.map_or(f64::NAN, |t| t.skin),
+        cells: best.is_some_and(|t| t.cells),
         trials,
         plan,
         seconds: clock() - start,
@@ -159,12 +204,12 @@ mod tests {
         };
         let skins = [0.2, 0.4, 0.6, 0.8, 1.2];
         let t = tune_with_clock(
-            &skins,
+            &lists(&skins),
             plan,
-            |skin| {
+            |c| {
                 trial.set(trial.get() + 1);
                 Ok::<_, ()>(Fake {
-                    skin,
+                    skin: c.skin,
                     builds: 1,
                     steps: 0,
                 })
@@ -184,11 +229,14 @@ mod tests {
             || now.get(),
         )
         .unwrap();
-        assert_eq!(t.skin, 0.6, "{t:?}");
+        assert_eq!((t.skin, t.cells), (0.6, false), "{t:?}");
         let per_step: Vec<f64> = t.trials.iter().map(|x| x.seconds_per_step).collect();
         let expected: Vec<f64> = skins.iter().map(|&s| cost(s)).collect();
         assert!(
-            per_step.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-12),
+            per_step
+                .iter()
+                .zip(&expected)
+                .all(|(a, b)| (a - b).abs() < 1e-12),
             "{per_step:?} against {expected:?}"
         );
         // 4 builds in 20 steps after 2 warm-up steps: at steps 5, 10, 15, 20.
@@ -205,13 +253,30 @@ mod tests {
             rounds: 1,
         };
         let r = tune_skin(
-            &[0.3],
+            &lists(&[0.3]),
             plan,
             |_| Err::<(), _>("box too small"),
             |_, _| Ok(()),
             |_| 0,
         );
         assert_eq!(r.unwrap_err(), "box too small");
+        // One candidate that cannot be built is left out.
+        let r = tune_skin(
+            &lists(&[0.3, 0.5]),
+            plan,
+            |c| {
+                if c.skin > 0.4 {
+                    Err("box too small")
+                } else {
+                    Ok(())
+                }
+            },
+            |_, _| Ok(()),
+            |_| 0,
+        )
+        .unwrap();
+        assert_eq!(r.trials.len(), 1);
+        assert_eq!(r.skin, 0.3);
     }
 
     #[test]

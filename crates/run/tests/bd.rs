@@ -537,84 +537,14 @@ fn the_lj_virial_pressure_follows_the_jzg_equation_of_state() {
     assert!(p["why_null"].is_null() && p["ideal"].as_f64().unwrap() > 0.0);
 }
 
-/// Asks the run to stop (as Ctrl-C) once `after` units of work are done.
-struct StopAfter {
-    after: u64,
-    done: std::sync::atomic::AtomicU64,
-}
-
-impl colloidsim_run::Progress for StopAfter {
-    fn advance(&self, done: u64) {
-        self.done.store(done, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    fn poll(&self) -> bool {
-        self.done.load(std::sync::atomic::Ordering::Relaxed) >= self.after
-    }
-}
-
-/// `run.tune_skin`: the run reports the skin it chose among the candidates, with each one's
-/// time; the scenario with `run.skin` set to that skin is bitwise the same run; a run stopped
-/// at step 200 continues with the skin it chose (the checkpoint's tuning: the whole trajectory
-/// is that of the skin the summary names). Checked to fail: with the restore leaving the
-/// checkpoint's tuning out, the resumed run reports no tuning.
-#[test]
-fn a_tuned_skin_is_recorded_and_its_run_is_reproduced_bitwise() {
-    let dir = tempfile::tempdir().unwrap();
-    let base = "method = \"bd\"\nseed = 5\n[system]\nparticles = 150\nbox_length = 10.0\n\
-                [run]\ndt = 0.001\ntime = 0.6\n\
-                [observe.trajectory]\nevery = 50\n";
-    let tuned_text = base.replace("[run]\n", "[run]\ntune_skin = true\n");
-    let (tuned, traj) = run_in(dir.path(), "tuned", &tuned_text);
-    let p = &tuned["parameters"];
-    let skin = p["skin"].as_f64().unwrap();
-    let trials = p["skin_tuning"]["trials"].as_array().unwrap();
-    assert!(trials.len() >= 4, "{p}");
-    assert!(
-        trials
-            .iter()
-            .all(|t| t["seconds_per_step"].as_f64().unwrap() > 0.0),
-        "{p}"
-    );
-    assert!(trials.iter().any(|t| t["skin"].as_f64() == Some(skin)), "{p}");
-    assert_eq!(p["skin_tuning"]["skin"].as_f64(), Some(skin));
-
-    let fixed = base.replace("[run]\n", &format!("[run]\nskin = {skin:?}\n"));
-    let (plain, plain_traj) = run_in(dir.path(), "fixed", &fixed);
-    assert!(!traj.is_empty());
-    assert_eq!(traj, plain_traj, "skin {skin}");
-    assert_eq!(tuned["self_diffusion"], plain["self_diffusion"]);
-
-    let sc = Scenario::from_toml(&tuned_text, dir.path()).unwrap();
-    let out = dir.path().join("stopped");
-    let stop = std::sync::Arc::new(StopAfter {
-        after: 200,
-        done: Default::default(),
-    });
-    let opts = RunOptions {
-        out: Some(out.clone()),
-        ..Default::default()
-    };
-    let e = colloidsim_run::run(&sc, &opts, &Control::new(stop)).unwrap_err();
-    assert!(e.downcast_ref::<colloidsim_run::Interrupted>().is_some(), "{e:#}");
-    let r = colloidsim_run::resume(&out, None, None, &Control::default()).unwrap();
-    let stopped_skin = &r.summary["parameters"]["skin_tuning"];
-    assert_eq!(r.summary["parameters"]["skin"], stopped_skin["skin"]);
-    let resumed_traj = std::fs::read(out.join("trajectory.gsd")).unwrap();
-    let s = stopped_skin["skin"].as_f64().unwrap();
-    let (_, again) = run_in(
-        dir.path(),
-        "again",
-        &base.replace("[run]\n", &format!("[run]\nskin = {s:?}\n")),
-    );
-    assert_eq!(resumed_traj, again, "skin {s}");
-}
-
 /// `run.tune_skin` refuses what it cannot tune, naming the key.
 #[test]
 fn skin_tuning_with_hydrodynamics_is_refused_naming_the_key() {
     let text = "method = \"bd\"\n[system]\nparticles = 20\nbox_length = 8.0\n\
                 [run]\ndt = 0.001\ntime = 0.1\ntune_skin = true\n[hydrodynamics]\nmodel = \"rpy\"\n";
     let e = format!("{:#}", read_bd(text).unwrap_err());
-    assert!(e.contains("run.tune_skin") && e.contains("free-draining"), "{e}");
+    assert!(
+        e.contains("run.tune_skin") && e.contains("free-draining"),
+        "{e}"
+    );
 }

@@ -24,9 +24,9 @@ use super::scenario::{read_initial, species_from_file};
 use super::{BdError, BdParams, Brownian, Integrator};
 use crate::init::{PackingError, random_mixture_in_box};
 use crate::neighbor::{BoxTooSmall, NeighborList};
-use crate::tune::{SkinTuning, TunePlan, candidate_skins, tune_skin};
 use crate::potential::{External, Pair};
 use crate::state::{Particles, SimBox};
+use crate::tune::{SkinTuning, TunePlan, candidate_skins, lists, tune_skin};
 use colloidsim_core::ParamError;
 use colloidsim_core::param::show;
 use colloidsim_core::trigger::log_spaced;
@@ -98,6 +98,7 @@ pub struct BulkParams {
     /// Verlet skin.
     pub skin: f64,
     /// Choose the skin from measured step times before the run ([`crate::tune`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub tune_skin: bool,
     /// The tuning that chose `skin`, once made.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -439,11 +440,11 @@ impl BulkParams {
         let max_range = 0.5 * self.box_length * (1.0 - 1e-9);
         let skins = candidate_skins(self.diameter, &SKIN_FACTORS, r_cut, max_range);
         tune_skin(
-            &skins,
+            &lists(&skins),
             SKIN_TUNE_PLAN,
-            |skin| {
+            |c| {
                 let mut p = self.clone();
-                p.skin = skin;
+                p.skin = c.skin;
                 p.build_replica(0)
             },
             |sim, n| Ok(sim.run(n)?),

@@ -29,6 +29,7 @@ use crate::bd_replica::{
 };
 use crate::checkpoint::Envelope;
 use crate::keys::Spec;
+use crate::keys::shared::RUN_TUNE_SKIN;
 use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
 use crate::output::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::output::trajectory::FrameDigest;
@@ -41,7 +42,6 @@ use colloidsim_md::Brownian;
 use colloidsim_md::brownian::bulk::{BodyForce, BulkError, BulkParams};
 use colloidsim_md::brownian::lj_eos::{jzg_pressure, lj_tail_pressure};
 use colloidsim_md::tune::SkinTuning;
-use crate::keys::shared::RUN_TUNE_SKIN;
 use colloidsim_particles::Interaction;
 use colloidsim_particles::PairSpec;
 use serde::{Deserialize, Serialize};
@@ -197,7 +197,10 @@ fn start(
                 RUN_TUNE_SKIN.path
             );
         }
-        let t = p.measure_skins().map_err(keyed).with_context(|| src.label())?;
+        let t = p
+            .measure_skins()
+            .map_err(keyed)
+            .with_context(|| src.label())?;
         p.skin = t.skin;
         p.skin_tuning = Some(t);
     }

@@ -5,8 +5,7 @@
 use super::keys::*;
 use crate::keys::shared::{
     self, HYDRO_MAX_ITERATIONS, HYDRO_SPLITTING, HYDRO_TOLERANCE, HYDRODYNAMICS, RUN_DT, RUN_SKIN,
-    RUN_TUNE_SKIN,
-    Spheres, TRAJECTORY_EVERY,
+    RUN_TUNE_SKIN, Spheres, TRAJECTORY_EVERY,
 };
 use crate::keys::{Reader, SEED_KEY, Spec, rekey};
 use anyhow::{Result, bail};

@@ -122,6 +122,9 @@ pub const RUN_STEPS: Spec = key("run.steps", "-", Value("10000"), Integer(0, COU
 pub const RUN_SKIN: Spec = key("run.skin", "rc", Value("0.4"), Closed(0.05, 2.0),
     "neighbour-list skin");
 
+pub const RUN_TUNE_SKIN: Spec = key("run.tune_skin", "-", Value("false"), Bool,
+    "choose the neighbour search from measured step times before the run (cells every step, or Verlet lists with skins 0.1-0.8 rc; each on a discarded copy of the start): run.skin and run.neighbors are then ignored, the choice and every candidate's time are in summary.json and the checkpoint (a rerun with run.skin and run.neighbors set to them is bitwise the same run); one process");
+
 pub const RUN_MAX_TEMPERATURE_DRIFT: Spec = key("run.max_temperature_drift", "-",
     Value("0.1"), LeftOpen(0.0, 10.0),
     "stop when the window-averaged kinetic temperature differs from kT by more than this fraction");
@@ -230,6 +233,7 @@ pub static KEYS: &[Spec] = &[
     RUN_DT,
     RUN_STEPS,
     RUN_SKIN,
+    RUN_TUNE_SKIN,
     RUN_MAX_TEMPERATURE_DRIFT,
     RUN_TEMPERATURE_WINDOW,
     RUN_NEIGHBORS,

@@ -22,8 +22,10 @@ use colloidsim_analysis::{
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_dft::oz;
+use colloidsim_md::dpd::NeighborMode;
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
+use colloidsim_md::tune::SkinTuning;
 use colloidsim_particles::gsd::GsdWriter;
 use colloidsim_particles::{Particles, SimBox};
 use monitor::TemperatureMonitor;
@@ -110,8 +112,25 @@ fn start(
     seed: Option<u64>,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let s = resolve(src, seed)?;
+    let mut s = resolve(src, seed)?;
     let (sync_every, _) = periods(s.steps);
+    if s.tune_skin {
+        if comm.as_ref().is_some_and(|c| c.size() > 1) {
+            bail!(
+                "{}: {}: the neighbour search is tuned on one process (each rank would time its \
+                 own and choose another); tune it in a run on one process and set run.skin and \
+                 run.neighbors to what it chose",
+                src.label(),
+                keys::RUN_TUNE_SKIN.path
+            );
+        }
+        let t = s
+            .setup
+            .measure_neighbors(sync_every)
+            .map_err(|e| anyhow::anyhow!(rekeyed(e)))
+            .with_context(|| src.label())?;
+        apply_tuning(&mut s, t);
+    }
     let mut sim = match comm {
         None => s.setup.build()?,
         Some(c) => s
@@ -123,6 +142,17 @@ fn start(
     DpdSession::new(s, sim, Observed::default(), 0).map(|d| Box::new(d) as Box<dyn Session>)
 }
 
+/// The neighbour search `run.tune_skin` chose, into the engine's parameters.
+fn apply_tuning(s: &mut Resolved, t: SkinTuning) {
+    s.setup.params.skin = t.skin;
+    s.setup.params.neighbors = if t.cells {
+        NeighborMode::Cells
+    } else {
+        NeighborMode::Verlet
+    };
+    s.skin_tuning = Some(t);
+}
+
 /// The session a checkpoint continues (on any number of ranks).
 fn restore(
     src: &Source,
@@ -131,8 +161,12 @@ fn restore(
     envelope: &Envelope,
     comm: Option<Box<dyn Exchange>>,
 ) -> Result<Box<dyn Session>> {
-    let s = resolve(src, Some(seed))?;
+    let mut s = resolve(src, Some(seed))?;
     let ck: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
+    // The search the run chose when it started, not a new tuning (bitwise restarts).
+    if let Some(t) = ck.skin_tuning.clone().filter(|_| s.tune_skin) {
+        apply_tuning(&mut s, t);
+    }
     if ck.sync_every != periods(s.steps).0 {
         bail!(
             "checkpoint: synchronisation period {} does not fit the scenario's {}",
@@ -176,6 +210,8 @@ struct Checkpoint<O> {
     forces: Vec<[f64; 3]>,
     /// Neighbour-list builds so far.
     neighbor_builds: u64,
+    /// `run.tune_skin`: the neighbour search the run chose.
+    skin_tuning: Option<SkinTuning>,
     obs: O,
 }
 
@@ -583,6 +619,7 @@ impl Session for DpdSession {
             particles: self.sim.snapshot(),
             forces: self.sim.forces(),
             neighbor_builds: self.builds0 + self.sim.neighbor_builds(),
+            skin_tuning: self.s.skin_tuning.clone(),
             obs: &self.obs,
         };
         Ok(bincode::serialize(&ck)?)
@@ -703,7 +740,7 @@ impl crate::Engine for DpdEngine {
 fn describe(s: &Resolved) -> serde_json::Value {
     let p = &s.setup.params;
     let c = &p.colloid;
-    json!({
+    let mut v = json!({
         "box": s.setup.sbox.l,
         "colloids": s.setup.colloids,
         "solvent_beads": s.setup.solvent,
@@ -736,7 +773,11 @@ fn describe(s: &Resolved) -> serde_json::Value {
         "contact_gap": s.contact_gap,
         "solvent_viscosity_kinetic_theory": solvent_viscosity_kinetic_theory(s),
         "shear_rate": p.shear_rate,
-    })
+    });
+    if let Some(t) = &s.skin_tuning {
+        v["skin_tuning"] = json!(t);
+    }
+    v
 }
 
 /// What a run accumulates; all of it is saved in every checkpoint.

@@ -111,6 +111,8 @@ pub struct Run {
     pub steps: u64,
     /// Neighbour-list skin.
     pub skin: f64,
+    /// Choose the skin and the neighbour search from measured step times.
+    pub tune_skin: bool,
     /// Largest relative drift of the window-averaged kinetic temperature.
     pub max_temperature_drift: f64,
     /// Window of that check (steps).
@@ -153,6 +155,10 @@ pub struct Resolved {
     pub setup: DpdSetup,
     /// Steps.
     pub steps: u64,
+    /// `run.tune_skin`: choose `setup.params.skin` and `.neighbors` before the run.
+    pub tune_skin: bool,
+    /// The tuning that chose them, once made.
+    pub skin_tuning: Option<colloidsim_md::tune::SkinTuning>,
     /// Temperature-drift limit (relative).
     pub max_temperature_drift: f64,
     /// Temperature window (steps).
@@ -217,6 +223,7 @@ impl Scenario {
                 dt: r.number(&RUN_DT)?,
                 steps: r.count(&RUN_STEPS)?,
                 skin: r.number(&RUN_SKIN)?,
+                tune_skin: r.flag(&RUN_TUNE_SKIN)?,
                 max_temperature_drift: r.number(&RUN_MAX_TEMPERATURE_DRIFT)?,
                 temperature_window: r.count(&RUN_TEMPERATURE_WINDOW)?,
                 neighbors: match r.word(&RUN_NEIGHBORS)?.as_str() {
@@ -513,6 +520,8 @@ impl Scenario {
                 tau: radius * radius / d0,
             },
             steps: run.steps,
+            tune_skin: run.tune_skin,
+            skin_tuning: None,
             max_temperature_drift: run.max_temperature_drift,
             temperature_window: run.temperature_window,
             observe: o.clone(),
