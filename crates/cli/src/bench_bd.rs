@@ -159,7 +159,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                     x.skin,
                     a.n as f64 / x.seconds_per_step,
                     x.builds,
-                    tuning.plan.steps
+                    x.steps
                 );
             }
             println!(

@@ -160,10 +160,37 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
         a.steps
     );
     println!("# load average (1, 5, 15 min) at start: {}", load());
-    println!("threads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbour_builds\tmode");
+    println!(
+        "threads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbour_builds\tmode\tskin"
+    );
     let mut medians = Vec::new();
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+        let mut setup = setup.clone();
+        if a.tune {
+            // The run's synchronisation period of a long run (lists rebuilt at least that often).
+            let tuning = pool.install(|| setup.measure_neighbors(1000))?;
+            for x in &tuning.trials {
+                println!(
+                    "# tuning on {t} thread(s): {}: {:.4e} particle-steps/s, {} list builds in {} steps",
+                    if x.cells {
+                        format!("cells (colloid lists skin {})", x.skin)
+                    } else {
+                        format!("verlet, skin {}", x.skin)
+                    },
+                    n as f64 / x.seconds_per_step,
+                    x.builds,
+                    x.steps
+                );
+            }
+            println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
+            setup.params.skin = tuning.skin;
+            setup.params.neighbors = if tuning.cells {
+                NeighborMode::Cells
+            } else {
+                NeighborMode::Verlet
+            };
+        }
         let (rates, cpu, builds, cells) = pool.install(|| -> Result<_> {
             let mut sim = setup.build()?;
             sim.run(a.warmup)?;
@@ -187,8 +214,9 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
         let (m, lo, hi) = median(rates);
         let (mc, _, _) = median(cpu);
         println!(
-            "{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{builds}\t{}",
-            if cells { "cells" } else { "verlet" }
+            "{t}\t{m:.4e}\t{lo:.4e}\t{hi:.4e}\t{mc:.4e}\t{builds}\t{}\t{}",
+            if cells { "cells" } else { "verlet" },
+            setup.params.skin
         );
         medians.push((t, m));
     }
@@ -292,7 +320,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                     },
                     n as f64 / x.seconds_per_step,
                     x.builds,
-                    tuning.plan.steps
+                    x.steps
                 );
             }
             println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);

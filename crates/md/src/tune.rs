@@ -18,8 +18,11 @@ pub struct TunePlan {
     /// Untimed steps before the timed ones (buffers and lists reach their size; the start's
     /// relaxation).
     pub warmup: u64,
-    /// Timed steps per candidate and round: at least one forced re-sort period, so that every
-    /// candidate pays its list builds in proportion.
+    /// Timed steps per candidate and round, at least: the timed stretch starts right after a
+    /// list build and ends with one (whole build cycles, so that every candidate pays its
+    /// builds in proportion; at most four times this many steps). A candidate without a
+    /// build within this many steps after the warm-up (cells, or a list that outlasts it) is
+    /// timed over this many steps.
     pub steps: u64,
     /// Interleaved rounds over the candidates; the median time of each is compared.
     pub rounds: usize,
@@ -36,6 +39,8 @@ pub struct SkinTrial {
     pub seconds_per_step: f64,
     /// Neighbour-list builds in the timed steps (of the last round).
     pub builds: u64,
+    /// Timed steps (of the last round).
+    pub steps: u64,
 }
 
 /// The skin chosen and what it was chosen from.
@@ -110,7 +115,7 @@ fn tune_with_clock<T, E>(
 ) -> Result<SkinTuning, E> {
     let start = clock();
     let mut times = vec![Vec::with_capacity(plan.rounds); skins.len()];
-    let mut counts = vec![0; skins.len()];
+    let mut counts = vec![(0, 0); skins.len()];
     // Candidates the system cannot be built with (a box too small for their range) are left
     // out; the error is returned only when none can be built.
     let mut usable = vec![true; skins.len()];
@@ -130,11 +135,34 @@ fn tune_with_clock<T, E>(
                 Err(e) => return Err(e),
             };
             run(&mut sim, plan.warmup)?;
+            // Up to the next build (untimed), then whole build cycles (timed).
+            let before = builds(&sim);
+            let mut synced = false;
+            for _ in 0..plan.steps {
+                run(&mut sim, 1)?;
+                if builds(&sim) > before {
+                    synced = true;
+                    break;
+                }
+            }
             let b0 = builds(&sim);
             let t0 = clock();
-            run(&mut sim, plan.steps)?;
-            times[k].push((clock() - t0) / plan.steps.max(1) as f64);
-            counts[k] = builds(&sim) - b0;
+            let mut steps = 0;
+            if synced {
+                while steps < 4 * plan.steps {
+                    let b = builds(&sim);
+                    run(&mut sim, 1)?;
+                    steps += 1;
+                    if steps >= plan.steps && builds(&sim) > b {
+                        break;
+                    }
+                }
+            } else {
+                run(&mut sim, plan.steps)?;
+                steps = plan.steps;
+            }
+            times[k].push((clock() - t0) / steps.max(1) as f64);
+            counts[k] = (builds(&sim) - b0, steps);
         }
     }
     if !usable.contains(&true)
@@ -148,11 +176,12 @@ fn tune_with_clock<T, E>(
         .zip(counts)
         .zip(&usable)
         .filter(|(_, ok)| **ok)
-        .map(|(((c, t), builds), _)| SkinTrial {
+        .map(|(((c, t), (builds, steps)), _)| SkinTrial {
             skin: c.skin,
             cells: c.cells,
             seconds_per_step: median(t),
             builds,
+            steps,
         })
         .collect();
     let best = trials
@@ -239,8 +268,12 @@ mod tests {
                 .all(|(a, b)| (a - b).abs() < 1e-12),
             "{per_step:?} against {expected:?}"
         );
-        // 4 builds in 20 steps after 2 warm-up steps: at steps 5, 10, 15, 20.
-        assert!(t.trials.iter().all(|x| x.builds == 4), "{t:?}");
+        // Warm-up to step 2, untimed to the build at step 5, then timed from step 6 to the
+        // build at step 25: 20 steps, 4 builds.
+        assert!(
+            t.trials.iter().all(|x| x.builds == 4 && x.steps == 20),
+            "{t:?}"
+        );
         assert_eq!(t.plan, plan);
         assert!((t.seconds - now.get()).abs() < 1e-9);
     }

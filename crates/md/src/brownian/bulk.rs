@@ -45,12 +45,11 @@ pub const WCA_RANGE: f64 = 1.122_462_048_309_373;
 /// best of WCA at phi 0.1, dt 1e-4 d^2 / D0 lies near 0.7-0.9: docs/performance.md).
 pub const SKIN_FACTORS: [f64; 6] = [0.2, 0.35, 0.5, 0.7, 0.9, 1.2];
 
-/// How [`BulkParams::measure_skins`] times each candidate: 100 steps to settle, then 500 (the
-/// engine's forced re-sort period, so that the largest skins pay their builds too), three
-/// interleaved rounds.
+/// How [`BulkParams::measure_skins`] times each candidate: 50 steps to settle, then whole list
+/// cycles of at least 200 steps ([`TunePlan`]), three interleaved rounds.
 pub const SKIN_TUNE_PLAN: TunePlan = TunePlan {
-    warmup: 100,
-    steps: 500,
+    warmup: 50,
+    steps: 200,
     rounds: 3,
 };
 

@@ -27,8 +27,9 @@ pub enum RadiusDistribution {
 /// Verlet-list skins of [`DpdSetup::measure_neighbors`], in units of rc.
 pub const DPD_SKIN_FACTORS: [f64; 6] = [0.1, 0.2, 0.3, 0.45, 0.6, 0.8];
 
-/// How [`DpdSetup::measure_neighbors`] times each candidate: 20 steps to settle, 100 timed,
-/// three interleaved rounds (a DPD step of 81,000 beads takes ~40 ms on one core).
+/// How [`DpdSetup::measure_neighbors`] times each candidate: 20 steps to settle, then whole list
+/// cycles of at least 100 steps ([`TunePlan`]), three interleaved rounds (a DPD step of 81,000
+/// beads takes ~40 ms on one core).
 pub const DPD_TUNE_PLAN: TunePlan = TunePlan {
     warmup: 20,
     steps: 100,
