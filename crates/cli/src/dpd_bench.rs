@@ -160,9 +160,7 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
         a.steps
     );
     println!("# load average (1, 5, 15 min) at start: {}", load());
-    println!(
-        "threads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbour_builds\tmode\tskin"
-    );
+    println!("threads\tparticle_steps_per_s\tmin\tmax\tcpu_rate\tneighbour_builds\tmode\tskin");
     let mut medians = Vec::new();
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
@@ -184,12 +182,7 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
                 );
             }
             println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
-            setup.params.skin = tuning.skin;
-            setup.params.neighbors = if tuning.cells {
-                NeighborMode::Cells
-            } else {
-                NeighborMode::Verlet
-            };
+            setup.params = colloidsim_md::dpd::setup::with_candidate(setup.params, tuning.choice());
         }
         let (rates, cpu, builds, cells) = pool.install(|| -> Result<_> {
             let mut sim = setup.build()?;
@@ -324,13 +317,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
                 );
             }
             println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
-            let mut params = params0;
-            params.skin = tuning.skin;
-            params.neighbors = if tuning.cells {
-                NeighborMode::Cells
-            } else {
-                NeighborMode::Verlet
-            };
+            let params = colloidsim_md::dpd::setup::with_candidate(params0, tuning.choice());
             let mut row = measure_ours(&relaxed, sbox, params, step0, a.steps, repeats, t)?;
             row.skin = tuning.skin;
             row.print(a.steps);
@@ -442,25 +429,18 @@ fn tuned_search(
     params: DpdParams,
     step0: u64,
 ) -> Result<colloidsim_md::tune::SkinTuning> {
-    use colloidsim_md::dpd::setup::{DPD_SKIN_FACTORS, DPD_TUNE_PLAN};
-    use colloidsim_md::tune::{Candidate, lists, tune_skin};
-    let mut candidates = vec![Candidate {
-        skin: params.skin,
-        cells: true,
-    }];
-    candidates.extend(lists(&DPD_SKIN_FACTORS.map(|f| f * params.rc)));
-    Ok(tune_skin(
-        &candidates,
+    use colloidsim_md::dpd::setup::{DPD_TUNE_PLAN, neighbour_candidates, with_candidate};
+    Ok(colloidsim_md::tune::tune_skin(
+        &neighbour_candidates(&params),
         DPD_TUNE_PLAN,
         |c| {
-            let mut p = params;
-            p.skin = c.skin;
-            p.neighbors = if c.cells {
-                NeighborMode::Cells
-            } else {
-                NeighborMode::Verlet
-            };
-            Dpd::new(relaxed.clone(), sbox, p, vec![false], step0)
+            Dpd::new(
+                relaxed.clone(),
+                sbox,
+                with_candidate(params, c),
+                vec![false],
+                step0,
+            )
         },
         |sim, k| sim.run(k),
         |sim| sim.neighbor_builds(),

@@ -58,6 +58,16 @@ pub struct SkinTuning {
     pub seconds: f64,
 }
 
+impl SkinTuning {
+    /// The chosen candidate.
+    pub fn choice(&self) -> Candidate {
+        Candidate {
+            skin: self.skin,
+            cells: self.cells,
+        }
+    }
+}
+
 /// Candidate skins `factors x unit` that leave a neighbour range `r_cut + skin` of at most
 /// `max_range` (the box's limit), in increasing order; at least the smallest factor.
 pub fn candidate_skins(unit: f64, factors: &[f64], r_cut: f64, max_range: f64) -> Vec<f64> {

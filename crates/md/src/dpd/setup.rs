@@ -36,6 +36,28 @@ pub const DPD_TUNE_PLAN: TunePlan = TunePlan {
     rounds: 3,
 };
 
+/// The candidates of [`DpdSetup::measure_neighbors`]: cells every step (at `params.skin`, which
+/// the colloid list keeps), then Verlet lists at [`DPD_SKIN_FACTORS`] `x rc`.
+pub fn neighbour_candidates(params: &DpdParams) -> Vec<Candidate> {
+    let mut c = vec![Candidate {
+        skin: params.skin,
+        cells: true,
+    }];
+    c.extend(lists(&DPD_SKIN_FACTORS.map(|f| f * params.rc)));
+    c
+}
+
+/// `params` with the neighbour search of candidate `c` (a tuning's choice included).
+pub fn with_candidate(mut params: DpdParams, c: Candidate) -> DpdParams {
+    params.skin = c.skin;
+    params.neighbors = if c.cells {
+        NeighborMode::Cells
+    } else {
+        NeighborMode::Verlet
+    };
+    params
+}
+
 /// A DPD system before its start is drawn: the engine's parameters, the box, the particle
 /// numbers and sizes.
 #[derive(Debug, Clone, PartialEq)]
@@ -356,23 +378,12 @@ impl DpdSetup {
     /// as in the run): cells every step, and Verlet lists with the skins [`DPD_SKIN_FACTORS`]
     /// `x rc` that fit the box; the caller sets `skin` and `neighbors` from the result.
     pub fn measure_neighbors(&self, sync_every: u64) -> Result<SkinTuning, DpdError> {
-        let rc = self.params.rc;
-        let mut candidates = vec![Candidate {
-            skin: self.params.skin,
-            cells: true,
-        }];
-        candidates.extend(lists(&DPD_SKIN_FACTORS.map(|f| f * rc)));
         tune_skin(
-            &candidates,
+            &neighbour_candidates(&self.params),
             DPD_TUNE_PLAN,
             |c| {
                 let mut s = self.clone();
-                s.params.skin = c.skin;
-                s.params.neighbors = if c.cells {
-                    NeighborMode::Cells
-                } else {
-                    NeighborMode::Verlet
-                };
+                s.params = with_candidate(s.params, c);
                 let mut sim = s.build()?;
                 sim.set_sync_every(sync_every);
                 Ok(sim)

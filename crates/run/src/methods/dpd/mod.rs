@@ -22,8 +22,7 @@ use colloidsim_analysis::{
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
 use colloidsim_dft::oz;
-use colloidsim_md::dpd::NeighborMode;
-use colloidsim_md::dpd::setup::DpdSetup;
+use colloidsim_md::dpd::setup::{DpdSetup, with_candidate};
 use colloidsim_md::dpd::{Dpd, PRESSURE_PARTS, StressAcf, Thermo};
 use colloidsim_md::tune::SkinTuning;
 use colloidsim_particles::gsd::GsdWriter;
@@ -144,12 +143,7 @@ fn start(
 
 /// The neighbour search `run.tune_skin` chose, into the engine's parameters.
 fn apply_tuning(s: &mut Resolved, t: SkinTuning) {
-    s.setup.params.skin = t.skin;
-    s.setup.params.neighbors = if t.cells {
-        NeighborMode::Cells
-    } else {
-        NeighborMode::Verlet
-    };
+    s.setup.params = with_candidate(s.setup.params, t.choice());
     s.skin_tuning = Some(t);
 }
 
