@@ -435,15 +435,24 @@ impl HardSphereMc {
             return best;
         }
         let own = cells.coord[i];
-        let wrap = |v: i64| v.rem_euclid(nc as i64) as u32;
-        let ahead = if sg > 0.0 { 1 } else { -1 };
-        for da in [0i64, ahead] {
-            for db in -1i64..=1 {
-                for dc in -1i64..=1 {
+        // The cells below, at and above along an axis, wrapped (nc >= 3: all distinct).
+        let around = |k: u32| {
+            let top = nc as u32 - 1;
+            [
+                if k == 0 { top } else { k - 1 },
+                k,
+                if k == top { 0 } else { k + 1 },
+            ]
+        };
+        let (na, nb, ncc) = (around(own[a]), around(own[b]), around(own[c]));
+        let ahead = if sg > 0.0 { na[2] } else { na[0] };
+        for ka in [own[a], ahead] {
+            for &kb in &nb {
+                for &kc in &ncc {
                     let mut cc = own;
-                    cc[a] = wrap(own[a] as i64 + da);
-                    cc[b] = wrap(own[b] as i64 + db);
-                    cc[c] = wrap(own[c] as i64 + dc);
+                    cc[a] = ka;
+                    cc[b] = kb;
+                    cc[c] = kc;
                     let id = cells.id(cc);
                     let first = id * cells.cap;
                     for &j in &cells.members[first..first + cells.count[id] as usize] {
