@@ -19,8 +19,8 @@
 //!   the *increase* of `beta V` since the last event (decreases not counted) reaches `-ln u`,
 //!   `u` uniform; then, as at the hard wall, the direction is reversed. `V` depends on `|r|`
 //!   alone and grows with it, and `|r + s e|` is convex in `s`, so along a straight path `V`
-//!   first falls (to `s* = -r.e`), then grows: the event solves `beta V(s) = beta V(max(0, s*))
-//!   - ln u` on the growing part, by bisection. A sphere that has not entered the interface's
+//!   first falls (to `s* = -r.e`), then grows: the event solves
+//!   `beta V(s) = beta V(max(0, s*)) + |ln u|` on the growing part, by bisection. A sphere that has not entered the interface's
 //!   range needs no draw until it does (the event rate is zero before).
 //!
 //! **Global balance.** The lifted chain lives on (configuration `x`, active sphere `i`,
