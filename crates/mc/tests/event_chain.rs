@@ -75,16 +75,36 @@ fn event_chain_z(n: usize, phi: f64, length: f64, blocks: usize, sweeps: u64) ->
     (m, e)
 }
 
+/// The virial series of hard spheres through `B12` (`Z = 1 + sum_n B_n eta^(n-1)`, reduced
+/// coefficients; to B10 those of Clisby & McCoy 2006, B11 and B12 estimates whose terms are
+/// 3e-5 and 1e-5 at eta = 0.3): at phi = 0.3 the truncation is below 1e-4, and the sum,
+/// 3.9838, lies 0.25 % above Carnahan–Starling (whose B4 is 18 instead of 18.365).
+fn virial_series(eta: f64) -> f64 {
+    let b = [
+        1.0, 4.0, 10.0, 18.3647684, 28.224512, 39.81514, 53.3444, 68.538, 85.813, 105.78, 127.9,
+        152.7,
+    ];
+    b.iter()
+        .enumerate()
+        .map(|(k, b)| b * eta.powi(k as i32))
+        .sum()
+}
+
+/// The exact event-chain pressure: within 1 % of Carnahan–Starling at phi 0.3 and 0.45, and
+/// within 4 of its standard errors of the virial series at 0.3 (measured 3.9857 +- 0.0044
+/// against 3.9838; CS 3.9738) and of CS at 0.45 (9.3922 +- 0.0164 against 9.3847). Lifts
+/// counted 1 % short: 3.9558 at phi 0.3, fails.
 #[test]
 fn event_chain_pressure_matches_carnahan_starling() {
     for phi in [0.3, 0.45] {
         let (z, e) = event_chain_z(500, phi, 5.0, 20, 100);
         let cs = carnahan_starling(phi);
+        let exact = if phi < 0.4 { virial_series(phi) } else { cs };
         assert!(e > 0.0 && e < 0.003 * cs, "phi {phi}: error {e}");
         assert!((z - cs).abs() < 0.01 * cs, "phi {phi}: Z {z} vs CS {cs}");
         assert!(
-            (z - cs).abs() < 4.0 * e,
-            "phi {phi}: Z {z} +- {e} vs CS {cs}"
+            (z - exact).abs() < 4.0 * e,
+            "phi {phi}: Z {z} +- {e} vs {exact}"
         );
     }
 }
