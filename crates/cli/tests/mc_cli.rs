@@ -11,6 +11,9 @@ use common::{assert_same_outputs, text};
 /// summary.json fields that depend on the session's timing.
 const VOLATILE: &[&str] = &["wall_seconds", "trial_moves_per_second"];
 
+/// The same for event chains.
+const VOLATILE_CHAINS: &[&str] = &["wall_seconds", "lifts_per_second"];
+
 /// 500 spheres at phi 0.3 in bulk, 500 warm-up and 600 sampling sweeps (checkpoints every 110).
 const BULK: &str = r#"
 method = "hs-mc"
@@ -94,6 +97,78 @@ fn killed_and_interrupted_runs_continue_bitwise() {
         } else {
             assert!(d.join("a/profile_mean.csv").exists() && d.join("a/g2.csv").exists());
         }
+    }
+}
+
+/// Event chains (`mc.move = "event-chain"`) in bulk and in the hard-wall and interface
+/// droplets: killed and interrupted runs continue bitwise; in bulk the exact event-chain
+/// pressure is the summary's `compressibility` (Carnahan–Starling within 5 of its standard
+/// errors, and the contact-value estimate kept beside it); the local moves' keys are refused
+/// beside it, and `mc.chain_length` beside local moves.
+#[test]
+fn event_chain_runs_continue_bitwise_and_give_the_pressure() {
+    let chain = "move = \"event-chain\"\nchain_length = 4.0\n";
+    let wall = INTERFACE
+        .replace("geometry = \"interface\"", "geometry = \"hard-wall\"")
+        .replace("[interface]\nstiffness = 50.0\n", "");
+    for scenario in [BULK, INTERFACE, &wall] {
+        let scenario = scenario.replace("[mc]\n", &format!("[mc]\n{chain}"));
+        let tmp = tempfile::tempdir().unwrap();
+        let d = tmp.path();
+        std::fs::write(d.join("s.toml"), &scenario).unwrap();
+        let o = run(d, &["run", "s.toml", "--out", "a"], &[]);
+        assert!(o.status.success(), "{}", text(&o));
+        for (k, hook) in [
+            ("k", "COLLOIDSIM_KILL_AT_STEP"),
+            ("i", "COLLOIDSIM_INTERRUPT_AT_STEP"),
+        ] {
+            let o = run(d, &["run", "s.toml", "--out", k], &[(hook, "333")]);
+            assert!(!o.status.success(), "{hook}: {}", text(&o));
+            let o = run(d, &["run", "--restart", k], &[]);
+            assert!(o.status.success(), "{}", text(&o));
+            assert_same_outputs(&d.join("a"), &d.join(k), VOLATILE_CHAINS);
+        }
+        let s: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("a/summary.json")).unwrap()).unwrap();
+        assert!(s.get("acceptance").is_none(), "{s}");
+        assert!(s["event_chain"]["lifts"].as_u64().unwrap() > 0, "{s}");
+        assert_eq!(s["parameters"]["chain_length"].as_f64(), Some(4.0));
+        if scenario.contains("bulk") {
+            let z = &s["compressibility"];
+            let (v, e) = (
+                z["value"].as_f64().unwrap(),
+                z["standard_error"].as_f64().unwrap(),
+            );
+            assert!(e > 0.0 && (v - 3.9738).abs() < 5.0 * e, "Z {v} +- {e}");
+            assert!(
+                s["compressibility_from_contact"]["value"]
+                    .as_f64()
+                    .is_some()
+            );
+        } else {
+            assert!(s["event_chain"]["reversals"].as_u64().unwrap() > 0, "{s}");
+            assert!(d.join("a/profile_mean.csv").exists() && d.join("a/g2.csv").exists());
+        }
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    for (extra, key) in [
+        ("move = \"event-chain\"\nnselect = 4\n", "mc.nselect"),
+        ("chain_length = 2.0\n", "mc.chain_length"),
+        (
+            "move = \"event-chain\"\nchain_length = -1.0\n",
+            "mc.chain_length",
+        ),
+        ("move = \"chains\"\n", "mc.move"),
+    ] {
+        std::fs::write(
+            d.join("s.toml"),
+            BULK.replace("[mc]\n", &format!("[mc]\n{extra}")),
+        )
+        .unwrap();
+        let o = run(d, &["check", "s.toml"], &[]);
+        assert!(!o.status.success(), "{extra}");
+        assert!(text(&o).contains(key), "{extra}: {}", text(&o));
     }
 }
 

@@ -46,6 +46,8 @@
 //! particle the binning keeps only its cell and slot. Nothing is allocated per move or per
 //! sweep (only when a cell overflows its capacity, which grows).
 
+pub mod chain;
+
 use crate::geometry::Geometry;
 use colloidsim_core::ParamError;
 use colloidsim_core::param::{positive, show};
@@ -524,6 +526,12 @@ pub struct HardSphereMc {
     /// range's group ends.
     bucket: Vec<u32>,
     bucket_end: Vec<u32>,
+    /// Event chains instead of local moves ([`chain`]).
+    chain: Option<chain::EventChain>,
+    /// The chains' cell list (scratch).
+    chain_cells: chain::ChainCells,
+    /// Counts of the last sweep's chains.
+    last_chain: chain::ChainStats,
 }
 
 /// Half of `diameter` times `scale` (exactly `diameter / 2` at scale 1).
@@ -726,6 +734,9 @@ impl HardSphereMc {
             cell_seen: vec![0; nc_cells],
             bucket: Vec::new(),
             bucket_end: Vec::new(),
+            chain: None,
+            chain_cells: Default::default(),
+            last_chain: Default::default(),
         };
         mc.delta = mc.delta.min(mc.max_delta());
         for (i, p) in positions.iter().enumerate() {
@@ -1181,8 +1192,14 @@ impl HardSphereMc {
             });
     }
 
-    /// One sweep: `nselect N` trial moves (see the module documentation).
+    /// One sweep: `nselect N` trial moves (see the module documentation), or with
+    /// [`Self::set_event_chain`] a sweep of event chains ([`chain`]; its counts in
+    /// [`Self::last_chains`], the returned counts zero).
     pub fn sweep(&mut self) -> SweepStats {
+        if let Some(c) = self.chain {
+            return self.chain_sweep(c);
+        }
+        self.last_chain = Default::default();
         let mut rng = stream(self.seed, self.sweep, Purpose::Moves, 0);
         let s = self.side;
         let offset = [

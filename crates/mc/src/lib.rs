@@ -7,6 +7,8 @@
 //!   overlap below the pair's mean diameter), checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
 //!   254, 27 (2013)) with counter-based random streams keyed by (seed, sweep, cell), so that a
 //!   run is fixed by its seed whatever the number of threads; move-size tuning in the warm-up.
+//! - [`engine::chain`]: event-chain Monte Carlo (Bernard, Krauth & Wilson 2009), the move type
+//!   beside the local moves, with its exact pressure.
 //! - [`init`]: lattice starting configurations (melted by the warm-up).
 //! - [`observe`]: pair-distance and radial histograms (per species too), contact values
 //!   extrapolated to contact, block-average errors, the Carnahan–Starling and BMCSL references.
@@ -25,5 +27,6 @@ pub mod observe;
 pub mod params;
 pub mod radial_pairs;
 
+pub use engine::chain::{ChainStats, EventChain};
 pub use engine::{HardSphereMc, McError, McParams, SweepStats};
 pub use geometry::{Geometry, RadialPotential};

@@ -1,6 +1,7 @@
 //! The parameters of a hard-sphere Monte Carlo run ([`McRun`]: plain data, as the run layer
 //! reads them from a scenario) and the engine they start.
 
+use crate::engine::chain::EventChain;
 use crate::engine::{HardSphereMc, McError, McParams, Mixture};
 use crate::geometry::Geometry;
 use crate::init::{fcc_in_box, fcc_in_sphere, shuffled};
@@ -51,6 +52,10 @@ pub struct McRun {
     pub sweeps: u64,
     /// Trial moves per sphere per sweep.
     pub nselect: usize,
+    /// Event chains of this length instead of local moves (`None`: local moves; not
+    /// serialised then).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chain_length: Option<f64>,
     /// Warm-up sweeps.
     pub warmup_sweeps: u64,
     /// Target acceptance of the tuning.
@@ -89,6 +94,15 @@ impl McRun {
             }
             (Some(r), None) => Geometry::HardWall { radius: r },
         }
+    }
+
+    /// Event chains per sweep at chain length `length`: `max(1, round(N lambda / length))`,
+    /// `lambda` the Carnahan–Starling free path between lifts at the run's volume fraction
+    /// ([`crate::engine::chain::free_path`]), so that a sweep makes about N lifts.
+    pub fn chains_per_sweep(&self, length: f64) -> u64 {
+        let lambda = crate::engine::chain::free_path(self.volume_fraction, self.diameter);
+        let k = (self.particles as f64 * lambda / length).round();
+        if k.is_finite() { (k as u64).max(1) } else { 1 }
     }
 
     /// Is this a bulk run?
@@ -199,6 +213,12 @@ impl McRun {
             mc.grow(GROW_SWEEPS, self.delta)?;
         }
         mc.set_nselect(self.nselect);
+        if let Some(length) = self.chain_length {
+            mc.set_event_chain(Some(EventChain {
+                length,
+                chains_per_sweep: self.chains_per_sweep(length),
+            }))?;
+        }
         Ok(mc)
     }
 }

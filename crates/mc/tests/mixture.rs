@@ -122,6 +122,7 @@ fn bulk_run(n: usize, xl: f64, phi: f64, seed: u32) -> McRun {
         interface: None,
         sweeps: 0,
         nselect: 1,
+        chain_length: None,
         warmup_sweeps: 0,
         target_acceptance: 0.3,
         tune_every: 100,

@@ -59,6 +59,15 @@ pub const MC_NSELECT: Spec = key("mc.nselect", "-",
     Value("1"), Integer(1, colloidsim_mc::params::NSELECT_MAX as i64),
     "trial moves per sphere per sweep, all on one binning of the cells (HOOMD-blue's nselect; docs/mc.md)");
 
+pub const MC_MOVE: Spec = key("mc.move", "-",
+    Word("local"), OneOf(&["local", "event-chain"]),
+    "local: single-sphere Metropolis displacements; event-chain: rejection-free event chains (Bernard, Krauth & Wilson 2009), with the exact pressure in bulk (docs/mc.md)");
+
+pub const MC_CHAIN_LENGTH: Spec = key("mc.chain_length", "length",
+    Means("N^(1/3) d / 2"), Positive,
+    "displacement of one event chain (event-chain only); a sweep is max(1, round(N lambda / chain_length)) chains, lambda the Carnahan-Starling free path between lifts, about N lifts")
+    .also("at most 1e6 d");
+
 pub const MC_WARMUP_SWEEPS: Spec = key("mc.warmup_sweeps", "sweeps",
     Value("2000"), Integer(0, COUNT),
     "warm-up sweeps, delta tuned every tune_every, then frozen");
@@ -134,6 +143,8 @@ pub static KEYS: &[Spec] = &[
     MC,
     MC_SWEEPS,
     MC_NSELECT,
+    MC_MOVE,
+    MC_CHAIN_LENGTH,
     MC_WARMUP_SWEEPS,
     MC_TARGET_ACCEPTANCE,
     MC_TUNE_EVERY,
@@ -150,3 +161,4 @@ pub static KEYS: &[Spec] = &[
     OBSERVE,
     crate::keys::shared::FIGURE_FORMAT,
 ];
+

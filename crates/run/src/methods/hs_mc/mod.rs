@@ -28,7 +28,7 @@ use colloidsim_mc::observe::{
     contact_pairs, mean_and_error, wall_contact_density,
 };
 use colloidsim_mc::params::McRun;
-use colloidsim_mc::{HardSphereMc, McError, SweepStats};
+use colloidsim_mc::{ChainStats, HardSphereMc, McError, SweepStats};
 use colloidsim_particles::gsd::{self, GsdWriter};
 use colloidsim_particles::{Particles, SimBox};
 use serde::{Deserialize, Serialize};
@@ -122,7 +122,15 @@ impl Method for HsMc {
         crate::method::on_one_rank(comm, src, self.names()[0])?;
         let p = resolve(src, Some(seed))?;
         let saved: Saved = crate::checkpoint::decode_payload(&envelope.payload)?;
-        if saved.pos.iter().any(|c| c.len() != p.particles) || saved.acc.blocks.len() != p.blocks {
+        if saved.pos.iter().any(|c| c.len() != p.particles)
+            || saved.acc.blocks.len() != p.blocks
+            || saved.acc.chains.len()
+                != if p.chain_length.is_some() {
+                    p.blocks
+                } else {
+                    0
+                }
+        {
             bail!("checkpoint: its state does not fit the scenario");
         }
         let rows: Vec<[f64; 3]> = (0..p.particles)
@@ -183,6 +191,9 @@ struct Accum {
     /// Frames in trajectory.gsd and their CRC-32.
     frames: u64,
     digest: FrameDigest,
+    /// Event chains: the counts of the sampling sweeps of each block (empty with local moves).
+    #[serde(default)]
+    chains: Vec<ChainStats>,
 }
 
 impl Accum {
@@ -236,6 +247,11 @@ impl Accum {
             blocks: vec![block; p.blocks],
             frames: 0,
             digest: FrameDigest::default(),
+            chains: if p.chain_length.is_some() {
+                vec![ChainStats::default(); p.blocks]
+            } else {
+                Vec::new()
+            },
         }
     }
 }
@@ -385,7 +401,14 @@ impl Session for McSession {
         while self.mc.sweeps() < until.min(self.total()) {
             let s = self.mc.sweep();
             let done = self.mc.sweeps();
-            if done <= p.warmup_sweeps {
+            if p.chain_length.is_some() {
+                // Event chains: nothing to tune; the sampling sweeps' chains go to their block.
+                if done > p.warmup_sweeps {
+                    let k = done - p.warmup_sweeps - 1;
+                    let b = ((k as u128 * p.blocks as u128) / p.sweeps as u128) as usize;
+                    self.acc.chains[b.min(p.blocks - 1)] += self.mc.last_chains();
+                }
+            } else if done <= p.warmup_sweeps {
                 self.acc.window += s;
                 if done.is_multiple_of(p.tune_every) {
                     self.mc
@@ -467,6 +490,39 @@ impl Session for McSession {
             let (m, e) = mean_and_error(v);
             json!({ "value": m, "standard_error": e })
         };
+        // Event chains: their counts instead of the local moves' (no trial moves, no delta).
+        let chain_blocks: Vec<&ChainStats> =
+            self.acc.chains.iter().filter(|c| c.chains > 0).collect();
+        if let (Some(length), Some(obj)) = (p.chain_length, summary.as_object_mut()) {
+            for k in [
+                "trial_moves",
+                "acceptance",
+                "left_cell_fraction",
+                "delta",
+                "trial_moves_per_second",
+            ] {
+                obj.remove(k);
+            }
+            let mut total = ChainStats::default();
+            for c in &chain_blocks {
+                total += **c;
+            }
+            obj.insert(
+                "event_chain".into(),
+                json!({
+                    "chain_length": length,
+                    "chains_per_sweep": self.mc.event_chain().map_or(0, |c| c.chains_per_sweep),
+                    "chains": total.chains,
+                    "lifts": total.lifts,
+                    "lifts_per_chain": total.lifts as f64 / total.chains.max(1) as f64,
+                    "reversals": total.reversals,
+                }),
+            );
+            obj.insert(
+                "lifts_per_second".into(),
+                json!(total.lifts as f64 / wall_s.max(1e-9)),
+            );
+        }
         if p.is_bulk() {
             let volume = self.mc.box_edge().powi(3);
             if let Some(m) = &p.mixture {
@@ -486,6 +542,19 @@ impl Session for McSession {
                     "compressibility": carnahan_starling(p.volume_fraction),
                     "contact_value": carnahan_starling_contact(p.volume_fraction),
                 });
+            }
+            if p.chain_length.is_some() {
+                // The exact event-chain pressure replaces the contact-value estimate, which is
+                // kept beside it.
+                let z: Vec<f64> = chain_blocks.iter().map(|c| c.compressibility()).collect();
+                let contact = summary["compressibility"].clone();
+                summary["compressibility_from_contact"] = contact;
+                summary["compressibility"] = value_error_or(
+                    out,
+                    "compressibility",
+                    &z,
+                    "no sampling sweep of event chains in some block",
+                );
             }
             let per_block: Vec<Vec<f64>> = blocks
                 .iter()
@@ -682,14 +751,23 @@ impl Session for McSession {
             files.push("trajectory.gsd".into());
         }
         summary["warnings"] = json!(warnings);
-        let message = format!(
-            "{} sweeps of {n} hard spheres ({}) in {wall_s:.1} s ({:.3e} trial moves/s), acceptance {:.3}; outputs in {}",
-            self.mc.sweeps(),
-            p.geometry,
-            (self.mc.sweeps() * n as u64) as f64 / wall_s.max(1e-9),
-            self.acc.sampling.acceptance(),
-            out.path().display()
-        );
+        let message = if p.chain_length.is_some() {
+            format!(
+                "{} sweeps of event chains, {n} hard spheres ({}) in {wall_s:.1} s; outputs in {}",
+                self.mc.sweeps(),
+                p.geometry,
+                out.path().display()
+            )
+        } else {
+            format!(
+                "{} sweeps of {n} hard spheres ({}) in {wall_s:.1} s ({:.3e} trial moves/s), acceptance {:.3}; outputs in {}",
+                self.mc.sweeps(),
+                p.geometry,
+                (self.mc.sweeps() * n as u64) as f64 / wall_s.max(1e-9),
+                self.acc.sampling.acceptance(),
+                out.path().display()
+            )
+        };
         Ok(Finished {
             summary,
             files,

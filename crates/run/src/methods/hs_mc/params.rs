@@ -28,12 +28,18 @@ const ENGINE_NAMES: &[(&str, &crate::keys::Spec)] = &[
     ("n", &SYSTEM_VOLUME_FRACTION),
     ("diameters", &SPECIES_DIAMETERS),
     ("counts", &SPECIES_COUNTS),
+    ("chain_length", &MC_CHAIN_LENGTH),
+    ("move", &MC_MOVE),
 ];
 
 /// An engine's error about one of its parameters, naming the scenario key instead.
 pub(super) fn keyed(e: ParamError) -> ParamError {
     rekey(e, ENGINE_NAMES)
 }
+
+/// Longest event chain, in diameters (`mc.chain_length`): far beyond any useful length, and
+/// short enough that a sweep's chain count and displacement stay exact in f64.
+const MAX_CHAIN_LENGTH: f64 = 1e6;
 
 /// A scenario's table checked against [`KEYS`] and resolved (with `seed` replacing the
 /// scenario's); `system.initial` is taken relative to `base`.
@@ -202,6 +208,39 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             ),
         ));
     }
+    let chain_length = match r.word(&MC_MOVE)?.as_str() {
+        "event-chain" => {
+            if r.has(&MC_NSELECT) {
+                bail!(ParamError::new(
+                    MC_NSELECT.path,
+                    "applies to mc.move = \"local\" only (a sweep of event chains makes about N lifts; set its chains' length with mc.chain_length)",
+                ));
+            }
+            let l = r
+                .opt_number(&MC_CHAIN_LENGTH)?
+                .unwrap_or(0.5 * d * (particles as f64).cbrt());
+            if !(l > 0.0 && l <= MAX_CHAIN_LENGTH * d) {
+                bail!(ParamError::new(
+                    MC_CHAIN_LENGTH.path,
+                    format!(
+                        "must lie in (0, {MAX_CHAIN_LENGTH:e} d = {}], got {}",
+                        show(MAX_CHAIN_LENGTH * d),
+                        show(l)
+                    ),
+                ));
+            }
+            Some(l)
+        }
+        _ => {
+            if r.has(&MC_CHAIN_LENGTH) {
+                bail!(ParamError::new(
+                    MC_CHAIN_LENGTH.path,
+                    "applies to mc.move = \"event-chain\" only",
+                ));
+            }
+            None
+        }
+    };
     let profile_bins = r.count(&OUTPUT_PROFILE_BINS)? as usize;
     let gr_bins = r.count(&OUTPUT_GR_BINS)? as usize;
     let half = 0.5 * box_edge;
@@ -276,6 +315,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
         interface,
         sweeps,
         nselect: r.count(&MC_NSELECT)? as usize,
+        chain_length,
         warmup_sweeps: r.count(&MC_WARMUP_SWEEPS)?,
         target_acceptance,
         tune_every: r.count(&MC_TUNE_EVERY)?,
