@@ -183,6 +183,13 @@ class _Solver:
         self._callback = lanczos_callback
         self.noiseStep = 0
         self._op = None
+        # As libMobility, positions given before stay in force (when the radii fit them).
+        if self._positions is not None:
+            n = self._positions.size // 3
+            if not isinstance(a, np.ndarray) or a.size == n:
+                self.setPositions(self._positions.reshape(self._shape))
+            else:
+                self._positions = None
 
     def setPositions(self, positions: ArrayLike) -> None:
         """The positions the mobility is computed at, shape (N, 3) or (3N,); results of

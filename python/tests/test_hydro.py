@@ -350,3 +350,16 @@ def test_bad_arguments_name_the_argument():
         with pytest.raises(ColloidsimError, match=f"^{name}:"):
             q.setPositions(np.zeros((2, 3)))
     assert issubclass(ColloidsimError, RuntimeError)  # libMobility raises RuntimeError
+
+
+def test_initialize_again_keeps_the_positions_and_shapes_follow_the_input():
+    s = NBody("open", "open", "open")
+    s.initialize(viscosity=1.0, hydrodynamicRadius=0.5, seed=3)
+    x = cluster(4, 2.0).reshape(-1)
+    s.setPositions(x)
+    assert s.numberParticles == 4 and s.sqrtMdotW()[0].shape == (12,)
+    s.initialize(viscosity=2.0, hydrodynamicRadius=0.5, seed=3)
+    u, _ = s.Mdot(np.ones((4, 3)))
+    assert u.shape == (4, 3)
+    assert np.allclose(u.reshape(-1), rpy_matrix(x.reshape(4, 3), [0.5] * 4, 2.0) @ np.ones(12), rtol=1e-12)
+    assert s.divM()[0].shape == (12,) and s.thermalDrift()[0].shape == (12,)
