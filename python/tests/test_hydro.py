@@ -9,6 +9,7 @@ import pytest
 
 import colloidsim
 from colloidsim import ColloidsimError
+from conftest import EXAMPLES
 from colloidsim.hydro import NBody, PSE, SelfMobility
 
 ETA = 0.7
@@ -234,6 +235,25 @@ def test_langevin_velocities_equal_the_engines_brownian_step():
     assert np.max(np.abs(v * dt - dx)) < 1e-12 * np.max(np.abs(dx))
     # Without noise it is M F.
     assert np.allclose(s.LangevinVelocities(dt=dt, kbt=0.0, forces=f0)[0], s.Mdot(f0)[0], rtol=0, atol=0)
+
+
+def test_nbody_langevin_velocities_equal_the_droplet_engines_brownian_step():
+    # A drying droplet with free-space RPY (direct sums), 30 spheres: its first step is the
+    # NBody solver's LangevinVelocities times dt at the engine's positions, forces (interface
+    # and WCA) and seed, to round-off.
+    bd = colloidsim.BrownianDynamics(
+        EXAMPLES / "droplet/drying-rpy.toml",
+        overrides={"system.particles": 30, "system.viscosity": ETA, "seed": 9},
+    )
+    x0, f0 = bd.positions.copy(), bd.forces.copy()
+    assert np.max(np.abs(f0)) > 0.1  # the forces take part
+    bd.step(1)
+    dx = bd.positions - x0
+    s = NBody("open", "open", "open")
+    s.initialize(viscosity=ETA, hydrodynamicRadius=0.5, tolerance=1e-3, seed=9)
+    s.setPositions(x0)
+    v, _ = s.LangevinVelocities(dt=bd.dt, kbt=1.0, forces=f0)
+    assert np.max(np.abs(v * bd.dt - dx)) < 1e-12 * np.max(np.abs(dx))
 
 
 def test_thermal_drift_is_the_random_finite_difference_and_averages_to_zero():
