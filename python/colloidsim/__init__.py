@@ -36,6 +36,7 @@ import numpy as np
 
 from . import _colloidsim
 from ._colloidsim import ColloidsimError
+from . import hydro  # noqa: E402 (colloidsim.hydro: libMobility-shaped mobility operators)
 
 __all__ = [
     "BCD",

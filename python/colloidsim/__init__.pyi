@@ -4,6 +4,8 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
+from . import hydro as hydro
+
 __version__: str
 
 ScenarioLike = Union[str, PathLike[str], Mapping[str, Any]]

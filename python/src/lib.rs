@@ -6,6 +6,8 @@
 //! polling Python's signals: Ctrl-C sets the run's interrupt flag, the run writes its
 //! checkpoint, and the call raises `KeyboardInterrupt`.
 
+mod hydro;
+
 use colloidsim_run::{Control, RunOptions, Scenario, TheoryOptions};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -413,5 +415,6 @@ fn _colloidsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(toml_from_json, m)?)?;
     m.add_class::<Engine>()?;
+    m.add_class::<hydro::HydroOperator>()?;
     Ok(())
 }
