@@ -4,6 +4,7 @@
 //! Tonks gas's contact density, the density at a hard wall and the single-file law agree with
 //! the exact results at steps where the pooling update is visibly off.
 
+#[allow(dead_code)] // shares the validation tests' helpers; uses only some
 mod common;
 
 use colloidsim_bcd::forces::{CosineForce, NoField, NoPair};
