@@ -29,7 +29,9 @@
 //! the state (the checkpoint holds it); `y_n` is derived from it and the step counter.
 //!
 //! Sorting is O(N) per step in practice (a step moves a rod by a fraction of the spacing): an
-//! insertion sort per chunk of [`CHUNK`] rods (in parallel), then a sequential fix-up across the
+//! insertion sort per chunk of [`CHUNK`] rods (in parallel; [`sort_near`] inserts by selects into a
+//! window of the last few sorted values instead of a loop with a mispredicted exit: in the crowded
+//! bench case, sigma = 0.99 at density 1, the whole step takes 40 % less time), then a sequential fix-up across the
 //! chunk boundaries, left to right, and the seam. Chunks are fixed by N, so the result does not
 //! depend on the thread count.
 
@@ -41,6 +43,10 @@ use rayon::prelude::*;
 /// An element sorted by its key: a reduced position, or a kicked point with the chain's free
 /// end point it carries.
 trait Folded: Copy + Send + Sync {
+    /// The carried value (0 for none).
+    fn carried(&self) -> f64;
+    /// An element from its key and carried value.
+    fn from_parts(key: f64, carried: f64) -> Self;
     fn key(&self) -> f64;
     /// Set the key (a reflection at a wall; a carried value stays).
     fn set_key(&mut self, k: f64);
@@ -49,6 +55,14 @@ trait Folded: Copy + Send + Sync {
 }
 
 impl Folded for f64 {
+    #[inline(always)]
+    fn carried(&self) -> f64 {
+        0.0
+    }
+    #[inline(always)]
+    fn from_parts(key: f64, _: f64) -> Self {
+        key
+    }
     #[inline(always)]
     fn key(&self) -> f64 {
         *self
@@ -64,6 +78,14 @@ impl Folded for f64 {
 }
 
 impl Folded for [f64; 2] {
+    #[inline(always)]
+    fn carried(&self) -> f64 {
+        self[1]
+    }
+    #[inline(always)]
+    fn from_parts(key: f64, carried: f64) -> Self {
+        [key, carried]
+    }
     #[inline(always)]
     fn key(&self) -> f64 {
         self[0]
@@ -290,11 +312,7 @@ fn fold<T: Folded>(v: &mut [T], domain: Domain) {
                 }
             }
         }
-        for i in 1..c.len() {
-            if c[i].key() < c[i - 1].key() {
-                sift_left(c, i);
-            }
-        }
+        sort_near(c);
     });
     // Chunk by chunk: [0, b) is sorted and so is [b, end); the points of [b, end) below the
     // largest of [0, b) are a prefix of it.
@@ -321,6 +339,62 @@ fn fold<T: Folded>(v: &mut [T], domain: Domain) {
             sift_left(v, n - 1);
         }
     }
+}
+
+/// Rank displacements a window insertion handles without branching (larger ones fall back to
+/// [`sift_left`]).
+const WINDOW: usize = 4;
+
+/// Stable insertion sort of `v` for small rank displacements (the result of [`sift_left`] on
+/// every element): the largest [`WINDOW`] elements sorted so far stay in registers and each new
+/// element is inserted among them by selects, without the mispredicted branch that ends an
+/// insertion loop; an element that belongs before the window takes the loop.
+fn sort_near<T: Folded>(v: &mut [T]) {
+    const K: usize = WINDOW;
+    let n = v.len();
+    for i in 1..n.min(K) {
+        if v[i].key() < v[i - 1].key() {
+            sift_left(v, i);
+        }
+    }
+    if n <= K {
+        return;
+    }
+    // The window's keys and carried values, apart (selects on plain f64).
+    let mut wk: [f64; K] = std::array::from_fn(|j| v[j].key());
+    let mut wc: [f64; K] = std::array::from_fn(|j| v[j].carried());
+    let flush = |v: &mut [T], at: usize, wk: &[f64; K], wc: &[f64; K]| {
+        for j in 0..K {
+            v[at + j] = T::from_parts(wk[j], wc[j]);
+        }
+    };
+    for i in K..n {
+        let e = v[i];
+        let (k, c) = (e.key(), e.carried());
+        if k < wk[0] {
+            flush(v, i - K, &wk, &wc);
+            sift_left(v, i);
+            wk = std::array::from_fn(|j| v[i + 1 - K + j].key());
+            wc = std::array::from_fn(|j| v[i + 1 - K + j].carried());
+            continue;
+        }
+        // gt[j]: w[j] moves right of e (false...false true...true; gt[0] is false).
+        let gt: [bool; K] = std::array::from_fn(|j| wk[j] > k);
+        v[i - K] = T::from_parts(wk[0], wc[0]);
+        let pick = |w: &[f64; K], e: f64| -> [f64; K] {
+            std::array::from_fn(|j| {
+                let next = if j + 1 < K {
+                    if gt[j + 1] { e } else { w[j + 1] }
+                } else {
+                    e
+                };
+                if gt[j] { w[j] } else { next }
+            })
+        };
+        wk = pick(&wk, k);
+        wc = pick(&wc, c);
+    }
+    flush(v, n - K, &wk, &wc);
 }
 
 /// Move `v[i]` left to its place in the sorted `v[..i]`.
@@ -416,6 +490,37 @@ mod tests {
                 .all(|e| off(e) < 1e-9 || (off(e) - n as f64).abs() < 1e-9)
         );
         assert!(p.windows(2).all(|w| w[0][0] <= w[1][0]));
+    }
+
+    /// The window insertion sort equals a stable sort, with rank displacements below and far
+    /// above its window (the fallback), and on short slices.
+    #[test]
+    fn sort_near_is_a_stable_sort() {
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for (n, spread) in [
+            (1, 1.0),
+            (5, 3.0),
+            (8, 3.0),
+            (9, 30.0),
+            (1000, 3.0),
+            (1000, 40.0),
+        ] {
+            // Keys on a coarse grid (ties), carried values number the elements.
+            let mut v: Vec<[f64; 2]> = (0..n)
+                .map(|i| [(i as f64 + spread * (rnd() - 0.5)).round(), i as f64])
+                .collect();
+            let mut want = v.clone();
+            // A stable sort by `<` (-0 and 0 are equal keys).
+            want.sort_by(|a, b| a[0].partial_cmp(&b[0]).expect("finite"));
+            sort_near(&mut v);
+            assert!(v == want, "n = {n}, spread = {spread}");
+        }
     }
 
     #[test]
