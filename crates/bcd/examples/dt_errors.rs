@@ -1,11 +1,12 @@
-//! The time-step error of BCD, Euler against Leimkuhler–Matthews (issue #21): density and
+//! The time-step error of BCD, Euler against Leimkuhler–Matthews (issue #21) and the reflecting
+//! collisions (`reflect`, issue #44): density and
 //! contact density against the exact theory as functions of dt, with error bars from
 //! independent seeds.
 //!
 //! ```text
 //! nice -n 10 cargo run --release -p colloidsim-bcd --example dt_errors -- \
 //!     [--cases NAME,..] [--dt 1e-2,1e-3,..] [--seeds 8] [--time 200] [--steps 2000000]
-//!     [--relax 2] [--csv FILE]
+//!     [--relax 2] [--schemes euler,lm,reflect] [--csv FILE]
 //! ```
 //!
 //! Cases (`--cases`, default all):
@@ -299,7 +300,12 @@ fn sample_with<P: PairForce>(
     pair: P,
 ) -> Profiles {
     // A fresh noise sequence for every scheme and dt (the seed's relaxation used `seed`).
-    let key = seed ^ 0x5bd1_e995 ^ (dt.to_bits() as u32) ^ ((scheme == Integrator::Lm) as u32);
+    let which = match scheme {
+        Integrator::Euler => 0,
+        Integrator::Lm => 1,
+        Integrator::Reflect => 2,
+    };
+    let key = seed ^ 0x5bd1_e995 ^ (dt.to_bits() as u32) ^ which;
     let mut st = state.clone();
     st.step = 0;
     let mut b = Bcd::from_state(case.config(dt, key), st, field, pair)
@@ -393,6 +399,8 @@ struct Args {
     time: f64,
     steps: u64,
     relax: f64,
+    /// Integrators to measure (`--schemes`).
+    schemes: Vec<Integrator>,
     csv: Option<String>,
 }
 
@@ -404,6 +412,7 @@ fn args() -> Args {
         time: 200.0,
         steps: 2_000_000,
         relax: 2.0,
+        schemes: vec![Integrator::Euler, Integrator::Lm, Integrator::Reflect],
         csv: None,
     };
     let v: Vec<String> = std::env::args().skip(1).collect();
@@ -418,6 +427,17 @@ fn args() -> Args {
             "--steps" => a.steps = val.parse::<f64>().expect("--steps") as u64,
             "--relax" => a.relax = val.parse().expect("--relax"),
             "--csv" => a.csv = Some(val),
+            "--schemes" => {
+                a.schemes = val
+                    .split(',')
+                    .map(|s| match s {
+                        "euler" => Integrator::Euler,
+                        "lm" => Integrator::Lm,
+                        "reflect" => Integrator::Reflect,
+                        _ => panic!("--schemes: euler, lm or reflect, got {s}"),
+                    })
+                    .collect()
+            }
             other => panic!("unknown option {other} (see the example's doc comment)"),
         }
         i += 2;
@@ -443,7 +463,11 @@ fn main() {
         let (rho_exact, contact_exact) = case.theory();
         let seeds: Vec<u32> = (1..=a.seeds).collect();
         let states: Vec<BcdState> = seeds.par_iter().map(|&s| prepare(&case, s)).collect();
-        for scheme in [Integrator::Euler, Integrator::Lm] {
+        for &scheme in &a.schemes {
+            // The reflecting integrator refuses sticky rods.
+            if scheme == Integrator::Reflect && pair_of(&case).is_some() {
+                continue;
+            }
             for &dt in &a.dts {
                 if let Some(st) = pair_of(&case) {
                     // Hard-rods paper Eq. 34, mu max|f| dt << eps: the scenario refuses steps
@@ -461,6 +485,7 @@ fn main() {
                 let name = match scheme {
                     Integrator::Euler => "euler",
                     Integrator::Lm => "lm",
+                    Integrator::Reflect => "reflect",
                 };
                 let mut report = |obs: &str, samples: Vec<&Vec<f64>>, exact: &[f64]| {
                     let e = errors(&samples, exact);

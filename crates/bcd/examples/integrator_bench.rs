@@ -1,9 +1,10 @@
-//! `colloidsim bench bcd`'s case for both integrators: the fast-bcd scaling case (sigma = 0.99,
+//! `colloidsim bench bcd`'s case for the three integrators: the fast-bcd scaling case (sigma = 0.99,
 //! U0 = 6 kT, one rod per wavelength, dt = 1e-3, periodic, rods started on a lattice, 50 warm-up
 //! steps, about `WORK` particle-steps per measurement), nanoseconds per particle-step, median of
 //! `REPEATS`. The bench command lives in the CLI; this example runs the same engine and force
 //! (`Field::new` of the cosine, as `colloidsim run` and the bench evaluate it) with
-//! `Integrator::Euler` and `Integrator::Lm`, alternating them within each repeat. Besides wall
+//! `Integrator::Euler`, `Integrator::Lm` and `Integrator::Reflect`, alternating them within each
+//! repeat. Besides wall
 //! time it reports the CPU time of the pool worker that runs the steps (with one thread, all of
 //! the work), which time given to other processes on a shared machine does not inflate.
 //!
@@ -48,7 +49,7 @@ fn main() {
         };
         let steps = (work / n as u64).max(20);
         let x0 = init::lattice(&cfg, n).expect("lattice");
-        let schemes = [Integrator::Euler, Integrator::Lm];
+        let schemes = [Integrator::Euler, Integrator::Lm, Integrator::Reflect];
         let mut times = vec![Vec::new(); schemes.len()];
         let mut cpu = vec![Vec::new(); schemes.len()];
         for _ in 0..repeats.max(1) {

@@ -20,6 +20,7 @@ pub mod observe;
 mod pava;
 #[doc(hidden)]
 pub use pava::PoolBench;
+mod reflect;
 mod ring;
 
 pub use engine::{Bcd, BcdConfig, BcdError, BcdState, Boundary, Integrator, Update};

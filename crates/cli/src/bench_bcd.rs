@@ -3,7 +3,7 @@
 use anyhow::Result;
 use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::NoPair;
-use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
+use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Integrator, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use std::time::Instant;
 
@@ -26,6 +26,10 @@ pub struct BenchArgs {
     /// Repetitions; the median is reported.
     #[arg(long, default_value_t = 5)]
     pub repeats: usize,
+    /// Integrators of the premerging case (`euler`, `lm`, `reflect`), alternated within each
+    /// repetition.
+    #[arg(long, value_delimiter = ',', default_value = "euler")]
+    pub integrators: Vec<String>,
     /// Instead: the whole run path (`colloidsim run`) at these N, with no observers and with
     /// the main example's (density of 100 bins, MSD of 30 lags and clusters, every step),
     /// beside the bare engine, alternating the three in each repetition; runs of at least
@@ -61,7 +65,18 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         a.repeats
     );
     println!("method\tN\tsteps\tns_per_particle_step\tmin\tmax\tRSS_bytes_per_particle");
-    let run = |n: usize, update: Update| -> Result<()> {
+    let integrators = a
+        .integrators
+        .iter()
+        .map(|s| match s.as_str() {
+            "euler" => Ok(Integrator::Euler),
+            "lm" => Ok(Integrator::Lm),
+            "reflect" => Ok(Integrator::Reflect),
+            o => anyhow::bail!("--integrators: '{o}' is not one of euler, lm, reflect"),
+        })
+        .collect::<Result<Vec<_>>>()?;
+    // The integrators of one N alternate within each repetition (the machine's load drifts).
+    let run = |n: usize, update: Update, schemes: &[Integrator]| -> Result<()> {
         let cfg = BcdConfig {
             length: n as f64,
             sigma: 0.99,
@@ -73,43 +88,47 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
             update,
         };
         let steps = (a.work / n as u64).max(20);
-        let mut times = Vec::new();
-        let mut mem = f64::NAN;
+        let mut times = vec![Vec::new(); schemes.len()];
+        let mut mem = vec![f64::NAN; schemes.len()];
         let x0 = init::lattice(&cfg, n)?;
         for rep in 0..a.repeats.max(1) {
-            let before = rss_bytes();
-            let mut b = Bcd::new(cfg.clone(), x0.clone(), force.clone(), NoPair)?;
-            b.run(steps.min(50))?; // warm-up: clusters form, buffers reach their size
-            let t = Instant::now();
-            b.run(steps)?;
-            times.push(t.elapsed().as_secs_f64() * 1e9 / (steps as f64 * n as f64));
-            if rep == 0
-                && let (Some(b0), Some(b1)) = (before, rss_bytes())
-            {
-                mem = (b1 - b0) / n as f64;
+            for (k, &scheme) in schemes.iter().enumerate() {
+                let before = rss_bytes();
+                let mut b = Bcd::new(cfg.clone(), x0.clone(), force.clone(), NoPair)?
+                    .with_integrator(scheme);
+                b.run(steps.min(50))?; // warm-up: clusters form, buffers reach their size
+                let t = Instant::now();
+                b.run(steps)?;
+                times[k].push(t.elapsed().as_secs_f64() * 1e9 / (steps as f64 * n as f64));
+                if rep == 0
+                    && let (Some(b0), Some(b1)) = (before, rss_bytes())
+                {
+                    mem[k] = (b1 - b0) / n as f64;
+                }
+                drop(b);
             }
-            drop(b);
         }
-        times.sort_by(f64::total_cmp);
-        let name = match update {
-            Update::Premerge => "premerge",
-            Update::Chronological => "chronological",
-        };
-        println!(
-            "{name}\t{n}\t{steps}\t{:.2}\t{:.2}\t{:.2}\t{:.0}",
-            times[times.len() / 2],
-            times[0],
-            times[times.len() - 1],
-            mem
-        );
+        for (k, &scheme) in schemes.iter().enumerate() {
+            let (m, lo, hi) = med(&mut times[k]);
+            let name = match (update, scheme) {
+                (Update::Chronological, _) => "chronological",
+                (_, Integrator::Euler) => "premerge",
+                (_, Integrator::Lm) => "premerge-lm",
+                (_, Integrator::Reflect) => "reflect",
+            };
+            println!(
+                "{name}\t{n}\t{steps}\t{m:.2}\t{lo:.2}\t{hi:.2}\t{:.0}",
+                mem[k]
+            );
+        }
         Ok(())
     };
     // A 0 in a list skips that method.
     for &n in a.n.iter().filter(|&&n| n > 0) {
-        run(n, Update::Premerge)?;
+        run(n, Update::Premerge, &integrators)?;
     }
     for &n in a.chronological.iter().filter(|&&n| n > 0) {
-        run(n, Update::Chronological)?;
+        run(n, Update::Chronological, &[Integrator::Euler])?;
     }
     Ok(())
 }

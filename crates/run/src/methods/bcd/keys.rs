@@ -140,8 +140,8 @@ pub const RUN: Spec = key("run", "-", Required, Table, "time stepping");
 
 pub const RUN_DT: Spec = key("run.dt", "time", Required, Positive, "time step");
 
-pub const RUN_INTEGRATOR: Spec = key("run.integrator", "-", Word("euler"), OneOf(&["euler", "lm"]),
-    "free motion: Euler-Maruyama, or Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2, second order for the forces, the same collisions; see docs/bcd.md)");
+pub const RUN_INTEGRATOR: Spec = key("run.integrator", "-", Word("euler"), OneOf(&["euler", "lm", "reflect"]),
+    "free motion: Euler-Maruyama, Leimkuhler-Matthews (noise (xi_n + xi_n+1)/2, second order for the forces, the same collisions), or reflect (elastic collisions, no boundary layer, with LM in its Markov form; needs kT > 0, no sticky rods, no cluster statistics, method bcd); see docs/bcd.md");
 
 pub const RUN_EQUILIBRATE: Spec = key("run.equilibrate", "time", Value("0"), NonNegative,
     "time run before sampling");

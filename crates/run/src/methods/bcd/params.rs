@@ -397,11 +397,12 @@ impl Scenario {
         let integrator = match self.run.integrator.as_deref() {
             None | Some("euler") => Integrator::Euler,
             Some("lm") => Integrator::Lm,
+            Some("reflect") => Integrator::Reflect,
             Some(other) => {
                 return Err(ParamError::new(
                     "run.integrator",
                     format!(
-                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews)"
+                        "'{other}' is not one of: euler (Euler-Maruyama), lm (Leimkuhler-Matthews), reflect (elastic collisions with LM)"
                     ),
                 )
                 .into());
@@ -410,6 +411,9 @@ impl Scenario {
         let seed = seed_override.unwrap_or(self.seed);
         let seed = colloidsim_core::param::seed("seed", seed)?;
         let s = &self.system;
+        if integrator == Integrator::Reflect {
+            self.check_reflect(update)?;
+        }
         let config = BcdConfig {
             length: s.length,
             sigma: s.diameter,
@@ -599,10 +603,11 @@ impl Scenario {
             // corrected diffusion approximation): rho2 in a window w is too high by ~ delta / w.
             // Leimkuhler–Matthews's correlated noise makes the layer 1.2-1.5x thicker (measured,
             // docs/validation.md).
-            let thicker = if integrator == Integrator::Lm {
-                1.5
-            } else {
-                1.0
+            let thicker = match integrator {
+                Integrator::Lm => 1.5,
+                Integrator::Euler => 1.0,
+                // Reflecting collisions leave no boundary layer.
+                Integrator::Reflect => 0.0,
             };
             let delta = thicker * 0.5826 * (4.0 * s.mobility * s.kt * self.run.dt).sqrt();
             let bias = delta / c.window;
@@ -651,6 +656,43 @@ impl Scenario {
             msd_max_lag: r.number(&OBSERVE_MSD_MAX_LAG)?,
             warnings,
         })
+    }
+
+    /// What `run.integrator = "reflect"` cannot do (yet), refused naming the keys.
+    fn check_reflect(&self, update: Update) -> Result<(), ParamError> {
+        let why = |key: &str, what: &str| {
+            Err(ParamError::new(
+                key,
+                format!(
+                    "run.integrator = \"reflect\" {what}; use run.integrator = \"euler\" or \"lm\" (docs/bcd.md, Which to use)"
+                ),
+            ))
+        };
+        if update == Update::Chronological {
+            return why(
+                "method",
+                "replaces the collision rule, so it has no chronological (inelastic) variant: use method = \"bcd\"",
+            );
+        }
+        if self.system.kt == 0.0 {
+            return why(
+                "system.kT",
+                "needs kT > 0: without noise, rods pressed together would bounce off each other instead of moving as a cluster",
+            );
+        }
+        if self.interaction.sticky.is_some() {
+            return why(
+                "interaction.sticky",
+                "is not validated for sticky rods (their contact force is stiff, and no rods end a step in contact)",
+            );
+        }
+        if self.observe.clusters {
+            return why(
+                "observe.clusters",
+                "never leaves rods in contact at the end of a step (collisions are elastic), so there are no clusters to count",
+            );
+        }
+        Ok(())
     }
 
     /// Refuse a run whose rods and observers would not fit in the machine's memory, before
@@ -706,15 +748,15 @@ impl Scenario {
                 ),
             ));
         }
-        let warn_above = if integrator == Integrator::Lm {
-            0.2
-        } else {
+        let warn_above = if integrator == Integrator::Euler {
             0.02
+        } else {
+            0.2
         };
         if kappa > warn_above {
             warnings.push(format!(
                 "run.dt: mu max|U''| dt = {kappa:.3}: expect a time-step bias of the density of several per cent (about 4 % at 0.12 with Euler; docs/bcd.md, time-step error); use a smaller run.dt{}",
-                if integrator == Integrator::Lm { "" } else { " or run.integrator = \"lm\"" }
+                if integrator == Integrator::Euler { " or run.integrator = \"lm\"" } else { "" }
             ));
         }
         // How far the positions go: the system, the drift and the noise over the run.
@@ -1007,6 +1049,43 @@ trajectory = { every = 10 }
         assert!(msg.contains("euler") && msg.contains("lm"), "{msg}");
         // Names are case-sensitive, like every other choice in a scenario.
         assert!(scenario("integrator = \"LM\"").is_err());
+    }
+
+    /// `run.integrator = "reflect"` is read, and what it cannot do is refused naming the key.
+    #[test]
+    fn reflect_is_read_and_refuses_what_it_cannot_do() {
+        assert_eq!(
+            scenario("integrator = \"reflect\"").unwrap().integrator,
+            Integrator::Reflect
+        );
+        let refused = |method: &str, system: &str, extra: &str| {
+            let text = format!(
+                "method = \"{method}\"\n[system]\nlength = 20.0\nparticles = 10\ndiameter = 0.5\n{system}\n\
+                 {extra}\n[run]\ndt = 1e-5\ntime = 1.0\nintegrator = \"reflect\"\n"
+            );
+            read(
+                &toml::from_str(&text).expect("scenario syntax"),
+                Path::new("."),
+                None,
+            )
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+        };
+        for (method, system, extra, key) in [
+            ("bcd", "kT = 0.0", "", "system.kT"),
+            (
+                "bcd",
+                "",
+                "[interaction]\nsticky = { gamma = 1.0 }",
+                "interaction.sticky",
+            ),
+            ("bcd", "", "[observe]\nclusters = true", "observe.clusters"),
+            ("bcd-chronological", "", "", "method"),
+        ] {
+            let msg = refused(method, system, extra);
+            assert!(msg.contains(key) && msg.contains("reflect"), "{key}: {msg}");
+        }
     }
 
     #[test]
