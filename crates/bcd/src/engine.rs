@@ -585,6 +585,26 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         cluster_origin(self.len(), periodic, |i| bond[i] != 0)
     }
 
+    /// The end of a step taken in reduced coordinates (the ring's or the reflecting
+    /// integrator's): the rod, velocity and reduced coordinate `y` that went non-finite, or the
+    /// step counted and the cached views dropped.
+    fn reduced_step_done(&mut self, done: Result<(), (usize, f64, f64)>) -> Result<(), BcdError> {
+        if let Err((i, u, y)) = done {
+            return Err(BcdError::NonFinite {
+                step: self.state.step,
+                particle: i,
+                position: y + i as f64 * self.cfg.sigma,
+                velocity: u,
+            });
+        }
+        self.view = OnceLock::new();
+        if let Some(x) = self.positions.take() {
+            *self.spare.get_mut().unwrap_or_else(|e| e.into_inner()) = x;
+        }
+        self.state.step += 1;
+        Ok(())
+    }
+
     /// Advance by one time step.
     pub fn step(&mut self) -> Result<(), BcdError> {
         if let Some(r) = &mut self.reflect {
@@ -597,37 +617,15 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 )
                 .into());
             }
-            if let Err((i, u)) = r.step(&self.ext, &self.pair, &self.cfg, step) {
-                return Err(BcdError::NonFinite {
-                    step,
-                    particle: i,
-                    position: r.y[i] + i as f64 * self.cfg.sigma,
-                    velocity: u,
-                });
-            }
-            self.view = OnceLock::new();
-            if let Some(x) = self.positions.take() {
-                *self.spare.get_mut().unwrap_or_else(|e| e.into_inner()) = x;
-            }
-            self.state.step += 1;
-            return Ok(());
+            let done = r.step(&self.ext, &self.pair, &self.cfg, step);
+            let done = done.map_err(|(i, u)| (i, u, r.y[i]));
+            return self.reduced_step_done(done);
         }
         if let Some(r) = &mut self.ring {
             let step = self.state.step;
-            if let Err((i, u)) = r.step(&self.ext, &self.pair, &self.cfg, self.noise_amp, step) {
-                return Err(BcdError::NonFinite {
-                    step,
-                    particle: i,
-                    position: r.y[i] + i as f64 * self.cfg.sigma,
-                    velocity: u,
-                });
-            }
-            self.view = OnceLock::new();
-            if let Some(x) = self.positions.take() {
-                *self.spare.get_mut().unwrap_or_else(|e| e.into_inner()) = x;
-            }
-            self.state.step += 1;
-            return Ok(());
+            let done = r.step(&self.ext, &self.pair, &self.cfg, self.noise_amp, step);
+            let done = done.map_err(|(i, u)| (i, u, r.y[i]));
+            return self.reduced_step_done(done);
         }
         let n = self.len();
         let origin = self.origin(&self.state.bond);

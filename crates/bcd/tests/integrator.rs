@@ -3,21 +3,16 @@
 //! premerged step still equals the chronological one, and it removes most of Euler's bias of
 //! the density in the hard-rods paper's cosine potential at equal cost per step.
 
-use colloidsim_bcd::forces::{CosineForce, NoField, NoPair};
+#[allow(dead_code)] // shares the validation tests' helpers; uses only some
+mod common;
+
+use colloidsim_bcd::forces::{NoField, NoPair};
 use colloidsim_bcd::observe::DensityProfile;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Integrator, Update, init};
-use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_core::rng::fill_normal_wide;
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
+use common::{cosine, cosine_field, mean_and_error};
 use rayon::prelude::*;
-
-/// Mean and standard error of independent samples.
-fn mean_and_error(samples: &[f64]) -> (f64, f64) {
-    let k = samples.len() as f64;
-    let m = samples.iter().sum::<f64>() / k;
-    let var = samples.iter().map(|s| (s - m).powi(2)).sum::<f64>() / (k - 1.0);
-    (m, (var / k).sqrt())
-}
 
 fn config(length: f64, sigma: f64, dt: f64, boundary: Boundary, update: Update) -> BcdConfig {
     BcdConfig {
@@ -30,20 +25,6 @@ fn config(length: f64, sigma: f64, dt: f64, boundary: Boundary, update: Update) 
         seed: 17,
         update,
     }
-}
-
-fn cosine_field() -> ExternalField {
-    ExternalField {
-        terms: vec![FieldTerm::Cosine {
-            amplitude: 6.0,
-            wavelength: 1.0,
-        }],
-        drive: 0.0,
-    }
-}
-
-fn cosine() -> CosineForce {
-    CosineForce::from_field(&cosine_field()).unwrap()
 }
 
 /// The noise is keyed by (seed, step, rod) as Euler's: one LM step of free rods moves rod i by

@@ -7,12 +7,11 @@
 #[allow(dead_code)] // shares the validation tests' helpers; uses only some
 mod common;
 
-use colloidsim_bcd::forces::{CosineForce, NoField, NoPair};
+use colloidsim_bcd::forces::{NoField, NoPair};
 use colloidsim_bcd::observe::{ContactDensity, DensityProfile};
 use colloidsim_bcd::{Bcd, BcdConfig, BcdError, Boundary, Integrator, Update, init};
-use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodsProblem};
-use common::mean_and_error;
+use common::{cosine, cosine_field, mean_and_error};
 use rayon::prelude::*;
 
 fn config(length: f64, sigma: f64, dt: f64, boundary: Boundary, seed: u32) -> BcdConfig {
@@ -26,20 +25,6 @@ fn config(length: f64, sigma: f64, dt: f64, boundary: Boundary, seed: u32) -> Bc
         seed,
         update: Update::Premerge,
     }
-}
-
-fn cosine_field() -> ExternalField {
-    ExternalField {
-        terms: vec![FieldTerm::Cosine {
-            amplitude: 6.0,
-            wavelength: 1.0,
-        }],
-        drive: 0.0,
-    }
-}
-
-fn cosine() -> CosineForce {
-    CosineForce::from_field(&cosine_field()).unwrap()
 }
 
 /// 2000 steps equal 1000 steps, a restart from the saved state, and 1000 more, bit for bit: on

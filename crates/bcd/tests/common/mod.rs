@@ -1,10 +1,26 @@
 //! Shared helpers of the validation tests: BCD density histograms against the exact theory.
 
-use colloidsim_bcd::forces::{ForceTable, NoPair, PairForce, Sticky};
+use colloidsim_bcd::forces::{CosineForce, ForceTable, NoPair, PairForce, Sticky};
 use colloidsim_bcd::observe::DensityProfile;
 use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};
+
+/// The hard-rods paper's cosine potential of 6 kT and period 1.
+pub fn cosine_field() -> ExternalField {
+    ExternalField {
+        terms: vec![FieldTerm::Cosine {
+            amplitude: 6.0,
+            wavelength: 1.0,
+        }],
+        drive: 0.0,
+    }
+}
+
+/// Its force.
+pub fn cosine() -> CosineForce {
+    CosineForce::from_field(&cosine_field()).unwrap()
+}
 
 /// Mean and standard error of independent samples.
 pub fn mean_and_error(samples: &[f64]) -> (f64, f64) {
