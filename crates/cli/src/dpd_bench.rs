@@ -168,20 +168,7 @@ fn bench_colloids(a: &BenchArgs) -> Result<()> {
         if a.tune {
             // The run's synchronisation period of a long run (lists rebuilt at least that often).
             let tuning = pool.install(|| setup.measure_neighbors(1000))?;
-            for x in &tuning.trials {
-                println!(
-                    "# tuning on {t} thread(s): {}: {:.4e} particle-steps/s, {} list builds in {} steps",
-                    if x.cells {
-                        format!("cells (colloid lists skin {})", x.skin)
-                    } else {
-                        format!("verlet, skin {}", x.skin)
-                    },
-                    n as f64 / x.seconds_per_step,
-                    x.builds,
-                    x.steps
-                );
-            }
-            println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
+            print_tuning(&tuning, t, n);
             setup.params = colloidsim_md::dpd::setup::with_candidate(setup.params, tuning.choice());
         }
         let (rates, cpu, builds, cells) = pool.install(|| -> Result<_> {
@@ -303,20 +290,7 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
         for &t in &a.threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
             let tuning = pool.install(|| tuned_search(&relaxed, sbox, params0, step0))?;
-            for x in &tuning.trials {
-                println!(
-                    "# tuning on {t} thread(s): {}: {:.4e} particle-steps/s, {} list builds in {} steps",
-                    if x.cells {
-                        "cells".to_string()
-                    } else {
-                        format!("verlet, skin {}", x.skin)
-                    },
-                    n as f64 / x.seconds_per_step,
-                    x.builds,
-                    x.steps
-                );
-            }
-            println!("# tuning on {t} thread(s) took {:.1} s", tuning.seconds);
+            print_tuning(&tuning, t, n);
             let params = colloidsim_md::dpd::setup::with_candidate(params0, tuning.choice());
             let mut row = measure_ours(&relaxed, sbox, params, step0, a.steps, repeats, t)?;
             row.skin = tuning.skin;
@@ -422,6 +396,27 @@ pub fn bench(a: &BenchArgs) -> Result<()> {
 }
 
 /// `repeats` runs of colloidsim on `threads` threads from the relaxed state.
+/// A tuning's table, as comment lines: each candidate's rate for `n` particles on `threads`.
+fn print_tuning(tuning: &colloidsim_md::tune::SkinTuning, threads: usize, n: usize) {
+    for x in &tuning.trials {
+        println!(
+            "# tuning on {threads} thread(s): {}: {:.4e} particle-steps/s, {} list builds in {} steps",
+            if x.cells {
+                format!("cells (colloid lists: skin {})", x.skin)
+            } else {
+                format!("verlet, skin {}", x.skin)
+            },
+            n as f64 / x.seconds_per_step,
+            x.builds,
+            x.steps
+        );
+    }
+    println!(
+        "# tuning on {threads} thread(s) took {:.1} s",
+        tuning.seconds
+    );
+}
+
 /// What `run.tune_skin` chooses for the relaxed water (on the current pool).
 fn tuned_search(
     relaxed: &Particles,
