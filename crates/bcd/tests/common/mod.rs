@@ -6,7 +6,8 @@ use colloidsim_bcd::{Bcd, BcdConfig, Boundary, Update, init};
 use colloidsim_core::field1d::{ExternalField, FieldTerm};
 use colloidsim_dft::rods::{self, BetaPotential, Domain, RodInteraction, RodsProblem};
 
-/// The hard-rods paper's cosine potential of 6 kT and period 1.
+/// The hard-rods paper's cosine potential of 6 kT and period 1 (the integrator tests').
+#[allow(dead_code)]
 pub fn cosine_field() -> ExternalField {
     ExternalField {
         terms: vec![FieldTerm::Cosine {
@@ -18,6 +19,7 @@ pub fn cosine_field() -> ExternalField {
 }
 
 /// Its force.
+#[allow(dead_code)]
 pub fn cosine() -> CosineForce {
     CosineForce::from_field(&cosine_field()).unwrap()
 }
