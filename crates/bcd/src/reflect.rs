@@ -431,18 +431,22 @@ mod tests {
         v.windows(2).all(|w| w[0] <= w[1]) && v[v.len() - 1] <= v[0] + period
     }
 
+    /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `state` (test data only).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The chunked fold equals a plain sort of the multiset, across chunk boundaries, with
     /// points displaced over several neighbours; walls reflect; the seam keeps the sum.
     #[test]
     fn fold_sorts_across_chunks_walls_and_the_seam() {
         let n = 3 * CHUNK + 17;
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(12345);
         // Walls [0, n]: points 1 apart displaced by up to +-3.
         let mut v: Vec<f64> = (0..n)
             .map(|i| i as f64 + 0.5 + 6.0 * (rnd() - 0.5))
@@ -496,13 +500,7 @@ mod tests {
     /// above its window (the fallback), and on short slices.
     #[test]
     fn sort_near_is_a_stable_sort() {
-        let mut state = 7u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(7);
         for (n, spread) in [
             (1, 1.0),
             (5, 3.0),
