@@ -37,6 +37,7 @@ import numpy as np
 from . import _colloidsim
 from ._colloidsim import ColloidsimError
 from . import hydro  # noqa: E402 (colloidsim.hydro: libMobility-shaped mobility operators)
+from . import analysis  # noqa: E402 (colloidsim.analysis: observables on arrays and gsd frames)
 
 __all__ = [
     "BCD",
@@ -48,6 +49,7 @@ __all__ = [
     "MonteCarlo",
     "Result",
     "Table",
+    "analyse",
     "check",
     "ensemble",
     "keys",
@@ -303,6 +305,61 @@ def theory(
             force,
             hydrodynamics,
             pair,
+            threads,
+        )
+    )
+    _warn(report)
+    return Result(report)
+
+
+def analyse(
+    trajectory: Union[str, "os.PathLike[str]"],
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    force: bool = False,
+    types: Optional[Sequence[str]] = None,
+    frames: Optional[Union[str, slice]] = None,
+    r_max: Optional[float] = None,
+    bins: Optional[int] = None,
+    contact_gap: Optional[float] = None,
+    centre: Optional[Union[str, Sequence[float]]] = None,
+    profile_bins: Optional[int] = None,
+    dt: Optional[float] = None,
+    percus_yevick: bool = False,
+    threads: Optional[int] = None,
+) -> Result:
+    """Analyse a GSD trajectory (HOOMD schema; any program's) as ``colloidsim analyse``: g(r)
+    with its standard error over frames (``gr``), S(q) (``sq``), the MSD (``msd``),
+    coordination numbers and clusters, radial profiles about ``centre`` (``"origin"``,
+    ``"com"`` or a point); ``frames`` a slice or ``"first:last:stride"`` (``last`` included);
+    ``out`` defaults to a new temporary folder. docs/analyse.md lists the files."""
+    if out is None:
+        out = tempfile.mkdtemp(prefix=f"colloidsim-{Path(trajectory).stem}-analysis-")
+    if isinstance(frames, slice):
+        if frames.step is not None and frames.step < 1 or any(
+            v is not None and v < 0 for v in (frames.start, frames.stop)
+        ):
+            raise ColloidsimError(f"frames: a slice without negative values, got {frames}")
+        # A Python slice leaves its stop out; the CLI's range keeps its last frame.
+        last = "" if frames.stop is None else str(frames.stop - 1)
+        frames = f"{frames.start or 0}:{last}:{frames.step or 1}"
+        if last == "-1":
+            raise ColloidsimError("frames: an empty slice selects no frame")
+    if centre is not None and not isinstance(centre, str):
+        centre = ",".join(repr(float(c)) for c in centre)
+    report = json.loads(
+        _colloidsim.analyse(
+            os.fspath(trajectory),
+            _out(out),
+            force,
+            None if types is None else [str(t) for t in types],
+            frames,
+            r_max,
+            bins,
+            contact_gap,
+            centre,
+            profile_bins,
+            dt,
+            percus_yevick,
             threads,
         )
     )

@@ -4,6 +4,7 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
+from . import analysis as analysis
 from . import hydro as hydro
 
 __version__: str
@@ -62,6 +63,21 @@ def theory(
     dx: Optional[float] = None,
     force: bool = False,
     hydrodynamics: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> Result: ...
+def analyse(
+    trajectory: Union[str, PathLike[str]],
+    out: Optional[Union[str, PathLike[str]]] = None,
+    force: bool = False,
+    types: Optional[Sequence[str]] = None,
+    frames: Optional[Union[str, slice]] = None,
+    r_max: Optional[float] = None,
+    bins: Optional[int] = None,
+    contact_gap: Optional[float] = None,
+    centre: Optional[Union[str, Sequence[float]]] = None,
+    profile_bins: Optional[int] = None,
+    dt: Optional[float] = None,
+    percus_yevick: bool = False,
     threads: Optional[int] = None,
 ) -> Result: ...
 def check(scenario: ScenarioLike, overrides: Overrides = None) -> Dict[str, Any]: ...

@@ -6,9 +6,10 @@
 //! polling Python's signals: Ctrl-C sets the run's interrupt flag, the run writes its
 //! checkpoint, and the call raises `KeyboardInterrupt`.
 
+mod analysis;
 mod hydro;
 
-use colloidsim_run::{Control, RunOptions, Scenario, TheoryOptions};
+use colloidsim_run::{AnalyseOptions, Control, RunOptions, Scenario, TheoryOptions};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -236,6 +237,71 @@ fn theory(
     Ok(report_json(&r))
 }
 
+/// Analyse a GSD trajectory (`colloidsim analyse`); returns the report as JSON. Options are
+/// named as the Python function's arguments in its errors.
+#[pyfunction]
+#[pyo3(signature = (trajectory, out=None, force=false, types=None, frames=None, r_max=None, bins=None, contact_gap=None, centre=None, profile_bins=None, dt=None, percus_yevick=false, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn analyse(
+    py: Python<'_>,
+    trajectory: PathBuf,
+    out: Option<PathBuf>,
+    force: bool,
+    types: Option<Vec<String>>,
+    frames: Option<String>,
+    r_max: Option<f64>,
+    bins: Option<usize>,
+    contact_gap: Option<f64>,
+    centre: Option<String>,
+    profile_bins: Option<usize>,
+    dt: Option<f64>,
+    percus_yevick: bool,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    // The CLI's option names in the messages become the arguments' names.
+    let pythonic = |e: anyhow::Error| {
+        let mut m = format!("{e:#}");
+        for flag in [
+            "--frames",
+            "--centre",
+            "--r-max",
+            "--bins",
+            "--contact-gap",
+            "--profile-bins",
+            "--dt",
+            "--types",
+            "--percus-yevick",
+        ] {
+            m = m.replace(flag, &flag[2..].replace('-', "_"));
+        }
+        anyhow::anyhow!(m)
+    };
+    let parsed = || -> anyhow::Result<AnalyseOptions> {
+        Ok(AnalyseOptions {
+            out,
+            force,
+            types,
+            frames: frames
+                .as_deref()
+                .map(str::parse)
+                .transpose()?
+                .unwrap_or_default(),
+            r_max,
+            bins,
+            contact_gap,
+            centre: centre.as_deref().map(str::parse).transpose()?,
+            profile_bins,
+            dt,
+            percus_yevick,
+        })
+    };
+    let opts = parsed().map_err(|e| to_py(pythonic(e)))?;
+    let r = blocking(py, threads, |_| {
+        colloidsim_run::analyse(&trajectory, &opts).map_err(pythonic)
+    })?;
+    Ok(report_json(&r))
+}
+
 /// Validate a scenario; returns `{"resolved": ..., "warnings": [...]}` as JSON.
 #[pyfunction]
 fn check(
@@ -410,11 +476,18 @@ fn _colloidsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(resume_ensemble, m)?)?;
     m.add_function(wrap_pyfunction!(theory, m)?)?;
+    m.add_function(wrap_pyfunction!(analyse, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(keys, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(toml_from_json, m)?)?;
     m.add_class::<Engine>()?;
     m.add_class::<hydro::HydroOperator>()?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_rdf, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_msd, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_contacts, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_cluster_labels, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_radial_profile, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analysis_structure_factor, m)?)?;
     Ok(())
 }

@@ -125,6 +125,53 @@ enum Command {
         #[command(flatten)]
         overrides: Overrides,
     },
+    /// Analyse any GSD trajectory (HOOMD-blue's, LAMMPS' dump gsd, colloidsim's): g(r) with
+    /// its standard error over frames, S(q), MSD, contacts, coordination, clusters and radial
+    /// profiles, written as a run writes them (docs/analyse.md).
+    #[command(visible_alias = "analyze")]
+    Analyse {
+        /// GSD trajectory (HOOMD schema; orthorhombic 3D boxes).
+        trajectory: PathBuf,
+        /// Output folder (default: the trajectory's name followed by `-analysis`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write into an output folder that already holds files.
+        #[arg(long)]
+        force: bool,
+        /// Particle types analysed, by name, comma-separated (default: all).
+        #[arg(long, value_delimiter = ',')]
+        types: Option<Vec<String>>,
+        /// Frames FIRST:LAST:STRIDE, counted from 0, each optional (default: all).
+        #[arg(long, default_value = "::1")]
+        frames: colloidsim_run::analyse::Frames,
+        /// Range of g(r), in the trajectory's length unit (default: 0.49 of the shortest box
+        /// edge; at most half of it).
+        #[arg(long)]
+        r_max: Option<f64>,
+        /// Bins of g(r) (default 200; 1 to 100000).
+        #[arg(long)]
+        bins: Option<usize>,
+        /// Two spheres touch when their surface gap is below this (default 0.1 mean diameters).
+        #[arg(long, allow_negative_numbers = true)]
+        contact_gap: Option<f64>,
+        /// Centre of the radial profiles: origin (the box centre), com (each frame's centre of
+        /// mass) or x,y,z (default: origin).
+        #[arg(long, allow_hyphen_values = true)]
+        centre: Option<colloidsim_run::analyse::Centre>,
+        /// Bins of the radial profiles, out to half the shortest box edge (default 50).
+        #[arg(long)]
+        profile_bins: Option<usize>,
+        /// Time per step: msd.csv gets a time column (default: lags in steps only).
+        #[arg(long)]
+        dt: Option<f64>,
+        /// Hard spheres of one diameter: write and draw the Percus-Yevick g(r) at the
+        /// trajectory's volume fraction beside the measured one.
+        #[arg(long)]
+        percus_yevick: bool,
+        /// Worker threads (default: all cores; at most 8 per core and 4096).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Run a scenario at its time step and at half of it (several seeds each) and write its
     /// tables extrapolated to dt -> 0 with their errors (Richardson).
     Extrapolate {
@@ -728,6 +775,44 @@ fn run_cli() -> Result<()> {
                 },
                 &control(false, Signals::CtrlC, None),
             )?;
+            println!("{}", report.message);
+            Ok(())
+        }
+        Command::Analyse {
+            trajectory,
+            out,
+            force,
+            types,
+            frames,
+            r_max,
+            bins,
+            contact_gap,
+            centre,
+            profile_bins,
+            dt,
+            percus_yevick,
+            threads,
+        } => {
+            thread_pool(threads)?;
+            let report = colloidsim_run::analyse(
+                &trajectory,
+                &colloidsim_run::AnalyseOptions {
+                    out,
+                    force,
+                    types,
+                    frames,
+                    r_max,
+                    bins,
+                    contact_gap,
+                    centre,
+                    profile_bins,
+                    dt,
+                    percus_yevick,
+                },
+            )?;
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
             println!("{}", report.message);
             Ok(())
         }

@@ -6,6 +6,7 @@
 //! interrupt, verified restarts, atomic writers and `summary.json`. [`theory`] computes a
 //! scenario's continuum counterpart, [`check`] validates it, [`keys`] lists its keys.
 
+pub mod analyse;
 pub mod checkpoint;
 pub mod control;
 mod driver;
@@ -22,6 +23,7 @@ pub mod scenario;
 mod bd_replica;
 pub mod two_body;
 
+pub use analyse::{AnalyseOptions, analyse};
 pub use control::{Control, Progress, Silent, Stop};
 pub use driver::{resume, resume_decomposed, run, run_decomposed};
 pub use engine::Engine;
