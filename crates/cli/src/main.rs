@@ -172,6 +172,42 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Draw particles from a run's trajectory.gsd (or any GSD file): a snapshot (spheres in
+    /// perspective, shaded; rods on a line as a space-time picture) or an animated GIF
+    /// (docs/render.md).
+    Render {
+        /// A run's output folder (its trajectory.gsd) or a GSD file.
+        input: PathBuf,
+        /// Picture file (default: snapshot.png, or movie.gif with --animate, beside the
+        /// trajectory).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Replace an existing picture.
+        #[arg(long)]
+        force: bool,
+        /// The snapshot's frame, counted from 0 (default: the last; rods: every frame).
+        #[arg(long)]
+        frame: Option<u64>,
+        /// An animated GIF of --frames instead of one snapshot.
+        #[arg(long)]
+        animate: bool,
+        /// Frames FIRST:LAST:STRIDE of an animation or a rods' space-time picture (default:
+        /// all, thinned evenly to 400).
+        #[arg(long, default_value = "::1")]
+        frames: colloidsim_run::analyse::Frames,
+        /// What colours the spheres: type, distance (from the centre) or diameter.
+        #[arg(long, default_value = "type")]
+        colour: colloidsim_run::render::Colour,
+        /// Leave out the half of the spheres facing the camera (the inside of a droplet).
+        #[arg(long)]
+        cut: bool,
+        /// Picture width in pixels (200 to 4000).
+        #[arg(long, default_value_t = 800)]
+        width: u32,
+        /// Animation frames per second (1 to 50).
+        #[arg(long, default_value_t = 10)]
+        fps: u32,
+    },
     /// Run a scenario at its time step and at half of it (several seeds each) and write its
     /// tables extrapolated to dt -> 0 with their errors (Richardson).
     Extrapolate {
@@ -814,6 +850,35 @@ fn run_cli() -> Result<()> {
                 eprintln!("warning: {w}");
             }
             println!("{}", report.message);
+            Ok(())
+        }
+        Command::Render {
+            input,
+            out,
+            force,
+            frame,
+            animate,
+            frames,
+            colour,
+            cut,
+            width,
+            fps,
+        } => {
+            let path = colloidsim_run::render(
+                &input,
+                &colloidsim_run::RenderOptions {
+                    out,
+                    force,
+                    frame,
+                    animate,
+                    frames,
+                    colour,
+                    cut,
+                    width,
+                    fps,
+                },
+            )?;
+            println!("drew {}", path.display());
             Ok(())
         }
         Command::Extrapolate {

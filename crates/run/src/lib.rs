@@ -18,6 +18,7 @@ pub mod method;
 pub mod methods;
 pub mod output;
 pub mod registry;
+pub mod render;
 pub mod scenario;
 
 mod bd_replica;
@@ -30,6 +31,7 @@ pub use engine::Engine;
 pub use ensemble::{EnsembleOptions, ensemble, resume_ensemble};
 pub use extrapolate::{ExtrapolateOptions, extrapolate};
 pub use method::{Checked, Finished, Method};
+pub use render::{RenderOptions, render};
 pub use scenario::Scenario;
 
 use std::path::PathBuf;

@@ -16,7 +16,7 @@ static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 static REGISTER: Once = Once::new();
 
-fn register_font() {
+pub(crate) fn register_font() {
     REGISTER.call_once(|| {
         // The font is embedded, so registration cannot fail for a missing file.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
