@@ -292,6 +292,13 @@ enum Command {
         /// Print instead the resolved parameters as JSON (summary.json's `parameters`).
         #[arg(long)]
         json: bool,
+        /// Skip the estimate of run time and memory (which starts the run and times its first
+        /// steps for about half a second).
+        #[arg(long)]
+        no_estimate: bool,
+        /// Worker threads the estimate is measured with (default: all cores, as a run).
+        #[arg(long)]
+        threads: Option<usize>,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -950,8 +957,11 @@ fn run_cli() -> Result<()> {
         Command::Check {
             scenario: path,
             json,
+            no_estimate,
+            threads,
             overrides,
         } => {
+            thread_pool(threads)?;
             let sc = scenario(&path, &overrides)?;
             let checked = colloidsim_run::check(&sc)?;
             for w in &checked.warnings {
@@ -964,6 +974,17 @@ fn run_cli() -> Result<()> {
                 print!("{}", colloidsim_run::keys::values(&sc.table()?, &keys));
             }
             println!("scenario {} is valid", path.display());
+            if !json && !no_estimate {
+                let e = colloidsim_run::estimate::estimate(&sc, Duration::from_millis(500))
+                    .context("estimating the run's cost (skip with --no-estimate)")?;
+                println!("{}", e.line());
+                if let Some(why) = &e.stopped {
+                    eprintln!("warning: the run stopped while it was timed: {why}");
+                }
+                if let Some(w) = e.warning() {
+                    eprintln!("warning: {w}");
+                }
+            }
             Ok(())
         }
         Command::Keys { method, format } => {

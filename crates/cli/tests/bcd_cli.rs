@@ -586,3 +586,38 @@ fn check_prints_keys_values_and_units() {
     let v: serde_json::Value = serde_json::from_str(&out[..=out.rfind('}').unwrap()]).unwrap();
     assert_eq!(v["run"]["dt"], 1e-3);
 }
+
+/// `check` prints the run's estimated cost after validating it, in a temporary folder of its
+/// own that it removes; `--no-estimate` and `--json` leave it out.
+#[test]
+fn check_estimates_the_cost_and_leaves_nothing_behind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scratch = tempfile::tempdir().unwrap();
+    let sc = write_scenario(tmp.path(), "small.toml", SMALL);
+    let check = |extra: &[&str]| {
+        let o = bin()
+            .args(["check", sc.to_str().unwrap()])
+            .args(extra)
+            .env("TMPDIR", scratch.path())
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let out = check(&[]);
+    // 500 equilibration steps and 5000 of the run.
+    assert!(
+        out.contains("estimate: about") && out.contains("of 5500"),
+        "{out}"
+    );
+    assert!(!check(&["--no-estimate"]).contains("estimate"));
+    assert!(!check(&["--json"]).contains("estimate"));
+    assert_eq!(std::fs::read_dir(scratch.path()).unwrap().count(), 0);
+    let mut left: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["small.toml"]);
+}

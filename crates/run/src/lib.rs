@@ -12,6 +12,7 @@ pub mod control;
 mod driver;
 pub mod engine;
 pub mod ensemble;
+pub mod estimate;
 pub mod extrapolate;
 pub mod keys;
 pub mod method;
