@@ -157,38 +157,53 @@ fn time_steps(sc: &Scenario, budget: Duration) -> Result<Timed> {
 
 /// Keys of a warm-up whose steps cost less than the production's (no sampling): the run is
 /// timed once as it is and once without its warm-up, and each phase counted at its own rate.
-const WARM_UP_KEYS: [(&str, toml::Value); 2] = [
-    ("run.equilibrate", toml::Value::Float(0.0)),
-    ("mc.warmup_sweeps", toml::Value::Integer(0)),
-];
+const WARM_UP_KEYS: [&str; 2] = ["run.equilibrate", "mc.warmup_sweeps"];
+
+/// The scenario without its warm-up: each key set to 0, as an integer where the method takes
+/// one (MPCD's collisions, MC's sweeps) and else as a time; `None` where neither is valid.
+fn without_warm_up(sc: &Scenario, keys: &[&str]) -> Option<Scenario> {
+    let mut sc = sc.clone();
+    for k in keys {
+        sc = [toml::Value::Integer(0), toml::Value::Float(0.0)]
+            .into_iter()
+            .find_map(|zero| {
+                let v = sc.with_values(&[(k.to_string(), zero)]).ok()?;
+                crate::check(&v).ok().map(|_| v)
+            })?;
+    }
+    Some(sc)
+}
 
 /// Time the run `sc` describes on its first steps (and, where it has a warm-up, on the first
 /// steps after it) for about `budget` in all; extrapolate to the whole run.
 pub fn estimate(sc: &Scenario, budget: Duration) -> Result<Estimate> {
     let m = registry::of(sc)?;
-    let warm_up: Vec<(String, toml::Value)> = WARM_UP_KEYS
-        .iter()
-        .filter(|(k, _)| m.keys().iter().any(|s| s.path == *k))
-        .map(|(k, v)| (k.to_string(), v.clone()))
+    let warm_up: Vec<&str> = WARM_UP_KEYS
+        .into_iter()
+        .filter(|k| m.keys().iter().any(|s| s.path == *k))
         .collect();
     let whole = time_steps(sc, budget / 2)?;
     let mut steps = (whole.measured_steps, whole.seconds_per_step);
     let mut total_seconds =
         whole.startup_seconds + whole.seconds_per_step * whole.total.saturating_sub(1) as f64;
-    if !warm_up.is_empty() && whole.stopped.is_none() {
-        let production = sc.with_values(&warm_up)?;
-        let p = time_steps(&production, budget / 2)?;
-        if p.total < whole.total && p.stopped.is_none() {
-            let warm = whole.total - p.total;
-            total_seconds = whole.startup_seconds
-                + whole.seconds_per_step * warm.saturating_sub(1) as f64
-                + p.seconds_per_step * p.total as f64;
-            // The rate quoted: the whole run's mean.
-            steps = (
-                whole.measured_steps + p.measured_steps,
-                (total_seconds - whole.startup_seconds) / whole.total.max(1) as f64,
-            );
-        }
+    let production = (!warm_up.is_empty() && whole.stopped.is_none())
+        .then(|| without_warm_up(sc, &warm_up))
+        .flatten();
+    // The production's timing is a refinement: where it cannot be had, the whole run's rate
+    // stands.
+    if let Some(p) = production.and_then(|p| time_steps(&p, budget / 2).ok())
+        && p.total < whole.total
+        && p.stopped.is_none()
+    {
+        let warm = whole.total - p.total;
+        total_seconds = whole.startup_seconds
+            + whole.seconds_per_step * warm.saturating_sub(1) as f64
+            + p.seconds_per_step * p.total as f64;
+        // The rate quoted: the whole run's mean.
+        steps = (
+            whole.measured_steps + p.measured_steps,
+            (total_seconds - whole.startup_seconds) / whole.total.max(1) as f64,
+        );
     }
     Ok(Estimate {
         steps: whole.total,
