@@ -47,6 +47,7 @@ __all__ = [
     "Engine",
     "MPCD",
     "MonteCarlo",
+    "Periodic",
     "Result",
     "Table",
     "analyse",
@@ -389,12 +390,40 @@ def methods() -> List[Dict[str, Any]]:
     return json.loads(_colloidsim.methods())
 
 
+class Periodic:
+    """A trigger as HOOMD-blue's ``hoomd.trigger.Periodic``: true at the steps ``phase + k
+    period`` (k = 0, 1, ...)."""
+
+    def __init__(self, period: int, phase: int = 0):
+        if int(period) < 1 or int(phase) < 0:
+            raise ColloidsimError(
+                f"period: must be >= 1 and phase >= 0, got period {period}, phase {phase}"
+            )
+        self.period, self.phase = int(period), int(phase)
+
+    def __call__(self, step: int) -> bool:
+        return step >= self.phase and (step - self.phase) % self.period == 0
+
+    def next_after(self, step: int) -> int:
+        """The first step after ``step`` at which the trigger is true."""
+        if step < self.phase:
+            return self.phase
+        return step + self.period - (step - self.phase) % self.period
+
+    def __repr__(self) -> str:
+        return f"Periodic({self.period}, phase={self.phase})"
+
+
 class Engine:
     """A method's engine built from a scenario, stepped by hand.
 
     ``positions``, ``velocities`` and ``forces`` are read-only numpy arrays (copies of the
     engine's state at the time of reading), shaped ``(N,)`` for rods and ``(N, 3)`` for spheres,
     in the particles' input order.
+
+    Analyzers and writers (``add_analyzer``) are Python callables run during ``step`` at the
+    steps their trigger selects (a :class:`Periodic`, or any callable ``step -> bool``, which is
+    asked after every step and so makes ``step`` advance one step at a time).
     """
 
     _method: Optional[Tuple[str, ...]] = None
@@ -407,17 +436,74 @@ class Engine:
     ):
         text, base, name, origin = _scenario(scenario)
         self._engine = _colloidsim.Engine(text, base, name, origin, _overrides(overrides), seed)
+        self.analyzers: List[Tuple[Any, Any]] = []
         if self._method is not None and self._engine.method not in self._method:
             raise ColloidsimError(
                 f"{type(self).__name__} takes a scenario with method = "
                 f"{' or '.join(repr(m) for m in self._method)}, got {self._engine.method!r}"
             )
 
+    def add_analyzer(self, analyzer: Any, trigger: Any) -> None:
+        """Call ``analyzer(engine)`` during ``step`` after every step ``trigger(step)`` selects
+        (``trigger``: a :class:`Periodic`, an int period, or a callable ``step -> bool``). The
+        analyzers are called in the order they were added; they see the engine at that step
+        and leave its trajectory as it would be without them."""
+        if isinstance(trigger, int):
+            trigger = Periodic(trigger)
+        if not callable(trigger):
+            raise ColloidsimError(f"trigger: a Periodic, an int or a callable, got {trigger!r}")
+        if not callable(analyzer):
+            raise ColloidsimError(f"analyzer: must be callable, got {analyzer!r}")
+        self.analyzers.append((trigger, analyzer))
+
     def step(self, steps: int = 1, threads: Optional[int] = None) -> None:
-        """Advance ``steps`` steps (releases the GIL; Ctrl-C stops at a whole step)."""
+        """Advance ``steps`` steps (releases the GIL; Ctrl-C stops at a whole step), calling
+        the analyzers at their trigger steps on the way."""
         if steps < 0:
             raise ValueError(f"steps: must be >= 0, got {steps}")
-        self._engine.step(steps, threads)
+        if not self.analyzers:
+            self._engine.step(steps, threads)
+            return
+        target = self.steps + steps
+        while self.steps < target:
+            now = self.steps
+            nxt = min(
+                t.next_after(now) if hasattr(t, "next_after") else now + 1
+                for t, _ in self.analyzers
+            )
+            self._engine.step(min(nxt, target) - now, threads)
+            for t, a in self.analyzers:
+                if t(self.steps):
+                    a(self)
+
+    def snapshot(self) -> Any:
+        """The engine's state as a ``gsd.hoomd.Frame`` (needs the ``gsd`` package): step, box
+        and positions in HOOMD's convention (a box centred on the origin). Rods: the line
+        ``[0, L)`` as the x axis of a 2D box ``[L, L, 0]``, shifted by ``-L/2``, with image flags
+        counting the turns of a ring. ``gsd.hoomd.open(path, "w").append(engine.snapshot())``
+        writes it."""
+        import gsd.hoomd
+
+        f = gsd.hoomd.Frame()
+        f.configuration.step = int(self.steps)
+        x = self.positions
+        if self._engine.dimensions == 1:
+            length = float(self.box[0])
+            f.configuration.box = [length, length, 0.0, 0.0, 0.0, 0.0]
+            f.configuration.dimensions = 2
+            turns = np.floor(x / length)
+            pos = np.zeros((len(x), 3))
+            pos[:, 0] = x - turns * length - 0.5 * length
+            image = np.zeros((len(x), 3), dtype=np.int32)
+            image[:, 0] = turns.astype(np.int32)
+            f.particles.image = image
+        else:
+            b = self.box
+            f.configuration.box = [float(b[0]), float(b[1]), float(b[2]), 0.0, 0.0, 0.0]
+            pos = np.asarray(x, dtype=float)
+        f.particles.N = len(pos)
+        f.particles.position = pos.astype(np.float32)
+        return f
 
     def _array(self, b: Optional[bytes]) -> Optional[np.ndarray]:
         if b is None:

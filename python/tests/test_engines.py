@@ -144,3 +144,44 @@ def test_engine_classes_check_the_method():
         colloidsim.DPD(BCD_SCENARIO)
     with pytest.raises(ValueError, match="steps"):
         colloidsim.BCD(BCD_SCENARIO).step(-1)
+
+
+def test_analyzers_see_every_trigger_step_and_leave_the_trajectory_alone():
+    seen = []
+    a = colloidsim.BCD(BCD_SCENARIO)
+    a.add_analyzer(lambda e: seen.append((e.steps, e.positions.copy())), colloidsim.Periodic(7))
+    odd = []
+    a.add_analyzer(lambda e: odd.append(e.steps), lambda step: step % 10 == 3)
+    a.step(20)
+    a.step(30)
+    assert [s for s, _ in seen] == list(range(7, 50, 7))
+    assert odd == [3, 13, 23, 33, 43]
+    b = colloidsim.BCD(BCD_SCENARIO)
+    b.step(50)
+    assert np.array_equal(a.positions, b.positions)
+    # Each analyzer saw the engine at its step: the positions of a plain run at step 21.
+    c = colloidsim.BCD(BCD_SCENARIO)
+    c.step(21)
+    assert np.array_equal(dict(seen)[21], c.positions)
+    with pytest.raises(colloidsim.ColloidsimError, match="period"):
+        colloidsim.Periodic(0)
+    with pytest.raises(colloidsim.ColloidsimError, match="trigger"):
+        a.add_analyzer(print, "often")
+
+
+def test_snapshots_are_gsd_frames(tmp_path):
+    gsd_hoomd = pytest.importorskip("gsd.hoomd")
+    e = colloidsim.BrownianDynamics(EXAMPLES / "droplet/drying-bd.toml")
+    path = tmp_path / "own.gsd"
+    with gsd_hoomd.open(str(path), "w") as t:
+        e.add_analyzer(lambda en: t.append(en.snapshot()), colloidsim.Periodic(5))
+        e.step(10)
+    with gsd_hoomd.open(str(path)) as t:
+        assert [f.configuration.step for f in t] == [5, 10]
+        np.testing.assert_array_equal(t[1].particles.position, e.positions.astype(np.float32))
+    rods = colloidsim.BCD(BCD_SCENARIO)
+    rods.step(100)
+    f = rods.snapshot()
+    x = f.particles.position[:, 0] + 10.0 + 20.0 * f.particles.image[:, 0]
+    np.testing.assert_allclose(x, rods.positions, atol=1e-5)
+    assert list(f.configuration.box) == [20.0, 20.0, 0.0, 0.0, 0.0, 0.0]
