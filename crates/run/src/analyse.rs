@@ -6,11 +6,11 @@
 
 use crate::Report;
 use crate::output::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
+use crate::output::{PairStructure, write_pair_structure};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
-    Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
+    cluster_stats, contacts, coordination_histogram, coordination_numbers,
     mean_squared_displacement, overlap_profile, pair_distribution, radial_profile,
-    structure_factor_windowed,
 };
 use colloidsim_core::output::OutputDir;
 use colloidsim_dft::oz;
@@ -19,8 +19,6 @@ use serde_json::json;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-/// Most wave numbers of `sq.csv` (as a run's).
-const MAX_Q_POINTS: usize = 400;
 /// Most g(r) and profile bins.
 const MAX_BINS: usize = 100_000;
 
@@ -427,62 +425,24 @@ pub fn analyse(path: &Path, opts: &AnalyseOptions) -> Result<Report> {
     if m < 2 {
         out.explain("gr.csv", "err", "one frame: no standard error");
     }
-    let r_over_d: Vec<f64> = r.iter().map(|x| x / d_mean).collect();
-    out.write_table(
-        "gr.csv",
-        &[
-            ("r", &r),
-            ("r_over_diameter", &r_over_d),
-            ("g", &g),
-            ("err", &g_err),
-        ],
-    )?;
-    files.push("gr.csv".into());
-    let py = py.map(|s| s.g_at(&r_over_d));
-    let mut series = vec![Series {
-        label: "trajectory (bars: standard error over frames)",
-        x: &r_over_d,
-        y: &g,
-        points: false,
-    }];
-    if let Some(py) = &py {
-        out.write_table(
-            "gr_percus_yevick.csv",
-            &[("r", &r), ("r_over_diameter", &r_over_d), ("g", py)],
-        )?;
-        files.push("gr_percus_yevick.csv".into());
-        series.push(Series {
-            label: "hard spheres, Percus-Yevick",
-            x: &r_over_d,
-            y: py,
-            points: false,
-        });
-    }
-    picture(
-        line_plot_styled(
-            &out.join("gr.png"),
-            &format!("g(r), {n} particles, box volume fraction {phi:.3}, {m} frames"),
-            "r / d (mean diameters)",
-            "g(r)",
-            &series,
-            &[Some(g_err.as_slice()), None],
-            Scale::Linear,
-            Style {
-                legend_outside: true,
-            },
-        ),
-        "gr.png",
+    write_pair_structure(
+        &out,
+        &PairStructure {
+            r: &r,
+            g: &g,
+            err: &g_err,
+            diameter: d_mean,
+            rho: n as f64 / volume,
+            r_max,
+            percus_yevick: py.as_ref(),
+            label: "trajectory (bars: standard error over frames)",
+            title: &format!("g(r), {n} particles, box volume fraction {phi:.3}, {m} frames"),
+            xlabel: "r / d (mean diameters)",
+        },
         &mut files,
         &mut warnings,
-    );
-
-    // sq.csv: the transform of g (Lorch window), as a run's.
+    )?;
     let rho = n as f64 / volume;
-    let q = default_q_grid(r_max, g.len().min(MAX_Q_POINTS));
-    let sq = structure_factor_windowed(&r, &g, rho, &q, Window::Lorch);
-    let q_d: Vec<f64> = q.iter().map(|x| x * d_mean).collect();
-    out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;
-    files.push("sq.csv".into());
 
     // coordination.csv, clusters.csv
     let total: u64 = coordination.iter().sum();

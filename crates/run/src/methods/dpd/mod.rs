@@ -12,12 +12,12 @@ use crate::checkpoint::Envelope;
 use crate::engine::flat;
 use crate::keys::{Spec, rekey_text};
 use crate::method::{Checked, Finished, Method, Session};
-use crate::output::plot::{Scale, Series, Style, line_plot, line_plot_styled, picture};
+use crate::output::plot::{Scale, Series, line_plot, picture};
 use crate::output::trajectory::FrameDigest;
+use crate::output::{PairStructure, write_pair_structure};
 use anyhow::{Context, Result, bail};
 use colloidsim_analysis::{
-    Window, cluster_stats, contacts, coordination_histogram, coordination_numbers, default_q_grid,
-    pair_distribution, structure_factor_windowed,
+    cluster_stats, contacts, coordination_histogram, coordination_numbers, pair_distribution,
 };
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::{CsvLog, OutputDir};
@@ -1034,9 +1034,6 @@ fn periods(steps: u64) -> (u64, u64) {
 /// Longest synchronisation period (steps).
 const SYNC_MAX: u64 = 1000;
 
-/// The most wave numbers of `sq.csv` (its transform costs wave numbers x g(r) bins).
-const MAX_Q_POINTS: usize = 1000;
-
 /// MSD at lags of whole frames, averaged over at most ~200 time origins per lag.
 fn msd(frames: &[Vec<[f64; 3]>]) -> Vec<f64> {
     let f = frames.len();
@@ -1247,7 +1244,6 @@ fn write_outputs(
             .map(|x| x / obs.gr_samples as f64)
             .collect();
         let r = &obs.gr_r;
-        let r_over_d: Vec<f64> = r.iter().map(|x| x / (2.0 * s.setup.radius)).collect();
         // Standard error of the mean over the structure samples (their scatter; samples closer
         // than the structural relaxation time are correlated, so this is a lower bound then).
         let m = obs.gr_samples as f64;
@@ -1266,24 +1262,6 @@ fn write_outputs(
         if obs.gr_samples < 2 {
             out.explain("gr.csv", "err", "one sample: no standard error");
         }
-        out.write_table(
-            "gr.csv",
-            &[
-                ("r", r),
-                ("r_over_diameter", &r_over_d),
-                ("g", &g),
-                ("err", &err),
-            ],
-        )?;
-        files.push("gr.csv".into());
-        let rho = s.setup.colloids as f64 / vol;
-        // S(q) costs wave numbers x bins: at most MAX_Q_POINTS wave numbers, q_k = k pi / r_max
-        // (q d up to 1000 pi d / r_max, far beyond the structure's first peaks).
-        let q = default_q_grid(s.gr_max, g.len().min(MAX_Q_POINTS));
-        let sq = structure_factor_windowed(r, &g, rho, &q, Window::Lorch);
-        let q_d: Vec<f64> = q.iter().map(|x| x * 2.0 * s.setup.radius).collect();
-        out.write_table("sq.csv", &[("q", &q), ("q_diameter", &q_d), ("S", &sq)])?;
-        files.push("sq.csv".into());
         // The hard-sphere reference: Percus–Yevick at the colloids' volume fraction (the
         // contact force is hard to 1e-3 diameters; docs/dpd.md).
         let phi =
@@ -1291,44 +1269,24 @@ fn write_outputs(
                 / vol;
         let py = (phi > 0.0 && phi <= oz::ETA_MAX)
             .then(|| oz::solve(phi, &oz::PyOptions::default()).ok())
-            .flatten()
-            .map(|s| s.g_at(&r_over_d));
-        let mut series = vec![Series {
-            label: "colloids (bars: standard error)",
-            x: &r_over_d,
-            y: &g,
-            points: false,
-        }];
-        if let Some(py) = &py {
-            out.write_table(
-                "gr_percus_yevick.csv",
-                &[("r", r), ("r_over_diameter", &r_over_d), ("g", py)],
-            )?;
-            files.push("gr_percus_yevick.csv".into());
-            series.push(Series {
-                label: "hard spheres, Percus-Yevick",
-                x: &r_over_d,
-                y: py,
-                points: false,
-            });
-        }
-        picture(
-            line_plot_styled(
-                &out.join("gr.png"),
-                &format!("Colloid g(r), phi = {phi:.3}, {} samples", obs.gr_samples),
-                "r / (2 R_c) (colloid diameters)",
-                "g(r)",
-                &series,
-                &[Some(err.as_slice()), None],
-                Scale::Linear,
-                Style {
-                    legend_outside: true,
-                },
-            ),
-            "gr.png",
+            .flatten();
+        write_pair_structure(
+            out,
+            &PairStructure {
+                r,
+                g: &g,
+                err: &err,
+                diameter: 2.0 * s.setup.radius,
+                rho: s.setup.colloids as f64 / vol,
+                r_max: s.gr_max,
+                percus_yevick: py.as_ref(),
+                label: "colloids (bars: standard error)",
+                title: &format!("Colloid g(r), phi = {phi:.3}, {} samples", obs.gr_samples),
+                xlabel: "r / (2 R_c) (colloid diameters)",
+            },
             &mut files,
             warnings,
-        );
+        )?;
         let total: u64 = obs.coordination.iter().sum();
         let z: Vec<f64> = (0..obs.coordination.len()).map(|k| k as f64).collect();
         let pz: Vec<f64> = obs
