@@ -12,7 +12,7 @@
 //! Pictures are drawn under a temporary name and renamed into place (docs/render.md).
 
 use crate::analyse::Frames;
-use crate::output::plot::tick_label;
+use crate::output::plot::{COLOURS, tick_label};
 use anyhow::{Context, Result, anyhow, bail};
 use colloidsim_particles::gsd::{frame_count, open_checked};
 use hoomd_gsd::file_layer::Mode;
@@ -212,15 +212,6 @@ fn frame_list(frames: Frames, total: u64) -> Result<Vec<u64>> {
         .collect())
 }
 
-const TYPE_COLOURS: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
-
 /// A perceptually ordered scale (viridis' end points and three stops between), `t` in [0, 1].
 fn scale_colour(t: f64) -> RGBColor {
     const STOPS: [(f64, f64, f64); 5] = [
@@ -402,7 +393,7 @@ where
         let (x, y, _, s) = camera.project(p);
         let r = (0.5 * shot.diameter[i] * s).max(0.8);
         let base = match opts.colour {
-            Colour::Type => TYPE_COLOURS[shot.typeid[i] as usize % TYPE_COLOURS.len()],
+            Colour::Type => COLOURS[shot.typeid[i] as usize % COLOURS.len()],
             Colour::Distance => scale_colour(
                 dot(sub(p, camera.centre), sub(p, camera.centre)).sqrt() / camera.extent,
             ),
@@ -456,7 +447,7 @@ where
                 area.draw(&Circle::new(
                     (px(20.0), px(y + 7.0)),
                     px(6.0).max(2),
-                    TYPE_COLOURS[t as usize % TYPE_COLOURS.len()].filled(),
+                    COLOURS[t as usize % COLOURS.len()].filled(),
                 ))
                 .map_err(e)?;
                 let name = shot.types.get(t as usize).cloned().unwrap_or_default();
@@ -495,7 +486,28 @@ fn rod_colour(shot: &Shot, i: usize) -> RGBColor {
     } else {
         i
     };
-    TYPE_COLOURS[k % TYPE_COLOURS.len()]
+    COLOURS[k % COLOURS.len()]
+}
+
+/// Each rod of `shot` as a bar of its length between heights `y`, clipped to `x`; a rod that
+/// crosses the ring's seam is drawn on both ends.
+fn rod_bars(
+    shot: &Shot,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> impl Iterator<Item = Rectangle<(f64, f64)>> + '_ {
+    let (lo, hi) = x;
+    shot.pos.iter().enumerate().flat_map(move |(i, p)| {
+        let half = 0.5 * shot.diameter[i];
+        let c = rod_colour(shot, i);
+        [-(hi - lo), 0.0, hi - lo]
+            .into_iter()
+            .filter_map(move |shift| {
+                let (a, b) = (p[0] - half + shift, p[0] + half + shift);
+                (b > lo && a < hi)
+                    .then(|| Rectangle::new([(a.max(lo), y.0), (b.min(hi), y.1)], c.filled()))
+            })
+    })
 }
 
 /// The x range a line of rods is drawn over: between the walls, else the box.
@@ -535,22 +547,9 @@ where
         .x_label_formatter(&|v| tick_label(*v, dx))
         .draw()
         .map_err(e)?;
-    for (i, p) in shot.pos.iter().enumerate() {
-        let half = 0.5 * shot.diameter[i];
-        let c = rod_colour(shot, i);
-        // A rod that crosses the ring's seam is drawn on both ends.
-        for shift in [-(hi - lo), 0.0, hi - lo] {
-            let (a, b) = (p[0] - half + shift, p[0] + half + shift);
-            if b > lo && a < hi {
-                chart
-                    .draw_series(std::iter::once(Rectangle::new(
-                        [(a.max(lo), -0.3), (b.min(hi), 0.3)],
-                        c.filled(),
-                    )))
-                    .map_err(e)?;
-            }
-        }
-    }
+    chart
+        .draw_series(rod_bars(shot, (lo, hi), (-0.3, 0.3)))
+        .map_err(e)?;
     if shot.walls.is_some() {
         for x in [lo, hi] {
             chart
@@ -602,21 +601,7 @@ where
     for shot in shots {
         let y = shot.step as f64;
         chart
-            .draw_series(shot.pos.iter().enumerate().flat_map(|(i, p)| {
-                let half = 0.5 * shot.diameter[i];
-                let c = rod_colour(shot, i);
-                [-(hi - lo), 0.0, hi - lo]
-                    .into_iter()
-                    .filter_map(move |shift| {
-                        let (a, b) = (p[0] - half + shift, p[0] + half + shift);
-                        (b > lo && a < hi).then(|| {
-                            Rectangle::new(
-                                [(a.max(lo), y - 0.45 * row), (b.min(hi), y + 0.45 * row)],
-                                c.filled(),
-                            )
-                        })
-                    })
-            }))
+            .draw_series(rod_bars(shot, (lo, hi), (y - 0.45 * row, y + 0.45 * row)))
             .map_err(e)?;
     }
     Ok(())

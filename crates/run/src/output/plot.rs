@@ -162,7 +162,8 @@ pub enum Scale {
     LogLog,
 }
 
-const COLOURS: [RGBColor; 5] = [
+/// The colours of curves (and of types in `colloidsim render`), in order.
+pub(crate) const COLOURS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
