@@ -2,6 +2,7 @@
 the same files from the CLI and from Python, g(r) and the MSD as freud computes them from the
 same frames, errors that name the argument."""
 
+import importlib
 import os
 
 import numpy as np
@@ -14,7 +15,7 @@ N, L, FRAMES, R_MAX, BINS = 400, 10.0, 12, 4.0, 80
 
 def _tool(name):
     if os.environ.get("COLLOIDSIM_REQUIRE_TOOLS"):
-        return __import__(name)  # CI: a missing tool fails, never skips
+        return importlib.import_module(name)  # CI: a missing tool fails, never skips
     return pytest.importorskip(name)
 
 
