@@ -362,14 +362,17 @@ fn bd_step(a: &BenchArgs, reps: usize) -> Result<()> {
         "# the two engines alternate (one free-draining run of 200 steps, then one RPY step, {reps} times); minima are the least disturbed by other load"
     );
     println!(
-        "threads\tfree_draining_s\tfd_min_s\trpy_pse_s\trpy_min_s\tratio_of_medians\tratio_of_minima\tfft_share"
+        "# shares of the RPY steps' time: FFTs, spreading, wave-space kernel and noise, interpolation, real space and Lanczos, set-up (lists, pair tensors, window weights), the rest (integrator, forces)"
+    );
+    println!(
+        "threads\tfree_draining_s\tfd_min_s\trpy_pse_s\trpy_min_s\tratio_of_medians\tratio_of_minima\tfft\tspread\tkernel_noise\tinterp\treal+lanczos\tsetup\tother"
     );
     for &t in &a.threads {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build()
             .context("thread pool")?;
-        let row = pool.install(|| -> Result<[f64; 5]> {
+        let row = pool.install(|| -> Result<([f64; 4], [f64; 7])> {
             let mut fd = colloidsim_md::bench::wca_periodic(a.bd_n, a.phi, 1e-4, 1)?;
             let mut hi =
                 colloidsim_md::bench::wca_periodic_rpy(a.bd_n, a.phi, 1e-4, 1, a.tolerance)?;
@@ -388,16 +391,26 @@ fn bd_step(a: &BenchArgs, reps: usize) -> Result<()> {
                 th.push(s.elapsed().as_secs_f64());
             }
             let total: f64 = th.iter().sum();
-            let fft = hi.mobility().pse().map_or(0.0, |p| p.times().fft);
+            let p = hi
+                .mobility()
+                .pse()
+                .map_or_else(Default::default, |p| *p.times());
+            let parts = [p.fft, p.spread, p.kernel, p.interpolate, p.real, p.setup];
+            let other = total - parts.iter().sum::<f64>();
+            let mut shares = [0.0; 7];
+            for (s, x) in shares.iter_mut().zip(parts.iter().chain([&other])) {
+                *s = 100.0 * x / total;
+            }
             let (mf, mh) = (median(&mut tf), median(&mut th));
-            Ok([mf, tf[0], mh, th[0], fft / total])
+            Ok(([mf, tf[0], mh, th[0]], shares))
         })?;
-        let [mf, f0, mh, h0, share] = row;
+        let ([mf, f0, mh, h0], shares) = row;
+        let shares: Vec<String> = shares.iter().map(|s| format!("{s:.1}%")).collect();
         println!(
-            "{t}\t{mf:.4e}\t{f0:.4e}\t{mh:.4e}\t{h0:.4e}\t{:.1}\t{:.1}\t{:.1}%",
+            "{t}\t{mf:.4e}\t{f0:.4e}\t{mh:.4e}\t{h0:.4e}\t{:.1}\t{:.1}\t{}",
             mh / mf,
             h0 / f0,
-            100.0 * share
+            shares.join("\t")
         );
     }
     Ok(())

@@ -30,6 +30,8 @@ pub struct Fft3 {
     scratch_len: usize,
     /// One scratch slot per plane.
     scratch: Vec<C64>,
+    /// Whether the kz line `(kx, ky)` is wanted (`[kx][ky]`; empty: all are).
+    active: Vec<bool>,
 }
 
 impl std::fmt::Debug for Fft3 {
@@ -63,7 +65,16 @@ impl Fft3 {
             inv,
             scratch_len,
             scratch: vec![C64::default(); scratch_len * n],
+            active: Vec::new(),
         }
+    }
+
+    /// Prune the kz lines: `active[kx n + ky]` false for the lines `(kx, ky)` of the full
+    /// spectrum whose values nobody reads after [`Self::forward`] (left unspecified there)
+    /// and which are zero before [`Self::inverse`] (their transform, zero, is skipped).
+    pub fn set_active_lines(&mut self, active: Vec<bool>) {
+        assert_eq!(active.len(), self.nh * self.n, "one flag per kz line");
+        self.active = active;
     }
 
     /// Length of a half spectrum (`spec` and `work` buffers).
@@ -96,8 +107,10 @@ impl Fft3 {
                 fwd.process_with_scratch(sp, &mut scratch[..fwd.get_inplace_scratch_len()]);
             });
         // z: per kx, gather [z][kx][ky] -> [kx][ky][kz] (contiguous reads; the writes stay in
-        // the plane) and transform the kz lines.
+        // the plane) and transform the kz lines (the active ones).
         let spec = &*spec;
+        let active = &self.active;
+        let fl = fwd.get_inplace_scratch_len();
         work.par_chunks_mut(n * n)
             .zip(self.scratch.par_chunks_mut(sl))
             .enumerate()
@@ -108,7 +121,11 @@ impl Fft3 {
                         wp[ky * n + z] = v;
                     }
                 }
-                fwd.process_with_scratch(wp, &mut scratch[..fwd.get_inplace_scratch_len()]);
+                for (ky, line) in wp.chunks_exact_mut(n).enumerate() {
+                    if active.is_empty() || active[kx * n + ky] {
+                        fwd.process_with_scratch(line, &mut scratch[..fl]);
+                    }
+                }
             });
     }
 
@@ -118,10 +135,18 @@ impl Fft3 {
     pub fn inverse(&mut self, work: &mut [C64], spec: &mut [C64], real: &mut [f64]) {
         let (n, nh, sl) = (self.n, self.nh, self.scratch_len);
         let (c2r, inv) = (&self.c2r, &self.inv);
+        let active = &self.active;
+        let il = inv.get_inplace_scratch_len();
         work.par_chunks_mut(n * n)
             .zip(self.scratch.par_chunks_mut(sl))
-            .for_each(|(wp, scratch)| {
-                inv.process_with_scratch(wp, &mut scratch[..inv.get_inplace_scratch_len()]);
+            .enumerate()
+            .for_each(|(kx, (wp, scratch))| {
+                for (ky, line) in wp.chunks_exact_mut(n).enumerate() {
+                    // An inactive line is zero, and so is its transform.
+                    if active.is_empty() || active[kx * n + ky] {
+                        inv.process_with_scratch(line, &mut scratch[..il]);
+                    }
+                }
             });
         {
             // [kx][ky][z] -> [z][kx][ky], blocks of Z planes so that each z line is read a
@@ -179,6 +204,42 @@ fn transpose(src: &[C64], dst: &mut [C64], rows: usize, cols: usize) {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// Pruned kz lines: the active lines of the forward transform and the whole inverse (of a
+    /// spectrum zero on the inactive lines) are those of the full transforms, bit for bit.
+    #[test]
+    fn pruned_lines_change_nothing_else() {
+        let n = 8;
+        let nh = n / 2 + 1;
+        let real: Vec<f64> = (0..n * n * n)
+            .map(|i| ((i * 29 % 31) as f64 - 15.0) / 7.0)
+            .collect();
+        let active: Vec<bool> = (0..nh * n).map(|i| (i * 7) % 5 != 0).collect();
+        let mut full = Fft3::new(n);
+        let mut pruned = Fft3::new(n);
+        pruned.set_active_lines(active.clone());
+        let len = full.spectrum_len();
+        let mut spec = vec![C64::default(); len];
+        let (mut a, mut b) = (vec![C64::default(); len], vec![C64::default(); len]);
+        full.forward(&mut real.clone(), &mut spec, &mut a);
+        pruned.forward(&mut real.clone(), &mut spec, &mut b);
+        for (line, (x, y)) in a.chunks_exact(n).zip(b.chunks_exact(n)).enumerate() {
+            if active[line] {
+                assert_eq!(x, y, "line {line}");
+            }
+        }
+        for (line, x) in a.chunks_exact_mut(n).enumerate() {
+            if !active[line] {
+                x.iter_mut().for_each(|v| *v = C64::default());
+            }
+        }
+        let mut b = a.clone();
+        let (mut ra, mut rb) = (vec![0.0; n * n * n], vec![0.0; n * n * n]);
+        full.inverse(&mut a, &mut spec, &mut ra);
+        pruned.inverse(&mut b, &mut spec, &mut rb);
+        assert_eq!(ra, rb);
+        assert!(ra.iter().any(|&x| x != 0.0));
+    }
 
     #[test]
     fn forward_matches_the_definition_and_round_trips() {

@@ -8,9 +8,9 @@ use serde::Serialize;
 
 /// Default tolerance (the drying-droplet paper's PSE setting).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
-/// Largest tolerance accepted: PSE's error split (Fourier cut-off, Gaussian support) meets its
-/// tolerance up to 1e-2 (tests/pse.rs); at 0.1 the Gaussian came out wider than the splitting
-/// allows and the product missed the tolerance by a factor of two.
+/// Largest tolerance accepted: PSE's error split (Fourier cut-off, window support) meets its
+/// tolerance up to 1e-2 (tests/pse.rs); at 0.1 the Gaussian window then in use came out wider
+/// than the splitting allows and the product missed the tolerance by a factor of two.
 pub const MAX_TOLERANCE: f64 = 1e-2;
 /// Default box edge of a periodic droplet, in droplet diameters (the paper's).
 pub const DEFAULT_BOX_FACTOR: f64 = 2.0;

@@ -8,11 +8,12 @@
 //!
 //! - wave space: `M^w` with kernel `b(k) (I − k̂k̂)`, `b(k) = sinc^2(ka) H(k) / (eta k^2)`,
 //!   summed over `k = 2 pi m / L`, `m != 0` (zero mean flow), by the spectral Ewald method:
-//!   forces spread to a grid with Gaussians of variance `sigma^2`, a real FFT, the kernel
-//!   `b(k) exp(sigma^2 k^2)` (the two Gaussians' transforms taken out), the inverse FFT and
-//!   the same Gaussian for the velocities (quadrature weight `h^3`). The Brownian part of the
-//!   wave space is drawn exactly in Fourier space: `sqrt(b) (I − k̂k̂) W` with complex Gaussian
-//!   `W` of variance V per mode (Hermitian-symmetric), through the same inverse FFT and
+//!   forces spread to a grid with a compact window `phi` (per axis; the three axes' product),
+//!   a real FFT, the kernel `b(k) / phi^(k)^2` (the two windows' transforms taken out;
+//!   `phi^(k) = phi^(kx) phi^(ky) phi^(kz)`), the inverse FFT and the same window for the
+//!   velocities (quadrature weight `h^3`). The Brownian part of the wave space is drawn
+//!   exactly in Fourier space: `sqrt(b / phi^2) (I − k̂k̂) W` with complex Gaussian `W` of
+//!   variance V per mode (Hermitian-symmetric), through the same inverse FFT and
 //!   interpolation, so its covariance is `M^w` exactly (the operators are the same).
 //! - real space: `M^r(r) = M^RPY(r) − M^w_free(r)` (short ranged, like `exp(−xi^2 r^2)`), where
 //!   `M^w_free(r) = A_w(r) I + B_w(r) r̂r̂` is the free-space transform of the wave kernel,
@@ -34,11 +35,19 @@
 //! species takes the monodisperse path (`sinc^2` in the kernel) unchanged.
 //!
 //! **Parameters from (xi, tolerance eps).** Fourier cut-off `K`: `(1 + x) e^(−x) = 6 eps`,
-//! `x = K^2/(4 xi^2)`; grid spacing `h <= pi / K` (n points per axis, the next even 2-3-5-smooth
-//! size); Gaussian `sigma = (h / pi) sqrt(ln(1/e_s))` (aliasing `exp(−pi^2 sigma^2 / h^2) = e_s`,
-//! `e_s = 2 eps`), support: the fewest points `P` per axis that cover the half-width
-//! `w = sigma sqrt(2 ln(1/e_s))` on both sides of any particle (`P = 2m` reaches `(m − 1) h`,
-//! `P = 2m + 1` centred on the nearest point `(m − 1/2) h`); real-space cut-off `r_c`: beyond it `|A_r|, |B_r| < 0.2 eps mu0`.
+//! `x = K^2/(4 xi^2)`, the kernel zero for `|k| > K` (about half the modes of the grid's cube,
+//! which neither the product nor the noise visits); grid spacing `h <= pi / K` (n points per
+//! axis, the next even 2-3-5-smooth size); the window is the "exponential of semicircle" of Barnett, Magland & af Klinteberg
+//! (SIAM J. Sci. Comput. 41, C479, 2019), `phi(x) = exp(beta (sqrt(1 − (x/w)^2) − 1))` for
+//! `|x| < w`, zero beyond, with `P = ceil(log10(1/eps)) + 2` points per axis, half-width
+//! `w = P h / 2` (the support holds the points closer than w: at most P) and `beta = 2.3 P`;
+//! its transform is a quadrature ([`PseGeometry::window_transform`]) per grid wave number,
+//! once per geometry. (Their rule for a grid twice as fine as the band is `P = log10(1/eps) +
+//! 1`; here the grid only just resolves K, and it is `b(k)`'s fall towards K that keeps the
+//! aliased copies small: one point more, and beta between 2.0 and 2.4 P, measured against
+//! Beenakker's sum at 1e-2 ... 1e-5. The Gaussian window it replaced needed 8 points per axis
+//! at 1e-3, this one 5, with a smaller error.) Real-space cut-off `r_c`: beyond it
+//! `|A_r|, |B_r| < 0.2 eps mu0`.
 //! The shares were set by measurement: against Beenakker's Ewald sum the error of the product
 //! is set by the real-space cut-off and lies between 0.07 and 0.6 of the tolerance
 //! (`tests/pse.rs`, docs/hydrodynamics.md). The real-space pair tensors are stored in single
@@ -63,8 +72,10 @@ use std::time::Instant;
 
 /// Threshold of the Fourier cut-off, relative to the tolerance.
 const FOURIER_SHARE: f64 = 6.0;
-/// Threshold of the Gaussian's aliasing and truncation, relative to the tolerance.
-const SUPPORT_SHARE: f64 = 2.0;
+/// Support of the spreading window: `ceil(log10(1/eps))` points per axis and this many more.
+const SUPPORT_EXTRA: usize = 2;
+/// Shape of the window: `beta = 2.3 P` (P the support).
+const BETA_PER_POINT: f64 = 2.3;
 /// Threshold of the real-space cut-off, relative to the tolerance (the real-space truncation
 /// dominates the error: measured against Beenakker's sum, the error is proportional to this
 /// share and nearly independent of the other two).
@@ -110,14 +121,15 @@ pub struct PseGeometry {
     pub spacing: f64,
     /// Fourier cut-off K the grid resolves.
     pub k_cut: f64,
-    /// Width sigma of the spreading Gaussian.
-    pub sigma: f64,
-    /// Gaussian support: points per axis.
+    /// Support of the spreading window: grid points per axis.
     pub support: usize,
+    /// Shape parameter beta of the window `exp(beta (sqrt(1 − (x/w)^2) − 1))`.
+    pub beta: f64,
+    /// Half-width w of the window (`support h / 2`): the support holds the grid points closer
+    /// than w to the particle, at most `support` per axis.
+    pub half_width: f64,
     /// Real-space cut-off r_c.
     pub r_cut: f64,
-    /// Fraction `4 xi^2 sigma^2` of the Gaussian split into the spreading (Fiore's eta, <= 1).
-    pub gaussian_fraction: f64,
 }
 
 /// Even 2-3-5-smooth size at least `n`.
@@ -185,7 +197,27 @@ struct WaveTable {
     dr: f64,
     inv_dr: f64,
     a: Vec<f64>,
+    /// The nodes of `B_w` (read by the tests' check of `cubics`).
+    #[cfg_attr(not(test), allow(dead_code))]
     b: Vec<f64>,
+    /// Per interval `i` (from node `i` to `i + 1`, `i >= 1`), the cubics through the nodes
+    /// `i − 1 ... i + 2` of `a` and `b` in powers of `u = r / dr − i` (one cache line).
+    cubics: Vec<Cubics>,
+}
+
+/// `[a0, a1, a2, a3, b0, b1, b2, b3]` of one interval of a [`WaveTable`].
+#[derive(Debug, Clone, Copy)]
+#[repr(align(64))]
+struct Cubics([f64; 8]);
+
+/// Coefficients in powers of `u` of the cubic through `(−1, y0), (0, y1), (1, y2), (2, y3)`.
+fn cubic_through(y: [f64; 4]) -> [f64; 4] {
+    [
+        y[1],
+        -y[0] / 3.0 - 0.5 * y[1] + y[2] - y[3] / 6.0,
+        0.5 * y[0] - y[1] + 0.5 * y[2],
+        (y[3] - y[0]) / 6.0 + 0.5 * (y[1] - y[2]),
+    ]
 }
 
 impl WaveTable {
@@ -228,16 +260,40 @@ impl WaveTable {
                 (pre * sa, pre * sb)
             })
             .unzip();
+        let cubics = (0..a.len() - 2)
+            .map(|i| {
+                let i = i.max(1);
+                let ca = cubic_through([a[i - 1], a[i], a[i + 1], a[i + 2]]);
+                let cb = cubic_through([b[i - 1], b[i], b[i + 1], b[i + 2]]);
+                Cubics([ca[0], ca[1], ca[2], ca[3], cb[0], cb[1], cb[2], cb[3]])
+            })
+            .collect();
         Self {
             dr,
             inv_dr: 1.0 / dr,
             a,
             b,
+            cubics,
         }
     }
 
-    /// `(A_w(r), B_w(r))`, 4-point Lagrange interpolation (B_w even in r, A_w too).
+    /// `(A_w(r), B_w(r))`, 4-point Lagrange interpolation ([`Self::eval_lagrange`]) from the
+    /// cubics' coefficients: one cache line and six multiply-adds.
+    #[inline(always)]
     fn eval(&self, r: f64) -> (f64, f64) {
+        let t = r * self.inv_dr;
+        let i = (t as usize).clamp(1, self.a.len() - 3);
+        let u = t - i as f64;
+        let c = &self.cubics[i].0;
+        (
+            c[0] + u * (c[1] + u * (c[2] + u * c[3])),
+            c[4] + u * (c[5] + u * (c[6] + u * c[7])),
+        )
+    }
+
+    /// `(A_w(r), B_w(r))`, 4-point Lagrange interpolation (B_w even in r, A_w too).
+    #[cfg(test)]
+    fn eval_lagrange(&self, r: f64) -> (f64, f64) {
         let t = r * self.inv_dr;
         let i = (t.floor() as usize).clamp(1, self.a.len() - 3);
         let u = t - i as f64;
@@ -275,7 +331,7 @@ pub struct PseTimes {
     pub interpolate: f64,
     /// Real-space products (including those of the Lanczos iterations).
     pub real: f64,
-    /// Neighbour lists, pair tensors and Gaussian weights (`set_positions`).
+    /// Neighbour lists, pair tensors and window weights (`set_positions`).
     pub setup: f64,
     /// Lanczos iterations.
     pub lanczos_iterations: u64,
@@ -404,7 +460,7 @@ pub struct Pse {
     /// Forces and velocities of the real-space product in row order.
     f_rows: Vec<f64>,
     u_rows: Vec<f64>,
-    // Gaussian spreading, in `plane_order`: first grid index per axis and P weights per axis
+    // Spreading, in `plane_order`: first grid index per axis and P weights per axis
     // of each particle, and the forces being spread.
     base: Vec<[u32; 3]>,
     weights: Vec<f64>,
@@ -425,7 +481,7 @@ pub struct Pse {
     real: [Vec<f64>; 3],
     spec: Vec<C64>,
     work: [Vec<C64>; 3],
-    /// `b(k) exp(sigma^2 k^2)` per mode of `work` (0 at k = 0 and at the Nyquist planes).
+    /// `b(k) / phi^(k)^2` per mode of `work` (0 at k = 0, at the Nyquist planes and beyond K).
     kernel: Vec<f64>,
     /// k components per index along an axis (`None`: the Nyquist index).
     kvec: Vec<Option<f64>>,
@@ -520,7 +576,6 @@ impl PseGeometry {
         }
         // Fourier side.
         let k_cut = 2.0 * xi * hasimoto_cut(FOURIER_SHARE * eps).sqrt();
-        let ln = (1.0 / (SUPPORT_SHARE * eps)).ln();
         let want = (k_cut * l / PI).ceil();
         if want.is_nan() || want > 1024.0 {
             // Before the count becomes an integer (1e300 would saturate it).
@@ -533,36 +588,23 @@ impl PseGeometry {
             )
             .into());
         }
-        let mut grid = fft_size(want as usize);
-        let support = |grid: usize| {
-            let h = l / grid as f64;
-            let sigma = h / PI * ln.sqrt();
-            let w = sigma * (2.0 * ln).sqrt();
-            // Fewest points whose worst-placed particle still has w covered on both sides:
-            // 2m points reach (m - 1) h, 2m + 1 points (m - 1/2) h.
-            let pts = (2..).find(|&p: &usize| {
-                let m = (p / 2) as f64;
-                (if p % 2 == 0 { m - 1.0 } else { m - 0.5 }) * h >= w
-            });
-            (h, sigma, pts.expect("finite support"))
-        };
-        let (mut h, mut sigma, mut pts) = support(grid);
-        if pts > grid {
-            grid = fft_size(pts);
-            (h, sigma, pts) = support(grid);
-        }
-        if pts > MAX_SUPPORT {
+        // The window: support and shape from the tolerance alone (module doc).
+        let digits = (1.0 / eps).log10().max(0.0);
+        if digits + SUPPORT_EXTRA as f64 > MAX_SUPPORT as f64 {
+            // Before the count becomes an integer.
             return Err(ParamError::new(
                 "tolerance",
                 format!(
-                    "{eps:e} needs a Gaussian support of {pts} grid points per axis, more than \
-                     {MAX_SUPPORT}; use a tolerance of 1e-13 or more"
+                    "{eps:e} needs a window support of more than {MAX_SUPPORT} grid points per \
+                     axis; use a tolerance of 1e-13 or more"
                 ),
             )
             .into());
         }
-        let frac = 4.0 * xi * xi * sigma * sigma;
-        debug_assert!(frac <= 1.0 + 1e-12, "Gaussian fraction {frac}");
+        let pts = (digits * (1.0 - 1e-12)).ceil() as usize + SUPPORT_EXTRA;
+        let beta = BETA_PER_POINT * pts as f64;
+        let grid = fft_size((want as usize).max(pts));
+        let h = l / grid as f64;
         if grid > 1024 {
             return Err(ParamError::new(
                 "splitting",
@@ -655,11 +697,20 @@ impl PseGeometry {
             grid,
             spacing: h,
             k_cut,
-            sigma,
             support: pts,
+            beta,
+            half_width: 0.5 * pts as f64 * h,
             r_cut,
-            gaussian_fraction: frac,
         };
+        // The deconvolution divides by the window's transform: positive up to the Nyquist
+        // wave number for the shapes chosen above (k w = pi P / 2 < beta there).
+        let nyquist = geom.window_transform(PI / h) / geom.window_transform(0.0);
+        if nyquist.is_nan() || nyquist <= 1e-300 {
+            return Err(HydroError::Invalid(format!(
+                "the spreading window's transform is {nyquist:e} at the grid's Nyquist wave \
+                 number (support {pts}, beta {beta})"
+            )));
+        }
         Ok((
             geom,
             RealTables {
@@ -668,6 +719,44 @@ impl PseGeometry {
                 r_cuts,
             },
         ))
+    }
+}
+
+impl PseGeometry {
+    /// The window per axis as a function of the distance in grid spacings (zero beyond the
+    /// half-width).
+    fn window_fn(&self) -> impl Fn(f64) -> f64 + Sync + Send + Copy + use<> {
+        let (beta, inv_w) = (self.beta, self.spacing / self.half_width);
+        move |d: f64| {
+            let x = d * inv_w;
+            let t = 1.0 - x * x;
+            if t > 0.0 {
+                (beta * (t.sqrt() - 1.0)).exp()
+            } else {
+                0.0
+            }
+        }
+    }
+
+    /// The window's Fourier transform `phi^(k) = int phi(x) e^(−ikx) dx` along an axis, by
+    /// Gauss–Legendre quadrature in `x = w sin(theta)`, where the integrand
+    /// `2 w exp(beta (cos theta − 1)) cos(k w sin theta) cos theta` on `[0, pi/2]` is smooth.
+    pub fn window_transform(&self, k: f64) -> f64 {
+        let (w, beta) = (self.half_width, self.beta);
+        let (gx, gw) = colloidsim_core::quadrature::gauss_legendre(16);
+        // 16 panels of 16 nodes: exact to rounding for k w and beta up to about 100.
+        let panels = 16;
+        let hw = 0.25 * PI / panels as f64;
+        let mut sum = 0.0;
+        for p in 0..panels {
+            let mid = (2 * p + 1) as f64 * hw;
+            for (&x, &wt) in gx.iter().zip(&gw) {
+                let t = mid + hw * x;
+                let (s, c) = t.sin_cos();
+                sum += hw * wt * (beta * (c - 1.0)).exp() * (k * w * s).cos() * c;
+            }
+        }
+        2.0 * w * sum
     }
 }
 
@@ -846,7 +935,7 @@ impl Pse {
             .iter()
             .map(|&a| 1.0 / (6.0 * PI * p.viscosity * a))
             .collect();
-        let (grid, sigma, pts, r_cut) = (geom.grid, geom.sigma, geom.support, geom.r_cut);
+        let (grid, pts, r_cut) = (geom.grid, geom.support, geom.r_cut);
         let fft = Fft3::new(grid);
         let nh = grid / 2 + 1;
         let kvec: Vec<Option<f64>> = (0..grid)
@@ -859,6 +948,15 @@ impl Pse {
                 (2 * m != grid).then(|| 2.0 * PI * f as f64 / l)
             })
             .collect();
+        // The window's transform along an axis, per index (1 at the Nyquist index, whose modes
+        // the kernel leaves out).
+        let hat: Vec<f64> = kvec
+            .iter()
+            .map(|k| k.map_or(1.0, |k| geom.window_transform(k)))
+            .collect();
+        // The kernel is cut at |k| = K (beyond, H < 6 eps): about half the modes of the cube,
+        // which neither the product nor the noise then visits.
+        let k_cut2 = geom.k_cut * geom.k_cut;
         let mut kernel = vec![0.0; nh * grid * grid];
         kernel
             .par_chunks_mut(grid * grid)
@@ -867,16 +965,21 @@ impl Pse {
                 for ky in 0..grid {
                     for kz in 0..grid {
                         plane[ky * grid + kz] = match (kvec[kx], kvec[ky], kvec[kz]) {
-                            (Some(x), Some(y), Some(z)) if kx + ky + kz > 0 => {
+                            (Some(x), Some(y), Some(z))
+                                if kx + ky + kz > 0 && x * x + y * y + z * z <= k_cut2 =>
+                            {
                                 let k2 = x * x + y * y + z * z;
                                 let q = k2 / (4.0 * xi * xi);
+                                // b(k) / phi^(k)^2, the window's transform the product of
+                                // the three axes'.
+                                let w = hat[kx] * hat[ky] * hat[kz];
+                                let b = (1.0 + q) * (-q).exp() / (p.viscosity * k2 * w * w);
                                 if general {
                                     // The sinc factors are the species' filters.
-                                    (1.0 + q) * (sigma * sigma * k2 - q).exp() / (p.viscosity * k2)
+                                    b
                                 } else {
                                     let s = sinc(k2.sqrt() * a);
-                                    s * s * (1.0 + q) * (sigma * sigma * k2 - q).exp()
-                                        / (p.viscosity * k2)
+                                    s * s * b
                                 }
                             }
                             _ => 0.0,
@@ -884,6 +987,14 @@ impl Pse {
                     }
                 }
             });
+        // The kz lines with no mode inside the kernel's sphere are never transformed.
+        let mut fft = fft;
+        fft.set_active_lines(
+            kernel
+                .chunks_exact(grid)
+                .map(|line| line.iter().any(|&b| b != 0.0))
+                .collect(),
+        );
         let n3 = grid * grid * grid;
         let len = fft.spectrum_len();
         let filters: Vec<Vec<f64>> = if general {
@@ -1091,19 +1202,18 @@ impl Pse {
     }
 
     /// The particles' order by the first grid plane and row of their support, and their grid
-    /// bases and Gaussian weights in that order (so that spreading and interpolation read them
+    /// bases and window weights in that order (so that spreading and interpolation read them
     /// one after the other).
     fn build_spreading(&mut self) {
         let (g, pts) = (self.geom.grid, self.geom.support);
-        let (h, l, sigma) = (self.geom.spacing, self.params.box_length, self.geom.sigma);
-        let norm = 1.0 / (2.0 * PI * sigma * sigma).sqrt();
-        let c = -0.5 / (sigma * sigma);
-        // Odd supports centre on the nearest grid point, even ones on the cell: the first
-        // point of the support along an axis, and the particle's position in grid units.
-        let (half, shift) = ((pts as isize - 1) / 2, if pts % 2 == 1 { 0.5 } else { 0.0 });
+        let (h, l) = (self.geom.spacing, self.params.box_length);
+        let window = self.geom.window_fn();
+        // The support: the `pts` points closer than `pts h / 2` to the particle (the first
+        // along an axis), and the particle's position in grid units.
+        let half = 0.5 * pts as f64;
         let first = move |x: f64| {
             let s = (x + 0.5 * l) / h;
-            ((s + shift).floor() as isize - half, s)
+            ((s - half).floor() as isize + 1, s)
         };
         let wrap_base = |i0: isize| i0.rem_euclid(g as isize) as u32;
         self.plane_key
@@ -1133,8 +1243,7 @@ impl Pse {
                     let (i0, s) = first(x[k]);
                     base[k] = wrap_base(i0);
                     for m in 0..pts {
-                        let d = ((i0 + m as isize) as f64 - s) * h;
-                        w[k * pts + m] = norm * (c * d * d).exp();
+                        w[k * pts + m] = window((i0 + m as isize) as f64 - s);
                     }
                 }
             });
@@ -1346,6 +1455,14 @@ impl Pse {
                     for kz in 0..g {
                         let i = ky * g + kz;
                         let b = kernel[i + kx * g * g];
+                        if b == 0.0 {
+                            // No flow and no noise (nor draws) at the modes the kernel leaves
+                            // out.
+                            px[i] = C64::default();
+                            py[i] = C64::default();
+                            pz[i] = C64::default();
+                            continue;
+                        }
                         let kzv = kvec[kz].unwrap_or(0.0);
                         let k = [kxv, kyv, kzv];
                         let k2 = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
@@ -1741,8 +1858,8 @@ fn for_row_chunks_collect<'a, T, U>(
     }
 }
 
-/// Largest Gaussian support (points per axis): tolerances down to about 1e-14 need fewer
-/// (1e-3: 8 points, 1e-6: 14); a smaller tolerance is refused.
+/// Largest window support (points per axis): tolerances down to 1e-30 need fewer
+/// (1e-3: 5 points, 1e-6: 8); a smaller tolerance is refused.
 const MAX_SUPPORT: usize = 32;
 
 /// The most points of the real-space table of the wave-space functions (each costs a
@@ -1779,10 +1896,10 @@ fn add_scaled_fixed<const P: usize>(y: &mut [f64], x: &[f64], c: f64) {
 }
 
 /// Call `$body` with the const `$p` equal to the support `$pts` for the supports the usual
-/// tolerances give (1e-2 to 1e-6: 6 to 14 points), else with `$p = 0` (read at run time).
+/// tolerances give (1e-2 to 1e-12: 4 to 14 points), else with `$p = 0` (read at run time).
 macro_rules! with_support {
     ($pts:expr, $p:ident => $body:expr) => {
-        with_support!(@arms $pts, $p, $body; 6 7 8 9 10 11 12 14)
+        with_support!(@arms $pts, $p, $body; 4 5 6 7 8 9 10 11 12 13 14)
     };
     (@arms $pts:expr, $p:ident, $body:expr; $($n:literal)*) => {
         match $pts {
@@ -1965,6 +2082,58 @@ impl Mobility for Pse {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The table's cubics are the 4-point Lagrange interpolation they replace.
+    #[test]
+    fn table_cubics_are_the_lagrange_interpolation() {
+        let t = WaveTable::build(0.5, 0.5, 1.0, 1.0, 6.5);
+        let scale = t.a[0]
+            .abs()
+            .max(t.b.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        for k in 0..5000 {
+            let r = k as f64 * 0.0013 + 1e-9;
+            let (a, b) = t.eval(r);
+            let (la, lb) = t.eval_lagrange(r);
+            assert!(
+                (a - la).abs() < 1e-13 * scale && (b - lb).abs() < 1e-13 * scale,
+                "r = {r}: ({a}, {b}) vs ({la}, {lb})"
+            );
+        }
+    }
+
+    /// The window's transform (the deconvolution of the kernel) against a brute-force
+    /// midpoint rule over the window itself, from k = 0 to the grid's Nyquist wave number,
+    /// at the supports of tolerances 1e-2 to 1e-6.
+    #[test]
+    fn window_transform_matches_a_brute_force_quadrature() {
+        for tol in [1e-2, 1e-3, 1e-4, 1e-6] {
+            let mut p = PseParams::paper(0.5, 1.0, 12.0);
+            p.tolerance = tol;
+            let g = PseGeometry::new(&p).unwrap();
+            let (w, h) = (g.half_width, g.spacing);
+            let phi = g.window_fn();
+            let m = 400_000;
+            let dx = 2.0 * w / m as f64;
+            for k in [0.0, 0.3, 1.0, 0.5 * PI / h, PI / h] {
+                let brute: f64 = (0..m)
+                    .map(|i| {
+                        let x = -w + (i as f64 + 0.5) * dx;
+                        phi(x / h) * (k * x).cos() * dx
+                    })
+                    .sum();
+                let got = g.window_transform(k);
+                assert!(
+                    (got - brute).abs() < 1e-7 * brute.abs(),
+                    "tolerance {tol}, support {}, k = {k}: {got} vs {brute}",
+                    g.support
+                );
+                assert!(got > 0.0);
+            }
+            // Nothing of the window beyond its support: zero at the half-width.
+            assert_eq!(phi(w / h), 0.0);
+            assert!(phi(0.999 * w / h) > 0.0);
+        }
+    }
 
     /// The species path (sinc filters per species, the kernel without them) with one species
     /// gives the monodisperse path (sinc^2 in the kernel) to rounding. (Their wave-space
