@@ -616,12 +616,14 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     /// [`Bcd::positions`] and [`ClusterSizes::sample`] after [`Bcd::step`]. On a ring with the
     /// premerged update (Euler or LM) the rods are binned and the clusters counted in the
     /// step's own parallel pass, each chunk into its own partial, the partials added in chunk
-    /// order (integer counts: the same for any number of threads); otherwise after the step.
-    /// On an error nothing is added.
+    /// order (integer counts: the same for any number of threads), and with `positions` the
+    /// centres [`Bcd::positions`] returns are written there too (not in a serial pass when
+    /// asked for); otherwise all is done after the step. On an error nothing is added.
     pub fn step_observed(
         &mut self,
         density: Option<&mut DensityProfile>,
         clusters: Option<&mut ClusterSizes>,
+        positions: bool,
     ) -> Result<(), BcdError> {
         if self.ring.is_none() {
             self.step_alone()?;
@@ -639,10 +641,19 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
         let want = Want {
             density: density.as_ref().map(|d| d.binning()),
             clusters: clusters.is_some(),
+            positions,
         };
         let Some(r) = &mut self.ring else {
             unreachable!("a ring step")
         };
+        if positions {
+            // The last positions' buffer (stale after this step), or the spare one.
+            let spare = self.spare.get_mut().unwrap_or_else(|e| e.into_inner());
+            r.x = self
+                .positions
+                .take()
+                .unwrap_or_else(|| std::mem::take(spare));
+        }
         let step = self.state.step;
         let done = r.step(
             &self.ext,
@@ -660,7 +671,14 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
                 c.add_counts(&r.clusters, r.y.len());
             }
         }
-        self.reduced_step_done(done)
+        let x = std::mem::take(&mut r.x);
+        self.reduced_step_done(done)?;
+        if positions {
+            let _ = self.positions.set(x);
+        } else if !x.is_empty() {
+            *self.spare.get_mut().unwrap_or_else(|e| e.into_inner()) = x;
+        }
+        Ok(())
     }
 
     /// One step, no observers.
@@ -1426,7 +1444,8 @@ mod observed_tests {
     }
 
     /// The density and clusters taken in the step's own parallel pass (partials per chunk,
-    /// corrected for the stitch) equal the observers sampled after a plain step, bit for bit, on
+    /// corrected for the stitch), and the positions written there, equal the observers sampled
+    /// after a plain step and its positions, bit for bit, on
     /// 1, 2 and 3 threads, with Euler and LM, on a dense ring of several chunks whose stitch
     /// pools blocks and rewrites rods every step.
     #[test]
@@ -1462,12 +1481,12 @@ mod observed_tests {
                 let (mut c_plain, mut c_fused) = (ClusterSizes::default(), ClusterSizes::default());
                 let (mut merges, mut dirty) = (0, 0);
                 pool.install(|| {
-                    for _ in 0..12 {
+                    for t in 0..12 {
                         plain.step().unwrap();
                         d_plain.sample(plain.positions());
                         c_plain.sample(&plain);
                         fused
-                            .step_observed(Some(&mut d_fused), Some(&mut c_fused))
+                            .step_observed(Some(&mut d_fused), Some(&mut c_fused), t % 3 != 1)
                             .unwrap();
                         let (m, d) = fused.ring.as_ref().unwrap().stitch_work();
                         merges += m;
@@ -1516,7 +1535,7 @@ mod observed_tests {
             d_plain.sample(plain.positions());
             c_plain.sample(&plain);
             fused
-                .step_observed(Some(&mut d_fused), Some(&mut c_fused))
+                .step_observed(Some(&mut d_fused), Some(&mut c_fused), true)
                 .unwrap();
         }
         assert_eq!(d_fused.profile(), d_plain.profile());

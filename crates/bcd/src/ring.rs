@@ -88,6 +88,8 @@ pub(crate) struct Want {
     pub density: Option<Binning>,
     /// Count the pooled blocks (the clusters at the end of the step) by size.
     pub clusters: bool,
+    /// Write the rods' end-of-step centres into [`RingStep::x`].
+    pub positions: bool,
 }
 
 /// What every chunk of a ring step reads.
@@ -237,6 +239,9 @@ pub(crate) struct RingStep {
     /// The last step's [`Want`] tallies: rods per density bin, clusters by size (the totals).
     pub density: Vec<u64>,
     pub clusters: Vec<u64>,
+    /// [`Want::positions`]: the centres `x_i = y_i + i sigma` at the end of the last step (a
+    /// buffer the caller lends and takes back).
+    pub x: Vec<f64>,
 }
 
 impl RingStep {
@@ -264,6 +269,7 @@ impl RingStep {
             merges: Vec::new(),
             density: Vec::new(),
             clusters: Vec::new(),
+            x: Vec::new(),
         }
     }
 
@@ -401,15 +407,24 @@ impl RingStep {
             want,
         };
         let scratch = &self.scratch;
-        self.chunks
+        let pass = |c: &mut Chunk, out: &mut [f64], xs: Option<&mut [f64]>| {
+            let slot = rayon::current_thread_index().unwrap_or(0) % scratch.len();
+            let mut guard = scratch[slot].lock().unwrap_or_else(|e| e.into_inner());
+            let s = guard.get_or_insert_with(Scratch::new);
+            chunk_pass(c, out, xs, s, &ctx);
+        };
+        let parts = self
+            .chunks
             .par_iter_mut()
-            .zip(self.y_next.par_chunks_mut(CHUNK))
-            .for_each(|(c, out)| {
-                let slot = rayon::current_thread_index().unwrap_or(0) % scratch.len();
-                let mut guard = scratch[slot].lock().unwrap_or_else(|e| e.into_inner());
-                let s = guard.get_or_insert_with(Scratch::new);
-                chunk_pass(c, out, s, &ctx);
-            });
+            .zip(self.y_next.par_chunks_mut(CHUNK));
+        if want.positions {
+            self.x.resize(self.y.len(), 0.0);
+            parts
+                .zip(self.x.par_chunks_mut(CHUNK))
+                .for_each(|((c, out), xs)| pass(c, out, Some(xs)));
+        } else {
+            parts.for_each(|(c, out)| pass(c, out, None));
+        }
         if let Some(bad) = self.chunks.iter().find_map(|c| c.bad) {
             // Some chunks have moved on to the next step's deviates: draw them again.
             self.kept_step = None;
@@ -435,10 +450,13 @@ impl RingStep {
                         let wraps = w / n;
                         let i = w - wraps * n;
                         let y = pos - wraps as f64 * lred;
+                        let at = (i as i32) as f64 * sigma;
                         if let Some(b) = &want.density {
-                            let at = (i as i32) as f64 * sigma;
                             self.density[b.bin(self.y_next[i] + at) as usize] -= 1;
                             self.density[b.bin(y + at) as usize] += 1;
+                        }
+                        if want.positions {
+                            self.x[i] = y + at;
                         }
                         self.y_next[i] = y;
                     }
@@ -453,10 +471,12 @@ impl RingStep {
 }
 
 /// The chunk's step: free end-of-step positions, pooling in [`LANES`] streams, joining the
-/// streams, writing the rods' end-of-step reduced positions into `out`.
+/// streams, writing the rods' end-of-step reduced positions into `out` (and their centres into
+/// `xs` when given), taking the tallies of [`RingCtx::want`].
 fn chunk_pass<E: ExternalForce, P: PairForce>(
     c: &mut Chunk,
     out: &mut [f64],
+    xs: Option<&mut [f64]>,
     s: &mut Scratch,
     ctx: &RingCtx<E, P>,
 ) {
@@ -521,10 +541,15 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     c.head = 0;
     c.end = blocks;
     c.last_start = a1 - pool.last().map_or(0, |b| count(b[1]));
+    // The rods' centres x_i = y_i + i sigma exactly as `Bcd::positions` forms them.
+    let sigma = ctx.m.sigma;
+    if let Some(xs) = xs {
+        for (k, (x, &yk)) in xs.iter_mut().zip(&out[..len]).enumerate() {
+            *x = yk + ((a0 + k) as i32) as f64 * sigma;
+        }
+    }
     if let Some(b) = &ctx.want.density {
-        // The rods' centres x_i = y_i + i sigma exactly as `Bcd::positions` forms them, binned
-        // while the chunk is in cache (a vectorised pass), then counted.
-        let sigma = ctx.m.sigma;
+        // Binned while the chunk is in cache (a vectorised pass), then counted.
         let bins = &mut s.bins[..len];
         for (k, (o, &yk)) in bins.iter_mut().zip(&out[..len]).enumerate() {
             *o = b.bin(yk + ((a0 + k) as i32) as f64 * sigma);

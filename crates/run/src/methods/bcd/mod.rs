@@ -388,6 +388,22 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         s > t.equilibrate && (s - t.equilibrate).is_multiple_of(t.every)
     }
 
+    /// Does an observation at step `s` read the positions (the MSD, the current, the contact
+    /// density, a GSD frame)?
+    fn positions_due(&self, s: u64) -> bool {
+        let t = &self.triggers;
+        let o = &self.obs;
+        let sampled = s > t.equilibrate && {
+            let k = s - t.equilibrate;
+            (o.msd.is_some() && self.msd_due == k - 1)
+                || (o.current.is_some() && k.is_multiple_of(t.current_every))
+                || (o.contact.is_some() && k.is_multiple_of(t.every))
+        };
+        sampled
+            || (s == t.equilibrate && o.current.is_some())
+            || (self.gsd.is_some() && t.frame_due(s))
+    }
+
     /// Take the observations due at step `s` (just reached); `tallied`: the step into `s`
     /// already added the density and the clusters ([`Bcd::step_observed`]).
     fn observe(&mut self, s: u64, tallied: bool) -> Result<()> {
@@ -540,15 +556,20 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
                 let next = self.next_observation(s).min(until);
                 // The density and the clusters of step `next` are taken in that step's own
                 // parallel pass.
+                // parallel pass, and so are the positions when an observer reads them.
+                let positions = self.positions_due(next);
                 let tally = self.every_due(next)
                     && (self.obs.density.is_some() || self.obs.clusters.is_some());
-                let plain = next - s - u64::from(tally);
-                let mut done = self.bcd.run(plain);
-                if tally && done.is_ok() {
+                let fused = tally || positions;
+                let mut done = self.bcd.run(next - s - u64::from(fused));
+                if fused && done.is_ok() {
                     let o = &mut self.obs;
-                    done = self
-                        .bcd
-                        .step_observed(o.density.as_mut(), o.clusters.as_mut());
+                    done = if tally {
+                        self.bcd
+                            .step_observed(o.density.as_mut(), o.clusters.as_mut(), positions)
+                    } else {
+                        self.bcd.step_observed(None, None, true)
+                    };
                 }
                 if let Err(e) = done {
                     return Ok(Some(e.to_string()));
