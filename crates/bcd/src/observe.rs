@@ -57,16 +57,18 @@ pub struct DensityProfile {
 /// the same bin as a truncation to usize clamped to the last bin (NaN to bin 0), in a loop that
 /// vectorises (a float-to-int conversion does not).
 #[derive(Debug, Clone, Copy)]
-struct Binning {
+pub(crate) struct Binning {
     period: f64,
     inv: f64,
     scale: f64,
     top: f64,
+    /// Number of bins.
+    pub(crate) bins: usize,
 }
 
 impl Binning {
     #[inline]
-    fn bin(&self, x: f64) -> u32 {
+    pub(crate) fn bin(&self, x: f64) -> u32 {
         let v = (fold(x, self.period, self.inv) * self.scale)
             .max(0.0)
             .min(self.top)
@@ -135,14 +137,25 @@ impl DensityProfile {
         self.marks.len()
     }
 
-    fn binning(&self) -> Binning {
+    pub(crate) fn binning(&self) -> Binning {
         let m = self.counts.len();
         Binning {
             period: self.period,
             inv: 1.0 / self.period,
             scale: m as f64 / self.period,
             top: (m - 1).min(i32::MAX as usize) as f64,
+            bins: m,
         }
+    }
+
+    /// Add one configuration's counts per bin (from a step that binned its rods in its own
+    /// parallel pass, [`Bcd::step_observed`]).
+    pub(crate) fn add_counts(&mut self, counts: &[u64]) {
+        for (c, &q) in self.counts.iter_mut().zip(counts) {
+            *c += q;
+        }
+        self.samples += 1;
+        self.close_block();
     }
 
     /// Count the `n` rods whose bins `bins_of(start, out)` writes for rods `start..start +
@@ -318,6 +331,17 @@ impl ClusterSizes {
     /// Add the clusters of the current configuration.
     pub fn sample<E: ExternalForce, P: PairForce>(&mut self, bcd: &Bcd<E, P>) {
         bcd.count_cluster_sizes(&mut self.counts);
+    }
+
+    /// Add a histogram of cluster sizes of a configuration of `n` rods (as
+    /// [`ClusterSizes::sample`] does: the counts grow to `n + 1` entries).
+    pub(crate) fn add_counts(&mut self, counts: &[u64], n: usize) {
+        if self.counts.len() <= n {
+            self.counts.resize(n + 1, 0);
+        }
+        for (c, &q) in self.counts.iter_mut().zip(counts) {
+            *c += q;
+        }
     }
 
     /// Rows `(size, probability)`: the fraction of clusters of each size.

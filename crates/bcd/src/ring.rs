@@ -19,6 +19,7 @@
 //! thread count, so results are bitwise identical for any number of threads.
 
 use crate::forces::{ExternalForce, PairForce};
+use crate::observe::Binning;
 use crate::pava::{self, Block, LANES, STACK};
 use colloidsim_core::rng::{WIDE, fill_normal_wide};
 use rayon::prelude::*;
@@ -78,6 +79,19 @@ impl Motion {
     }
 }
 
+/// What a ring step tallies for the observers in its own chunk pass: each chunk into its own
+/// partial, the partials added in chunk order after the stitch and corrected for what the
+/// stitch changed (integer counts: the totals do not depend on the thread count).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Want {
+    /// Bin the rods' end-of-step centres `x_i = y_i + i sigma`.
+    pub density: Option<Binning>,
+    /// Count the pooled blocks (the clusters at the end of the step) by size.
+    pub clusters: bool,
+    /// Write the rods' end-of-step centres into [`RingStep::x`].
+    pub positions: bool,
+}
+
 /// What every chunk of a ring step reads.
 pub(crate) struct RingCtx<'a, E, P> {
     /// Reduced positions at the start of the step.
@@ -88,6 +102,8 @@ pub(crate) struct RingCtx<'a, E, P> {
     /// Leimkuhler–Matthews only: the chunks' kept deviates are not those of this step (first
     /// step, restart, or after an error) and are drawn afresh from the step counter.
     pub fresh: bool,
+    /// The observers' tallies to take in the chunk pass.
+    pub want: Want,
 }
 
 impl<E: ExternalForce, P: PairForce> RingCtx<'_, E, P> {
@@ -159,6 +175,8 @@ struct Scratch {
     /// Noise deviates of one segment (kept here: zeroing a fresh array per chunk showed in
     /// small runs).
     noise: [f64; SEG],
+    /// The density bins of the chunk's rods ([`Want::density`]).
+    bins: Vec<u32>,
 }
 
 impl Scratch {
@@ -168,6 +186,7 @@ impl Scratch {
             stacks: pava::new_stacks(),
             blocks: vec![[0.0; 2]; CHUNK],
             noise: [0.0; SEG],
+            bins: vec![0; CHUNK],
         }
     }
 }
@@ -191,6 +210,10 @@ struct Chunk {
     /// Leimkuhler–Matthews: the deviates `xi_{n+1}` of the chunk's rods, drawn in step n and
     /// kept for step n + 1 (empty for Euler).
     kept: Vec<f64>,
+    /// [`Want::density`]: the chunk's rods per density bin, as the chunk pass wrote them.
+    density: Vec<u64>,
+    /// [`Want::clusters`]: the chunk's pooled blocks by size, before the stitch.
+    sizes: Vec<u64>,
 }
 
 /// State and buffers of the ring step.
@@ -211,6 +234,14 @@ pub(crate) struct RingStep {
     blocks_current: bool,
     /// Scratch of [`RingStep::count_clusters_from_blocks`]: one size histogram per worker.
     cluster_parts: Mutex<Vec<Vec<u64>>>,
+    /// The sizes `[a, b]` of the blocks pooled by the last stitch, in order.
+    merges: Vec<[usize; 2]>,
+    /// The last step's [`Want`] tallies: rods per density bin, clusters by size (the totals).
+    pub density: Vec<u64>,
+    pub clusters: Vec<u64>,
+    /// [`Want::positions`]: the centres `x_i = y_i + i sigma` at the end of the last step (a
+    /// buffer the caller lends and takes back).
+    pub x: Vec<f64>,
 }
 
 impl RingStep {
@@ -235,6 +266,10 @@ impl RingStep {
             kept_step: None,
             blocks_current: false,
             cluster_parts: Mutex::new(Vec::new()),
+            merges: Vec::new(),
+            density: Vec::new(),
+            clusters: Vec::new(),
+            x: Vec::new(),
         }
     }
 
@@ -287,6 +322,51 @@ impl RingStep {
         true
     }
 
+    /// The chunks' partial tallies added in chunk order into the totals; the cluster sizes
+    /// corrected for the stitch's poolings (each replaces blocks of `a` and `b` rods by one of
+    /// `a + b`).
+    fn add_partials(&mut self, want: Want) {
+        if let Some(b) = &want.density {
+            self.density.clear();
+            self.density.resize(b.bins, 0);
+            for c in &self.chunks {
+                for (t, &q) in self.density.iter_mut().zip(&c.density) {
+                    *t += q;
+                }
+            }
+        }
+        if want.clusters {
+            let h = &mut self.clusters;
+            h.clear();
+            for c in &self.chunks {
+                if h.len() < c.sizes.len() {
+                    h.resize(c.sizes.len(), 0);
+                }
+                for (t, &q) in h.iter_mut().zip(&c.sizes) {
+                    *t += q;
+                }
+            }
+            // In the order of the stitch, every pooled block is present when it pools.
+            for &[a, b] in &self.merges {
+                if h.len() <= a + b {
+                    h.resize(a + b + 1, 0);
+                }
+                h[a] -= 1;
+                h[b] -= 1;
+                h[a + b] += 1;
+            }
+        }
+    }
+
+    /// The last stitch's poolings and the chunks whose last block it grew (for tests).
+    #[cfg(test)]
+    pub(crate) fn stitch_work(&self) -> (usize, usize) {
+        (
+            self.merges.len(),
+            self.chunks.iter().filter(|c| c.dirty).count(),
+        )
+    }
+
     /// Use the Leimkuhler–Matthews noise (`true`) or Euler's (`false`). Costs 8 bytes per rod
     /// for the kept deviates, which are drawn again from the step counter at the next step.
     pub fn set_lm(&mut self, lm: bool) {
@@ -301,15 +381,16 @@ impl RingStep {
         }
     }
 
-    /// One premerged step; on a non-finite free velocity, returns the first such rod and its
-    /// velocity and leaves the state unchanged.
+    /// One premerged step, taking the tallies `want` of its end configuration into
+    /// [`RingStep::density`] and [`RingStep::clusters`]; on a non-finite free velocity, returns
+    /// the first such rod and its velocity and leaves the state unchanged.
     pub fn step<E: ExternalForce, P: PairForce>(
         &mut self,
         ext: &E,
         pair: &P,
         cfg: &crate::engine::BcdConfig,
-        noise_amp: f64,
-        step: u64,
+        (noise_amp, step): (f64, u64),
+        want: Want,
     ) -> Result<(), (usize, f64)> {
         let threads = rayon::current_num_threads().max(1);
         if self.scratch.len() < threads {
@@ -323,17 +404,27 @@ impl RingStep {
             pair,
             m,
             fresh: m.lm && self.kept_step != Some(step),
+            want,
         };
         let scratch = &self.scratch;
-        self.chunks
+        let pass = |c: &mut Chunk, out: &mut [f64], xs: Option<&mut [f64]>| {
+            let slot = rayon::current_thread_index().unwrap_or(0) % scratch.len();
+            let mut guard = scratch[slot].lock().unwrap_or_else(|e| e.into_inner());
+            let s = guard.get_or_insert_with(Scratch::new);
+            chunk_pass(c, out, xs, s, &ctx);
+        };
+        let parts = self
+            .chunks
             .par_iter_mut()
-            .zip(self.y_next.par_chunks_mut(CHUNK))
-            .for_each(|(c, out)| {
-                let slot = rayon::current_thread_index().unwrap_or(0) % scratch.len();
-                let mut guard = scratch[slot].lock().unwrap_or_else(|e| e.into_inner());
-                let s = guard.get_or_insert_with(Scratch::new);
-                chunk_pass(c, out, s, &ctx);
-            });
+            .zip(self.y_next.par_chunks_mut(CHUNK));
+        if want.positions {
+            self.x.resize(self.y.len(), 0.0);
+            parts
+                .zip(self.x.par_chunks_mut(CHUNK))
+                .for_each(|((c, out), xs)| pass(c, out, Some(xs)));
+        } else {
+            parts.for_each(|(c, out)| pass(c, out, None));
+        }
         if let Some(bad) = self.chunks.iter().find_map(|c| c.bad) {
             // Some chunks have moved on to the next step's deviates: draw them again.
             self.kept_step = None;
@@ -342,9 +433,13 @@ impl RingStep {
         self.kept_step = m.lm.then_some(step + 1);
         let n = self.y.len();
         let lred = cfg.length - n as f64 * cfg.sigma;
-        stitch(&mut self.chunks, &mut self.live, lred);
-        // Rewrite the rods of the blocks that grew in the stitch (always a chunk's last block).
+        self.merges.clear();
+        stitch(&mut self.chunks, &mut self.live, lred, &mut self.merges);
+        self.add_partials(want);
+        // Rewrite the rods of the blocks that grew in the stitch (always a chunk's last block),
+        // moving their density counts from the bins the chunk pass found to the new ones.
         let mut seam = false;
+        let sigma = cfg.sigma;
         for c in &self.chunks {
             if c.head < c.end {
                 let [pos, cnt] = c.pool[c.end - 1];
@@ -353,7 +448,17 @@ impl RingStep {
                 if c.dirty {
                     for w in start..start + cnt {
                         let wraps = w / n;
-                        self.y_next[w - wraps * n] = pos - wraps as f64 * lred;
+                        let i = w - wraps * n;
+                        let y = pos - wraps as f64 * lred;
+                        let at = (i as i32) as f64 * sigma;
+                        if let Some(b) = &want.density {
+                            self.density[b.bin(self.y_next[i] + at) as usize] -= 1;
+                            self.density[b.bin(y + at) as usize] += 1;
+                        }
+                        if want.positions {
+                            self.x[i] = y + at;
+                        }
+                        self.y_next[i] = y;
                     }
                 }
             }
@@ -366,10 +471,12 @@ impl RingStep {
 }
 
 /// The chunk's step: free end-of-step positions, pooling in [`LANES`] streams, joining the
-/// streams, writing the rods' end-of-step reduced positions into `out`.
+/// streams, writing the rods' end-of-step reduced positions into `out` (and their centres into
+/// `xs` when given), taking the tallies of [`RingCtx::want`].
 fn chunk_pass<E: ExternalForce, P: PairForce>(
     c: &mut Chunk,
     out: &mut [f64],
+    xs: Option<&mut [f64]>,
     s: &mut Scratch,
     ctx: &RingCtx<E, P>,
 ) {
@@ -434,6 +541,36 @@ fn chunk_pass<E: ExternalForce, P: PairForce>(
     c.head = 0;
     c.end = blocks;
     c.last_start = a1 - pool.last().map_or(0, |b| count(b[1]));
+    // The rods' centres x_i = y_i + i sigma exactly as `Bcd::positions` forms them.
+    let sigma = ctx.m.sigma;
+    if let Some(xs) = xs {
+        for (k, (x, &yk)) in xs.iter_mut().zip(&out[..len]).enumerate() {
+            *x = yk + ((a0 + k) as i32) as f64 * sigma;
+        }
+    }
+    if let Some(b) = &ctx.want.density {
+        // Binned while the chunk is in cache (a vectorised pass), then counted.
+        let bins = &mut s.bins[..len];
+        for (k, (o, &yk)) in bins.iter_mut().zip(&out[..len]).enumerate() {
+            *o = b.bin(yk + ((a0 + k) as i32) as f64 * sigma);
+        }
+        c.density.clear();
+        c.density.resize(b.bins, 0);
+        for &o in bins.iter() {
+            c.density[o as usize] += 1;
+        }
+    }
+    if ctx.want.clusters {
+        let h = &mut c.sizes;
+        h.clear();
+        for b in pool.iter() {
+            let k = count(b[1]);
+            if k >= h.len() {
+                h.resize(k + 1, 0);
+            }
+            h[k] += 1;
+        }
+    }
     if !finite || at != len {
         c.bad = first_non_finite(a0, a1, ctx);
     }
@@ -475,7 +612,8 @@ fn first_non_finite<E: ExternalForce, P: PairForce>(
 /// Pool the chunks' blocks across chunk boundaries and the periodic seam (pooling at the
 /// centre of mass, fast-bcd Eq. 6). Sets each chunk's live range `pool[head..end]`; grown
 /// blocks are marked dirty. `lred = L - N sigma` is the reduced period.
-fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
+/// The sizes of the pooled pairs are appended to `merges`.
+fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64, merges: &mut Vec<[usize; 2]>) {
     live.clear();
     for c in chunks.iter_mut() {
         c.dirty = false;
@@ -484,11 +622,11 @@ fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
         while chunks[ci].head < chunks[ci].end {
             let Some(&pi) = live.last() else { break };
             let first = chunks[ci].pool[chunks[ci].head];
-            if !absorb(&mut chunks[pi], &first) {
+            if !absorb(&mut chunks[pi], &first, merges) {
                 break;
             }
             chunks[ci].head += 1;
-            cascade(chunks, live, 0);
+            cascade(chunks, live, 0, merges);
         }
         if chunks[ci].head < chunks[ci].end {
             live.push(ci);
@@ -502,24 +640,25 @@ fn stitch(chunks: &mut [Chunk], live: &mut Vec<usize>, lred: f64) {
             break;
         }
         let [pos, cnt] = chunks[fi].pool[chunks[fi].head];
-        if !absorb(&mut chunks[li], &[pos + lred, cnt]) {
+        if !absorb(&mut chunks[li], &[pos + lred, cnt], merges) {
             break;
         }
         chunks[fi].head += 1;
         if chunks[fi].head == chunks[fi].end {
             lf += 1;
         }
-        cascade(chunks, live, lf);
+        cascade(chunks, live, lf, merges);
     }
 }
 
 /// Pool `block` into chunk `c`'s last block when they meet (marking the chunk dirty); false
 /// when they do not.
-fn absorb(c: &mut Chunk, block: &Block) -> bool {
+fn absorb(c: &mut Chunk, block: &Block, merges: &mut Vec<[usize; 2]>) -> bool {
     let last = &mut c.pool[c.end - 1];
     if !meet(last, block) {
         return false;
     }
+    merges.push([count(last[1]), count(block[1])]);
     *last = pool_pair(last, block);
     c.dirty = true;
     true
@@ -527,7 +666,7 @@ fn absorb(c: &mut Chunk, block: &Block) -> bool {
 
 /// Pool the last live block into its left neighbours for as long as they meet (live chunks
 /// `live[lf..]`).
-fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize) {
+fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize, merges: &mut Vec<[usize; 2]>) {
     loop {
         let pi = live[live.len() - 1];
         let c = &mut chunks[pi];
@@ -538,6 +677,7 @@ fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize) {
                 return;
             }
             c.end -= 1;
+            merges.push([count(prev[1]), count(top[1])]);
             c.pool[c.end - 1] = pool_pair(&prev, &top);
             c.last_start -= count(prev[1]);
             c.dirty = true;
@@ -550,6 +690,7 @@ fn cascade(chunks: &mut [Chunk], live: &mut Vec<usize>, lf: usize) {
             if !meet(prev, &top) {
                 return;
             }
+            merges.push([count(prev[1]), count(top[1])]);
             *prev = pool_pair(prev, &top);
             qc.dirty = true;
             chunks[pi].end -= 1;

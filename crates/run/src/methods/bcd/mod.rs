@@ -382,35 +382,67 @@ impl<P: PairForce + Clone + Send> BcdSession<P> {
         next
     }
 
-    /// Take the observations due at step `s` (just reached).
-    fn observe(&mut self, s: u64) -> Result<()> {
+    /// Are the density and the clusters due at step `s`?
+    fn every_due(&self, s: u64) -> bool {
+        let t = &self.triggers;
+        s > t.equilibrate && (s - t.equilibrate).is_multiple_of(t.every)
+    }
+
+    /// Does an observation at step `s` read the positions (the MSD, the current, the contact
+    /// density, a GSD frame)?
+    fn positions_due(&self, s: u64) -> bool {
+        let t = &self.triggers;
+        let o = &self.obs;
+        let sampled = s > t.equilibrate && {
+            let k = s - t.equilibrate;
+            (o.msd.is_some() && self.msd_due == k - 1)
+                || (o.current.is_some() && k.is_multiple_of(t.current_every))
+                || (o.contact.is_some() && k.is_multiple_of(t.every))
+        };
+        sampled
+            || (s == t.equilibrate && o.current.is_some())
+            || (self.gsd.is_some() && t.frame_due(s))
+    }
+
+    /// Take the observations due at step `s` (just reached); `tallied`: the step into `s`
+    /// already added the density and the clusters ([`Bcd::step_observed`]).
+    fn observe(&mut self, s: u64, tallied: bool) -> Result<()> {
         let t = self.triggers;
         let n = self.r.initial.len() as f64;
         let dt = self.r.config.dt;
         if s > t.equilibrate {
             let k = s - t.equilibrate;
             let every = k.is_multiple_of(t.every);
+            let (density, clusters) = if tallied {
+                (None, None)
+            } else {
+                (self.obs.density.as_mut(), self.obs.clusters.as_mut())
+            };
             let msd = self.obs.msd.is_some() && self.msd_due == k - 1;
             let current = self.obs.current.is_some() && k.is_multiple_of(t.current_every);
             let reduced = self.bcd.reduced();
-            if every && !msd && !current && self.obs.contact.is_none() && reduced.is_some() {
+            let contact = every && self.obs.contact.is_some();
+            if every && !msd && !current && !contact && reduced.is_some() {
                 // Density and clusters only: straight from the ring's reduced positions.
-                if let (Some(d), Some(y)) = (self.obs.density.as_mut(), reduced) {
+                if let (Some(d), Some(y)) = (density, reduced) {
                     d.sample_reduced(y, self.r.config.sigma);
                 }
-                if let Some(c) = self.obs.clusters.as_mut() {
+                if let Some(c) = clusters {
                     c.sample(&self.bcd);
                 }
-            } else if every || msd || current {
+            } else if (every && (density.is_some() || clusters.is_some() || contact))
+                || msd
+                || current
+            {
                 let x = self.bcd.positions();
                 if every {
-                    if let Some(d) = self.obs.density.as_mut() {
+                    if let Some(d) = density {
                         d.sample(x);
                     }
                     if let Some(c) = self.obs.contact.as_mut() {
                         c.sample(x);
                     }
-                    if let Some(c) = self.obs.clusters.as_mut() {
+                    if let Some(c) = clusters {
                         c.sample(&self.bcd);
                     }
                 }
@@ -522,10 +554,27 @@ impl<P: PairForce + Clone + Send> Session for BcdSession<P> {
             while self.bcd.steps() < until {
                 let s = self.bcd.steps();
                 let next = self.next_observation(s).min(until);
-                if let Err(e) = self.bcd.run(next - s) {
+                // The density and the clusters of step `next` are taken in that step's own
+                // parallel pass.
+                // parallel pass, and so are the positions when an observer reads them.
+                let positions = self.positions_due(next);
+                let tally = self.every_due(next)
+                    && (self.obs.density.is_some() || self.obs.clusters.is_some());
+                let fused = tally || positions;
+                let mut done = self.bcd.run(next - s - u64::from(fused));
+                if fused && done.is_ok() {
+                    let o = &mut self.obs;
+                    done = if tally {
+                        self.bcd
+                            .step_observed(o.density.as_mut(), o.clusters.as_mut(), positions)
+                    } else {
+                        self.bcd.step_observed(None, None, true)
+                    };
+                }
+                if let Err(e) = done {
                     return Ok(Some(e.to_string()));
                 }
-                self.observe(next)?;
+                self.observe(next, tally)?;
             }
             Ok(None)
         })
