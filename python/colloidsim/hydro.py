@@ -468,9 +468,11 @@ class PSE(_Solver):
 
     @property
     def geometry(self) -> dict:
-        """The PSE grid and cut-offs chosen for psi and tolerance (colloidsim's)."""
+        """The PSE grid, spreading window (exponential of semicircle: support points per axis,
+        shape ``beta``, ``half_width``) and cut-offs chosen for psi and tolerance."""
         g = self._ready().pse_geometry()
-        return dict(zip(("grid", "spacing", "k_cut", "sigma", "support", "r_cut"), g))
+        keys = ("grid", "spacing", "k_cut", "support", "beta", "half_width", "r_cut")
+        return dict(zip(keys, g))
 
 
 class SelfMobility(_Solver):

@@ -235,12 +235,21 @@ impl HydroOperator {
         Ok(self.op.stokes_mobility(i))
     }
 
-    /// The PSE grid and cut-offs as (grid, spacing, k_cut, sigma, support, r_cut); None for
-    /// the other methods.
-    fn pse_geometry(&self) -> Option<(usize, f64, f64, f64, usize, f64)> {
+    /// The PSE grid, window and cut-offs as (grid, spacing, k_cut, support, beta, half_width,
+    /// r_cut); None for the other methods.
+    #[allow(clippy::type_complexity)]
+    fn pse_geometry(&self) -> Option<(usize, f64, f64, usize, f64, f64, f64)> {
         self.op.pse().map(|p| {
             let g = p.geometry();
-            (g.grid, g.spacing, g.k_cut, g.sigma, g.support, g.r_cut)
+            (
+                g.grid,
+                g.spacing,
+                g.k_cut,
+                g.support,
+                g.beta,
+                g.half_width,
+                g.r_cut,
+            )
         })
     }
 
