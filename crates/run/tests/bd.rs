@@ -102,7 +102,7 @@ fn hasimoto_from_the_msd(l: f64, xi: f64, time: f64, replicas: usize) {
 
 #[test]
 fn one_sphere_diffuses_with_hasimoto_mobility_at_l_10a() {
-    hasimoto_from_the_msd(5.0, 2.0, 400.0, 1);
+    hasimoto_from_the_msd(5.0, 2.0, 1000.0, 1);
 }
 
 #[test]
