@@ -697,18 +697,9 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             let done = done.map_err(|(i, u)| (i, u, r.y[i]));
             return self.reduced_step_done(done);
         }
-        if let Some(r) = &mut self.ring {
-            let step = self.state.step;
-            let want = Want::default();
-            let done = r.step(
-                &self.ext,
-                &self.pair,
-                &self.cfg,
-                (self.noise_amp, step),
-                want,
-            );
-            let done = done.map_err(|(i, u)| (i, u, r.y[i]));
-            return self.reduced_step_done(done);
+        if self.ring.is_some() {
+            // The ring step with nothing to observe.
+            return self.step_observed(None, None, false);
         }
         let n = self.len();
         let origin = self.origin(&self.state.bond);
