@@ -38,6 +38,7 @@ from . import _colloidsim
 from ._colloidsim import ColloidsimError
 from . import hydro  # noqa: E402 (colloidsim.hydro: libMobility-shaped mobility operators)
 from . import analysis  # noqa: E402 (colloidsim.analysis: observables on arrays and gsd frames)
+from . import _build
 
 __all__ = [
     "BCD",
@@ -415,33 +416,206 @@ class Periodic:
 
 
 class Engine:
-    """A method's engine built from a scenario, stepped by hand.
+    """A method's engine, stepped by hand: built from a scenario, from keywords (the method's
+    keys by name) or from arrays (:meth:`from_arrays`, :meth:`from_frame`).
 
-    ``positions``, ``velocities`` and ``forces`` are read-only numpy arrays (copies of the
-    engine's state at the time of reading), shaped ``(N,)`` for rods and ``(N, 3)`` for spheres,
-    in the particles' input order.
+    ``positions``, ``velocities`` and ``forces`` are numpy arrays (copies of the engine's state
+    at the time of reading), shaped ``(N,)`` for rods and ``(N, 3)`` for spheres, in the
+    particles' input order. ``positions``, ``velocities``, ``steps`` and ``seed`` can be set
+    between runs (:meth:`set_state` sets several at once): the engine is then set up afresh from
+    the new state, as if it had been built from it at that step.
 
     Analyzers and writers (``add_analyzer``) are Python callables run during ``step`` at the
     steps their trigger selects (a :class:`Periodic`, or any callable ``step -> bool``, which is
-    asked after every step and so makes ``step`` advance one step at a time).
+    asked after every step and so makes ``step`` advance one step at a time). Forces of one's
+    own (``add_force``) are Python callables evaluated before every step (Brownian dynamics).
     """
 
     _method: Optional[Tuple[str, ...]] = None
 
     def __init__(
         self,
-        scenario: ScenarioLike,
+        scenario: Optional[ScenarioLike] = None,
         overrides: Optional[Union[Mapping[str, Any], Sequence[str]]] = None,
         seed: Optional[int] = None,
+        method: Optional[str] = None,
+        **keys: Any,
     ):
+        """``Engine(scenario, overrides=None, seed=None)``, or ``Engine(method=..., **keys)``
+        with the method's keys as keywords: by their path with underscores for dots
+        (``run_dt``) or by their last name where it is unique (``dt``, ``kT``); a section as a
+        dict; ``hydrodynamics="pse"`` (or ``"direct"``, ``"rpy"``, ``"free-draining"``)."""
+        self.analyzers: List[Tuple[Any, Any]] = []
+        self.custom_forces: List[Any] = []
+        if scenario is None:
+            m = self._method_for(method)
+            scenario = _build.nested(m, _build.keyword_paths(m, keys), None)
+        elif keys or method is not None:
+            raise ColloidsimError(
+                "keywords: give a scenario (and overrides) or the method's keys as keywords, not both"
+            )
         text, base, name, origin = _scenario(scenario)
         self._engine = _colloidsim.Engine(text, base, name, origin, _overrides(overrides), seed)
-        self.analyzers: List[Tuple[Any, Any]] = []
         if self._method is not None and self._engine.method not in self._method:
             raise ColloidsimError(
                 f"{type(self).__name__} takes a scenario with method = "
                 f"{' or '.join(repr(m) for m in self._method)}, got {self._engine.method!r}"
             )
+
+    @classmethod
+    def _method_for(cls, method: Optional[str]) -> str:
+        if method is None:
+            if cls._method is not None and cls._method[0] == "bcd":
+                return "bcd"
+            if cls._method is None or len(cls._method) > 1:
+                choices = " or ".join(repr(m) for m in cls._method) if cls._method else "a method"
+                raise ColloidsimError(f"method: {cls.__name__} needs method = {choices}")
+            return cls._method[0]
+        if cls._method is not None and method not in cls._method:
+            raise ColloidsimError(
+                f"method: {cls.__name__} builds {' or '.join(repr(m) for m in cls._method)}, got {method!r}"
+            )
+        return method
+
+    @classmethod
+    def from_arrays(
+        cls,
+        positions: Any,
+        box: Optional[Any] = None,
+        types: Optional[Sequence[Any]] = None,
+        diameters: Optional[Any] = None,
+        type_names: Optional[Sequence[str]] = None,
+        velocities: Optional[Any] = None,
+        timestep: Optional[int] = None,
+        seed: Optional[int] = None,
+        method: Optional[str] = None,
+        **keys: Any,
+    ) -> "Engine":
+        """An engine whose particles start at ``positions`` (``(N, 3)``; rods: ``(N,)``, sorted,
+        unwrapped on the ring), with the method's other keys as keywords (see the constructor).
+
+        - ``box``: the periodic box's edge (``bd``, ``hs-mc`` in bulk; a cube) or the ring's
+          length (``bcd``); a droplet's size is its ``radius`` (or ``phi0``) keyword.
+        - ``types``: each particle's typeid (int) or type name; ``type_names`` orders the names;
+          ``diameters``: one number, one per type or one per particle (default 1). Types
+          become the scenario's species ``A``, ``B``, ... in typeid order, each with its
+          diameter and count.
+        - ``velocities`` (DPD, MPCD), ``timestep`` (the steps done, as HOOMD names it) and
+          ``seed`` as :meth:`set_state` takes them.
+
+        Spheres (BD, Monte Carlo) are written exactly to a temporary GSD file that the
+        scenario's ``system.initial`` reads, so the engine is bitwise the one built from that
+        scenario. Rods (BCD) start on a lattice and are then given ``positions`` in the order
+        given (a file would be read sorted into ``[0, L)``); DPD and MPCD, which start from
+        their own solvent, are built from the keywords and then given ``positions`` (and
+        velocities) of as many particles as the keywords make."""
+        m = cls._method_for(method)
+        kw = _build.keyword_paths(m, keys)
+        rods = m.startswith("bcd")
+        x = np.asarray(positions, dtype=float)
+        n = len(x)
+        shape = (n,) if rods else (n, 3)
+        if x.shape != shape:
+            raise ColloidsimError(f"positions: shape {shape} for {m}, got {x.shape}")
+        start = _build.Start()
+        try:
+            if m in ("dpd", "mpcd", "droplet-mpcd"):
+                if box is not None:
+                    kw.setdefault("system.box_length" if m == "dpd" else "system.box", box)
+                engine = cls(_build.nested(m, kw, seed))
+                engine.set_state(positions=x, velocities=velocities, steps=timestep)
+                return engine
+            typeid, names, per = _build.species(n, types, type_names, diameters)
+            ds, counts = _build.type_diameters(typeid, names, per)
+            kw["system.particles"] = n
+            if len(names) == 1:
+                kw.setdefault("system.diameter", ds[0])
+            else:
+                kw["system.species.diameters"] = ds
+                kw["system.species.counts"] = counts
+            if rods:
+                if box is None:
+                    raise ColloidsimError("box: the ring's (or walls') length, required for rods")
+                kw["system.length"] = float(np.asarray(box, dtype=float).ravel()[0])
+                if len(names) != 1:
+                    raise ColloidsimError("types: rods are one species")
+                # On a lattice first, then at the positions in the order given (a file would
+                # be read sorted into [0, L), turning the ring).
+                kw["initial.placement"] = "lattice"
+                engine = cls(_build.nested(m, kw, seed))
+                engine.set_state(positions=x, steps=timestep)
+                return engine
+            else:
+                if box is not None:
+                    b = np.asarray(box, dtype=float).ravel()
+                    if len(b) not in (1, 3) or np.any(b != b[0]):
+                        raise ColloidsimError(f"box: a cube's edge (one number or three equal), got {b.tolist()}")
+                    edge = float(b[0])
+                    kw["system.box_length" if m == "bd" else "system.box"] = edge
+                    box3 = [edge] * 3
+                else:
+                    if m == "bd" or (m == "hs-mc" and kw.get("system.geometry") == "bulk"):
+                        raise ColloidsimError(f"box: the periodic cube's edge, required for {m} in bulk")
+                    reach = float(np.abs(x).max()) if n else 1.0
+                    box3 = [4.0 * reach + 4.0 * float(per.max())] * 3
+                _colloidsim.write_initial_gsd(
+                    start.path + ".gsd", box3, np.ascontiguousarray(x, dtype="<f8").tobytes(),
+                    typeid.tolist(), names, per.tolist(),
+                )
+                kw["system.initial"] = start.path + ".gsd"
+            engine = cls(_build.nested(m, kw, seed))
+            if velocities is not None or timestep is not None:
+                engine.set_state(velocities=velocities, steps=timestep)
+            return engine
+        except ColloidsimError as e:
+            raise ColloidsimError(start.message(e)) from None
+        finally:
+            start.close()
+
+    @classmethod
+    def from_frame(
+        cls,
+        frame: Any,
+        seed: Optional[int] = None,
+        method: Optional[str] = None,
+        **keys: Any,
+    ) -> "Engine":
+        """An engine started from a ``gsd.hoomd.Frame`` (or the last frame of a GSD file named
+        by a path): its positions (exact where the frame logs ``particles/position_f64``, as
+        :meth:`snapshot` and colloidsim's checkpoints write), box, types, diameters, velocities
+        and step; the method's other keys as keywords (:meth:`from_arrays`)."""
+        if isinstance(frame, (str, os.PathLike)):
+            import gsd.hoomd
+
+            with gsd.hoomd.open(os.fspath(frame), "r") as t:
+                if len(t) == 0:
+                    raise ColloidsimError(f"frame: {os.fspath(frame)} holds no frame")
+                frame = t[len(t) - 1]
+        m = cls._method_for(method)
+        p, c = frame.particles, frame.configuration
+        box = [float(v) for v in c.box[:3]]
+        log = getattr(frame, "log", {}) or {}
+        image = np.zeros((p.N, 3)) if p.image is None else np.asarray(p.image, dtype=float)
+        if m.startswith("bcd"):
+            if "rods/position_f64" in log:
+                x = np.asarray(log["rods/position_f64"], dtype=float).ravel()
+            else:
+                x = np.asarray(p.position, dtype=float)[:, 0] + 0.5 * box[0] + image[:, 0] * box[0]
+            args: Dict[str, Any] = {"box": box[0]}
+        else:
+            pos = log.get("particles/position_f64")
+            x = np.asarray(p.position if pos is None else pos, dtype=float).reshape(-1, 3)
+            args = {"box": box[0]} if m in ("bd",) or keys.get("geometry") == "bulk" else {}
+            if m in ("dpd", "mpcd", "droplet-mpcd"):
+                x = x + image * np.asarray(box)
+        if m not in ("dpd", "mpcd", "droplet-mpcd"):
+            args["types"] = None if p.typeid is None else np.asarray(p.typeid, dtype=np.int64)
+            args["type_names"] = None if p.types is None else list(p.types)
+            args["diameters"] = None if p.diameter is None else np.asarray(p.diameter, dtype=float)
+        vel = log.get("particles/velocity_f64", p.velocity)
+        if m in ("dpd", "mpcd", "droplet-mpcd") and vel is not None:
+            args["velocities"] = np.asarray(vel, dtype=float).reshape(-1, 3)
+        return cls.from_arrays(x, timestep=int(c.step or 0), seed=seed, method=m, **args, **keys)
 
     def add_analyzer(self, analyzer: Any, trigger: Any) -> None:
         """Call ``analyzer(engine)`` during ``step`` after every step ``trigger(step)`` selects
@@ -456,31 +630,97 @@ class Engine:
             raise ColloidsimError(f"analyzer: must be callable, got {analyzer!r}")
         self.analyzers.append((trigger, analyzer))
 
+    def add_force(self, force: Any) -> None:
+        """Add ``force(engine)`` (a callable returning an ``(N, 3)`` array, input order) to the
+        systematic forces: it is evaluated at the positions before every step, which ``step``
+        then takes one at a time, as a built-in external or pair force would be (Brownian
+        dynamics, ``bd`` and ``droplet-bd``; the sum of every added force). Slower than the
+        built-in forces: docs/python.md measures it."""
+        if not callable(force):
+            raise ColloidsimError(f"force: must be callable, got {force!r}")
+        self._engine.set_extra_forces(b"")  # refused by an engine that takes none
+        self.custom_forces.append(force)
+
+    def remove_force(self, force: Any) -> None:
+        """Remove a force :meth:`add_force` added."""
+        self.custom_forces.remove(force)
+        if not self.custom_forces:
+            self._engine.set_extra_forces(b"")
+
+    def _apply_forces(self) -> None:
+        n = self.particles
+        total = np.zeros((n, 3))
+        for f in self.custom_forces:
+            a = np.asarray(f(self), dtype=float)
+            if a.shape != (n, 3):
+                raise ColloidsimError(f"force: {f!r} returned shape {a.shape}, expected ({n}, 3)")
+            total += a
+        self._engine.set_extra_forces(np.ascontiguousarray(total, dtype="<f8").tobytes())
+
     def step(self, steps: int = 1, threads: Optional[int] = None) -> None:
         """Advance ``steps`` steps (releases the GIL; Ctrl-C stops at a whole step), calling
-        the analyzers at their trigger steps on the way."""
+        the analyzers at their trigger steps and the forces before every step on the way."""
         if steps < 0:
             raise ValueError(f"steps: must be >= 0, got {steps}")
-        if not self.analyzers:
+        if not self.analyzers and not self.custom_forces:
             self._engine.step(steps, threads)
             return
         target = self.steps + steps
         while self.steps < target:
             now = self.steps
             nxt = min(
-                t.next_after(now) if hasattr(t, "next_after") else now + 1
-                for t, _ in self.analyzers
+                [t.next_after(now) if hasattr(t, "next_after") else now + 1 for t, _ in self.analyzers]
+                + [now + 1 if self.custom_forces else target]
             )
+            if self.custom_forces:
+                self._apply_forces()
             self._engine.step(min(nxt, target) - now, threads)
             for t, a in self.analyzers:
                 if t(self.steps):
                     a(self)
 
+    def set_state(
+        self,
+        positions: Optional[Any] = None,
+        velocities: Optional[Any] = None,
+        steps: Optional[int] = None,
+        seed: Optional[int] = None,
+    ) -> None:
+        """Replace what is given of the state at once; the engine is set up afresh from it, as
+        if it had been built from it at that step (lists built, particles sorted), and is left
+        as it was on an error (which names the argument). Positions are laid out as
+        :attr:`positions` gives them (any periodic image: they are the unwrapped positions from
+        then on)."""
+
+        def raw(name: str, a: Optional[Any]) -> Optional[bytes]:
+            if a is None:
+                return None
+            try:
+                v = np.asarray(a, dtype=float)
+            except (TypeError, ValueError) as e:
+                raise ColloidsimError(f"{name}: not an array of numbers ({e})") from None
+            return np.ascontiguousarray(v, dtype="<f8").tobytes()
+
+        if steps is not None and (isinstance(steps, bool) or int(steps) != steps or steps < 0):
+            raise ColloidsimError(f"steps: a whole number >= 0, got {steps!r}")
+        if seed is not None and (isinstance(seed, bool) or int(seed) != seed or seed < 0):
+            raise ColloidsimError(f"seed: a whole number in [0, 4294967295], got {seed!r}")
+        self._engine.set_state(
+            raw("positions", positions),
+            raw("velocities", velocities),
+            None if steps is None else int(steps),
+            None if seed is None else int(seed),
+        )
+
     def snapshot(self) -> Any:
-        """The engine's state as a ``gsd.hoomd.Frame`` (needs the ``gsd`` package): step, box
-        and positions in HOOMD's convention (a box centred on the origin). Rods: the line
-        ``[0, L)`` as the x axis of a 2D box ``[L, L, 0]``, shifted by ``-L/2``, with image flags
-        counting the turns of a ring. ``gsd.hoomd.open(path, "w").append(engine.snapshot())``
+        """The engine's state as a ``gsd.hoomd.Frame`` (needs the ``gsd`` package): step, box,
+        positions in HOOMD's convention (a box centred on the origin, wrapped, with image
+        flags), types and diameters, velocities where the engine has them, and the exact
+        double-precision positions (and velocities) in the frame's log
+        (``particles/position_f64``, as colloidsim's checkpoints), which :meth:`from_frame`
+        reads. Rods: the line ``[0, L)`` as the x axis of a 2D box ``[L, L, 0]``, shifted by
+        ``-L/2``, with image flags counting the turns of a ring; their exact unwrapped centres
+        are logged as ``rods/position_f64``. ``gsd.hoomd.open(path, "w").append(engine.snapshot())``
         writes it."""
         import gsd.hoomd
 
@@ -496,13 +736,27 @@ class Engine:
             pos[:, 0] = x - turns * length - 0.5 * length
             image = np.zeros((len(x), 3), dtype=np.int32)
             image[:, 0] = turns.astype(np.int32)
-            f.particles.image = image
+            f.log["rods/position_f64"] = np.asarray(x, dtype=np.float64)
         else:
-            b = self.box
+            b = np.asarray(self.box, dtype=float)
             f.configuration.box = [float(b[0]), float(b[1]), float(b[2]), 0.0, 0.0, 0.0]
-            pos = np.asarray(x, dtype=float)
+            turns = np.floor(x / b + 0.5)
+            pos = x - turns * b
+            image = turns.astype(np.int32)
+            f.log["particles/position_f64"] = np.ascontiguousarray(pos, dtype=np.float64)
+            v = self.velocities
+            if v is not None:
+                f.particles.velocity = v.astype(np.float32)
+                f.log["particles/velocity_f64"] = np.ascontiguousarray(v, dtype=np.float64)
         f.particles.N = len(pos)
         f.particles.position = pos.astype(np.float32)
+        f.particles.image = image
+        t = self._engine.types()
+        if t is not None:
+            names, typeid, diameter = t
+            f.particles.types = list(names)
+            f.particles.typeid = np.asarray(typeid, dtype=np.uint32)
+            f.particles.diameter = np.asarray(diameter, dtype=np.float32)
         return f
 
     def _array(self, b: Optional[bytes]) -> Optional[np.ndarray]:
@@ -519,24 +773,47 @@ class Engine:
 
     @property
     def positions(self) -> np.ndarray:
-        """Positions (unwrapped where the engine keeps them so)."""
+        """Positions (unwrapped where the engine keeps them so); settable (:meth:`set_state`)."""
         return self._array(self._engine.positions_bytes())
+
+    @positions.setter
+    def positions(self, value: Any) -> None:
+        self.set_state(positions=value)
 
     @property
     def velocities(self) -> Optional[np.ndarray]:
-        """Velocities (DPD); None for Brownian engines, which have none."""
+        """Velocities (DPD, MPCD); None for Brownian engines, which have none; settable."""
         return self._array(self._engine.velocities_bytes())
+
+    @velocities.setter
+    def velocities(self, value: Any) -> None:
+        self.set_state(velocities=value)
 
     @property
     def forces(self) -> np.ndarray:
-        """Forces: for Brownian engines the systematic force at the current positions; for
-        DPD the total force of the last step (conservative, dissipative and random)."""
+        """Forces: for Brownian engines the systematic force at the current positions (with
+        the forces of :meth:`add_force` as last evaluated); for DPD the total force of the
+        last step (conservative, dissipative and random)."""
         return self._array(self._engine.forces_bytes())
 
     @property
     def steps(self) -> int:
-        """Steps done."""
+        """Steps done; settable (the time is ``steps * dt``, the random streams are keyed by
+        it)."""
         return self._engine.steps
+
+    @steps.setter
+    def steps(self, value: int) -> None:
+        self.set_state(steps=value)
+
+    @property
+    def seed(self) -> int:
+        """Seed of the counter-based random streams; settable."""
+        return self._engine.seed
+
+    @seed.setter
+    def seed(self, value: int) -> None:
+        self.set_state(seed=value)
 
     @property
     def time(self) -> float:

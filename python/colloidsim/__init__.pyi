@@ -93,22 +93,65 @@ class Periodic:
 
 class Engine:
     analyzers: List[Tuple[Any, Any]]
+    custom_forces: List[Any]
     def __init__(
-        self, scenario: ScenarioLike, overrides: Overrides = None, seed: Optional[int] = None
+        self,
+        scenario: Optional[ScenarioLike] = None,
+        overrides: Overrides = None,
+        seed: Optional[int] = None,
+        method: Optional[str] = None,
+        **keys: Any,
     ) -> None: ...
+    @classmethod
+    def from_arrays(
+        cls,
+        positions: Any,
+        box: Optional[Any] = None,
+        types: Optional[Sequence[Any]] = None,
+        diameters: Optional[Any] = None,
+        type_names: Optional[Sequence[str]] = None,
+        velocities: Optional[Any] = None,
+        timestep: Optional[int] = None,
+        seed: Optional[int] = None,
+        method: Optional[str] = None,
+        **keys: Any,
+    ) -> "Engine": ...
+    @classmethod
+    def from_frame(
+        cls, frame: Any, seed: Optional[int] = None, method: Optional[str] = None, **keys: Any
+    ) -> "Engine": ...
     def add_analyzer(self, analyzer: Callable[["Engine"], Any], trigger: Union[Periodic, int, Callable[[int], bool]]) -> None: ...
+    def add_force(self, force: Callable[["Engine"], Any]) -> None: ...
+    def remove_force(self, force: Callable[["Engine"], Any]) -> None: ...
     def step(self, steps: int = 1, threads: Optional[int] = None) -> None: ...
+    def set_state(
+        self,
+        positions: Optional[Any] = None,
+        velocities: Optional[Any] = None,
+        steps: Optional[int] = None,
+        seed: Optional[int] = None,
+    ) -> None: ...
     def snapshot(self) -> Any: ...
     @property
     def method(self) -> str: ...
     @property
     def positions(self) -> np.ndarray: ...
+    @positions.setter
+    def positions(self, value: Any) -> None: ...
     @property
     def velocities(self) -> Optional[np.ndarray]: ...
+    @velocities.setter
+    def velocities(self, value: Any) -> None: ...
     @property
     def forces(self) -> np.ndarray: ...
     @property
     def steps(self) -> int: ...
+    @steps.setter
+    def steps(self, value: int) -> None: ...
+    @property
+    def seed(self) -> int: ...
+    @seed.setter
+    def seed(self, value: int) -> None: ...
     @property
     def time(self) -> float: ...
     @property

@@ -14,7 +14,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 pyo3::create_exception!(
@@ -39,8 +39,32 @@ fn to_py(e: anyhow::Error) -> PyErr {
     ColloidsimError::new_err(format!("{e:#}"))
 }
 
+/// A pool of `n` worker threads, built once per size and kept (an engine stepped one step at
+/// a time calls [`blocking`] every step).
+fn pool_of(n: usize) -> PyResult<Arc<rayon::ThreadPool>> {
+    /// Pools by their number of threads.
+    type Pools = Vec<(usize, Arc<rayon::ThreadPool>)>;
+    static POOLS: std::sync::OnceLock<Mutex<Pools>> = std::sync::OnceLock::new();
+    let mut pools = POOLS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some((_, p)) = pools.iter().find(|(k, _)| *k == n) {
+        return Ok(p.clone());
+    }
+    let p = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| ColloidsimError::new_err(format!("thread pool: {e}")))?,
+    );
+    pools.push((n, p.clone()));
+    Ok(p)
+}
+
 /// Run `f` on a thread of its own (inside a pool of `threads` workers if given) while this
-/// thread waits without the GIL and polls Python's signals.
+/// thread waits without the GIL and polls Python's signals every 20 ms (it wakes as soon as
+/// `f` returns).
 fn blocking<T: Send>(
     py: Python<'_>,
     threads: Option<usize>,
@@ -48,24 +72,28 @@ fn blocking<T: Send>(
 ) -> PyResult<T> {
     let pool = match threads {
         Some(0) => return Err(PyValueError::new_err("threads: must be at least 1, got 0")),
-        Some(n) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| ColloidsimError::new_err(format!("thread pool: {e}")))?,
-        ),
+        Some(n) => Some(pool_of(n)?),
         None => None,
     };
     let ctl = Control::default();
+    let (done, finished) = std::sync::mpsc::channel::<()>();
+    // (a Receiver is not Sync: the waits borrow it through a lock only this thread takes)
+    let finished = Mutex::new(finished);
     let (joined, signal) = std::thread::scope(|s| {
         let worker_ctl = ctl.clone();
-        let h = s.spawn(move || match &pool {
-            Some(p) => p.install(|| f(&worker_ctl)),
-            None => f(&worker_ctl),
+        let h = s.spawn(move || {
+            let r = match &pool {
+                Some(p) => p.install(|| f(&worker_ctl)),
+                None => f(&worker_ctl),
+            };
+            let _ = done.send(());
+            r
         });
         let mut signal = None;
-        while !h.is_finished() {
-            py.detach(|| std::thread::sleep(Duration::from_millis(20)));
+        while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = py.detach(|| {
+            let rx = finished.lock().unwrap_or_else(|e| e.into_inner());
+            rx.recv_timeout(Duration::from_millis(20))
+        }) {
             if signal.is_none()
                 && let Err(e) = py.check_signals()
             {
@@ -347,6 +375,19 @@ fn le_bytes<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyBytes> {
     PyBytes::new(py, &bytes)
 }
 
+/// Little-endian `f64` bytes as numbers (the Python side sends numpy arrays so).
+fn from_le_bytes(name: &str, b: &[u8]) -> PyResult<Vec<f64>> {
+    if !b.len().is_multiple_of(8) {
+        return Err(ColloidsimError::new_err(format!(
+            "{name}: {} bytes are not a whole number of f64 values",
+            b.len()
+        )));
+    }
+    Ok(b.chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect())
+}
+
 /// A method's engine built from a scenario, stepped by hand.
 #[pyclass(module = "colloidsim._colloidsim")]
 struct Engine {
@@ -453,6 +494,74 @@ impl Engine {
         let v = self.with(|e| e.forces()).map_err(to_py)?;
         Ok(le_bytes(py, &v))
     }
+    /// Each particle's type and diameter and the type names: `(names, typeid, diameter)`,
+    /// or None where the engine has no such types (MPCD).
+    #[allow(clippy::type_complexity)]
+    fn types(&self) -> Option<(Vec<String>, Vec<u32>, Vec<f64>)> {
+        self.with(|e| e.types())
+            .map(|t| (t.names, t.typeid, t.diameter))
+    }
+    /// Seed of the random streams.
+    #[getter]
+    fn seed(&self) -> u32 {
+        self.with(|e| e.seed())
+    }
+    /// Replace what is given of the state (arrays as little-endian f64 bytes); the engine is
+    /// set up afresh from it, or left as it was on an error.
+    #[pyo3(signature = (positions=None, velocities=None, step=None, seed=None))]
+    fn set_state(
+        &self,
+        positions: Option<&[u8]>,
+        velocities: Option<&[u8]>,
+        step: Option<u64>,
+        seed: Option<u64>,
+    ) -> PyResult<()> {
+        let change = colloidsim_run::StateChange {
+            positions: positions
+                .map(|b| from_le_bytes("positions", b))
+                .transpose()?,
+            velocities: velocities
+                .map(|b| from_le_bytes("velocities", b))
+                .transpose()?,
+            step,
+            seed: seed
+                .map(colloidsim_run::seed32)
+                .transpose()
+                .map_err(to_py)?,
+        };
+        self.with(|e| e.set_state(change)).map_err(to_py)
+    }
+    /// Forces added to the systematic forces of every step (little-endian f64 bytes, N x 3;
+    /// empty: none).
+    fn set_extra_forces(&self, forces: &[u8]) -> PyResult<()> {
+        let f = from_le_bytes("forces", forces)?;
+        self.with(|e| e.set_extra_forces(&f)).map_err(to_py)
+    }
+}
+
+/// Spheres as the exact GSD frame `system.initial` reads (an engine built from arrays).
+#[pyfunction]
+#[pyo3(signature = (path, box_lengths, positions, typeid, type_names, diameters, step=0))]
+fn write_initial_gsd(
+    path: PathBuf,
+    box_lengths: [f64; 3],
+    positions: &[u8],
+    typeid: Vec<u32>,
+    type_names: Vec<String>,
+    diameters: Vec<f64>,
+    step: u64,
+) -> PyResult<()> {
+    let x = from_le_bytes("positions", positions)?;
+    colloidsim_run::engine::write_initial_gsd(
+        &path,
+        box_lengths,
+        &x,
+        &typeid,
+        &type_names,
+        &diameters,
+        step,
+    )
+    .map_err(to_py)
 }
 
 /// Engine stepping stopped by Ctrl-C at a whole step.
@@ -481,6 +590,7 @@ fn _colloidsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(keys, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(toml_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(write_initial_gsd, m)?)?;
     m.add_class::<Engine>()?;
     m.add_class::<hydro::HydroOperator>()?;
     m.add_function(wrap_pyfunction!(analysis::analysis_rdf, m)?)?;

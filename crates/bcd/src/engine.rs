@@ -259,6 +259,17 @@ pub struct Bcd<E: ExternalForce, P: PairForce> {
 impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
     /// Set up a run from rod centres `x` (sorted, non-overlapping; unwrapped on the ring).
     pub fn new(cfg: BcdConfig, x: Vec<f64>, ext: E, pair: P) -> Result<Self, BcdError> {
+        Self::new_at(cfg, x, ext, pair, 0)
+    }
+
+    /// [`Self::new`] with `step` steps done (the time and the random streams go on from it).
+    pub fn new_at(
+        cfg: BcdConfig,
+        x: Vec<f64>,
+        ext: E,
+        pair: P,
+        step: u64,
+    ) -> Result<Self, BcdError> {
         cfg.validate(x.len())?;
         check_positions(&cfg, &x)?;
         let n = x.len();
@@ -286,7 +297,7 @@ impl<E: ExternalForce, P: PairForce> Bcd<E, P> {
             bond,
             left_contact,
             right_contact,
-            step: 0,
+            step,
             reduced: Vec::new(),
         };
         Self::from_state(cfg, state, ext, pair)

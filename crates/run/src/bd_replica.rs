@@ -4,7 +4,7 @@
 //! beside `checkpoint.bin`, the verified read of that checkpoint, and the engine Python steps.
 
 use crate::checkpoint::file_crc;
-use crate::engine::flat;
+use crate::engine::{StateChange, check_array, flat, rows};
 use crate::keys::shared::{HYDRO_MAX_ITERATIONS, RUN_DT};
 use crate::keys::{Spec, rekey_text};
 use crate::method::{Finished, Session};
@@ -137,6 +137,15 @@ impl<E: External> Replica<E> {
             Self::Free(s) => s.run(n).map_err(|e| rekeyed(&e)),
             Self::Hydro(s) => s.run(n).map_err(|e| rekeyed(&e)),
         }
+    }
+
+    /// Add `forces` (input order; empty: none) to the systematic forces of every step.
+    pub(crate) fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<()> {
+        match self {
+            Self::Free(s) => s.set_extra_forces(forces)?,
+            Self::Hydro(s) => s.set_extra_forces(forces)?,
+        }
+        Ok(())
     }
 
     /// The systematic forces at the current positions, in input order.
@@ -742,11 +751,39 @@ where
     }
 }
 
+/// Replica 0 of a scenario built afresh from its particles (input order, exact positions and
+/// image counts) at a step with a seed, as a checkpoint restores it.
+pub(crate) type Rebuild<E> = Box<dyn Fn(Particles, u64, u32) -> Result<Replica<E>> + Send>;
+
 /// Replica 0 of a Brownian-dynamics scenario, stepped by hand (Python's `BrownianDynamics`).
 pub(crate) struct ReplicaEngine<E: External> {
     /// The scenario's method.
     pub(crate) method: &'static str,
     pub(crate) sim: Replica<E>,
+    /// The seed of its random streams.
+    pub(crate) seed: u32,
+    /// How its state is set ([`crate::Engine::set_state`]).
+    pub(crate) rebuild: Rebuild<E>,
+    /// The script's forces ([`crate::Engine::set_extra_forces`]), kept across a rebuild.
+    pub(crate) extra: Vec<[f64; 3]>,
+}
+
+impl<E: External> ReplicaEngine<E> {
+    /// Replica 0 at step 0 with seed `seed`, its state set by `rebuild`.
+    pub(crate) fn new(
+        method: &'static str,
+        sim: Replica<E>,
+        seed: u32,
+        rebuild: impl Fn(Particles, u64, u32) -> Result<Replica<E>> + Send + 'static,
+    ) -> Self {
+        Self {
+            method,
+            sim,
+            seed,
+            rebuild: Box::new(rebuild),
+            extra: Vec::new(),
+        }
+    }
 }
 
 impl<E: External> crate::Engine for ReplicaEngine<E> {
@@ -782,5 +819,39 @@ impl<E: External> crate::Engine for ReplicaEngine<E> {
     }
     fn box_lengths(&self) -> Vec<f64> {
         self.sim.sbox().l.to_vec()
+    }
+    fn seed(&self) -> u32 {
+        self.seed
+    }
+    fn types(&self) -> Option<crate::engine::ParticleTypes> {
+        Some(crate::engine::ParticleTypes::of(&self.sim.snapshot()))
+    }
+    fn set_state(&mut self, change: StateChange) -> Result<()> {
+        change.check(self.particles(), 3, false, self.method)?;
+        let mut p = self.sim.snapshot();
+        if let Some(x) = &change.positions {
+            for ((q, img), x) in p.pos.iter_mut().zip(&mut p.image).zip(rows(x)) {
+                *q = x;
+                *img = [0; 3];
+            }
+        }
+        let (step, seed) = (
+            change.step.unwrap_or(self.sim.step()),
+            change.seed.unwrap_or(self.seed),
+        );
+        let mut sim = (self.rebuild)(p, step, seed)?;
+        sim.set_extra_forces(self.extra.clone())?;
+        (self.sim, self.seed) = (sim, seed);
+        Ok(())
+    }
+    fn set_extra_forces(&mut self, forces: &[f64]) -> Result<()> {
+        let n = self.particles();
+        if !forces.is_empty() {
+            check_array("forces", forces, n, 3)?;
+        }
+        let f = rows(forces);
+        self.sim.set_extra_forces(f.clone())?;
+        self.extra = f;
+        Ok(())
     }
 }

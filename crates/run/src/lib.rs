@@ -28,7 +28,7 @@ pub mod two_body;
 pub use analyse::{AnalyseOptions, analyse};
 pub use control::{Control, Progress, Silent, Stop};
 pub use driver::{resume, resume_decomposed, run, run_decomposed};
-pub use engine::Engine;
+pub use engine::{Engine, ParticleTypes, StateChange};
 pub use ensemble::{EnsembleOptions, ensemble, resume_ensemble};
 pub use extrapolate::{ExtrapolateOptions, extrapolate};
 pub use method::{Checked, Finished, Method};

@@ -106,6 +106,9 @@ pub struct HydroBrownian<P: Pair, E: External, M: Mobility> {
     unwrapped: Vec<[f64; 3]>,
     disp: Vec<[f64; 3]>,
     last_iterations: usize,
+    /// Forces added to each particle's systematic force every step, in input order (empty:
+    /// none).
+    extra: Vec<[f64; 3]>,
 }
 
 impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
@@ -158,6 +161,7 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             unwrapped: vec![[0.0; 3]; n],
             disp: vec![[0.0; 3]; n],
             last_iterations: 0,
+            extra: Vec::new(),
         };
         s.nlist.build(&s.sbox, &s.particles.pos, &s.key)?;
         Ok(s)
@@ -203,6 +207,20 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
         self.nlist.builds()
     }
 
+    /// Add `forces` (input order; empty: none) to the systematic forces of every step from
+    /// now on, as a further external field would be.
+    pub fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<(), HydroBdError> {
+        if !forces.is_empty() && forces.len() != self.particles.len() {
+            return Err(HydroBdError::Invalid(format!(
+                "{} extra forces for {} particles",
+                forces.len(),
+                self.particles.len()
+            )));
+        }
+        self.extra = forces;
+        Ok(())
+    }
+
     /// Forces on the particles at the current positions and time (into the engine's buffer).
     fn compute_forces(&mut self) {
         let mut f = std::mem::take(&mut self.forces);
@@ -222,12 +240,16 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
         let t = self.time();
         let p = &self.particles;
         let (pair, external, sbox, nlist) = (&self.pair, &self.external, &self.sbox, &self.nlist);
+        let extra = &self.extra;
         out.par_iter_mut()
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, f)| {
                 let xi = p.pos[i];
                 let mut s = external.force_on(xi, t, p.diameter[i]);
+                if let Some(e) = extra.get(i) {
+                    s = [s[0] + e[0], s[1] + e[1], s[2] + e[2]];
+                }
                 for &j in nlist.neighbors(i) {
                     let j = j as usize;
                     let xj = p.pos[j];

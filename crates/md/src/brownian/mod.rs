@@ -237,6 +237,9 @@ pub struct Brownian<P: Pair, E: External> {
     runs: Vec<(usize, usize, usize)>,
     /// Decomposed: every particle's constants (type, diameter, mass, velocity) in input order.
     whole: Option<Box<Particles>>,
+    /// Forces added to each particle's systematic force every step, by input index (empty:
+    /// none; [`Self::set_extra_forces`]).
+    extra: Vec<[f64; 3]>,
 }
 
 /// What one chunk reports: the largest squared displacement from the list's reference
@@ -547,6 +550,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
             own: (0, n),
             runs: vec![(0, n, 0)],
             whole: None,
+            extra: Vec::new(),
         };
         if params.integrator == Integrator::Lm {
             s.lm_now = vec![[0.0; 3]; n];
@@ -722,6 +726,25 @@ impl<P: Pair, E: External> Brownian<P, E> {
         self.builds
     }
 
+    /// Add `forces` (input order; empty: none) to the systematic forces of every step from
+    /// now on, as a further external field would be (on one process).
+    pub fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<(), BdError> {
+        if !forces.is_empty() && (forces.len() != self.tag.len() || self.domain.is_some()) {
+            return Err(BdError::Invalid(format!(
+                "{} extra forces for {} particles{}",
+                forces.len(),
+                self.tag.len(),
+                if self.domain.is_some() {
+                    " decomposed over ranks (extra forces act on one process)"
+                } else {
+                    ""
+                }
+            )));
+        }
+        self.extra = forces;
+        Ok(())
+    }
+
     /// Forces on the particles in input order at the current positions and time (allocates;
     /// collective when decomposed).
     pub fn forces(&self) -> Vec<[f64; 3]> {
@@ -739,7 +762,10 @@ impl<P: Pair, E: External> Brownian<P, E> {
         let mut pair_force = PairForceCursor::new(&slabs, &self.slab_of, 0);
         for (k, &tag) in self.tag.iter().enumerate() {
             let mut f = pair_force.force(k);
-            let e = self.external.force_on(p.pos[k], t, p.diameter[k]);
+            let mut e = self.external.force_on(p.pos[k], t, p.diameter[k]);
+            if let Some(x) = self.extra.get(tag as usize) {
+                e = [e[0] + x[0], e[1] + x[1], e[2] + x[2]];
+            }
             for a in 0..3 {
                 f[a] += e[a];
             }
@@ -911,6 +937,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
             slabs: &self.slabs,
             slab_of: &self.slab_of,
             external: &self.external,
+            extra: &self.extra,
             t,
             seed,
             step,
@@ -988,6 +1015,8 @@ struct StepPass<'a, E> {
     slabs: &'a [Slab],
     slab_of: &'a [u32],
     external: &'a E,
+    /// Extra forces by input index (empty: none).
+    extra: &'a [[f64; 3]],
     t: f64,
     seed: u32,
     step: u64,
@@ -1019,7 +1048,10 @@ impl<E: External> StepPass<'_, E> {
                 let [drift_per_force, amp, limit2] = self.kinetics[i];
                 let x = self.pos[i];
                 let fp = pair_force.force(i);
-                let fe = self.external.force_on(x, self.t, self.diameter[i]);
+                let mut fe = self.external.force_on(x, self.t, self.diameter[i]);
+                if let Some(e) = self.extra.get(self.tag[i] as usize) {
+                    fe = [fe[0] + e[0], fe[1] + e[1], fe[2] + e[2]];
+                }
                 let f = [fp[0] + fe[0], fp[1] + fe[1], fp[2] + fe[2]];
                 let drift = [
                     f[0] * drift_per_force,

@@ -20,7 +20,7 @@ use anyhow::{Context, Result, bail};
 use colloidsim_bcd::forces::Field;
 use colloidsim_bcd::forces::{ExternalForce, NoPair, PairForce};
 use colloidsim_bcd::observe::{ClusterSizes, ContactDensity, DensityProfile, Msd};
-use colloidsim_bcd::{Bcd, BcdState, Boundary};
+use colloidsim_bcd::{Bcd, BcdState, Boundary, Integrator};
 use colloidsim_core::exchange::Exchange;
 use colloidsim_core::output::OutputDir;
 use colloidsim_core::trigger::log_spaced;
@@ -115,6 +115,9 @@ impl Method for BcdMethod {
         Ok(Box::new(BcdEngine {
             bcd,
             method: sc.method,
+            field: r.engine_field,
+            pair: r.pair,
+            integrator: r.integrator,
         }))
     }
 }
@@ -717,10 +720,13 @@ fn write_frame(g: &mut GsdFile, step: u64, b: &RodBox, x: &[f32], image: &[i32])
     Ok(())
 }
 
-/// A BCD engine stepped by hand.
+/// A BCD engine stepped by hand, with what sets it up afresh ([`crate::Engine::set_state`]).
 struct BcdEngine {
     bcd: Bcd<Field, colloidsim_bcd::forces::Pair>,
     method: String,
+    field: Field,
+    pair: colloidsim_bcd::forces::Pair,
+    integrator: Integrator,
 }
 
 impl crate::Engine for BcdEngine {
@@ -756,6 +762,36 @@ impl crate::Engine for BcdEngine {
     }
     fn box_lengths(&self) -> Vec<f64> {
         vec![self.bcd.config().length]
+    }
+    fn seed(&self) -> u32 {
+        self.bcd.config().seed
+    }
+    fn types(&self) -> Option<crate::engine::ParticleTypes> {
+        Some(crate::engine::ParticleTypes {
+            names: vec!["rod".into()],
+            typeid: vec![0; self.bcd.len()],
+            diameter: vec![self.bcd.config().sigma; self.bcd.len()],
+        })
+    }
+    /// Positions are rod centres in ring order (unwrapped on the ring), as `positions` gives
+    /// them: sorted, without overlap.
+    fn set_state(&mut self, change: crate::StateChange) -> Result<()> {
+        change.check(self.particles(), 1, false, &self.method)?;
+        let mut cfg = self.bcd.config().clone();
+        cfg.seed = change.seed.unwrap_or(cfg.seed);
+        let step = change.step.unwrap_or(self.bcd.steps());
+        let given = change.positions.is_some();
+        let x = change
+            .positions
+            .unwrap_or_else(|| self.bcd.positions().to_vec());
+        let (field, pair) = (self.field.clone(), self.pair.clone());
+        self.bcd = Bcd::new_at(cfg, x, field, pair, step)
+            .map_err(|e| match given {
+                true => anyhow::anyhow!("positions: {e}"),
+                false => e.into(),
+            })?
+            .with_integrator(self.integrator);
+        Ok(())
     }
 }
 

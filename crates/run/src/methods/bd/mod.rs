@@ -176,7 +176,16 @@ impl Method for BulkBd {
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve(src, seed)?;
         let sim = build_replica(&p, 0).with_context(|| src.label())?;
-        Ok(Box::new(ReplicaEngine { method: "bd", sim }))
+        let seed = p.seed;
+        Ok(Box::new(ReplicaEngine::new(
+            "bd",
+            sim,
+            seed,
+            move |x, step, seed| {
+                let p = BulkParams { seed, ..p.clone() };
+                replica_at(&p, x, p.sbox(), step, None, 0)
+            },
+        )))
     }
 }
 
@@ -285,29 +294,47 @@ fn restore_replica(
         &p.species.diameters,
     )?;
     let path = out.join(&state.0);
-    let engine = &state.2;
-    let sim = if hydro {
-        Replica::Hydro(Box::new(
-            p.restart_hydro_replica(f.particles, p.hydro_bd_params(saved.replica as u32), f.step)
-                .with_context(|| format!("restart from {}", path.display()))?,
-        ))
-    } else {
-        Replica::Free(Box::new(
-            Brownian::restart(
-                f.particles,
-                f.sbox,
-                p.pair()?,
-                p.body(),
-                p.bd_params(saved.replica as u32),
-                f.step,
-                f.list.as_ref(),
-            )
-            .with_context(|| format!("restart from {}", path.display()))?,
-        ))
-    };
+    let sim = replica_at(
+        p,
+        f.particles,
+        f.sbox,
+        f.step,
+        f.list.as_ref(),
+        saved.replica as u32,
+    )
+    .with_context(|| format!("restart from {}", path.display()))?;
     // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
-    let builds = engine.builds.saturating_sub(sim.neighbor_builds());
+    let builds = state.2.builds.saturating_sub(sim.neighbor_builds());
     Ok((sim, builds))
+}
+
+/// Replica `replica` of `p` from its particles (input order, exact positions and image counts)
+/// in `sbox` at `step`, with the free-draining engine's list state when a checkpoint holds one.
+fn replica_at(
+    p: &BulkParams,
+    particles: colloidsim_particles::Particles,
+    sbox: colloidsim_particles::SimBox,
+    step: u64,
+    list: Option<&colloidsim_particles::gsd::ListState>,
+    replica: u32,
+) -> Result<Replica> {
+    Ok(if p.has_hydrodynamics() {
+        Replica::Hydro(Box::new(p.restart_hydro_replica(
+            particles,
+            p.hydro_bd_params(replica),
+            step,
+        )?))
+    } else {
+        Replica::Free(Box::new(Brownian::restart(
+            particles,
+            sbox,
+            p.pair()?,
+            p.body(),
+            p.bd_params(replica),
+            step,
+            list,
+        )?))
+    })
 }
 
 /// The block under way: its MSD and the centre of mass at its start.

@@ -9,7 +9,7 @@ pub mod params;
 
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
-use crate::engine::flat;
+use crate::engine::{flat, rows};
 use crate::keys::{Spec, rekey_text};
 use crate::method::{Checked, Finished, Method, Session};
 use crate::output::plot::{Scale, Series, line_plot, picture};
@@ -101,6 +101,7 @@ impl Method for DpdMethod {
         let s = resolve(src, seed)?;
         Ok(Box::new(DpdEngine {
             sim: s.setup.build()?,
+            setup: s.setup,
         }))
     }
 }
@@ -682,9 +683,10 @@ impl Session for DpdSession {
     }
 }
 
-/// A DPD engine stepped by hand.
+/// A DPD engine stepped by hand, with what sets it up afresh ([`crate::Engine::set_state`]).
 struct DpdEngine {
     sim: Dpd,
+    setup: colloidsim_md::dpd::setup::DpdSetup,
 }
 
 impl crate::Engine for DpdEngine {
@@ -728,6 +730,37 @@ impl crate::Engine for DpdEngine {
     }
     fn box_lengths(&self) -> Vec<f64> {
         self.sim.sbox.l.to_vec()
+    }
+    fn seed(&self) -> u32 {
+        self.sim.params().seed
+    }
+    fn types(&self) -> Option<crate::engine::ParticleTypes> {
+        Some(crate::engine::ParticleTypes::of(&self.sim.snapshot()))
+    }
+    /// Colloids given overlapping positions are refused (as at the start).
+    fn set_state(&mut self, change: crate::StateChange) -> Result<()> {
+        change.check(self.particles(), 3, true, "dpd")?;
+        let mut p = self.sim.snapshot();
+        if let Some(x) = &change.positions {
+            for ((q, img), x) in p.pos.iter_mut().zip(&mut p.image).zip(rows(x)) {
+                *q = x;
+                *img = [0; 3];
+            }
+        }
+        if let Some(v) = &change.velocities {
+            p.vel = rows(v);
+        }
+        let mut setup = self.setup.clone();
+        setup.params.seed = change.seed.unwrap_or(self.seed());
+        let step = change.step.unwrap_or(self.sim.step);
+        self.sim = setup
+            .build_from(p, step)
+            .map_err(|e| match change.positions {
+                Some(_) => anyhow::anyhow!("positions: {}", rekeyed(e)),
+                None => anyhow::anyhow!(rekeyed(e)),
+            })?;
+        self.setup = setup;
+        Ok(())
     }
 }
 

@@ -131,10 +131,23 @@ impl Method for DropletBd {
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve(src, seed)?;
         let sim = build_replica(&p, 0)?;
-        Ok(Box::new(ReplicaEngine {
-            method: "droplet-bd",
+        let seed = p.seed;
+        Ok(Box::new(ReplicaEngine::new(
+            "droplet-bd",
             sim,
-        }))
+            seed,
+            move |x, step, seed| {
+                let p = DropletParams { seed, ..p.clone() };
+                replica_at(
+                    &p,
+                    x,
+                    colloidsim_particles::SimBox::cube(p.box_edge()),
+                    step,
+                    None,
+                    0,
+                )
+            },
+        )))
     }
 }
 
@@ -265,33 +278,49 @@ fn restore_replica(
         &p.species.diameters,
     )?;
     let path = out.join(&state.0);
-    let engine = &state.2;
-    let sim = match hydro {
-        None => Replica::Free(Box::new(
-            DropletSim::restart(
-                f.particles,
-                f.sbox,
+    let sim = replica_at(
+        p,
+        f.particles,
+        f.sbox,
+        f.step,
+        f.list.as_ref(),
+        saved.replica as u32,
+    )
+    .with_context(|| format!("restart from {}", path.display()))?;
+    // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
+    let builds = state.2.builds.saturating_sub(sim.neighbor_builds());
+    Ok(Some((sim, builds)))
+}
+
+/// Replica `replica` of `p` from its particles (input order, exact positions and image counts)
+/// in `sbox` at `step`, with the free-draining engine's list state when a checkpoint holds one.
+fn replica_at(
+    p: &DropletParams,
+    particles: colloidsim_particles::Particles,
+    sbox: colloidsim_particles::SimBox,
+    step: u64,
+    list: Option<&colloidsim_particles::gsd::ListState>,
+    replica: u32,
+) -> Result<Replica> {
+    Ok(
+        match p.hydrodynamics.as_ref().filter(|_| p.has_hydrodynamics()) {
+            None => Replica::Free(Box::new(DropletSim::restart(
+                particles,
+                sbox,
                 p.interaction()?,
                 p.species_interface(),
-                p.bd_params(saved.replica as u32),
-                f.step,
-                f.list.as_ref(),
-            )
-            .with_context(|| format!("restart from {}", path.display()))?,
-        )),
-        Some(h) => Replica::Hydro(Box::new(
-            p.restart_hydro_replica(
-                f.particles,
+                p.bd_params(replica),
+                step,
+                list,
+            )?)),
+            Some(h) => Replica::Hydro(Box::new(p.restart_hydro_replica(
+                particles,
                 h,
-                p.hydro_bd_params(saved.replica as u32),
-                f.step,
-            )
-            .with_context(|| format!("restart from {}", path.display()))?,
-        )),
-    };
-    // The rebuild on restoring is not one the uninterrupted run makes: leave it out.
-    let builds = engine.builds.saturating_sub(sim.neighbor_builds());
-    Ok(Some((sim, builds)))
+                p.hydro_bd_params(replica),
+                step,
+            )?)),
+        },
+    )
 }
 
 /// A running droplet replica, in the moving harmonic interface.

@@ -150,7 +150,10 @@ impl Method for HsMc {
 
     fn engine(&self, src: &Source, seed: Option<u64>) -> Result<Box<dyn crate::Engine>> {
         let p = resolve(src, seed)?;
-        Ok(Box::new(McEngine { mc: build(&p)? }))
+        Ok(Box::new(McEngine {
+            mc: build(&p)?,
+            run: p,
+        }))
     }
 }
 
@@ -1136,9 +1139,11 @@ fn columns(per_block: &[Vec<f64>], bins: usize) -> (Vec<f64>, Vec<f64>) {
         .unzip()
 }
 
-/// The engine of a scenario, stepped by hand (a step is a sweep, without tuning).
+/// The engine of a scenario, stepped by hand (a step is a sweep, without tuning), with the
+/// run it sets up afresh from ([`crate::Engine::set_state`]).
 struct McEngine {
     mc: HardSphereMc,
+    run: McRun,
 }
 
 impl crate::Engine for McEngine {
@@ -1177,6 +1182,42 @@ impl crate::Engine for McEngine {
     }
     fn box_lengths(&self) -> Vec<f64> {
         vec![self.mc.box_edge(); 3]
+    }
+    fn seed(&self) -> u32 {
+        self.mc.seed()
+    }
+    fn types(&self) -> Option<crate::engine::ParticleTypes> {
+        let d = self.mc.diameters();
+        let names = match &self.run.mixture {
+            Some(m) => m.names.clone(),
+            None => vec!["A".into()],
+        };
+        Some(crate::engine::ParticleTypes {
+            names,
+            typeid: self.mc.types().to_vec(),
+            diameter: self.mc.types().iter().map(|&t| d[t as usize]).collect(),
+        })
+    }
+    /// Positions relative to the box centre, species by species as `positions` gives them;
+    /// overlapping spheres or centres outside the wall are refused (as at the start). The
+    /// move size is kept.
+    fn set_state(&mut self, change: crate::StateChange) -> Result<()> {
+        change.check(self.particles(), 3, false, "hs-mc")?;
+        let mut run = self.run.clone();
+        run.seed = change.seed.unwrap_or(run.seed);
+        let pos: Vec<[f64; 3]> = match &change.positions {
+            Some(x) => crate::engine::rows(x),
+            None => (0..self.mc.len()).map(|i| self.mc.position(i)).collect(),
+        };
+        let mut mc = run.engine(Some(&pos), "positions").map_err(|e| match e {
+            McError::Param(e) => anyhow::Error::from(params::keyed(e)),
+            e => e.into(),
+        })?;
+        let [x, y, z] = mc.positions().map(<[f64]>::to_vec);
+        let step = change.step.unwrap_or(self.mc.sweeps());
+        mc.restore([x, y, z], step, self.mc.delta());
+        (self.mc, self.run) = (mc, run);
+        Ok(())
     }
 }
 

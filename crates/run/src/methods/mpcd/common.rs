@@ -316,6 +316,66 @@ impl crate::Engine for SolventEngine {
     fn box_lengths(&self) -> Vec<f64> {
         self.srd.sbox().l.to_vec()
     }
+    fn seed(&self) -> u32 {
+        self.srd.params().seed
+    }
+    /// The arrays laid out as `positions` gives them (solvent, colloid centres unwrapped,
+    /// vertices); the solvent keeps its number (a drying droplet's shrinks as it goes).
+    fn set_state(&mut self, change: crate::StateChange) -> Result<()> {
+        use crate::engine::rows;
+        change.check(self.particles(), 3, true, self.method)?;
+        let ns = self.srd.len();
+        let (mut pos, mut vel) = (self.srd.positions(), self.srd.velocities());
+        if let Some(x) = &change.positions {
+            pos = rows(&x[..3 * ns]);
+        }
+        if let Some(v) = &change.velocities {
+            vel = rows(&v[..3 * ns]);
+        }
+        let step = change.step.unwrap_or(self.srd.step());
+        let mut params = *self.srd.params();
+        params.seed = change.seed.unwrap_or(params.seed);
+        let srd = Srd::from_state(params, *self.srd.sbox(), &pos, &vel, step)
+            .map_err(|e| anyhow::anyhow!("positions: {e}"))?;
+        let colloids = match &self.colloids {
+            None => None,
+            Some(c) => {
+                let mut state = c.state();
+                state.step = step;
+                let (nc, sbox) = (c.len(), *self.srd.sbox());
+                if let Some(x) = &change.positions {
+                    let centres = rows(&x[3 * ns..3 * (ns + nc)]);
+                    let vertices = rows(&x[3 * (ns + nc)..]);
+                    for (i, u) in centres.iter().enumerate() {
+                        let (mut a, mut img) = (*u, [0; 3]);
+                        sbox.wrap(&mut a, &mut img);
+                        for (v, w) in state.vertex_pos[c.vertex_range(i)]
+                            .iter_mut()
+                            .zip(&vertices[c.vertex_range(i)])
+                        {
+                            *v = std::array::from_fn(|k| w[k] - u[k] + a[k]);
+                        }
+                        (state.centre_pos[i], state.centre_image[i]) = (a, img);
+                    }
+                }
+                if let Some(v) = &change.velocities {
+                    state.centre_vel = rows(&v[3 * ns..3 * (ns + nc)]);
+                    state.vertex_vel = rows(&v[3 * (ns + nc)..]);
+                }
+                Some(
+                    DiscreteColloids::from_state_mixture(
+                        *c.params(),
+                        c.mixture(),
+                        sbox,
+                        &state,
+                    )
+                    .map_err(|e| anyhow::anyhow!("positions: {e}"))?,
+                )
+            }
+        };
+        (self.srd, self.colloids) = (srd, colloids);
+        Ok(())
+    }
 }
 
 // ------------------------------------------------------------------------------------------
