@@ -679,6 +679,10 @@ class Engine:
                 if t(self.steps):
                     a(self)
 
+    def run(self, steps: int, threads: Optional[int] = None) -> None:
+        """:meth:`step` by the name HOOMD-blue's ``Simulation.run(steps)`` has."""
+        self.step(steps, threads)
+
     def set_state(
         self,
         positions: Optional[Any] = None,

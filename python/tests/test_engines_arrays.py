@@ -201,7 +201,7 @@ def test_a_python_force_moves_particles_as_the_built_in_force(hydro):
 
     b.add_force(push)
     a.step(25)
-    b.step(25)
+    b.run(25)  # HOOMD's name for step
     assert calls == list(range(25))
     assert np.array_equal(a.positions, b.positions)
     assert np.array_equal(a.forces, b.forces)
