@@ -126,8 +126,10 @@ pub fn setup_from(p: &DropletParams, dr: f64) -> Result<DropletSetup> {
 /// One written output time.
 struct Written {
     fraction: f64,
-    r: Vec<f64>,
-    phi: Vec<f64>,
+    /// The profile on the theory's own grid (`theory_profile_<f>.csv`'s `r`, `phi`), drawn as
+    /// it is: bin averages on the BD's shells alias the FMT layering.
+    fine_r: Vec<f64>,
+    fine_phi: Vec<f64>,
     /// Face radii and `beta F_eff d` (kT/d) of the effective force.
     force_r: Vec<f64>,
     force: Vec<f64>,
@@ -400,8 +402,8 @@ fn write_snapshot(
     )?;
     written.push(Written {
         fraction,
-        r,
-        phi,
+        fine_r: rf.to_vec(),
+        fine_phi: phif,
         force_r: s.force.r.clone(),
         force,
         mean_force: s.force.mean() * p.diameter,
@@ -459,8 +461,8 @@ fn draw(
         .zip(&labels)
         .map(|(w, l)| Series {
             label: l,
-            x: &w.r,
-            y: &w.phi,
+            x: &w.fine_r,
+            y: &w.fine_phi,
             points: false,
         })
         .collect();
@@ -490,19 +492,25 @@ fn draw(
             points: true,
         });
     }
-    let title = if bd.is_empty() {
-        format!("Drying droplet: radial FMT DDFT ({tag})")
+    let (title, x_label) = if bd.is_empty() {
+        (
+            format!("Drying droplet: radial FMT DDFT ({tag})"),
+            "r (length)",
+        )
     } else {
-        format!(
-            "Drying droplet: DDFT {tag} (lines), BD (points, {})",
-            run_dir.display()
+        (
+            format!(
+                "Drying droplet: DDFT {tag} (lines), BD (points, {})",
+                run_dir.display()
+            ),
+            "r (length; BD: inner shells merged to >= 10 particles)",
         )
     };
     plot::line_plot_styled(
         &dir.join("profiles.png"),
         &title,
-        "r (length; BD: inner shells merged to >= 10 particles)",
-        "phi (bin average of pi d^3 rho / 6)",
+        x_label,
+        "pi d^3 rho / 6 (centre density x sphere volume)",
         &series,
         &[],
         Scale::Linear,
