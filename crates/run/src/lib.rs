@@ -162,7 +162,32 @@ pub fn theory(sc: &Scenario, opts: &TheoryOptions, ctl: &Control) -> anyhow::Res
     if opts.pair.is_some() && m.names()[0] != "droplet-bd" {
         anyhow::bail!("--pair applies to droplet-bd scenarios only");
     }
-    m.theory(sc, opts, ctl)
+    let mut report = m.theory(sc, opts, ctl)?;
+    // The pictures were drawn in the folder's formats: name the files written.
+    report.files = report
+        .files
+        .iter()
+        .flat_map(|f| output::plot::picture_files(&report.out, f))
+        .collect();
+    Ok(report)
+}
+
+/// The output folder of `colloidsim theory` (`--out`, or the scenario's name and `-theory`),
+/// created, its pictures in the scenario's `observe.figure_format`.
+pub(crate) fn theory_folder(
+    src: &Scenario,
+    opts: &TheoryOptions,
+) -> anyhow::Result<colloidsim_core::output::OutputDir> {
+    use anyhow::Context;
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
+    let format = keys::shared::figure_format(&src.table()?)?;
+    let dir = colloidsim_core::output::OutputDir::create(&out, opts.force)
+        .with_context(|| format!("cannot use output folder {}", out.display()))?;
+    output::plot::set_figure_format(dir.path(), format);
+    Ok(dir)
 }
 
 /// Every key of a method's scenarios (`colloidsim keys METHOD`).

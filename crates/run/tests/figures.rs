@@ -92,6 +92,30 @@ fn pictures_are_written_as_svg_png_or_both() {
     }
 }
 
+/// `colloidsim theory` draws its pictures in the scenario's format too, and names them.
+#[test]
+fn theory_pictures_follow_the_figure_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("{RODS}figure_format = \"svg\"\n");
+    let sc = Scenario::from_toml(&text, dir.path()).unwrap();
+    let out = dir.path().join("theory");
+    let opts = colloidsim_run::TheoryOptions {
+        out: Some(out.clone()),
+        ..Default::default()
+    };
+    let r = colloidsim_run::theory(&sc, &opts, &Control::default()).unwrap();
+    let svg = with_ext(&out, "svg");
+    assert!(!svg.is_empty(), "no svg in {:?}", r.files);
+    assert_eq!(with_ext(&out, "png"), Vec::<String>::new());
+    for f in &svg {
+        assert!(is_svg(&out.join(f)), "{f}");
+        assert!(r.files.contains(f), "{f} not in {:?}", r.files);
+    }
+    for f in &r.files {
+        assert!(out.join(f).is_file(), "{f} listed, not written");
+    }
+}
+
 #[test]
 fn a_figure_format_not_allowed_is_refused_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();

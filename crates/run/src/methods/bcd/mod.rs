@@ -1383,15 +1383,6 @@ fn bin_means(x: &[f64], y: &[f64], period: f64, bins: usize) -> (Vec<f64>, Vec<f
     (centres, means)
 }
 
-/// The output folder of `colloidsim theory` (`--out`, or the scenario's name and `-theory`).
-fn theory_outdir(src: &Source, opts: &TheoryOptions) -> Result<OutputDir> {
-    let out = opts
-        .out
-        .clone()
-        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
-    Ok(OutputDir::create(&out, opts.force)?)
-}
-
 /// Write `summary.json` last and report `what` with the folder.
 fn theory_report(
     outdir: &OutputDir,
@@ -1427,7 +1418,7 @@ fn driven_theory(
     let start = Instant::now();
     let st = driven_steady_state(r, opts.dx, None)?;
     let wall = start.elapsed().as_secs_f64();
-    let outdir = theory_outdir(src, opts)?;
+    let outdir = crate::theory_folder(src, opts)?;
     let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
     let (centres, means) = bin_means(&st.x, &st.rho, r.period, bins);
     outdir.write_table("density.csv", &[("x", &centres), ("rho", &means)])?;
@@ -1515,7 +1506,7 @@ fn theory(src: &Source, opts: &TheoryOptions) -> Result<Report> {
     let start = Instant::now();
     let eq = solve_theory(&r, dx)?;
     let wall = start.elapsed().as_secs_f64();
-    let outdir = theory_outdir(src, opts)?;
+    let outdir = crate::theory_folder(src, opts)?;
     let bins = sc.observe.density.as_ref().map_or(1000, |d| d.bins);
     let b = eq.bin_average(bins, r.period)?;
     let mut files = vec!["density.csv"];

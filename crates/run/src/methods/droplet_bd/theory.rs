@@ -16,7 +16,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use colloidsim_core::ParamError;
 use colloidsim_core::output::{OutputDir, read_table};
 use colloidsim_dft::radial::{
@@ -189,12 +189,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
         .map_err(relabel)
         .map_err(|e| anyhow!("{}: {e}", src.label()))?;
 
-    let out = topts
-        .out
-        .clone()
-        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
-    let dir = OutputDir::create(&out, topts.force)
-        .with_context(|| format!("cannot use output folder {}", out.display()))?;
+    let dir = crate::theory_folder(src, topts)?;
     let opts = DdftOptions::new(p.d0, p.diameter);
     let eq_opts = EquilibriumOptions::default();
     let pb = ctl.progress();

@@ -16,8 +16,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
-use colloidsim_core::output::OutputDir;
+use anyhow::{Result, anyhow};
 use colloidsim_dft::radial::mixture::mixture_volume_fraction;
 use colloidsim_dft::radial::mixture::{Functional, MixtureSetup, Species, run_mixture_droplet};
 use colloidsim_dft::radial::{
@@ -88,12 +87,7 @@ pub(super) fn theory(
     let schedule = setup
         .validate()
         .map_err(|e| anyhow!("{}: {e}", src.label()))?;
-    let out = topts
-        .out
-        .clone()
-        .unwrap_or_else(|| format!("{}-theory", src.name()).into());
-    let dir = OutputDir::create(&out, topts.force)
-        .with_context(|| format!("cannot use output folder {}", out.display()))?;
+    let dir = crate::theory_folder(src, topts)?;
     let pb = ctl.progress();
     pb.begin("theory", 1000, 0);
     let mut files = Vec::new();

@@ -363,13 +363,8 @@ impl crate::Engine for SolventEngine {
                     state.vertex_vel = rows(&v[3 * (ns + nc)..]);
                 }
                 Some(
-                    DiscreteColloids::from_state_mixture(
-                        *c.params(),
-                        c.mixture(),
-                        sbox,
-                        &state,
-                    )
-                    .map_err(|e| anyhow::anyhow!("positions: {e}"))?,
+                    DiscreteColloids::from_state_mixture(*c.params(), c.mixture(), sbox, &state)
+                        .map_err(|e| anyhow::anyhow!("positions: {e}"))?,
                 )
             }
         };
