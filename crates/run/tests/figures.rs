@@ -174,3 +174,70 @@ fn droplet_volume_fractions_by_overlap_stay_below_close_packing() {
     // exceed 1 (the case of the issue, 3.38 in the full example).
     assert!(centre_max > 0.80, "{centre_max}");
 }
+
+/// The columns of a CSV file by name.
+fn columns(path: &Path) -> std::collections::BTreeMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut cols = vec![Vec::new(); names.len()];
+    for l in lines {
+        for (c, x) in cols.iter_mut().zip(l.split(',')) {
+            c.push(x.parse().unwrap());
+        }
+    }
+    names.into_iter().zip(cols).collect()
+}
+
+/// Monte Carlo in a hard-walled droplet and a drying MPCD droplet (their examples, smaller)
+/// write the volume fraction by overlap beside the centre density, as droplet-bd does: below
+/// close packing everywhere, where the centre density of the wall's contact layer is not.
+#[test]
+fn monte_carlo_and_mpcd_droplets_write_volume_fractions_by_overlap() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    for (file, overrides, csv) in [
+        (
+            "mc/droplet-static.toml",
+            vec![
+                "mc.sweeps=400",
+                "mc.warmup_sweeps=100",
+                "mc.blocks=4",
+                "output.rho2_r_bins=0",
+            ],
+            vec!["profile_mean.csv"],
+        ),
+        (
+            "droplet/drying-mpcd.toml",
+            vec!["drying.peclet=1000", "observe.solvent.window=10"],
+            vec!["profile_0.00.csv", "profile_1.00.csv"],
+        ),
+    ] {
+        let overrides: Vec<String> = overrides.into_iter().map(String::from).collect();
+        let sc = Scenario::from_path(&examples.join(file))
+            .unwrap()
+            .with_overrides(&overrides)
+            .unwrap();
+        let out = dir.path().join(file.replace('/', "-"));
+        let opts = RunOptions {
+            out: Some(out.clone()),
+            seed: None,
+            force: false,
+        };
+        colloidsim_run::run(&sc, &opts, &Control::default()).unwrap();
+        let mut centre_max: f64 = 0.0;
+        for name in csv {
+            let c = columns(&out.join(name));
+            let o = &c["phi_overlap"];
+            assert_eq!(o.len(), c["phi"].len(), "{file}: {name}");
+            assert!(
+                o.iter().all(|v| (0.0..0.80).contains(v)),
+                "{file}: {name}: {o:?}"
+            );
+            centre_max = centre_max.max(c["phi"].iter().cloned().fold(0.0, f64::max));
+        }
+        if file.starts_with("mc") {
+            assert!(centre_max > 0.80, "{file}: {centre_max}");
+        }
+    }
+}

@@ -232,11 +232,14 @@ struct DropletRow {
     colloid_temperature: f64,
 }
 
-/// The colloid volume-fraction profiles: per profile time, phi per bin, the bin centres and
-/// the radius when taken.
+/// The colloid profiles: per profile time, the centre density times the sphere volume per bin
+/// (`phi`), the volume fraction by sphere-shell overlap (`overlap`; empty when continued from
+/// a checkpoint written without it), the bin centres and the radius when taken.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 struct ColloidProfiles {
     phi: Vec<Vec<f64>>,
+    #[serde(default)]
+    overlap: Vec<Vec<f64>>,
     r: Vec<Vec<f64>>,
     radius: Vec<f64>,
     taken: Vec<bool>,
@@ -290,6 +293,7 @@ impl DropletAccum {
                 let k = p.profile_collisions.len();
                 ColloidProfiles {
                     phi: vec![Vec::new(); k],
+                    overlap: vec![Vec::new(); k],
                     r: vec![Vec::new(); k],
                     radius: vec![0.0; k],
                     taken: vec![false; k],
@@ -400,6 +404,16 @@ impl DropletSession {
                     self.acc
                         .species
                         .record(&species_run(p), j, pos, &diameters, col.species(), r);
+                    let o = colloidsim_analysis::overlap_profile(
+                        pos,
+                        &diameters,
+                        [0.0; 3],
+                        r,
+                        p.profile.bins,
+                    );
+                    if let Some(slot) = cp.overlap.get_mut(j) {
+                        *slot = o;
+                    }
                     cp.phi[j] = prof.phi;
                     cp.r[j] = prof.r;
                     cp.radius[j] = r;
@@ -632,18 +646,36 @@ impl Session for DropletSession {
             let mut labels = Vec::new();
             let mut xs = Vec::new();
             let mut drawn = Vec::new();
+            let mut by_overlap = true;
             for j in (0..cp.taken.len()).filter(|&j| cp.taken[j]) {
                 let name = crate::output::profile_name(p.profile.fractions[j]);
-                out.write_table(&name, &[("r", &cp.r[j]), ("phi", &cp.phi[j])])?;
+                // phi: the centre density times the sphere volume (above 1 where a shell is
+                // thinner than a sphere); phi_overlap: the volume fraction by sphere-shell
+                // overlap (as droplet-bd's).
+                let overlap = cp.overlap.get(j).filter(|o| o.len() == cp.phi[j].len());
+                match overlap {
+                    Some(o) => out.write_table(
+                        &name,
+                        &[("r", &cp.r[j]), ("phi", &cp.phi[j]), ("phi_overlap", o)],
+                    )?,
+                    None => out.write_table(&name, &[("r", &cp.r[j]), ("phi", &cp.phi[j])])?,
+                };
                 files.push(name);
                 labels.push(format!(
                     "t = {:.0} % (R = {:.2})",
                     p.profile.fractions[j] * 100.0,
                     cp.radius[j]
                 ));
-                // The picture merges the small inner shells (plot::merged_shells).
-                let vp = std::f64::consts::PI / 6.0 * p.diameter.powi(3);
-                let (x, y) = merged_shells(&cp.r[j], &cp.phi[j], vp, 1.0, SHELL_PARTICLES);
+                // The picture shows the volume fraction by overlap; without it (an older
+                // checkpoint) the centre density with the small inner shells merged.
+                let (x, y) = match overlap {
+                    Some(o) => (cp.r[j].clone(), o.clone()),
+                    None => {
+                        let vp = std::f64::consts::PI / 6.0 * p.diameter.powi(3);
+                        merged_shells(&cp.r[j], &cp.phi[j], vp, 1.0, SHELL_PARTICLES)
+                    }
+                };
+                by_overlap &= overlap.is_some();
                 xs.push((x.iter().map(|x| x / cp.radius[j]).collect::<Vec<f64>>(), y));
                 drawn.push(j);
             }
@@ -664,8 +696,16 @@ impl Session for DropletSession {
                         "Drying droplet, MPCD ({boundary}): N = {}, Pe = {}",
                         p.particles, p.peclet
                     ),
-                    "r / R(t) (inner shells merged to >= 10 particles)",
-                    "volume fraction phi(r)",
+                    if by_overlap {
+                        "r / R(t)"
+                    } else {
+                        "r / R(t) (inner shells merged to >= 10 particles)"
+                    },
+                    if by_overlap {
+                        "volume fraction (sphere-shell overlap)"
+                    } else {
+                        "pi d^3 rho / 6 (centre density x sphere volume)"
+                    },
                     &series,
                     &[],
                     Scale::Linear,

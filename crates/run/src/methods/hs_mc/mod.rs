@@ -179,6 +179,11 @@ struct Block {
     /// Each species' centre distances next to its own wall `R - d_s/2` (hard wall, mixtures).
     #[serde(default)]
     species_wall: Option<Vec<RadialHistogram>>,
+    /// The sum over the samples of the volume fraction by sphere-shell overlap on the
+    /// profile's shells, and the samples (droplets; `None` when continued from a checkpoint
+    /// written without it).
+    #[serde(default)]
+    overlap: Option<(Vec<f64>, u64)>,
 }
 
 /// Everything a run accumulates, saved in every checkpoint.
@@ -212,6 +217,7 @@ impl Accum {
             profile: p
                 .radius
                 .map(|r| RadialHistogram::new(0.0, r, p.profile_bins)),
+            overlap: p.radius.map(|_| (vec![0.0; p.profile_bins], 0)),
             wall: (p.geometry == "hard-wall")
                 .then(|| {
                     rc.map(|rc| RadialHistogram::new(rc - CONTACT_WINDOW * d, rc, CONTACT_BINS))
@@ -306,6 +312,15 @@ impl McSession {
             }
             if let Some(h) = block.profile.as_mut() {
                 h.sample(&self.mc);
+            }
+            if let (Some((sum, n)), Some(r)) = (block.overlap.as_mut(), p.radius) {
+                let mc = &self.mc;
+                let d = mc.diameters();
+                let pos: Vec<[f64; 3]> = (0..mc.len()).map(|i| mc.position(i)).collect();
+                let dia: Vec<f64> = mc.types().iter().map(|&t| d[t as usize]).collect();
+                let o = colloidsim_analysis::overlap_profile(&pos, &dia, [0.0; 3], r, sum.len());
+                sum.iter_mut().zip(o).for_each(|(s, v)| *s += v);
+                *n += 1;
             }
             if let Some(h) = block.wall.as_mut() {
                 h.sample(&self.mc);
@@ -625,11 +640,41 @@ impl Session for McSession {
             if let Some(h) = blocks.first().and_then(|b| b.profile.as_ref()) {
                 let r = h.centres();
                 let (phi, err) = columns(&per_block, r.len());
-                out.write_table(
-                    "profile_mean.csv",
-                    &[("r", &r), ("phi", &phi), ("err", &err)],
-                )?;
+                // phi: the centre density times the sphere volume (above 1 at a hard wall's
+                // contact layer); phi_overlap: the volume fraction by sphere-shell overlap,
+                // each with its standard error over the blocks.
+                let overlap_blocks: Vec<Vec<f64>> = blocks
+                    .iter()
+                    .filter_map(|b| b.overlap.as_ref())
+                    .filter(|(_, n)| *n > 0)
+                    .map(|(s, n)| s.iter().map(|v| v / *n as f64).collect())
+                    .collect();
+                let overlap = (overlap_blocks.len() == blocks.len())
+                    .then(|| columns(&overlap_blocks, r.len()));
+                match &overlap {
+                    Some((o, oe)) => out.write_table(
+                        "profile_mean.csv",
+                        &[
+                            ("r", &r),
+                            ("phi", &phi),
+                            ("err", &err),
+                            ("phi_overlap", o),
+                            ("phi_overlap_err", oe),
+                        ],
+                    )?,
+                    None => out.write_table(
+                        "profile_mean.csv",
+                        &[("r", &r), ("phi", &phi), ("err", &err)],
+                    )?,
+                };
                 files.push("profile_mean.csv".into());
+                let ((y, ey), y_label) = match overlap {
+                    Some(o) => (o, "volume fraction (sphere-shell overlap)"),
+                    None => (
+                        (phi, err),
+                        "pi d^3 rho / 6 (centre density x sphere volume)",
+                    ),
+                };
                 let radius = p.radius.unwrap_or(1.0);
                 let x: Vec<f64> = r.iter().map(|v| v / radius).collect();
                 let title = format!(
@@ -639,7 +684,7 @@ impl Session for McSession {
                 let series = [Series {
                     label: "equilibrium (bars: standard error over the blocks)",
                     x: &x,
-                    y: &phi,
+                    y: &y,
                     points: false,
                 }];
                 picture(
@@ -647,9 +692,9 @@ impl Session for McSession {
                         &out.join("profiles.png"),
                         &title,
                         "r / R",
-                        "volume fraction phi(r)",
+                        y_label,
                         &series,
-                        &[Some(err.as_slice())],
+                        &[Some(ey.as_slice())],
                         Scale::Linear,
                     ),
                     "profiles.png",
