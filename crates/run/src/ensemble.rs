@@ -1287,6 +1287,54 @@ mod tests {
     }
 
     #[test]
+    fn headline_means_need_every_replica_and_say_why_not() {
+        let decl = crate::registry::find("bcd").unwrap().headline();
+        let member = |peak: Option<f64>, l1: f64| {
+            json!({"peak_density": peak, "theory_l1": l1, "particle_current": null,
+                   "mean_contact_density": null,
+                   "nulls": {"peak_density": "no density observed (observe.density)"}})
+        };
+        let t = HeadlineTable::pool(
+            decl,
+            &[
+                vec![member(Some(1.0), 0.1), member(Some(3.0), 0.3)],
+                vec![member(Some(2.0), 0.2), member(None, 0.4)],
+            ],
+        );
+        let names: Vec<&str> = t.columns.iter().map(|c| c.column.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "peak_density",
+                "theory_l1",
+                "particle_current",
+                "mean_contact_density"
+            ]
+        );
+        let (mean, err, n, of) = t.stats[0][0];
+        assert_eq!((mean, n, of), (2.0, 2, 2));
+        assert!(
+            (err - 1.0).abs() < 1e-15,
+            "s = sqrt(2), s / sqrt(2) = 1: {err}"
+        );
+        // One replica of two without a value: no mean, and the member's reason.
+        let (mean, _, n, of) = t.stats[1][0];
+        assert!(mean.is_nan() && n == 1 && of == 2);
+        let why = t.why[1][0].as_deref().unwrap();
+        assert!(
+            why.contains("1 of 2") && why.contains("observe.density"),
+            "{why}"
+        );
+        assert!(t.stats[1][1].0.is_finite());
+        assert!(
+            t.why[0][2]
+                .as_deref()
+                .unwrap()
+                .starts_with("no replica gave a value")
+        );
+    }
+
+    #[test]
     fn summary_numbers_skip_the_bookkeeping() {
         let v = json!({"seed": 3, "wall_seconds": 1.0, "parameters": {"dt": 1e-3}, "threads": 2,
                        "particle_steps_per_second": 1e6,

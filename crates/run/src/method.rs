@@ -336,3 +336,62 @@ fn not_decomposed(sc: &Scenario, method: &str) -> String {
         sc.label()
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    const DECLARED: &[Headline] = &[
+        Headline {
+            name: "Z",
+            path: "compressibility.value",
+            labels: None,
+            unit: "-",
+            doc: "",
+            absent: "bulk only",
+        },
+        Headline {
+            name: "phi",
+            path: "shell.phi",
+            labels: Some("shell.labels"),
+            unit: "-",
+            doc: "",
+            absent: "no profile",
+        },
+    ];
+
+    #[test]
+    fn headline_columns_name_a_labelled_list_element_by_element() {
+        let s = json!({"compressibility": {"value": 1.5},
+                       "shell": {"labels": ["t0.00", "t1.00"], "phi": [0.1, null]}});
+        let cols = headline_columns(DECLARED, &s);
+        let got: Vec<(&str, &str, Option<f64>)> = cols
+            .iter()
+            .map(|c| (c.column.as_str(), c.path.as_str(), c.value))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("Z", "compressibility.value", Some(1.5)),
+                ("phi_t0.00", "shell.phi[0]", Some(0.1)),
+                ("phi_t1.00", "shell.phi[1]", None),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_headline_the_method_did_not_write_becomes_null_with_its_reason() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = OutputDir::create(dir.path().join("o"), false).unwrap();
+        let mut s = json!({"steps": 3});
+        complete_headline(DECLARED, &mut s, &out);
+        assert_eq!(s, json!({"steps": 3, "compressibility": {"value": null}}));
+        let nulls = crate::driver::null_reasons(&s, &out);
+        assert_eq!(nulls["compressibility.value"], "bulk only");
+        // A value the method wrote is left as it is.
+        let mut s = json!({"compressibility": {"value": 2.0}});
+        complete_headline(DECLARED, &mut s, &out);
+        assert_eq!(s, json!({"compressibility": {"value": 2.0}}));
+    }
+}
