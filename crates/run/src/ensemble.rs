@@ -765,6 +765,8 @@ struct HeadlineTable {
     stats: Vec<Vec<(f64, f64, usize, usize)>>,
     /// Per point, per column: why the mean or the error is missing.
     why: Vec<Vec<Option<String>>>,
+    /// Per point, the replicas averaged (the finished members).
+    replicas: Vec<usize>,
 }
 
 impl HeadlineTable {
@@ -840,6 +842,7 @@ impl HeadlineTable {
             columns,
             stats,
             why,
+            replicas: summaries.iter().map(Vec::len).collect(),
         }
     }
 
@@ -885,16 +888,7 @@ impl Ensemble {
         };
         for (p, values) in self.points.iter().enumerate() {
             let mut row: Vec<String> = values.iter().map(|(_, v)| quote(&cell(v))).collect();
-            row.push(t.stats[p].first().map_or_else(
-                || {
-                    self.members
-                        .iter()
-                        .filter(|m| m.point == p)
-                        .count()
-                        .to_string()
-                },
-                |s| s.3.to_string(),
-            ));
+            row.push(t.replicas[p].to_string());
             for &(mean, err, _, _) in &t.stats[p] {
                 row.push(num(mean));
                 row.push(num(err));
@@ -980,7 +974,11 @@ impl Ensemble {
             let series: Vec<Series> = data
                 .iter()
                 .map(|(label, x, y, _)| Series {
-                    label,
+                    label: if label.is_empty() {
+                        "mean (bars: std. error)"
+                    } else {
+                        label
+                    },
                     x,
                     y,
                     points: true,
@@ -996,7 +994,7 @@ impl Ensemble {
             let drawn = sweep_plot(
                 &out.join(&name),
                 &format!(
-                    "{}: {}, mean of {replicas} replica(s) per point",
+                    "{}: {}, mean +- standard error of {replicas} replica(s)",
                     method.names()[0],
                     h.name
                 ),

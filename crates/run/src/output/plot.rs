@@ -240,8 +240,9 @@ pub fn line_plot_styled(
 }
 
 /// An observable against a swept parameter (`colloidsim ensemble`'s `headline_NAME.png`):
-/// [`line_plot_with_errors`] with each series' points marked and joined, and the x axis
-/// padded so that no point sits on its edge (a single x value gets an axis about it).
+/// [`line_plot_with_errors`] with each series' points marked and joined, the x axis padded so
+/// that no point sits on its edge (a single x value gets an axis about it), and the legend
+/// right of the axes.
 pub fn sweep_plot(
     path: &Path,
     title: &str,
@@ -250,18 +251,23 @@ pub fn sweep_plot(
     series: &[Series],
     errors: &[Option<&[f64]>],
 ) -> Result<()> {
-    let style = Style::default();
-    save!(path, (800, 500), |area| draw_line_plot(
-        area,
-        title,
-        xlabel,
-        ylabel,
-        series,
-        errors,
-        Scale::Linear,
-        style,
-        true
-    ))
+    // The legend beside the axes, where it hides no point or bar.
+    let style = Style {
+        legend_outside: true,
+    };
+    save!(path, (800 + legend_width(series), 500), |area| {
+        draw_line_plot(
+            area,
+            title,
+            xlabel,
+            ylabel,
+            series,
+            errors,
+            Scale::Linear,
+            style,
+            true,
+        )
+    })
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -55,7 +55,7 @@ const HEADLINE: &[Headline] = &[
         labels: None,
         unit: "-",
         doc: "L1 distance of the density profile to the exact equilibrium on the same bins, \
-              sum |rho - rho_exact| / sum rho_exact (density.csv, density_theory.csv)",
+              sum of abs(rho - rho_exact) over sum of rho_exact (density.csv, density_theory.csv)",
         absent: "no exact equilibrium beside the density",
     },
     Headline {

@@ -72,7 +72,7 @@ const HEADLINE: &[Headline] = &[
         name: "D",
         path: "colloid_diffusion_long_time",
         labels: None,
-        unit: "rc^2/time",
+        unit: "rc^2/time (DPD time)",
         doc: "long-time colloid self-diffusion coefficient from the MSD slope over the second \
               half of the lags (colloid_diffusion_note)",
         absent: "no colloids or no MSD",
