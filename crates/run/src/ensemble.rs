@@ -11,7 +11,9 @@
 //! `s / sqrt(n)` (`COLUMN_err`, `s` the sample standard deviation between replicas; a run's own
 //! error columns, `err` and `NAME_err`, are replaced by this spread), and every
 //! number in the members' `summary.json` (outside `parameters`) is averaged the same way into
-//! `observables.csv` and the ensemble's `summary.json`.
+//! `observables.csv` and the ensemble's `summary.json`. The method's headline observables
+//! ([`crate::method::Headline`]) go into `headline.csv`, one row per sweep point, and are
+//! pictured against the first swept key (`headline_NAME.png`).
 
 use crate::control::Control;
 use crate::method::{Headline, HeadlineValue, headline_columns};
