@@ -117,10 +117,11 @@ def _warn(report: Dict[str, Any]) -> None:
 
 
 def _column(values: List[str]) -> np.ndarray:
-    """A CSV column as floats, or as strings when it holds text (``observables.csv`` of an
-    ensemble names its observables and may sweep text values)."""
+    """A CSV column as floats (an empty field, a number that is not finite, as NaN), or as
+    strings when it holds text (``observables.csv`` of an ensemble names its observables and
+    may sweep text values)."""
     try:
-        return np.array([float(x) for x in values], dtype=float)
+        return np.array([float(x) if x.strip() else np.nan for x in values], dtype=float)
     except ValueError:
         return np.array([x.strip() for x in values], dtype=str)
 
@@ -235,6 +236,12 @@ def ensemble(
     listed values. Each member is a plain run in ``out/replica-R`` (``out/point-P/replica-R`` with
     a sweep); the tables the replicas share are written beside them with each column's mean and
     standard error (``COLUMN_err``), and the summaries' numbers into ``observables.csv``.
+    ``result.headline`` (``headline.csv``) holds the method's headline observables as numpy
+    arrays, one element per sweep point: the swept keys' values
+    (``result.headline["system.particles"]``), ``replicas``, and each observable ``NAME`` (mean
+    over the replicas) with its standard error ``NAME_err`` (NaN where a replica gave no value:
+    ``result.summary["nulls"]`` says why); ``result.summary["headline"]`` gives each one's unit,
+    meaning and columns, and ``headline_NAME.png`` pictures it against the first swept key.
     ``out`` defaults to a new temporary folder. Spreading members over MPI ranks is the CLI's
     (``mpirun -n 4 colloidsim ensemble ...``, docs/parallel.md)."""
     text, base, name, origin = _scenario(scenario)

@@ -245,6 +245,46 @@ def test_ensemble_equals_the_cli_and_averages_the_replicas(tmp_path, cli):
     assert not (tmp_path / "bad").exists()
 
 
+def test_ensemble_returns_the_headline_observables_per_sweep_point(tmp_path, cli):
+    scenario = {
+        "method": "bcd",
+        "seed": 11,
+        "system": {"length": 10.0, "particles": 5, "diameter": 0.5},
+        "potential": {"cosine": {"amplitude": 2.0, "wavelength": 1.0}},
+        "run": {"dt": 1e-3, "equilibrate": 0.2, "time": 2.0},
+        "observe": {"density": {"bins": 20}, "current": True},
+    }
+    path = tmp_path / "tiny.toml"
+    path.write_text(colloidsim._colloidsim.toml_from_json(json.dumps(scenario)))
+    vary = ["--vary", "potential.cosine.amplitude=[1.0, 3.0]"]
+    cli("ensemble", path, "--out", tmp_path / "cli", "--replicas", "2", *vary, "--quiet")
+    r = colloidsim.ensemble(
+        path, replicas=2, vary={"potential.cosine.amplitude": [1.0, 3.0]}, out=tmp_path / "py"
+    )
+    assert (tmp_path / "cli" / "headline.csv").read_bytes() == (r.out / "headline.csv").read_bytes()
+    h = r.headline
+    np.testing.assert_array_equal(h["potential.cosine.amplitude"], [1.0, 3.0])
+    np.testing.assert_array_equal(h["replicas"], [2, 2])
+    assert [d["name"] for d in r.summary["headline"]] == [
+        "peak_density", "theory_l1", "particle_current", "mean_contact_density"
+    ]
+    for name in ["peak_density", "theory_l1", "particle_current"]:
+        members = np.array(
+            [
+                [json.loads((r.out / f"point-{p}/replica-{k}/summary.json").read_text())[name]
+                 for k in range(2)]
+                for p in range(2)
+            ]
+        )
+        np.testing.assert_allclose(h[name], members.mean(axis=1), rtol=1e-12)
+        np.testing.assert_allclose(
+            h[name + "_err"], members.std(axis=1, ddof=1) / np.sqrt(2), rtol=1e-9
+        )
+    # Not observed: empty fields (NaN), with the reason in the summary.
+    assert np.all(np.isnan(h["mean_contact_density"]))
+    assert "observe.contact_density" in r.summary["nulls"]["points[0].headline.mean_contact_density.mean"]
+
+
 def test_an_interrupted_ensemble_resumes_to_the_cli_folder(tmp_path, cli):
     path = tmp_path / "tiny.toml"
     path.write_text(

@@ -218,3 +218,86 @@ fn an_interrupted_ensemble_continues_to_the_uninterrupted_folder() {
     let none = run(&["ensemble", "--restart", tmp.path().to_str().unwrap()]);
     assert!(text(&none).contains("ensemble.json"), "{}", text(&none));
 }
+
+/// A BCD sweep (2 points x 2 replicas) writes its headline observables (`Method::headline`):
+/// one row per point, the swept key first, then every declared observable and its error, each
+/// the mean and standard error s / sqrt(n) of the members' summary.json values, recomputed
+/// here; and one picture per observable against the swept key.
+#[test]
+fn a_sweep_writes_the_headline_observables_with_the_replicas_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = tmp.path().join("tiny.toml");
+    std::fs::write(&sc, TINY).unwrap();
+    let out = tmp.path().join("ens");
+    let r = run(&[
+        "ensemble",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--replicas",
+        "2",
+        "--vary",
+        "potential.cosine.amplitude=[1.0, 3.0]",
+        "--set",
+        "observe.current=true",
+        "--set",
+        "observe.contact_density={ bins = 10, window = 0.05 }",
+        "--quiet",
+    ]);
+    assert!(r.status.success(), "{}", text(&r));
+    let (h, rows) = table(&out.join("headline.csv"));
+    let bcd = colloidsim_run::registry::find("bcd").unwrap();
+    let mut want = vec!["potential.cosine.amplitude".to_string(), "replicas".into()];
+    for d in bcd.headline() {
+        want.push(d.name.to_string());
+        want.push(format!("{}_err", d.name));
+    }
+    assert_eq!(h, want);
+    assert_eq!(rows[0], [1.0, 3.0], "the swept key's values");
+    assert_eq!(rows[1], [2.0, 2.0], "the replicas per point");
+    for (p, amplitude) in ["1.0", "3.0"].iter().enumerate() {
+        let members: Vec<serde_json::Value> = (0..2)
+            .map(|r| {
+                let f = out.join(format!("point-{p}/replica-{r}/summary.json"));
+                serde_json::from_slice(&std::fs::read(f).unwrap()).unwrap()
+            })
+            .collect();
+        for (k, d) in bcd.headline().iter().enumerate() {
+            let v: Vec<f64> = members
+                .iter()
+                .map(|m| {
+                    colloidsim_run::method::at(m, d.path)
+                        .unwrap()
+                        .as_f64()
+                        .unwrap()
+                })
+                .collect();
+            let mean = (v[0] + v[1]) / 2.0;
+            // s / sqrt(2) with s^2 = sum (v - mean)^2 / (2 - 1)
+            let err = (((v[0] - mean).powi(2) + (v[1] - mean).powi(2)) / 2.0).sqrt();
+            let (m, e) = (rows[2 + 2 * k][p], rows[3 + 2 * k][p]);
+            assert!(m.is_finite() && e.is_finite(), "{} at {amplitude}", d.name);
+            assert!(
+                (m - mean).abs() <= 1e-12 * mean.abs().max(1e-300),
+                "{} at {amplitude}: {m} against the members' mean {mean}",
+                d.name
+            );
+            assert!(
+                (e - err).abs() <= 1e-9 * err.max(1e-300),
+                "{} at {amplitude}: {e} against the members' standard error {err}",
+                d.name
+            );
+        }
+    }
+    for d in bcd.headline() {
+        assert!(
+            out.join(format!("headline_{}.png", d.name)).exists(),
+            "no picture of {}",
+            d.name
+        );
+    }
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["headline"][1]["name"], "theory_l1");
+    assert!(summary["points"][1]["headline"]["peak_density"]["mean"].is_f64());
+}

@@ -252,10 +252,65 @@ fn canonical(v: &serde_json::Value) -> String {
     }
 }
 
+/// Every headline observable its method declares (`Method::headline`, what `colloidsim
+/// ensemble` tabulates) sits in the example's summary.json: a number, or null with its reason
+/// in `nulls`; a labelled one as a list as long as its labels. Returns the method's name.
+fn headline_in_summary(example: &str, out: &Path) -> &'static str {
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    let m = colloidsim_run::registry::find(summary["method"].as_str().unwrap()).unwrap();
+    assert!(
+        !m.headline().is_empty(),
+        "method '{}' declares no headline observable",
+        m.names()[0]
+    );
+    let at = colloidsim_run::method::at;
+    for h in m.headline() {
+        let v = at(&summary, h.path).unwrap_or_else(|| {
+            panic!(
+                "{example}: headline {} ({}) is not in summary.json",
+                h.name, h.path
+            )
+        });
+        let (values, paths): (Vec<&serde_json::Value>, Vec<String>) = match h.labels {
+            None => (vec![v], vec![h.path.to_string()]),
+            Some(l) => {
+                let labels = at(&summary, l).and_then(|l| l.as_array());
+                let list = v.as_array();
+                assert!(
+                    labels.is_some()
+                        && list.is_some()
+                        && labels.unwrap().len() == list.unwrap().len(),
+                    "{example}: headline {}: {} and {l} are not lists of one length",
+                    h.name,
+                    h.path
+                );
+                let list = list.unwrap();
+                (
+                    list.iter().collect(),
+                    (0..list.len())
+                        .map(|i| format!("{}[{i}]", h.path))
+                        .collect(),
+                )
+            }
+        };
+        for (v, path) in values.into_iter().zip(paths) {
+            assert!(
+                v.as_f64().is_some_and(f64::is_finite)
+                    || (v.is_null() && summary["nulls"][&path].is_string()),
+                "{example}: headline {} at {path} is {v}, neither a number nor null with a reason",
+                h.name
+            );
+        }
+    }
+    m.names()[0]
+}
+
 #[test]
 fn every_example_writes_the_outputs_of_before() {
     let tmp = tempfile::tempdir().unwrap();
     let mut got = BTreeMap::new();
+    let mut covered = std::collections::BTreeSet::new();
     for (example, overrides) in EXAMPLES {
         let stem = example.trim_end_matches(".toml").replace('/', "-");
         let out = tmp.path().join(&stem);
@@ -277,11 +332,20 @@ fn every_example_writes_the_outputs_of_before() {
             "{example}: {}",
             String::from_utf8_lossy(&o.stderr)
         );
+        covered.insert(headline_in_summary(example, &out));
         let mut files = BTreeMap::new();
         fingerprints(&out, "", &mut files);
         for (name, fp) in files {
             got.insert(format!("{stem}/{name}"), fp);
         }
+    }
+    // Every registered method's headline observables were checked against an example's summary.
+    for m in colloidsim_run::registry::all() {
+        assert!(
+            covered.contains(m.names()[0]),
+            "no example of method '{}' checks its headline observables",
+            m.names()[0]
+        );
     }
     let text: String = got.iter().map(|(k, v)| format!("{k} {v}\n")).collect();
     if std::env::var_os("COLLOIDSIM_BLESS").is_some() {

@@ -318,7 +318,7 @@ fn run_with(
     if let Err(e) = record_files(&out, &*session, &kept) {
         return Err(session.fail_alone(e));
     }
-    drive(session, out, envelope, ctl, warnings, kept)
+    drive(session, out, envelope, ctl, warnings, kept, m.headline())
 }
 
 /// The scenario as a run with `seed` runs it: with its `seed` key set when `--seed` (or an
@@ -684,7 +684,7 @@ fn resume_with(
     if let Err(e) = session.begin(&out, false) {
         return Err(session.fail_alone(e));
     }
-    drive(session, out, envelope, ctl, warnings, kept)
+    drive(session, out, envelope, ctl, warnings, kept, m.headline())
 }
 
 /// Write a checkpoint at the session's position (every rank of a decomposed run takes part;
@@ -769,6 +769,7 @@ fn drive(
     ctl: &Control,
     mut warnings: Vec<String>,
     kept: Vec<String>,
+    headline: &'static [crate::method::Headline],
 ) -> Result<Report> {
     let total = s.total();
     let hooks = Hooks::from_env();
@@ -904,6 +905,9 @@ fn drive(
     }
     warnings.extend(fin.warnings);
     let mut summary = fin.summary;
+    if s_is_writer {
+        crate::method::complete_headline(headline, &mut summary, &out);
+    }
     // The scenario.toml the run was given, in its folder, is the user's, not the run's.
     let mut files = Vec::new();
     if !kept.iter().any(|k| k == "scenario.toml") {

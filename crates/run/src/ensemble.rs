@@ -11,9 +11,12 @@
 //! `s / sqrt(n)` (`COLUMN_err`, `s` the sample standard deviation between replicas; a run's own
 //! error columns, `err` and `NAME_err`, are replaced by this spread), and every
 //! number in the members' `summary.json` (outside `parameters`) is averaged the same way into
-//! `observables.csv` and the ensemble's `summary.json`.
+//! `observables.csv` and the ensemble's `summary.json`. The method's headline observables
+//! ([`crate::method::Headline`]) go into `headline.csv`, one row per sweep point, and are
+//! pictured against the first swept key (`headline_NAME.png`).
 
 use crate::control::Control;
+use crate::method::{Headline, HeadlineValue, headline_columns};
 use crate::{Report, RunOptions, Scenario};
 use anyhow::{Context, Result, bail};
 use colloidsim_core::output::{OutputDir, read_table};
@@ -572,6 +575,7 @@ impl Ensemble {
         let mut files = Vec::new();
         let mut warnings = Vec::new();
         let mut observables = Vec::new();
+        let mut headline = Vec::new();
         for (p, values) in self.points.iter().enumerate() {
             let folders: Vec<PathBuf> = self
                 .members
@@ -598,6 +602,12 @@ impl Ensemble {
             } else {
                 pool_summaries(&folders)?
             };
+            headline.push(
+                folders
+                    .iter()
+                    .map(|f| read_summary(f))
+                    .collect::<Result<Vec<Value>>>()?,
+            );
             for (k, (m, e, _)) in &obs {
                 let at = format!("points[{}].observables.{k}", observables.len());
                 for (x, field, why) in [
@@ -627,6 +637,36 @@ impl Ensemble {
             self.observables_csv(&observables).as_bytes(),
         )?;
         files.push("observables.csv".into());
+        let method = crate::registry::of(&self.scenario)?;
+        let table = HeadlineTable::pool(method.headline(), &headline);
+        for (p, point) in observables.iter_mut().enumerate() {
+            point["headline"] = table.point_json(p, &out);
+        }
+        out.write_bytes("headline.csv", self.headline_csv(&table).as_bytes())?;
+        files.push("headline.csv".into());
+        crate::output::plot::set_figure_format(
+            out.path(),
+            crate::keys::shared::figure_format(&self.scenario.table()?)?,
+        );
+        self.headline_pictures(method, &table, &out, &mut files, &mut warnings);
+        summary["headline"] = method
+            .headline()
+            .iter()
+            .enumerate()
+            .map(|(k, h)| {
+                let mut d = json!({
+                    "name": h.name,
+                    "unit": h.unit,
+                    "doc": h.doc,
+                    "path": h.path,
+                    "columns": table.columns.iter().filter(|c| c.of == k).map(|c| c.column.clone()).collect::<Vec<_>>(),
+                });
+                if let Some(labels) = h.labels {
+                    d["labels"] = json!(labels);
+                }
+                d
+            })
+            .collect();
         summary["completed"] = json!(true);
         summary["error"] = Value::Null;
         if !left_out.is_empty() {
@@ -715,6 +755,274 @@ impl Ensemble {
             }
         }
         s
+    }
+}
+
+/// The headline observables of every sweep point ([`crate::method::Headline`]): per column,
+/// per point, the mean over the replicas, its standard error and why a value is missing.
+struct HeadlineTable {
+    /// The columns, in the order of the method's declaration.
+    columns: Vec<HeadlineValue>,
+    /// Per point, per column: mean, standard error, replicas with a value, replicas.
+    stats: Vec<Vec<(f64, f64, usize, usize)>>,
+    /// Per point, per column: why the mean or the error is missing.
+    why: Vec<Vec<Option<String>>>,
+    /// Per point, the replicas averaged (the finished members).
+    replicas: Vec<usize>,
+}
+
+impl HeadlineTable {
+    /// Pool the members' summaries, per point (`summaries[p]`).
+    fn pool(headline: &[Headline], summaries: &[Vec<Value>]) -> Self {
+        let values: Vec<Vec<Vec<HeadlineValue>>> = summaries
+            .iter()
+            .map(|point| {
+                point
+                    .iter()
+                    .map(|s| headline_columns(headline, s))
+                    .collect()
+            })
+            .collect();
+        let mut columns: Vec<HeadlineValue> = Vec::new();
+        for v in values.iter().flatten().flatten() {
+            if !columns.iter().any(|c| c.column == v.column) {
+                columns.push(v.clone());
+            }
+        }
+        // Declaration order first, then the order met (a labelled list's elements in turn).
+        columns.sort_by_key(|c| c.of);
+        let mut stats = Vec::new();
+        let mut why = Vec::new();
+        for (point, members) in values.iter().zip(summaries) {
+            let mut st = Vec::new();
+            let mut wh = Vec::new();
+            for c in &columns {
+                let got: Vec<Option<f64>> = point
+                    .iter()
+                    .map(|m| {
+                        m.iter()
+                            .find(|v| v.column == c.column)
+                            .and_then(|v| v.value)
+                            .filter(|x| x.is_finite())
+                    })
+                    .collect();
+                let n = got.len();
+                let finite: Vec<f64> = got.iter().flatten().copied().collect();
+                // The member's own reason for its null, from its summary's `nulls`.
+                let reason = || {
+                    members
+                        .iter()
+                        .zip(&got)
+                        .find(|(_, g)| g.is_none())
+                        .and_then(|(m, _)| m["nulls"][&c.path].as_str().map(String::from))
+                        .unwrap_or_else(|| format!("{} is not in its summary.json", c.path))
+                };
+                if n == 0 {
+                    st.push((f64::NAN, f64::NAN, 0, 0));
+                    wh.push(Some("no finished member at this point".to_string()));
+                } else if finite.is_empty() {
+                    st.push((f64::NAN, f64::NAN, 0, n));
+                    wh.push(Some(format!("no replica gave a value: {}", reason())));
+                } else if finite.len() < n {
+                    st.push((f64::NAN, f64::NAN, finite.len(), n));
+                    wh.push(Some(format!(
+                        "{} of {n} replicas gave no value, so no mean of all: {}",
+                        n - finite.len(),
+                        reason()
+                    )));
+                } else {
+                    let (mean, err) = mean_err(finite.iter().copied(), n as f64);
+                    let err = if n >= 2 { err } else { f64::NAN };
+                    st.push((mean, err, n, n));
+                    wh.push((n < 2).then(|| "one replica: no standard error".to_string()));
+                }
+            }
+            stats.push(st);
+            why.push(wh);
+        }
+        Self {
+            columns,
+            stats,
+            why,
+            replicas: summaries.iter().map(Vec::len).collect(),
+        }
+    }
+
+    /// Point `p` as the ensemble's `summary.json` holds it (`points[p].headline`), the reasons
+    /// of its nulls given to `out`.
+    fn point_json(&self, p: usize, out: &OutputDir) -> Value {
+        let mut m = serde_json::Map::new();
+        for (k, c) in self.columns.iter().enumerate() {
+            let (mean, err, n, _) = self.stats[p][k];
+            if let Some(why) = &self.why[p][k] {
+                for (x, field) in [(mean, "mean"), (err, "err")] {
+                    if !x.is_finite() {
+                        let at = format!("points[{p}].headline.{}.{field}", c.column);
+                        out.explain("summary.json", &at, why);
+                    }
+                }
+            }
+            m.insert(c.column.clone(), json!({"mean": mean, "err": err, "n": n}));
+        }
+        Value::Object(m)
+    }
+}
+
+impl Ensemble {
+    /// `headline.csv`: one row per sweep point: the swept keys' values, the replicas averaged,
+    /// then each headline observable's mean and standard error (`NAME`, `NAME_err`); a value
+    /// missing (see `summary.json`) is an empty field.
+    fn headline_csv(&self, t: &HeadlineTable) -> String {
+        let mut head: Vec<String> = self.vary.iter().map(|(k, _)| quote(k)).collect();
+        head.push("replicas".into());
+        for c in &t.columns {
+            head.push(quote(&c.column));
+            head.push(quote(&format!("{}_err", c.column)));
+        }
+        let mut s = head.join(",");
+        s.push('\n');
+        let num = |x: f64| {
+            if x.is_finite() {
+                format!("{x:e}")
+            } else {
+                String::new()
+            }
+        };
+        for (p, values) in self.points.iter().enumerate() {
+            let mut row: Vec<String> = values.iter().map(|(_, v)| quote(&cell(v))).collect();
+            row.push(t.replicas[p].to_string());
+            for &(mean, err, _, _) in &t.stats[p] {
+                row.push(num(mean));
+                row.push(num(err));
+            }
+            s.push_str(&row.join(","));
+            s.push('\n');
+        }
+        s
+    }
+
+    /// `headline_NAME.png`: each headline observable against the first swept key (a number),
+    /// with its standard error as bars; one series per value of the other swept keys (and per
+    /// label of a labelled observable). Nothing without a sweep, or for an observable with no
+    /// value at any point.
+    fn headline_pictures(
+        &self,
+        method: &dyn crate::method::Method,
+        t: &HeadlineTable,
+        out: &OutputDir,
+        files: &mut Vec<String>,
+        warnings: &mut Vec<String>,
+    ) {
+        use crate::output::plot::{Series, picture, picture_files, sweep_plot};
+        let Some((key, _)) = self.vary.first() else {
+            return;
+        };
+        let x: Option<Vec<f64>> = self
+            .points
+            .iter()
+            .map(|v| match &v[0].1 {
+                toml::Value::Integer(i) => Some(*i as f64),
+                toml::Value::Float(f) => Some(*f),
+                _ => None,
+            })
+            .collect();
+        let Some(x) = x else {
+            return;
+        };
+        // The points of each combination of the other swept keys, in order.
+        let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+        for (p, v) in self.points.iter().enumerate() {
+            let label: Vec<String> = v[1..]
+                .iter()
+                .map(|(k, v)| format!("{k} = {}", cell(v)))
+                .collect();
+            let label = label.join(", ");
+            match groups.iter_mut().find(|g| g.0 == label) {
+                Some(g) => g.1.push(p),
+                None => groups.push((label, vec![p])),
+            }
+        }
+        let replicas = self.replicas;
+        for (of, h) in method.headline().iter().enumerate() {
+            let cols: Vec<usize> = (0..t.columns.len())
+                .filter(|&k| t.columns[k].of == of)
+                .collect();
+            let any = cols
+                .iter()
+                .any(|&k| t.stats.iter().any(|s| s[k].0.is_finite()));
+            if !any {
+                continue;
+            }
+            let mut data: Vec<Curve> = Vec::new();
+            for &k in &cols {
+                let label = t.columns[k]
+                    .column
+                    .strip_prefix(h.name)
+                    .unwrap_or("")
+                    .trim_start_matches('_');
+                for (g, points) in &groups {
+                    let name: Vec<&str> = [label, g.as_str()]
+                        .into_iter()
+                        .filter(|s| !s.is_empty())
+                        .collect();
+                    data.push((
+                        name.join(", "),
+                        points.iter().map(|&p| x[p]).collect(),
+                        points.iter().map(|&p| t.stats[p][k].0).collect(),
+                        points.iter().map(|&p| t.stats[p][k].1).collect(),
+                    ));
+                }
+            }
+            let series: Vec<Series> = data
+                .iter()
+                .map(|(label, x, y, _)| Series {
+                    label: if label.is_empty() {
+                        "mean (bars: std. error)"
+                    } else {
+                        label
+                    },
+                    x,
+                    y,
+                    points: true,
+                })
+                .collect();
+            let errors: Vec<Option<&[f64]>> = data.iter().map(|d| Some(d.3.as_slice())).collect();
+            let unit = if h.unit == "-" {
+                String::new()
+            } else {
+                format!(" ({})", h.unit)
+            };
+            let name = format!("headline_{}.png", h.name);
+            let drawn = sweep_plot(
+                &out.join(&name),
+                &format!(
+                    "{}: {}, mean +- standard error of {replicas} replica(s)",
+                    method.names()[0],
+                    h.name
+                ),
+                key,
+                &format!("{}{unit}", h.name),
+                &series,
+                &errors,
+            );
+            let mut drawn_files = Vec::new();
+            picture(drawn, &name, &mut drawn_files, warnings);
+            for f in drawn_files {
+                files.extend(picture_files(out.path(), &f));
+            }
+        }
+    }
+}
+
+/// One curve of a sweep picture: label, x, mean, standard error.
+type Curve = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// A CSV field: quoted where it holds a comma, a quote or a line break.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
     }
 }
 
@@ -976,6 +1284,54 @@ mod tests {
         assert_eq!(m, 3.0);
         // s^2 = (4 + 1 + 0 + 9) / 3
         assert!((e - (14.0f64 / 3.0 / 4.0).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn headline_means_need_every_replica_and_say_why_not() {
+        let decl = crate::registry::find("bcd").unwrap().headline();
+        let member = |peak: Option<f64>, l1: f64| {
+            json!({"peak_density": peak, "theory_l1": l1, "particle_current": null,
+                   "mean_contact_density": null,
+                   "nulls": {"peak_density": "no density observed (observe.density)"}})
+        };
+        let t = HeadlineTable::pool(
+            decl,
+            &[
+                vec![member(Some(1.0), 0.1), member(Some(3.0), 0.3)],
+                vec![member(Some(2.0), 0.2), member(None, 0.4)],
+            ],
+        );
+        let names: Vec<&str> = t.columns.iter().map(|c| c.column.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "peak_density",
+                "theory_l1",
+                "particle_current",
+                "mean_contact_density"
+            ]
+        );
+        let (mean, err, n, of) = t.stats[0][0];
+        assert_eq!((mean, n, of), (2.0, 2, 2));
+        assert!(
+            (err - 1.0).abs() < 1e-15,
+            "s = sqrt(2), s / sqrt(2) = 1: {err}"
+        );
+        // One replica of two without a value: no mean, and the member's reason.
+        let (mean, _, n, of) = t.stats[1][0];
+        assert!(mean.is_nan() && n == 1 && of == 2);
+        let why = t.why[1][0].as_deref().unwrap();
+        assert!(
+            why.contains("1 of 2") && why.contains("observe.density"),
+            "{why}"
+        );
+        assert!(t.stats[1][1].0.is_finite());
+        assert!(
+            t.why[0][2]
+                .as_deref()
+                .unwrap()
+                .starts_with("no replica gave a value")
+        );
     }
 
     #[test]

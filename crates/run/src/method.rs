@@ -97,6 +97,118 @@ pub trait Method: Sync {
     fn keys(&self) -> &'static [Spec];
     /// An engine a script can step by hand (Python's engine classes).
     fn engine(&self, sc: &Scenario, seed: Option<u64>) -> Result<Box<dyn crate::Engine>>;
+    /// Its headline observables, declared once: the numbers of `summary.json` that an ensemble
+    /// tabulates and pictures against the swept key (`headline.csv`, docs/parallel.md).
+    fn headline(&self) -> &'static [Headline];
+}
+
+/// One headline observable of a method: a number (or a labelled list of numbers) of its
+/// `summary.json`, which `colloidsim ensemble` writes per sweep point with its error between
+/// replicas (`headline.csv`) and pictures against the first swept key.
+#[derive(Debug, Clone, Copy)]
+pub struct Headline {
+    /// Its column in `headline.csv` (`NAME`, `NAME_err`); with `labels`, one column per label
+    /// (`NAME_LABEL`).
+    pub name: &'static str,
+    /// Where it sits in `summary.json`: the keys from the top, joined by dots
+    /// (`compressibility.value`). A number or `null`; with `labels`, a list of them.
+    pub path: &'static str,
+    /// The path of the list of texts that name the elements of a list value (e.g. the output
+    /// times `t0.25`), or `None` for one number.
+    pub labels: Option<&'static str>,
+    /// Its unit.
+    pub unit: &'static str,
+    /// What it is.
+    pub doc: &'static str,
+    /// Why it is `null` in a run that does not measure it: where the method's summary lacks
+    /// it, the driver writes `null` with this reason ([`complete_headline`]).
+    pub absent: &'static str,
+}
+
+/// The value at the dotted `path` of `v` (`None` when a key is missing).
+pub fn at<'a>(v: &'a serde_json::Value, path: &str) -> Option<&'a serde_json::Value> {
+    path.split('.').try_fold(v, |v, k| v.get(k))
+}
+
+/// One column of the headline observables a summary gives ([`headline_columns`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadlineValue {
+    /// The column: `NAME`, or `NAME_LABEL` for an element of a labelled list.
+    pub column: String,
+    /// The observable's index in the method's declaration.
+    pub of: usize,
+    /// Where the value sits in `summary.json` (`compressibility.value`, `outer_shell.phi[2]`).
+    pub path: String,
+    /// The value (`None` where it is `null` or absent).
+    pub value: Option<f64>,
+}
+
+/// The columns a summary gives a method's headline observables, in declaration order: a
+/// number gives `NAME`; a labelled list `NAME_LABEL` per label, nothing when it is absent.
+pub fn headline_columns(headline: &[Headline], summary: &serde_json::Value) -> Vec<HeadlineValue> {
+    let mut cols = Vec::new();
+    for (of, h) in headline.iter().enumerate() {
+        let value = at(summary, h.path);
+        match h.labels {
+            None => cols.push(HeadlineValue {
+                column: h.name.to_string(),
+                of,
+                path: h.path.to_string(),
+                value: value.and_then(|v| v.as_f64()),
+            }),
+            Some(labels) => {
+                let labels = at(summary, labels).and_then(|l| l.as_array());
+                let values = value.and_then(|v| v.as_array());
+                if let (Some(labels), Some(values)) = (labels, values) {
+                    for (i, (l, v)) in labels.iter().zip(values).enumerate() {
+                        let l = l.as_str().map_or_else(|| l.to_string(), String::from);
+                        cols.push(HeadlineValue {
+                            column: format!("{}_{l}", h.name),
+                            of,
+                            path: format!("{}[{i}]", h.path),
+                            value: v.as_f64(),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    cols
+}
+
+/// Give every declared headline observable a place in `summary`: one the method did not write
+/// becomes `null` with its declared reason (`absent`), so that every summary of a method holds
+/// all of them (a labelled one is left to its method).
+pub(crate) fn complete_headline(
+    headline: &[Headline],
+    summary: &mut serde_json::Value,
+    out: &OutputDir,
+) {
+    if !summary.is_object() {
+        return;
+    }
+    for h in headline.iter().filter(|h| h.labels.is_none()) {
+        if at(summary, h.path).is_some() {
+            continue;
+        }
+        let mut v = &mut *summary;
+        let keys: Vec<&str> = h.path.split('.').collect();
+        for (i, k) in keys.iter().enumerate() {
+            let Some(map) = v.as_object_mut() else {
+                break;
+            };
+            let last = i + 1 == keys.len();
+            let next = map.entry(k.to_string()).or_insert_with(|| {
+                if last {
+                    serde_json::Value::Null
+                } else {
+                    serde_json::json!({})
+                }
+            });
+            v = next;
+        }
+        out.explain("summary.json", h.path, h.absent);
+    }
 }
 
 /// A run of one scenario: its engine, its observers and where it stands. Progress is counted
@@ -223,4 +335,63 @@ fn not_decomposed(sc: &Scenario, method: &str) -> String {
          and sweeps over ranks with `colloidsim ensemble`",
         sc.label()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    const DECLARED: &[Headline] = &[
+        Headline {
+            name: "Z",
+            path: "compressibility.value",
+            labels: None,
+            unit: "-",
+            doc: "",
+            absent: "bulk only",
+        },
+        Headline {
+            name: "phi",
+            path: "shell.phi",
+            labels: Some("shell.labels"),
+            unit: "-",
+            doc: "",
+            absent: "no profile",
+        },
+    ];
+
+    #[test]
+    fn headline_columns_name_a_labelled_list_element_by_element() {
+        let s = json!({"compressibility": {"value": 1.5},
+                       "shell": {"labels": ["t0.00", "t1.00"], "phi": [0.1, null]}});
+        let cols = headline_columns(DECLARED, &s);
+        let got: Vec<(&str, &str, Option<f64>)> = cols
+            .iter()
+            .map(|c| (c.column.as_str(), c.path.as_str(), c.value))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("Z", "compressibility.value", Some(1.5)),
+                ("phi_t0.00", "shell.phi[0]", Some(0.1)),
+                ("phi_t1.00", "shell.phi[1]", None),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_headline_the_method_did_not_write_becomes_null_with_its_reason() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = OutputDir::create(dir.path().join("o"), false).unwrap();
+        let mut s = json!({"steps": 3});
+        complete_headline(DECLARED, &mut s, &out);
+        assert_eq!(s, json!({"steps": 3, "compressibility": {"value": null}}));
+        let nulls = crate::driver::null_reasons(&s, &out);
+        assert_eq!(nulls["compressibility.value"], "bulk only");
+        // A value the method wrote is left as it is.
+        let mut s = json!({"compressibility": {"value": 2.0}});
+        complete_headline(DECLARED, &mut s, &out);
+        assert_eq!(s, json!({"compressibility": {"value": 2.0}}));
+    }
 }

@@ -227,7 +227,11 @@ fn a_mixture_writes_its_species_outputs() {
         let r = s["bmcsl"]["contact_values"][pair].as_f64().unwrap();
         assert!((g / r - 1.0).abs() < 0.15, "{pair}: {g} vs {r}");
     }
-    assert!(s.get("contact_value").is_none() && s.get("carnahan_starling").is_none());
+    // No one-component contact value (the headline contact_g is null, pointing to the pairs'),
+    // and no Carnahan-Starling reference.
+    assert!(s["contact_value"]["value"].is_null() && s.get("carnahan_starling").is_none());
+    let why = s["nulls"]["contact_value.value"].as_str().unwrap();
+    assert!(why.contains("contact_values"), "{why}");
 }
 
 /// Bad species and options without mixture support are refused naming the key.

@@ -235,8 +235,39 @@ pub fn line_plot_styled(
         800
     };
     save!(path, (width, 500), |area| draw_line_plot(
-        area, title, xlabel, ylabel, series, errors, scale, style
+        area, title, xlabel, ylabel, series, errors, scale, style, false
     ))
+}
+
+/// An observable against a swept parameter (`colloidsim ensemble`'s `headline_NAME.png`):
+/// [`line_plot_with_errors`] with each series' points marked and joined, the x axis padded so
+/// that no point sits on its edge (a single x value gets an axis about it), and the legend
+/// right of the axes.
+pub fn sweep_plot(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: &[Series],
+    errors: &[Option<&[f64]>],
+) -> Result<()> {
+    // The legend beside the axes, where it hides no point or bar.
+    let style = Style {
+        legend_outside: true,
+    };
+    save!(path, (800 + legend_width(series), 500), |area| {
+        draw_line_plot(
+            area,
+            title,
+            xlabel,
+            ylabel,
+            series,
+            errors,
+            Scale::Linear,
+            style,
+            true,
+        )
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -249,14 +280,21 @@ fn draw_line_plot<DB: DrawingBackend>(
     errors: &[Option<&[f64]>],
     scale: Scale,
     style: Style,
+    sweep: bool,
 ) -> Result<()> {
     register_font();
     let finite = |v: f64| v.is_finite() && (scale == Scale::Linear || v > 0.0);
     let (xr, yr) = data_ranges(series, errors, scale);
-    if xr.0 >= xr.1 {
+    if xr.0 > xr.1 || (xr.0 == xr.1 && !sweep) {
         return Err(anyhow!("no finite data to draw"));
     }
     let (xr, yr) = (widened(xr), widened(yr));
+    let xr = if sweep {
+        let pad = 0.05 * (xr.1 - xr.0);
+        (xr.0 - pad, xr.1 + pad)
+    } else {
+        xr
+    };
     whole.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
     let (root, side) = if style.legend_outside {
         let (l, r) = whole.split_horizontally(800);
@@ -307,7 +345,16 @@ fn draw_line_plot<DB: DrawingBackend>(
                         .zip(s.y)
                         .filter(|(x, y)| finite(**x) && finite(**y))
                         .map(|(x, y)| (*x, *y));
-                if s.points {
+                if s.points && sweep {
+                    chart
+                        .draw_series(LineSeries::new(data.clone(), c.stroke_width(1)))
+                        .map_err(|e| anyhow!("plot: {e}"))?;
+                    chart
+                        .draw_series(data.map(|p| Circle::new(p, 4, c.filled())))
+                        .map_err(|e| anyhow!("plot: {e}"))?
+                        .label(s.label)
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+                } else if s.points {
                     chart
                         .draw_series(data.map(|p| Circle::new(p, 2, c.filled())))
                         .map_err(|e| anyhow!("plot: {e}"))?

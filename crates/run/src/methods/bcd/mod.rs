@@ -9,7 +9,7 @@ pub mod params;
 use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Spec;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Headline, Method, Session};
 use crate::output::plot::{
     Labels, Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors,
     linear_picture, picture,
@@ -39,6 +39,45 @@ fn read(src: &Source, seed: Option<u64>) -> Result<(Scenario, Resolved)> {
     params::read(&src.table()?, src.base(), seed).with_context(|| src.label())
 }
 
+/// BCD's headline observables (summary.json).
+const HEADLINE: &[Headline] = &[
+    Headline {
+        name: "peak_density",
+        path: "peak_density",
+        labels: None,
+        unit: "1/length",
+        doc: "the largest value of the density profile (density.csv)",
+        absent: "no density observed (observe.density)",
+    },
+    Headline {
+        name: "theory_l1",
+        path: "theory_l1",
+        labels: None,
+        unit: "-",
+        doc: "L1 distance of the density profile to the exact equilibrium on the same bins, \
+              sum of abs(rho - rho_exact) over sum of rho_exact (density.csv, density_theory.csv)",
+        absent: "no exact equilibrium beside the density",
+    },
+    Headline {
+        name: "particle_current",
+        path: "particle_current",
+        labels: None,
+        unit: "1/time",
+        doc: "mean particle current rho v through a cross-section over the sampled time \
+              (current.csv)",
+        absent: "no current observed (observe.current)",
+    },
+    Headline {
+        name: "mean_contact_density",
+        path: "mean_contact_density",
+        labels: None,
+        unit: "1/length^2",
+        doc: "the two-particle density at contact rho2(x, x + sigma) averaged over x \
+              (contact_density.csv)",
+        absent: "no contact density observed (observe.contact_density)",
+    },
+];
+
 impl Method for BcdMethod {
     fn names(&self) -> &'static [&'static str] {
         &["bcd", "bcd-chronological"]
@@ -50,6 +89,10 @@ impl Method for BcdMethod {
 
     fn docs(&self) -> &'static str {
         "docs/bcd.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
@@ -831,9 +874,26 @@ where
         }
         _ => None,
     };
+    // Headline observables (Method::headline): the profile's peak, its L1 distance to the
+    // exact theory, the mean contact density.
+    let mut peak_density = None;
+    let mut theory_l1 = None;
+    let mut mean_contact_density = None;
     if let Some(d) = &obs.density {
         let (x, rho) = d.profile();
         let err = d.errors();
+        peak_density = Some(rho.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+        theory_l1 = theory
+            .as_ref()
+            .filter(|t| t.density.rho.len() == rho.len())
+            .map(|t| {
+                let diff: f64 = rho
+                    .iter()
+                    .zip(&t.density.rho)
+                    .map(|(a, b)| (a - b).abs())
+                    .sum();
+                diff / t.density.rho.iter().sum::<f64>()
+            });
         out.write_table("density.csv", &[("x", &x), ("rho", &rho), ("err", &err)])?;
         files.push("density.csv".into());
         let mut series = vec![Series {
@@ -887,6 +947,7 @@ where
     if let Some(cd) = &obs.contact {
         let (x, rho2) = cd.profile();
         let err = cd.errors();
+        mean_contact_density = Some(rho2.iter().sum::<f64>() / rho2.len().max(1) as f64);
         out.write_table(
             "contact_density.csv",
             &[("x", &x), ("rho2", &rho2), ("err", &err)],
@@ -1081,6 +1142,16 @@ where
             "no DDFT steady state: the ring is not driven, or the density is not observed",
         ),
         ("theory_error", "no error"),
+        ("peak_density", "no density observed (observe.density)"),
+        (
+            "theory_l1",
+            "no exact equilibrium beside the density: not observed (observe.density), a driven \
+             ring, kT = 0, a Yukawa or table pair force, or the theory failed (theory_error)",
+        ),
+        (
+            "mean_contact_density",
+            "no contact density observed (observe.contact_density)",
+        ),
     ] {
         out.explain("summary.json", key, why);
     }
@@ -1104,6 +1175,9 @@ where
             "relaxation_times": st.time / st.relaxation_time,
         })),
         "theory_error": theory_error,
+        "peak_density": peak_density,
+        "theory_l1": theory_l1,
+        "mean_contact_density": mean_contact_density,
         "warnings": warnings,
     });
     let message = format!(

@@ -30,7 +30,7 @@ use crate::bd_replica::{
 use crate::checkpoint::Envelope;
 use crate::keys::Spec;
 use crate::keys::shared::RUN_TUNE_SKIN;
-use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
+use crate::method::{Checked, Finished, Headline, Method, Session, fail_alone_over};
 use crate::output::plot::{Scale, Series, line_plot_with_errors, picture};
 use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
@@ -124,6 +124,44 @@ fn keyed(e: BulkError) -> anyhow::Error {
     }
 }
 
+/// Bulk BD's headline observables (summary.json).
+const HEADLINE: &[Headline] = &[
+    Headline {
+        name: "D",
+        path: "self_diffusion.D",
+        labels: None,
+        unit: "length^2/time",
+        doc: "long-time self-diffusion coefficient from the MSD slope between T/4 and T \
+              (self_diffusion)",
+        absent: "no MSD observed",
+    },
+    Headline {
+        name: "sedimentation_velocity",
+        path: "mean_velocity.along_force",
+        labels: None,
+        unit: "length/time",
+        doc: "mean velocity along the body force (mean_velocity)",
+        absent: "no body force (system.body_force)",
+    },
+    Headline {
+        name: "sedimentation_coefficient",
+        path: "sedimentation_coefficient.K",
+        labels: None,
+        unit: "-",
+        doc: "K = U / (mu0 F), the mean velocity along the force over one sphere's Stokes \
+              velocity",
+        absent: "no body force (system.body_force)",
+    },
+    Headline {
+        name: "pressure",
+        path: "pressure.value",
+        labels: None,
+        unit: "energy/length^3",
+        doc: "virial pressure N kT / V + (1/3V) sum r_ij . F_ij (pressure)",
+        absent: "no pressure measured",
+    },
+];
+
 impl Method for BulkBd {
     fn names(&self) -> &'static [&'static str] {
         &["bd"]
@@ -135,6 +173,10 @@ impl Method for BulkBd {
 
     fn docs(&self) -> &'static str {
         "docs/bd.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {

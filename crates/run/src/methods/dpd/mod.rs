@@ -11,7 +11,7 @@ use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::engine::{flat, rows};
 use crate::keys::{Spec, rekey_text};
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Headline, Method, Session};
 use crate::output::plot::{Scale, Series, line_plot, picture};
 use crate::output::trajectory::FrameDigest;
 use crate::output::{PairStructure, write_pair_structure};
@@ -50,6 +50,51 @@ fn resolve(src: &Source, seed: Option<u64>) -> Result<Resolved> {
     Ok(r)
 }
 
+/// DPD's headline observables (summary.json).
+const HEADLINE: &[Headline] = &[
+    Headline {
+        name: "T",
+        path: "mean_temperature_second_half",
+        labels: None,
+        unit: "energy (kT units)",
+        doc: "kinetic temperature averaged over the second half of the run (thermo.csv)",
+        absent: "no thermo sample in the second half",
+    },
+    Headline {
+        name: "P",
+        path: "mean_pressure_second_half",
+        labels: None,
+        unit: "energy/rc^3",
+        doc: "pressure (trace of the pressure tensor / 3) averaged over the second half",
+        absent: "no thermo sample in the second half",
+    },
+    Headline {
+        name: "D",
+        path: "colloid_diffusion_long_time",
+        labels: None,
+        unit: "rc^2/time (DPD time)",
+        doc: "long-time colloid self-diffusion coefficient from the MSD slope over the second \
+              half of the lags (colloid_diffusion_note)",
+        absent: "no colloids or no MSD",
+    },
+    Headline {
+        name: "viscosity",
+        path: "viscosity",
+        labels: None,
+        unit: "energy time/rc^3",
+        doc: "Green-Kubo shear viscosity from the stress autocorrelation (viscosity_note)",
+        absent: "not observed (observe.viscosity_every = 0)",
+    },
+    Headline {
+        name: "shear_viscosity",
+        path: "shear_viscosity",
+        labels: None,
+        unit: "energy time/rc^3",
+        doc: "viscosity under steady shear, <-P_xy> / shear_rate (shear_viscosity_note)",
+        absent: "no shear (run.shear_rate = 0)",
+    },
+];
+
 impl Method for DpdMethod {
     fn names(&self) -> &'static [&'static str] {
         &["dpd"]
@@ -61,6 +106,10 @@ impl Method for DpdMethod {
 
     fn docs(&self) -> &'static str {
         "docs/dpd.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {

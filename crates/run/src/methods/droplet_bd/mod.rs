@@ -10,7 +10,7 @@ use crate::bd_replica::{
 use crate::checkpoint::Envelope;
 use crate::control::Control;
 use crate::keys::Spec;
-use crate::method::{Checked, Finished, Method, Session, fail_alone_over};
+use crate::method::{Checked, Finished, Headline, Method, Session, fail_alone_over};
 use crate::output::plot::{
     Disc, SHELL_PARTICLES, Scale, SectionLabels, Series, Style, cross_section, line_plot_styled,
     merged_shells, picture,
@@ -71,6 +71,89 @@ pub(crate) fn resolve(src: &Source, seed: Option<u64>) -> Result<DropletParams> 
     params::read(&src.table()?, src.base(), seed).with_context(|| src.label())
 }
 
+/// `outer_shell` of a droplet's summary (its headline, [`HEADLINE`]): at each profile time
+/// (`fractions`), the volume fraction by centre count in the outer shell `R - w < r < R`, `w`
+/// the outermost `max(1, round(d / dr))` of the profile's equal shells of `[0, R]` (about one
+/// diameter `d`): the shells' `phi` (centres per shell volume times the particle volume)
+/// averaged with their volumes as weights, i.e. `sum v_i / V_shell` over the centres in it.
+/// `profiles[j]`: the profile `phi` and radius `R` at time `j`, or why there is none.
+pub(crate) fn outer_shell(
+    fractions: &[f64],
+    profiles: &[Result<(&[f64], f64), &str>],
+    d: f64,
+    out: &OutputDir,
+) -> serde_json::Value {
+    let mut labels = Vec::new();
+    let (mut phi, mut inner, mut radius) = (Vec::new(), Vec::new(), Vec::new());
+    for (j, (&f, prof)) in fractions.iter().zip(profiles).enumerate() {
+        let name = profile_name(f);
+        let label = name
+            .strip_prefix("profile_")
+            .and_then(|n| n.strip_suffix(".csv"))
+            .unwrap_or(&name);
+        labels.push(format!("t{label}"));
+        match prof {
+            Ok((p, r)) if !p.is_empty() && *r > 0.0 => {
+                let bins = p.len();
+                let dr = r / bins as f64;
+                let k = ((d / dr).round() as usize).clamp(1, bins);
+                let (mut num, mut vol) = (0.0, 0.0);
+                for (b, v) in p.iter().enumerate().skip(bins - k) {
+                    let w = ((b + 1) as f64 * dr).powi(3) - (b as f64 * dr).powi(3);
+                    num += v * w;
+                    vol += w;
+                }
+                phi.push(Some(num / vol));
+                inner.push(Some(r - k as f64 * dr));
+                radius.push(Some(*r));
+            }
+            Ok(_) => {
+                for (key, v) in [
+                    ("phi", &mut phi),
+                    ("inner_radius", &mut inner),
+                    ("radius", &mut radius),
+                ] {
+                    out.explain(
+                        "summary.json",
+                        &format!("outer_shell.{key}[{j}]"),
+                        "an empty profile",
+                    );
+                    v.push(None);
+                }
+            }
+            Err(why) => {
+                for (key, v) in [
+                    ("phi", &mut phi),
+                    ("inner_radius", &mut inner),
+                    ("radius", &mut radius),
+                ] {
+                    out.explain("summary.json", &format!("outer_shell.{key}[{j}]"), why);
+                    v.push(None);
+                }
+            }
+        }
+    }
+    serde_json::json!({
+        "definition": "volume fraction by centre count in the outer shell inner_radius < r < radius: the outermost max(1, round(d / dr)) shells of the profile (about one diameter), sum of the centres' particle volumes over the shell volume",
+        "labels": labels,
+        "fraction": fractions,
+        "radius": radius,
+        "inner_radius": inner,
+        "phi": phi,
+    })
+}
+
+/// Droplet BD's headline observables (summary.json).
+pub(crate) const HEADLINE: &[Headline] = &[Headline {
+    name: "outer_shell_phi",
+    path: "outer_shell.phi",
+    labels: Some("outer_shell.labels"),
+    unit: "-",
+    doc: "volume fraction (centre count) in the droplet's outer shell, about one diameter \
+          thick, at each profile time (label tF: a fraction F of the drying time)",
+    absent: "no profile taken",
+}];
+
 impl Method for DropletBd {
     fn names(&self) -> &'static [&'static str] {
         &["droplet-bd"]
@@ -82,6 +165,10 @@ impl Method for DropletBd {
 
     fn docs(&self) -> &'static str {
         "docs/droplet.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
@@ -730,6 +817,18 @@ impl BdMethod<SpeciesInterface> for DropletObs {
         if !stratification.is_null() {
             summary["stratification"] = stratification;
         }
+        let mut k = 0;
+        let profiles: Vec<Result<(&[f64], f64), &str>> = (0..n_frac)
+            .map(|j| {
+                if drawn.get(k) == Some(&j) {
+                    k += 1;
+                    Ok((means[k - 1].as_slice(), radii[j]))
+                } else {
+                    Err("no profile at this time (the run stopped before it)")
+                }
+            })
+            .collect();
+        summary["outer_shell"] = outer_shell(&p.fractions, &profiles, p.diameter, out);
         let message = format!(
             "{} replica(s) x {} steps of {} colloids in {wall_s:.1} s ({:.3e} particle-steps/s); outputs in {}",
             p.replicas,

@@ -5,7 +5,7 @@
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::keys::Spec;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Headline, Method, Session};
 use crate::methods::mpcd::common::*;
 use crate::output::plot::{
     SHELL_PARTICLES, Scale, Series, Style, line_plot, line_plot_styled, merged_shells, picture,
@@ -118,6 +118,10 @@ impl Method for DropletMpcd {
 
     fn docs(&self) -> &'static str {
         "docs/mpcd.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        crate::methods::droplet_bd::HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
@@ -912,6 +916,20 @@ impl Session for DropletSession {
         if !stratification.is_null() {
             summary["stratification"] = stratification;
         }
+        let cp = &self.acc.colloid_profiles;
+        let profiles: Vec<Result<(&[f64], f64), &str>> = (0..p.profile.fractions.len())
+            .map(|j| match (&self.colloids, cp.taken.get(j)) {
+                (None, _) => Err("no colloids"),
+                (Some(_), Some(true)) => Ok((cp.phi[j].as_slice(), cp.radius[j])),
+                _ => Err("no profile at this time (the run stopped before it)"),
+            })
+            .collect();
+        summary["outer_shell"] = crate::methods::droplet_bd::outer_shell(
+            &p.profile.fractions,
+            &profiles,
+            p.diameter,
+            out,
+        );
         let message = match failure {
             Some(f) => format!("droplet-mpcd stopped at collision {collisions}: {f}"),
             None => format!(

@@ -13,7 +13,7 @@ pub mod params;
 
 use crate::engine::flat;
 use crate::keys::Spec;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Headline, Method, Session};
 use crate::output::plot::{
     Scale, Series, Style, line_plot, line_plot_styled, line_plot_with_errors, picture,
 };
@@ -76,6 +76,28 @@ fn build(p: &McRun) -> Result<HardSphereMc> {
         })
 }
 
+/// Hard-sphere MC's headline observables (summary.json).
+const HEADLINE: &[Headline] = &[
+    Headline {
+        name: "Z",
+        path: "compressibility.value",
+        labels: None,
+        unit: "-",
+        doc: "compressibility factor Z = P / (rho kT), from the contact value (from the \
+              event chains' pressure with mc.chain_length)",
+        absent: "measured in the bulk only (system.geometry = \"bulk\")",
+    },
+    Headline {
+        name: "contact_g",
+        path: "contact_value.value",
+        labels: None,
+        unit: "-",
+        doc: "contact value g(d+) of the pair correlation",
+        absent: "measured in a one-component bulk only (system.geometry = \"bulk\"; a \
+                 mixture's are per pair, contact_values)",
+    },
+];
+
 impl Method for HsMc {
     fn names(&self) -> &'static [&'static str] {
         &["hs-mc"]
@@ -87,6 +109,10 @@ impl Method for HsMc {
 
     fn docs(&self) -> &'static str {
         "docs/mc.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {

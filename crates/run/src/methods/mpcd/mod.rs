@@ -13,7 +13,7 @@
 use crate::Scenario as Source;
 use crate::checkpoint::Envelope;
 use crate::keys::Spec;
-use crate::method::{Checked, Finished, Method, Session};
+use crate::method::{Checked, Finished, Headline, Method, Session};
 use crate::output::plot::{Scale, Series, line_plot, picture};
 use crate::output::trajectory::FrameDigest;
 use anyhow::{Context, Result, bail};
@@ -142,6 +142,27 @@ fn build_bulk_colloids(p: &BulkRun) -> Result<Option<DiscreteColloids>> {
     .context("system.colloids")
 }
 
+/// Bulk MPCD's headline observables (summary.json).
+const HEADLINE: &[Headline] = &[
+    Headline {
+        name: "viscosity",
+        path: "viscosity.value",
+        labels: None,
+        unit: "sqrt(m kT)/a^2",
+        doc: "solvent viscosity from periodic Poiseuille flow (viscosity)",
+        absent: "not measured: no Poiseuille drive (the viscosity key)",
+    },
+    Headline {
+        name: "D",
+        path: "colloid_diffusion.value",
+        labels: None,
+        unit: "a sqrt(kT/m)",
+        doc: "colloid self-diffusion coefficient, Green-Kubo of the centre-of-mass velocities \
+              (colloid_diffusion)",
+        absent: "not measured: no colloids (or no velocity autocorrelation observed)",
+    },
+];
+
 impl Method for MpcdBulk {
     fn names(&self) -> &'static [&'static str] {
         &["mpcd"]
@@ -153,6 +174,10 @@ impl Method for MpcdBulk {
 
     fn docs(&self) -> &'static str {
         "docs/mpcd.md"
+    }
+
+    fn headline(&self) -> &'static [Headline] {
+        HEADLINE
     }
 
     fn check(&self, src: &Source) -> Result<Checked> {
