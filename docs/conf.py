@@ -1,0 +1,64 @@
+"""Sphinx configuration of colloidsim's documentation site (`docs/build.sh` builds it).
+
+Sphinx with MyST, as HOOMD-blue, freud and gsd do: the Markdown pages of docs/ are read as
+they are, the tutorials are MyST-NB text notebooks executed at every build, and the reference
+is generated from the code (the CLI's parser, the Python docstrings and stubs, the keys'
+declarations through `colloidsim keys`, whose pages a Rust test keeps equal to the code).
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent
+REPO = DOCS.parent
+
+project = "colloidsim"
+author = "the colloidsim authors"
+copyright = "2026, the colloidsim authors"
+
+extensions = [
+    "myst_nb",  # MyST Markdown pages and MyST-NB text notebooks (includes myst_parser)
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+]
+
+# Pages and folders that are not part of the site: outputs, data tables, build folders.
+exclude_patterns = [
+    "_build",
+    "data",
+    "**/.ipynb_checkpoints",
+    "**.ipynb",
+    "README.md",
+]
+
+# Every warning is an error under `-W` (docs/build.sh): a broken internal link or anchor, a
+# page in no toctree, a failed cell.
+myst_heading_anchors = 4  # GitHub's anchors (`page.md#a-heading`), as the pages already use
+myst_enable_extensions = ["dollarmath", "colon_fence"]
+suppress_warnings = []
+
+# Tutorials: executed at every build, an error in a cell fails the build.
+nb_execution_mode = "force"
+nb_execution_raise_on_error = True
+nb_execution_show_tb = True
+nb_execution_timeout = 300
+nb_merge_streams = True
+
+# Python API from the installed package (its docstrings; the stubs give the extension's types).
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+autodoc_default_options = {"members": True, "undoc-members": False}
+napoleon_google_docstring = True
+napoleon_numpy_docstring = True
+
+html_theme = "furo"
+html_title = "colloidsim"
+
+sys.path.insert(0, str(DOCS))
+import generate  # noqa: E402  (docs/generate.py: the CLI pages, written before the build reads)
+
+generate.cli_pages(DOCS / "reference" / "cli")
