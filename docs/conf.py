@@ -61,4 +61,5 @@ html_title = "colloidsim"
 sys.path.insert(0, str(DOCS))
 import generate  # noqa: E402  (docs/generate.py: the CLI pages, written before the build reads)
 
-generate.cli_pages(DOCS / "reference" / "cli")
+generate.cli_pages(DOCS / "reference" / "generated" / "cli")
+generate.output_page(DOCS / "reference" / "generated" / "outputs.md")

@@ -100,3 +100,81 @@ def cli_pages(folder: Path) -> None:
         "",
     ]
     _write(folder / "index.md", "\n".join(index))
+
+
+# One tiny run of each method (and the theory where there is one), from its example with
+# overrides that make it short: the files it writes and each CSV's header, as written.
+OUTPUT_CASES = [
+    ("bcd", "bcd.md#outputs-in-the---out-folder-default-the-scenarios-name", "bcd/hard-rods-cosine.toml",
+     {"run.time": 1.0, "run.equilibrate": 0.1, "observe.trajectory": {"every": 1000}}, True),
+    ("droplet-bd", "droplet.md#outputs", "droplet/drying-bd.toml",
+     {"system.particles": 30, "replicas": 1, "observe.trajectory.every": 500}, True),
+    ("droplet-bd with RPY", "droplet.md#outputs", "droplet/drying-rpy.toml",
+     {"system.particles": 20, "replicas": 1}, False),
+    ("bd", "bd.md#outputs", "bd/sedimentation.toml",
+     {"system.particles": 20, "run.time": 2.0, "observe.trajectory.every": 500}, False),
+    ("dpd", "dpd.md#outputs", "dpd/colloids-equilibrium.toml",
+     {"system.box_length": 8.0, "run.steps": 200, "observe.structure_every": 100,
+      "observe.trajectory_every": 100, "observe.viscosity_every": 10,
+      "observe.viscosity_time": 0.1, "observe.msd_every": 20, "observe.thermo_every": 50}, False),
+    ("dpd under shear", "dpd.md#shear-flow-leesedwards", "dpd/shear.toml",
+     {"system.box_length": 5.0, "run.steps": 200, "observe.thermo_every": 20}, False),
+    ("hs-mc", "mc.md#outputs", "mc/bulk.toml",
+     {"system.particles": 64, "mc.sweeps": 400, "mc.warmup_sweeps": 50,
+      "output.gr_max": 2.0}, False),
+    ("mpcd", "mpcd.md#bulk-mpcd", "mpcd/viscosity.toml", {"system.box": 6, "run.collisions": 200}, False),
+    ("droplet-mpcd", "mpcd.md#drying-droplet-droplet-mpcd", "droplet/drying-mpcd-solvent.toml",
+     {"system.radius": 4, "drying.duration": 20, "observe.solvent.window": 100}, False),
+]
+
+KINDS = {".png": "picture", ".svg": "picture (vector)", ".gif": "animation",
+         ".gsd": "trajectory (HOOMD GSD schema)", ".json": "JSON", ".toml": "the scenario as run",
+         ".bin": "checkpoint"}
+
+
+def _describe(path: Path) -> str:
+    if path.suffix == ".csv":
+        with open(path) as f:
+            header = f.readline().strip()
+        return "columns `" + header.replace(",", ", ") + "`"
+    return KINDS.get(path.suffix, "")
+
+
+def output_page(path: Path) -> None:
+    """reference/generated/outputs.md: the files of a tiny run of each example, with headers."""
+    import tempfile
+    import warnings
+
+    import colloidsim
+
+    lines = [
+        "# Output files and their columns",
+        "",
+        "Generated at build time: one short run of an example of each method (and `colloidsim "
+        "theory` where the method has one), with the files it wrote and each CSV file's header "
+        "as written. What each column means, in which units, and the files other keys add: the "
+        "*Outputs* section of each method's page, linked below. Every run also writes "
+        "`summary.json` when it finishes (`completed`, the resolved parameters, the headline "
+        "numbers, and for each null number the reason); `checkpoint.bin` lives in the folder "
+        "while a run is under way ([run.md](../../run.md#what-every-run-shares-the-driver)).",
+        "",
+    ]
+    for title, page, example, overrides, theory in OUTPUT_CASES:
+        lines += [f"## {title}", "",
+                  f"`examples/{example}` with `{overrides}` (the files are described in "
+                  f"[{page.split('#')[0]}](../../{page})).", ""]
+        results = []
+        with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = colloidsim.run(REPO / "examples" / example, out=Path(tmp) / "run",
+                               overrides=overrides)
+            results.append(("`colloidsim run`", r))
+            if theory:
+                results.append(("`colloidsim theory`", colloidsim.theory(
+                    REPO / "examples" / example, out=Path(tmp) / "theory", overrides=overrides)))
+            for label, res in results:
+                names = sorted(set(res.files) | {p.name for p in res.out.iterdir()})
+                lines += [f"{label}:", "", "| file | holds |", "|---|---|"]
+                lines += [f"| `{n}` | {_describe(res.out / n)} |" for n in names]
+                lines.append("")
+    _write(path, "\n".join(lines))
