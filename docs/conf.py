@@ -68,3 +68,19 @@ if not os.environ.get("COLLOIDSIM_DOCS_SKIP_GENERATED"):
 
     generate.cli_pages(DOCS / "reference" / "generated" / "cli")
     generate.output_page(DOCS / "reference" / "generated" / "outputs.md")
+    _stale = generate.stale_keys_pages()
+
+
+def _warn_stale_keys(app):
+    """docs/keys pages that differ from the program's `colloidsim keys` fail the build (-W)."""
+    from sphinx.util import logging
+
+    for method in globals().get("_stale", []):
+        logging.getLogger(__name__).warning(
+            f"docs/keys/{method}.md differs from `colloidsim keys {method} --format markdown`: "
+            "write it again (crates/cli/tests/keys_pages.rs says how)"
+        )
+
+
+def setup(app):
+    app.connect("builder-inited", _warn_stale_keys)

@@ -140,6 +140,32 @@ def _describe(path: Path) -> str:
     return KINDS.get(path.suffix, "")
 
 
+def _toml(v) -> str:
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, str):
+        return f'"{v}"'
+    return str(v).lower() if isinstance(v, bool) else str(v)
+
+
+def _set_flags(overrides) -> str:
+    """Overrides as the CLI's `--set KEY=VALUE` flags."""
+    return " ".join(f"--set {k}={_toml(v).replace(' ', '')}" for k, v in overrides.items())
+
+
+def stale_keys_pages():
+    """Methods whose docs/keys/METHOD.md differs from `colloidsim keys METHOD --format
+    markdown` (crates/cli/tests/keys_pages.rs checks the same; this makes the site say so)."""
+    binary = cli_binary()
+    stale = []
+    for page in sorted((REPO / "docs" / "keys").glob("*.md")):
+        p = subprocess.run([str(binary), "keys", page.stem, "--format", "markdown"],
+                           capture_output=True, text=True)
+        if p.returncode != 0 or p.stdout != page.read_text():
+            stale.append(page.stem)
+    return stale
+
+
 def output_page(path: Path) -> None:
     """reference/generated/outputs.md: the files of a tiny run of each example, with headers."""
     import tempfile
@@ -161,7 +187,7 @@ def output_page(path: Path) -> None:
     ]
     for title, page, example, overrides, theory in OUTPUT_CASES:
         lines += [f"## {title}", "",
-                  f"`examples/{example}` with `{overrides}` (the files are described in "
+                  f"`colloidsim run examples/{example} {_set_flags(overrides)}` (the files are described in "
                   f"[{page.split('#')[0]}](../../{page})).", ""]
         results = []
         with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
