@@ -7,7 +7,9 @@ declarations through `colloidsim keys`, whose pages a Rust test keeps equal to t
 """
 
 import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
@@ -82,5 +84,12 @@ def _warn_stale_keys(app):
         )
 
 
+# The tutorials' runs write into new temporary folders (`out=None`); the kernels inherit TMPDIR,
+# so they land in one folder of this build, removed when the build ends.
+_runs = tempfile.mkdtemp(prefix="colloidsim-docs-")
+os.environ["TMPDIR"] = _runs
+
+
 def setup(app):
     app.connect("builder-inited", _warn_stale_keys)
+    app.connect("build-finished", lambda app, exc: shutil.rmtree(_runs, ignore_errors=True))
