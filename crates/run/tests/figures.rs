@@ -148,17 +148,8 @@ fn droplet_volume_fractions_by_overlap_stay_below_close_packing() {
     let dir = tempfile::tempdir().unwrap();
     let example =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/droplet/drying-bd.toml");
-    let sc = Scenario::from_path(&example)
-        .unwrap()
-        .with_overrides(&["system.particles=300".into(), "replicas=2".into()])
-        .unwrap();
     let out = dir.path().join("droplet");
-    let opts = RunOptions {
-        out: Some(out.clone()),
-        seed: None,
-        force: false,
-    };
-    colloidsim_run::run(&sc, &opts, &Control::default()).unwrap();
+    run_example(&example, &["system.particles=300", "replicas=2"], &out);
     let mut centre_max: f64 = 0.0;
     for f in ["0.00", "0.25", "0.50", "0.75", "1.00"] {
         let text = std::fs::read_to_string(out.join(format!("profile_{f}.csv"))).unwrap();
@@ -173,6 +164,21 @@ fn droplet_volume_fractions_by_overlap_stay_below_close_packing() {
     // The centre density is not a volume fraction: in a shell thinner than a sphere it can
     // exceed 1 (the case of the issue, 3.38 in the full example).
     assert!(centre_max > 0.80, "{centre_max}");
+}
+
+/// Run the scenario file `path` with `overrides` (`key=value`) into the new folder `out`.
+fn run_example(path: &Path, overrides: &[&str], out: &Path) {
+    let overrides: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
+    let sc = Scenario::from_path(path)
+        .unwrap()
+        .with_overrides(&overrides)
+        .unwrap();
+    let opts = RunOptions {
+        out: Some(out.to_path_buf()),
+        seed: None,
+        force: false,
+    };
+    colloidsim_run::run(&sc, &opts, &Control::default()).unwrap();
 }
 
 /// The columns of a CSV file by name.
@@ -213,18 +219,8 @@ fn monte_carlo_and_mpcd_droplets_write_volume_fractions_by_overlap() {
             vec!["profile_0.00.csv", "profile_1.00.csv"],
         ),
     ] {
-        let overrides: Vec<String> = overrides.into_iter().map(String::from).collect();
-        let sc = Scenario::from_path(&examples.join(file))
-            .unwrap()
-            .with_overrides(&overrides)
-            .unwrap();
         let out = dir.path().join(file.replace('/', "-"));
-        let opts = RunOptions {
-            out: Some(out.clone()),
-            seed: None,
-            force: false,
-        };
-        colloidsim_run::run(&sc, &opts, &Control::default()).unwrap();
+        run_example(&examples.join(file), &overrides, &out);
         let mut centre_max: f64 = 0.0;
         for name in csv {
             let c = columns(&out.join(name));
