@@ -154,12 +154,23 @@ fn droplet_volume_fractions_by_overlap_stay_below_close_packing() {
     for f in ["0.00", "0.25", "0.50", "0.75", "1.00"] {
         let text = std::fs::read_to_string(out.join(format!("profile_{f}.csv"))).unwrap();
         let mut lines = text.lines();
-        assert_eq!(lines.next(), Some("r,phi,phi_overlap"));
+        assert_eq!(lines.next(), Some("r,phi,phi_overlap,phi_overlap_err"));
+        let mut error_max: f64 = 0.0;
         for l in lines {
             let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
             centre_max = centre_max.max(v[1]);
             assert!((0.0..0.80).contains(&v[2]), "profile_{f}.csv: {l}");
+            // The replicas' error: none where no sphere reaches, below the value it bars.
+            assert!(
+                v[3] >= 0.0 && v[3] <= v[2].max(1e-300),
+                "profile_{f}.csv: {l}"
+            );
+            error_max = error_max.max(v[3]);
         }
+        assert!(
+            error_max > 0.0,
+            "profile_{f}.csv: no error over the replicas"
+        );
     }
     // The centre density is not a volume fraction: in a shell thinner than a sphere it can
     // exceed 1 (the case of the issue, 3.38 in the full example).

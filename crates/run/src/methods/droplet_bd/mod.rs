@@ -322,6 +322,10 @@ struct Accum {
     /// sphere–shell overlap (empty when continued from a checkpoint written without it).
     #[serde(default)]
     overlap: Vec<Vec<f64>>,
+    /// Per profile fraction: the sum of its squares, for the error over the replicas (empty
+    /// when continued from a checkpoint written without it).
+    #[serde(default)]
+    overlap_squares: Vec<Vec<f64>>,
 }
 
 impl Accum {
@@ -340,8 +344,19 @@ impl Accum {
             checkpoints: 0,
             species: Default::default(),
             overlap: vec![vec![0.0; p.bins]; n_frac],
+            overlap_squares: vec![vec![0.0; p.bins]; n_frac],
         }
     }
+}
+
+/// The standard error of the mean `s / sqrt(n)` of `n` samples per point from their `mean`
+/// and the sum of their squares (`s` the sample standard deviation).
+fn standard_errors(mean: &[f64], squares: &[f64], n: u64) -> Vec<f64> {
+    let n = n as f64;
+    mean.iter()
+        .zip(squares)
+        .map(|(m, q)| ((q / n - m * m).max(0.0) / (n - 1.0)).sqrt())
+        .collect()
 }
 
 /// Restore the running replica from a checkpoint (verified against its CRC first).
@@ -521,6 +536,11 @@ impl Observe<SpeciesInterface> for DropletObs {
                     for (a, b) in sum.iter_mut().zip(&phi) {
                         *a += b;
                     }
+                    if let Some(sq) = acc.overlap_squares.get_mut(j) {
+                        for (a, b) in sq.iter_mut().zip(&phi) {
+                            *a += b * b;
+                        }
+                    }
                 }
                 acc.counts[j] += 1;
                 acc.radii[j] = radius;
@@ -623,6 +643,7 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             frames,
             species,
             overlap,
+            overlap_squares,
             ..
         } = self.acc;
         let mut warnings = Vec::new();
@@ -630,6 +651,8 @@ impl BdMethod<SpeciesInterface> for DropletObs {
         let mut means: Vec<Vec<f64>> = Vec::new();
         let mut drawn = Vec::new();
         let mut overlaps: Vec<Vec<f64>> = Vec::new();
+        // The standard error of the overlap profile over the replicas (two or more).
+        let mut overlap_errors: Vec<Option<Vec<f64>>> = Vec::new();
         for j in 0..n_frac {
             if counts[j] == 0 {
                 continue;
@@ -643,11 +666,27 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             match overlap.get(j).filter(|o| o.len() == phi.len()) {
                 Some(o) => {
                     let o: Vec<f64> = o.iter().map(|v| v / reps).collect();
-                    out.write_table(
-                        &name,
-                        &[("r", &r_axes[j]), ("phi", &phi), ("phi_overlap", &o)],
-                    )?;
+                    let err: Option<Vec<f64>> = overlap_squares
+                        .get(j)
+                        .filter(|q| q.len() == o.len() && counts[j] >= 2)
+                        .map(|q| standard_errors(&o, q, counts[j]));
+                    match &err {
+                        Some(e) => out.write_table(
+                            &name,
+                            &[
+                                ("r", &r_axes[j]),
+                                ("phi", &phi),
+                                ("phi_overlap", &o),
+                                ("phi_overlap_err", e),
+                            ],
+                        )?,
+                        None => out.write_table(
+                            &name,
+                            &[("r", &r_axes[j]), ("phi", &phi), ("phi_overlap", &o)],
+                        )?,
+                    };
                     overlaps.push(o);
+                    overlap_errors.push(err);
                 }
                 None => {
                     out.write_table(&name, &[("r", &r_axes[j]), ("phi", &phi)])?;
@@ -692,6 +731,10 @@ impl BdMethod<SpeciesInterface> for DropletObs {
                 points: false,
             })
             .collect();
+        let errors: Vec<Option<&[f64]>> = match by_overlap {
+            true => overlap_errors.iter().map(|e| e.as_deref()).collect(),
+            false => Vec::new(),
+        };
         let title = match (p.is_static(), mobility_label(p)) {
             (false, None) => format!(
                 "Drying droplet, free-draining BD: N = {}, Pe = {}, {} replica(s)",
@@ -764,12 +807,16 @@ impl BdMethod<SpeciesInterface> for DropletObs {
                     "r / R(t) (inner shells merged to >= 10 particles)"
                 },
                 if by_overlap {
-                    "volume fraction phi(r) (sphere-shell overlap)"
+                    if errors.iter().any(Option::is_some) {
+                        "volume fraction (sphere-shell overlap; bars: error over replicas)"
+                    } else {
+                        "volume fraction (sphere-shell overlap)"
+                    }
                 } else {
                     "centre density x particle volume"
                 },
                 &series,
-                &[],
+                &errors,
                 Scale::Linear,
                 Style {
                     legend_outside: true,
@@ -920,4 +967,30 @@ fn write_cross_section(
         &labels,
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// The error of the replicas' mean from running sums equals `s / sqrt(n)` from the samples.
+    #[test]
+    fn standard_errors_from_sums_are_those_of_the_samples() {
+        let samples = [[0.31, 0.0, 0.12], [0.27, 0.0, 0.18], [0.36, 0.0, 0.09]];
+        let n = samples.len() as f64;
+        let mean: Vec<f64> = (0..3)
+            .map(|b| samples.iter().map(|s| s[b]).sum::<f64>() / n)
+            .collect();
+        let squares: Vec<f64> = (0..3)
+            .map(|b| samples.iter().map(|s| s[b] * s[b]).sum())
+            .collect();
+        let got = super::standard_errors(&mean, &squares, samples.len() as u64);
+        for b in 0..3 {
+            let var = samples
+                .iter()
+                .map(|s| (s[b] - mean[b]).powi(2))
+                .sum::<f64>()
+                / (n - 1.0);
+            assert!((got[b] - (var / n).sqrt()).abs() < 1e-12, "{b}: {got:?}");
+        }
+        assert_eq!(got[1], 0.0);
+    }
 }
