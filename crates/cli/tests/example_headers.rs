@@ -1,0 +1,93 @@
+//! The numbers example headers quote from their own seeded run: each `# header-check: PATH =
+//! VALUE, ...` line of an example names a value of its summary.json (a dotted path) and the
+//! value the header prints; the example is run as a user runs it, and the value must read the
+//! same to the digits printed. A header that drifts from what its run gives fails here.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The `(path, value as printed)` pairs of an example's `# header-check:` lines.
+fn checks(text: &str) -> Vec<(String, String)> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("# header-check:"))
+        .flat_map(|l| l.split(','))
+        .map(|item| {
+            let (path, value) = item.split_once('=').expect("PATH = VALUE");
+            (path.trim().to_string(), value.trim().to_string())
+        })
+        .collect()
+}
+
+/// `x` rounded to the decimals of `printed` (`0.7218`: four), as the header prints it.
+fn as_printed(x: f64, printed: &str) -> String {
+    let decimals = printed.split_once('.').map_or(0, |(_, d)| d.len());
+    format!("{x:.decimals$}")
+}
+
+#[test]
+fn example_headers_quote_what_their_runs_give() {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut checked = 0;
+    for dir in std::fs::read_dir(&examples).unwrap() {
+        let dir = dir.unwrap().path();
+        if !dir.is_dir() {
+            continue;
+        }
+        for file in std::fs::read_dir(&dir).unwrap() {
+            let file = file.unwrap().path();
+            if file.extension().is_none_or(|e| e != "toml") {
+                continue;
+            }
+            let wanted = checks(&std::fs::read_to_string(&file).unwrap());
+            if wanted.is_empty() {
+                continue;
+            }
+            let out = tempfile::tempdir().unwrap();
+            let run = Command::new(env!("CARGO_BIN_EXE_colloidsim"))
+                .args(["run", "--quiet", "--out"])
+                .arg(out.path().join("run"))
+                .arg(&file)
+                .output()
+                .unwrap();
+            assert!(
+                run.status.success(),
+                "{}: {}",
+                file.display(),
+                String::from_utf8_lossy(&run.stderr)
+            );
+            let summary: serde_json::Value = serde_json::from_slice(
+                &std::fs::read(out.path().join("run/summary.json")).unwrap(),
+            )
+            .unwrap();
+            for (path, printed) in wanted {
+                let value = path
+                    .split('.')
+                    .fold(&summary, |v, k| &v[k])
+                    .as_f64()
+                    .unwrap_or_else(|| {
+                        panic!("{}: summary.json has no number at {path}", file.display())
+                    });
+                assert_eq!(
+                    as_printed(value, &printed),
+                    printed,
+                    "{}: the header says {path} = {printed}, the run gives {value}",
+                    file.display()
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 3, "only {checked} header numbers checked");
+}
+
+#[test]
+fn header_checks_are_read_and_rounded_as_printed() {
+    let c = checks("# x\n# header-check: a.b = 0.7218, c = 12\nseed = 1\n");
+    assert_eq!(
+        c,
+        [("a.b".into(), "0.7218".into()), ("c".into(), "12".into())]
+    );
+    assert_eq!(as_printed(0.721839, "0.7218"), "0.7218");
+    assert_eq!(as_printed(0.0496255, "0.0496"), "0.0496");
+    assert_ne!(as_printed(0.7229, "0.7218"), "0.7218");
+}
