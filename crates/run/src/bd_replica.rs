@@ -140,7 +140,7 @@ impl<E: External> Replica<E> {
     }
 
     /// Add `forces` (input order; empty: none) to the systematic forces of every step.
-    pub(crate) fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<()> {
+    pub(crate) fn set_extra_forces(&mut self, forces: &[[f64; 3]]) -> Result<()> {
         match self {
             Self::Free(s) => s.set_extra_forces(forces)?,
             Self::Hydro(s) => s.set_extra_forces(forces)?,
@@ -840,7 +840,7 @@ impl<E: External> crate::Engine for ReplicaEngine<E> {
             change.seed.unwrap_or(self.seed),
         );
         let mut sim = (self.rebuild)(p, step, seed)?;
-        sim.set_extra_forces(self.extra.clone())?;
+        sim.set_extra_forces(&self.extra)?;
         (self.sim, self.seed) = (sim, seed);
         Ok(())
     }
@@ -849,9 +849,10 @@ impl<E: External> crate::Engine for ReplicaEngine<E> {
         if !forces.is_empty() {
             check_array("forces", forces, n, 3)?;
         }
-        let f = rows(forces);
-        self.sim.set_extra_forces(f.clone())?;
-        self.extra = f;
+        self.extra.clear();
+        self.extra
+            .extend(forces.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        self.sim.set_extra_forces(&self.extra)?;
         Ok(())
     }
 }

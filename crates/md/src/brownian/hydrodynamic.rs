@@ -209,7 +209,7 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
 
     /// Add `forces` (input order; empty: none) to the systematic forces of every step from
     /// now on, as a further external field would be.
-    pub fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<(), HydroBdError> {
+    pub fn set_extra_forces(&mut self, forces: &[[f64; 3]]) -> Result<(), HydroBdError> {
         if !forces.is_empty() && forces.len() != self.particles.len() {
             return Err(HydroBdError::Invalid(format!(
                 "{} extra forces for {} particles",
@@ -217,7 +217,8 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
                 self.particles.len()
             )));
         }
-        self.extra = forces;
+        self.extra.clear();
+        self.extra.extend_from_slice(forces);
         Ok(())
     }
 

@@ -728,7 +728,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
 
     /// Add `forces` (input order; empty: none) to the systematic forces of every step from
     /// now on, as a further external field would be (on one process).
-    pub fn set_extra_forces(&mut self, forces: Vec<[f64; 3]>) -> Result<(), BdError> {
+    pub fn set_extra_forces(&mut self, forces: &[[f64; 3]]) -> Result<(), BdError> {
         if !forces.is_empty() && (forces.len() != self.tag.len() || self.domain.is_some()) {
             return Err(BdError::Invalid(format!(
                 "{} extra forces for {} particles{}",
@@ -741,7 +741,9 @@ impl<P: Pair, E: External> Brownian<P, E> {
                 }
             )));
         }
-        self.extra = forces;
+        // Copied into the kept buffer: a script setting them every step allocates nothing.
+        self.extra.clear();
+        self.extra.extend_from_slice(forces);
         Ok(())
     }
 
