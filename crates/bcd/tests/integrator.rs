@@ -4,7 +4,7 @@
 //! the density in the hard-rods paper's cosine potential at equal cost per step.
 
 #[allow(dead_code)] // shares the validation tests' helpers; uses only some
-mod common;
+use crate::common;
 
 use colloidsim_bcd::forces::{NoField, NoPair};
 use colloidsim_bcd::observe::DensityProfile;

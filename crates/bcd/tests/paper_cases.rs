@@ -3,7 +3,7 @@
 //! {0.1, 1, 10}, against the exact theory. Long: `cargo test -p colloidsim-bcd --test paper_cases
 //! --release -- --ignored --nocapture`; the table it prints is in docs/validation.md.
 
-mod common;
+use crate::common;
 
 use common::{Case, compare};
 

@@ -5,7 +5,7 @@
 //! the exact results at steps where the pooling update is visibly off.
 
 #[allow(dead_code)] // shares the validation tests' helpers; uses only some
-mod common;
+use crate::common;
 
 use colloidsim_bcd::forces::{NoField, NoPair};
 use colloidsim_bcd::observe::{ContactDensity, DensityProfile};

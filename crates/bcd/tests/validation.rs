@@ -1,7 +1,7 @@
 //! Validation against exact results, with tolerances from the runs' statistical errors
 //! (fixed seeds). Each test also checks that a deliberately wrong reference would be rejected.
 
-mod common;
+use crate::common;
 
 use colloidsim_bcd::forces::{NoField, NoPair, Sticky};
 use colloidsim_bcd::observe::ContactDensity;

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{assert_same_outputs, colloidsim as run, complete, files, p, restarts_bitwise, text};
 
 /// summary.json fields that depend on the session (timing, threads) or on when the neighbour

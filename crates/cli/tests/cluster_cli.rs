@@ -10,7 +10,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
-mod common;
+use crate::common;
 use common::{TINY_BCD as TINY, assert_same_outputs, assert_same_tree, cli, text};
 
 /// The summary fields of a BCD run that differ between runs of the same scenario.

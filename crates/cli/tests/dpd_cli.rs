@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 use common::{assert_same_outputs, files, text};
 
 /// summary.json fields that depend on the session (timing); neighbor_builds must match.

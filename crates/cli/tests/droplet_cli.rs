@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 use common::{assert_same_outputs, colloidsim as run, files, p, text};
 
 /// summary.json fields that depend on the session (timing) or on when the neighbour list was

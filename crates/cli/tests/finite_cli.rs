@@ -3,7 +3,7 @@
 //! still not finite is written as an empty field and listed in summary.json (`non_finite`) with
 //! its reason; values that almost surely mean a unit mistake are warned of by `check` and `run`.
 
-mod common;
+use crate::common;
 use common::{cli, text};
 use std::path::Path;
 

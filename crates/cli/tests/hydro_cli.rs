@@ -4,7 +4,7 @@
 //! through the failure path, naming the step, and bad `[hydrodynamics]` input is refused before
 //! anything is written.
 
-mod common;
+use crate::common;
 use common::{colloidsim as run, complete, files, p, restarts_bitwise, text};
 
 /// summary.json fields that depend on the session (timing) or on when the neighbour list was

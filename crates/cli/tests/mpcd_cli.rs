@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 use common::{assert_same_outputs, text};
 
 /// summary.json fields that depend on the session's timing or machine.

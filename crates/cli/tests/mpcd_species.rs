@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{assert_same_outputs, cli, text};
 
 const VOLATILE: &[&str] = &["wall_seconds", "particle_updates_per_second", "threads"];

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 use common::text;
 
 /// A small hard-sphere Monte Carlo run (a fraction of a second) with a trajectory.

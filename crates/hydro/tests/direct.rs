@@ -5,7 +5,7 @@ use colloidsim_hydro::direct::dense_matrix;
 use colloidsim_hydro::lanczos::LanczosParams;
 use colloidsim_hydro::{DirectRpy, Mobility, NoiseKey};
 
-mod common;
+use crate::common;
 use common::fdt_deviation;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::PI;

@@ -164,7 +164,7 @@ fn single_sphere_self_mobility_follows_hasimoto() {
     }
 }
 
-mod common;
+use crate::common;
 
 #[test]
 fn pse_noise_covariance_is_2_kt_dt_m() {

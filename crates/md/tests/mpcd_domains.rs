@@ -3,7 +3,7 @@
 //! set of particles, for any number of ranks, including one layer of cells per rank (where a
 //! fast particle crosses a whole domain in a step and is passed on).
 
-mod common;
+use crate::common;
 
 use colloidsim_md::SimBox;
 use colloidsim_md::mpcd::{Acceleration, Confinement, MpcdError, Srd, SrdParams};

@@ -3,8 +3,7 @@
 //! be bitwise the single-rank run for any number of ranks: periodic (with a body force that
 //! drives particles across every domain face and the periodic seam) and in a drying droplet.
 
-#[path = "../../md/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 use colloidsim_md::brownian::ListState;
 use colloidsim_md::{BdError, BdParams, Brownian, Integrator};

@@ -2,8 +2,7 @@
 //! ([`LocalRanks`]); the MPI ranks of the CLI run the same code. A decomposed run must be
 //! bitwise the single-rank run, for any number of ranks, with lists or cells, with colloids.
 
-#[path = "../../md/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::{Dpd, DpdError, NeighborMode, Thermo};

@@ -7,8 +7,7 @@ use colloidsim_particles::{Particles, SimBox};
 use colloidsim_run::methods::dpd::monitor::TemperatureMonitor;
 use colloidsim_run::methods::dpd::params;
 
-#[path = "../../md/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 /// Mean and standard error from `blocks` block averages of `x`.
 fn mean_and_error(x: &[f64], blocks: usize) -> (f64, f64) {

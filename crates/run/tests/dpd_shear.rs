@@ -9,8 +9,7 @@ use colloidsim_md::dpd::{Dpd, NeighborMode};
 use colloidsim_particles::Particles;
 use colloidsim_run::methods::dpd::params;
 
-#[path = "../../md/tests/common/mod.rs"]
-mod common;
+use crate::common;
 use common::{brute_force, on_ranks};
 
 /// FNV-1a over the bits of `x`.

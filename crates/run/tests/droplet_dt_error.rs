@@ -2,7 +2,7 @@
 //! static droplet is clearly biased, Leimkuhler–Matthews' markedly less, at the same cost per
 //! step (docs/validation.md, *Time-step error of the droplet BD*).
 
-mod dt_error;
+use crate::dt_error;
 
 use colloidsim_md::Integrator;
 

@@ -1,0 +1,9 @@
+//! The integration tests of `colloidsim-md`, one test binary: each file of this folder is a module,
+//! so that they are compiled and linked once and their tests share the threads of one run
+//! (`cargo test -p colloidsim-md --test integration MODULE::` runs one file's).
+
+mod common;
+
+mod integrator;
+mod mpcd_domains;
+mod validation;
