@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Pictures of the RPY DDFT with the Monte Carlo g2 (crates/mc/examples/ddft_mc_g2.rs output
-folders; docs/theory-droplet.md, "The Monte Carlo g2 in the flux").
+folders; docs/reports/theory-droplet-validation.md, "The Monte Carlo g2 in the flux").
 
 Usage:
   plot_ddft_mc_g2.py profiles PICTURE.png DIR=LABEL [DIR=LABEL ...]
@@ -12,7 +12,8 @@ Usage:
       densest bin near the interface and in a bin a third of the way out
   plot_ddft_mc_g2.py bd PICTURE.png DIR=LABEL [DIR=LABEL ...]
       fractions of the particles beyond 0.7 R(t) and 0.85 R(t) at 25/50/75/100 % of the drying
-      time (counted as in the table of docs/theory-droplet.md: see outer_fractions), with the
+      time (counted as in the table of docs/reports/theory-droplet-validation.md: see
+      outer_fractions), with the
       BD+RPY droplet of that table (N = 1000, one droplet, binomial errors)
 """
 import csv
@@ -25,7 +26,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-# BD+RPY, examples/droplet/drying-rpy.toml (docs/theory-droplet.md, "Against BD+RPY").
+# BD+RPY, examples/droplet/drying-rpy.toml (docs/reports/theory-droplet-validation.md).
 BD = {
     0.7: [(0.25, 0.751, 0.014), (0.5, 0.832, 0.012), (0.75, 0.881, 0.010), (1.0, 0.830, 0.012)],
     0.85: [(0.25, 0.455, 0.016), (0.5, 0.589, 0.016), (0.75, 0.708, 0.014), (1.0, 0.607, 0.015)],
@@ -102,8 +103,8 @@ def pairs(picture, d, stage):
 
 def outer_fractions(d):
     """Fractions of the particles beyond 0.7 R(t) and "0.85 R(t)" as the table of
-    docs/theory-droplet.md counts them: 30 equal bins of [0, R(t)], the bins whose centre lies
-    beyond c R(t), normalised by the particles in all 30 bins. For c = 0.85 the bin centred at
+    docs/reports/theory-droplet-validation.md counts them: 30 equal bins of [0, R(t)], the bins
+    whose centre lies beyond c R(t), normalised by the particles in all 30 bins. For c = 0.85 the bin centred at
     exactly 0.85 R fell out at 25 and 50 % and in at 75 and 100 % (floating-point rounding), so
     "0.85" means r > 0.867 R at 25/50 % and r > 0.833 R at 75/100 %; reproduced here so that the
     DDFT is counted exactly as the BD droplet was (this reproduces that table's Trokhymchuk

@@ -1,4 +1,5 @@
-//! A bidisperse drying droplet with the radial mixture DDFT (docs/theory-droplet.md, "Mixtures").
+//! A bidisperse drying droplet with the radial mixture DDFT (docs/theory-droplet.md, "Mixtures";
+//! the run: docs/reports/theory-droplet-validation.md, "A bidisperse drying run").
 //!
 //! `cargo run --release -p colloidsim-dft --example binary_drying -- [free-draining|rpy] [white-bear|rosenfeld] [dr]`
 //!

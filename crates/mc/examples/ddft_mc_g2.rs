@@ -1,6 +1,6 @@
 //! The drying droplet's RPY DDFT with the pair correlation measured by hard-sphere Monte Carlo at
-//! the DDFT's own density (issue #15, item 4; docs/theory-droplet.md, "The Monte Carlo g2 in the
-//! flux").
+//! the DDFT's own density (issue #15, item 4; docs/reports/theory-droplet-validation.md, "The
+//! Monte Carlo g2 in the flux").
 //!
 //! ```text
 //! cargo run --release -p colloidsim-mc --example ddft_mc_g2 -- OUT [key=value ...]

@@ -553,7 +553,7 @@ const CELL_MIN: f64 = 2.0;
 /// fuller cells: fewer moves leave their cell, and the gathered neighbours amortise over more
 /// moves), or 2 in boxes too short for 4 such cells (then `s >= d`, the edge being `>= 2 d`).
 /// A multiple of 4 gives each parity an even number of layers, which two threads share
-/// equally (an odd number of 5 layers capped 2 threads at 5/3 = 1.67x; docs/mc.md, "Speed").
+/// equally (an odd number of 5 layers capped 2 threads at 5/3 = 1.67x; docs/reports/mc-validation.md, "Speed").
 /// A function of the geometry alone, so a run does not depend on the thread count.
 fn cells_per_edge(edge: f64, d: f64) -> usize {
     let fit = (edge / (CELL_MIN * d)).floor() as usize;

@@ -17,7 +17,7 @@
 //! - [`params`]: the parameters of a run ([`params::McRun`]) and the engine they start.
 //! - [`bench`]: trial moves per second (`colloidsim bench mc`).
 //!
-//! Conventions and validation numbers: docs/mc.md.
+//! Conventions: docs/mc.md; validation numbers: docs/reports/mc-validation.md.
 
 pub mod bench;
 pub mod engine;

@@ -1,6 +1,6 @@
 //! Event-chain Monte Carlo (`colloidsim_mc::engine::chain`): hard constraints kept, restarts
 //! bitwise, the event-chain pressure against Carnahan–Starling, the equilibrium of droplets
-//! against local moves (tolerances from the runs' own block errors; docs/mc.md lists the numbers).
+//! against local moves (tolerances from the runs' own block errors; docs/reports/mc-validation.md lists the numbers).
 
 use colloidsim_mc::engine::chain::free_path;
 use colloidsim_mc::engine::{HardSphereMc, McParams};

@@ -321,7 +321,7 @@ fn binary_z(n: usize, xl: f64, phi: f64, warmup: u64, sweeps: u64, blocks: u64) 
 /// phi = 0.3 with a quarter and a half of large spheres, each within 3 standard errors of
 /// BMCSL. N = 1000, 2000 warm-up sweeps, 20 blocks of 1000 sweeps; some 20 s each in
 /// release: `cargo test --release -p colloidsim-mc --test mixture -- --ignored --nocapture`.
-/// Measured: see docs/mc.md ("Mixtures").
+/// Measured: see docs/reports/mc-validation.md ("Validation").
 #[test]
 #[ignore = "release: some 40 s"]
 fn binary_bulk_z_matches_bmcsl_at_two_compositions() {

@@ -1,5 +1,5 @@
 //! Validation of the hard-sphere Monte Carlo against exact and published results, with
-//! tolerances from the runs' own block-average errors (docs/mc.md lists the numbers).
+//! tolerances from the runs' own block-average errors (docs/reports/mc-validation.md lists the numbers).
 
 use colloidsim_mc::engine::{HardSphereMc, McError, McParams};
 use colloidsim_mc::geometry::Geometry;
@@ -531,7 +531,7 @@ fn profile_misfit(
 /// MC against Rosenfeld FMT in the hard-wall droplet R = 6 d, N = 518 (mean phi 0.3): in the
 /// interior (more than 1 d from the wall) within the MC's errors (chi-square at p ~ 1e-4);
 /// next to the wall Rosenfeld's own error shows (its first minimum 5 % low, contact 1 % high,
-/// docs/mc.md), so every bin is held to 4 SE + 5 %. An FMT with 2 % fewer particles fails.
+/// docs/reports/mc-validation.md), so every bin is held to 4 SE + 5 %. An FMT with 2 % fewer particles fails.
 #[test]
 fn hard_wall_profile_matches_the_radial_fmt_equilibrium() {
     let (n, radius) = (518, 6.0);

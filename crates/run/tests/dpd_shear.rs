@@ -364,8 +364,8 @@ fn dpd_water_under_shear_has_the_linear_profile_and_the_green_kubo_viscosity() {
     assert!((r.slope.0 - RATE).abs() < 4.0 * r.slope.1, "{r:?}");
     // The temperature of the peculiar velocities: kT plus the viscous heating (3 %).
     assert!((r.temperature - 1.0).abs() < 0.06, "{r:?}");
-    // The viscosity agrees with Green-Kubo (0.832 +- 0.012 at t_max = 2, docs/dpd.md) within
-    // 4 combined standard errors.
+    // The viscosity agrees with Green-Kubo (0.832 +- 0.012 at t_max = 2,
+    // docs/reports/dpd-validation.md) within 4 combined standard errors.
     let (gk, gk_err) = (0.832, 0.012);
     let tol = 4.0 * (r.eta.1.powi(2) + gk_err * gk_err).sqrt();
     assert!(r.eta.1 < 0.03, "{r:?}");
@@ -399,8 +399,8 @@ fn shear_viscosity(setup: &DpdSetup, rate: f64, steps: u64) -> (f64, f64) {
 /// The suspension at phi = 0.1 is more viscous than its solvent by the dilute theory:
 /// `eta_r = 1 + 2.5 phi + 5.2 phi^2 = 1.302` (Einstein with Batchelor's 1977 hydrodynamic pair
 /// term; 6.2 with the Brownian stress gives 1.312) within 4 standard errors of
-/// the ratio (the long runs of docs/dpd.md give 1.271 +- 0.015), and certainly above 1: a
-/// suspension whose colloids did not take part in the flow would fail.
+/// the ratio (the long runs of docs/reports/dpd-validation.md give 1.271 +- 0.015), and
+/// certainly above 1: a suspension whose colloids did not take part in the flow would fail.
 #[test]
 fn the_colloid_suspension_has_the_dilute_relative_viscosity() {
     let (rate, steps) = (0.2, 16_000);
@@ -414,7 +414,7 @@ fn the_colloid_suspension_has_the_dilute_relative_viscosity() {
     assert!((r - 1.302).abs() < 4.0 * err, "eta_r = {r} +- {err}");
 }
 
-/// The table of docs/dpd.md: longer runs at three rates (`-- --ignored --nocapture`).
+/// The table of docs/reports/dpd-validation.md: longer runs at three rates (`-- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn shear_viscosity_table() {

@@ -1,6 +1,6 @@
 //! Green–Kubo viscosity of the DPD solvent (issue 19): the standard DPD fluid of Groot & Warren
 //! (a = 25 kT/rc, gamma = 4.5, density 3, kT = 1, rc = 1) against the kinetic theory of Marsh,
-//! Backx & Ernst and against the long run recorded in docs/dpd.md.
+//! Backx & Ernst and against the long run recorded in docs/reports/dpd-validation.md.
 
 use colloidsim_md::dpd::setup::DpdSetup;
 use colloidsim_md::dpd::viscosity::Estimate;
@@ -90,7 +90,8 @@ fn the_pressure_step_changes_nothing_and_gives_the_thermo_pressure() {
     assert!(a.snapshot() == b.snapshot() && b.snapshot() == c.snapshot());
 }
 
-/// The long runs recorded in docs/dpd.md (`long_green_kubo_viscosity_of_the_solvent`):
+/// The long runs recorded in docs/reports/dpd-validation.md
+/// (`long_green_kubo_viscosity_of_the_solvent`):
 /// viscosity and block standard error at kT = 1 (t_max = 1) and kT = 0.1 (t_max = 2).
 const LONG_KT1: (f64, f64) = (0.8013, 0.0095);
 const LONG_KT01: (f64, f64) = (0.3203, 0.0063);
@@ -130,7 +131,8 @@ fn green_kubo_viscosity_of_the_standard_fluid() {
         e[0]
     );
     // Marsh's kinetic theory neglects the conservative force: 0.957 is 15-20 % above the
-    // measured value (docs/dpd.md); more than 35 % off would be a different fluid.
+    // measured value (docs/reports/dpd-validation.md); more than 35 % off would be a different
+    // fluid.
     assert!((e[0].value / (k + d) - 1.0).abs() < 0.35, "{:?}", e[0]);
 }
 
@@ -156,7 +158,7 @@ fn green_kubo_viscosity_of_the_notes_solvent() {
 }
 
 #[test]
-#[ignore = "long validation (~10 min on 2 cores); results in docs/dpd.md"]
+#[ignore = "long validation (~10 min on 2 cores); results in docs/reports/dpd-validation.md"]
 fn long_green_kubo_viscosity_of_the_solvent() {
     // Ten times the CI runs, other seeds.
     let a = green_kubo(
@@ -183,7 +185,7 @@ fn long_green_kubo_viscosity_of_the_solvent() {
         b[1].error
     );
     // The runs are deterministic (fixed seeds; bitwise for any number of threads): the numbers
-    // recorded above and in docs/dpd.md come back to their last digit.
+    // recorded above and in docs/reports/dpd-validation.md come back to their last digit.
     for (x, y) in [(a[0], LONG_KT1), (b[0], LONG_KT01)] {
         assert!(
             (x.value - y.0).abs() < 1e-4 && (x.error - y.1).abs() < 1e-4,
