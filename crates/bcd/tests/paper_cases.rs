@@ -1,6 +1,6 @@
 //! The hard-rods paper's validation set (Sec. III C and IV B): density profiles of hard rods for
 //! sigma in {0.2, 0.5, 0.8} x mean density in {0.2, 0.5, 0.8}, and sticky rods gamma in
-//! {0.1, 1, 10}, against the exact theory. Long: `cargo test -p colloidsim-bcd --test paper_cases
+//! {0.1, 1, 10}, against the exact theory. Long: `cargo test -p colloidsim-bcd --test integration paper_cases::
 //! --release -- --ignored --nocapture`; the table it prints is in docs/validation.md.
 
 use crate::common;

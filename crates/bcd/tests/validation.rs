@@ -87,7 +87,7 @@ fn single_file_diffusion_follows_the_exact_law() {
 /// without hydrodynamics), where `S(0)` is that of the simulated finite-range model from the
 /// exact isobaric solution. The hard-rod law (`S(0) = (1 - rho sigma)^2`), 26 % lower, must be
 /// rejected. 16 replicas, equilibrated for 5 time units from random placement. About 5 minutes
-/// on one core (`cargo test --release -p colloidsim-bcd --test validation -- --ignored sticky`).
+/// on one core (`cargo test --release -p colloidsim-bcd --test integration validation::sticky -- --ignored`).
 #[test]
 #[ignore]
 fn sticky_single_file_diffusion_follows_the_exact_law() {
@@ -506,8 +506,8 @@ fn peak_deviation(h: &[f64], t: &[f64]) -> f64 {
 /// fills) and extrapolated to dt = 0. The extrapolation must meet the Monte Carlo peak within
 /// 3 combined errors and reject the eps -> 0 theory; the largest step (the paper's Eq. 34
 /// would allow larger) must lie measurably below (docs/figures.md, "All of Fig. 6"). 17 min of
-/// CPU, 13.5 min on 2 shared cores (`cargo test --release -p colloidsim-bcd --test validation --
-/// --ignored time_step`); with 5 instead of 10 time units per run it failed (the theory not
+/// CPU, 13.5 min on 2 shared cores (`cargo test --release -p colloidsim-bcd --test integration
+/// validation::sticky_dense_time_step -- --ignored`); with 5 instead of 10 time units per run it failed (the theory not
 /// rejected: +0.68 % +- 0.39 %).
 #[test]
 #[ignore]

@@ -5,7 +5,7 @@
 //! outputs fails here.
 //!
 //! The reference was written by the binary of commit 705c480 with
-//! `COLLOIDSIM_BLESS=1 cargo test -p colloidsim-cli --test examples_golden`; bless again only
+//! `COLLOIDSIM_BLESS=1 cargo test -p colloidsim-cli --test integration examples_golden::`; bless again only
 //! for a change that is meant to change outputs, and say so in the commit.
 
 use std::collections::BTreeMap;

@@ -320,7 +320,7 @@ fn binary_z(n: usize, xl: f64, phi: f64, warmup: u64, sweeps: u64, blocks: u64) 
 /// The binary hard-sphere equation of state (issue #43's check): Z of a 1:2 mixture at
 /// phi = 0.3 with a quarter and a half of large spheres, each within 3 standard errors of
 /// BMCSL. N = 1000, 2000 warm-up sweeps, 20 blocks of 1000 sweeps; some 20 s each in
-/// release: `cargo test --release -p colloidsim-mc --test mixture -- --ignored --nocapture`.
+/// release: `cargo test --release -p colloidsim-mc --test integration mixture:: -- --ignored --nocapture`.
 /// Measured: see docs/reports/mc-validation.md ("Validation").
 #[test]
 #[ignore = "release: some 40 s"]

@@ -3,7 +3,7 @@
 //! panic or an abort (proptest reports a panic as a failure with the input that caused it).
 //!
 //! The cases are drawn from a fixed seed, so that every run (CI's too) checks the same inputs;
-//! `COLLOIDSIM_FUZZ_RANDOM=1 cargo test -p colloidsim-run --test fuzz` draws new ones, and a
+//! `COLLOIDSIM_FUZZ_RANDOM=1 cargo test -p colloidsim-run --test integration fuzz::` draws new ones, and a
 //! failure found so is saved in `fuzz.proptest-regressions` and replayed by every later run.
 
 use colloidsim_run::{Control, RunOptions, Scenario};

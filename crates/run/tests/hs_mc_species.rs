@@ -524,7 +524,7 @@ fn a_static_bidisperse_droplet_matches_the_binary_fmt() {
 /// of 10,000 sweeps; the integrated test and the chi-square of every bin (block error and 2 % of
 /// the FMT in quadrature) within its p ~ 1e-4 limit. With `COLLOIDSIM_FIGURE=<png>` it draws
 /// the comparison (docs/img/hs-mc-bidisperse-fmt.png):
-/// `COLLOIDSIM_FIGURE=docs/img/hs-mc-bidisperse-fmt.png cargo test --release -p colloidsim-run --test hs_mc_species -- --ignored --nocapture`
+/// `COLLOIDSIM_FIGURE=docs/img/hs-mc-bidisperse-fmt.png cargo test --release -p colloidsim-run --test integration hs_mc_species:: -- --ignored --nocapture`
 #[test]
 #[ignore = "release: about 30 s"]
 fn a_static_bidisperse_droplet_matches_the_binary_fmt_long() {
