@@ -35,7 +35,7 @@ SCENARIO = os.path.join(HERE, "examples", "droplet", "drying-bd.toml")
 def read_profile(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
-    return [float(r["r"]) for r in rows], [float(r["phi"]) for r in rows]
+    return [float(r["r"]) for r in rows], [float(r["rho_v"]) for r in rows]
 
 
 def n3_of_histogram(r, phi, diameter=1.0, samples=40):

@@ -57,7 +57,7 @@ def outer_fraction(c, summary, fr, cut=0.8):
     big_r = radius(summary, fr)
     k = round(cut * len(r))
     inside = sum(
-        c["phi"][j] * 4 * math.pi / 3 * ((r[j] + dr / 2) ** 3 - (r[j] - dr / 2) ** 3) / vp
+        c["rho_v"][j] * 4 * math.pi / 3 * ((r[j] + dr / 2) ** 3 - (r[j] - dr / 2) ** 3) / vp
         for j in range(k)
     )
     q = 1 - inside / n
@@ -81,7 +81,7 @@ def main():
                 continue
             c = columns(path)
             r = radius(summary, fr)
-            x, phi = merged(c["r"], c["phi"], merge)
+            x, phi = merged(c["r"], c["rho_v"], merge)
             ax.plot([v / r for v in x], phi, label=label, lw=1.4, marker="o", ms=3)
     for ax, fr in zip(axes, fractions):
         ax.set_title(f"t = {fr:.0%} of the drying time")

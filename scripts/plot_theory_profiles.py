@@ -30,7 +30,7 @@ def load(folder):
             continue
         radius = math.sqrt(p["r0"] ** 2 - p["alpha"] * t / (4 * math.pi))
         with open(path) as f:
-            rows = [(float(r["r"]) / radius, float(r["phi"])) for r in csv.DictReader(f)]
+            rows = [(float(r["r"]) / radius, float(r["rho_v"])) for r in csv.DictReader(f)]
         out[frac] = rows
     return s, out
 

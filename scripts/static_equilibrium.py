@@ -112,10 +112,10 @@ def main():
     rows = (len(results) + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
     for ax, (phi, bd, mc, th) in zip(axes.flat, results):
-        ax.errorbar(bd["r"], bd["phi"], yerr=bd["err"], fmt="o", ms=3, label="BD (WCA)")
-        ax.errorbar(mc["r"], mc["phi"], yerr=mc["err"], fmt="s", ms=2.5, label="hard-sphere MC")
-        ax.plot(th["r"], th["phi"], "-", color="k", lw=1, label="Rosenfeld FMT equilibrium")
-        ax.set_ylim(0.0, 1.35 * max(th["phi"]))
+        ax.errorbar(bd["r"], bd["rho_v"], yerr=bd["rho_v_err"], fmt="o", ms=3, label="BD (WCA)")
+        ax.errorbar(mc["r"], mc["rho_v"], yerr=mc["rho_v_err"], fmt="s", ms=2.5, label="hard-sphere MC")
+        ax.plot(th["r"], th["rho_v"], "-", color="k", lw=1, label="Rosenfeld FMT equilibrium")
+        ax.set_ylim(0.0, 1.35 * max(th["rho_v"]))
         ax.set_title(f"mean phi = {phi}")
         ax.set_xlabel("r / d")
         ax.set_ylabel("phi (bin average)")

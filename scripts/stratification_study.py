@@ -557,12 +557,12 @@ def profile_figure(args, methods, pe, phi0, fraction, path):
         x = [float(r["r"]) / radius for r in runs[0]]
         for ax, sp in zip(axes, ("A", "B")):
             if len(runs) > 1:
-                cols = list(zip(*[[float(r[f"phi_{sp}"]) for r in rs] for rs in runs]))
+                cols = list(zip(*[[float(r[f"rho_v_{sp}"]) for r in rs] for rs in runs]))
                 y = [sum(c) / len(c) for c in cols]
                 e = [math.sqrt(sum((v - m) ** 2 for v in c) / (len(c) - 1) / len(c))
                      for c, m in zip(cols, y)]
             else:
-                y = [float(r[f"phi_{sp}"]) for r in runs[0]]
+                y = [float(r[f"rho_v_{sp}"]) for r in runs[0]]
                 e = [float(r[f"err_{sp}"]) if r.get(f"err_{sp}") not in (None, "") else 0.0
                      for r in runs[0]]
             ax.errorbar(x, y, yerr=e, color=f"C{k}", lw=1.2, capsize=1.5, label=method)

@@ -28,7 +28,7 @@ def load(folder):
         t = step * p["dt"]
         radius = math.sqrt(p["r0"] ** 2 - p["alpha"] * t / (4 * math.pi))
         with open(os.path.join(folder, f"profile_{frac:.2f}.csv")) as f:
-            rows = [(float(r["r"]), float(r["phi"])) for r in csv.DictReader(f)]
+            rows = [(float(r["r"]), float(r["rho_v"])) for r in csv.DictReader(f)]
         out.append((frac, t, radius, rows))
     return p, out
 

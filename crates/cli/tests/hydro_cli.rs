@@ -201,7 +201,7 @@ fn a_static_droplet_with_rpy_keeps_its_radius_and_writes_the_mean_profile() {
     assert_eq!(par["r_end"], par["r0"]);
     let mean = std::fs::read_to_string(a.join("profile_mean.csv")).unwrap();
     let mut lines = mean.lines();
-    assert_eq!(lines.next(), Some("r,phi,err"));
+    assert_eq!(lines.next(), Some("r,rho_v,rho_v_err"));
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();

@@ -76,7 +76,7 @@ fn a_bidisperse_mpcd_droplet_writes_species_outputs_and_restarts_bitwise() {
         }
         let (names, cols) =
             colloidsim_core::output::read_table(&a.join("species_profile_1.00.csv")).unwrap();
-        assert_eq!(names, ["r", "phi_A", "err_A", "phi_B", "err_B"]);
+        assert_eq!(names, ["r", "rho_v_A", "err_A", "rho_v_B", "err_B"]);
         assert!(cols[1].iter().sum::<f64>() > 0.0 && cols[3].iter().sum::<f64>() > 0.0);
         // The trajectory names the species: A, B, then the vertices and the solvent.
         let f = colloidsim_particles::gsd::read_frame(&a.join("trajectory.gsd"), Some(0)).unwrap();

@@ -151,7 +151,7 @@ fn one_declared_species_is_the_plain_run_bit_for_bit() {
     }
 }
 
-/// A binary droplet writes `species_profile_mean.csv` (r, phi_A, err_A, phi_B, err_B) whose
+/// A binary droplet writes `species_profile_mean.csv` (r, rho_v_A, err_A, rho_v_B, err_B) whose
 /// species sum to `profile_mean.csv`, `species_profiles.png`, each species' mean radius and the
 /// hard wall's sum rule generalised to species, every number finite; trajectory frames carry
 /// the species' typeids and diameters. A bulk mixture gives the partial contact values and Z
@@ -171,7 +171,7 @@ fn a_mixture_writes_its_species_outputs() {
     let run = dir.path().join("run");
     let (header, cols) =
         colloidsim_core::output::read_table(&run.join("species_profile_mean.csv")).unwrap();
-    assert_eq!(header, ["r", "phi_A", "err_A", "phi_B", "err_B"]);
+    assert_eq!(header, ["r", "rho_v_A", "err_A", "rho_v_B", "err_B"]);
     let (_, total) = colloidsim_core::output::read_table(&run.join("profile_mean.csv")).unwrap();
     for b in 0..cols[0].len() {
         assert!(cols.iter().all(|c| c[b].is_finite()));
@@ -289,7 +289,7 @@ fn bad_species_are_refused_naming_the_key() {
 
 /// The static bidisperse droplet: `counts` spheres of diameters 1 and 2 in a hard wall of
 /// radius `radius` (centres within R - d_s/2), `warmup` and `sweeps` sampling sweeps in
-/// `blocks` blocks; the run's `species_profile_mean.csv` columns (r, phi_A, err_A, phi_B,
+/// `blocks` blocks; the run's `species_profile_mean.csv` columns (r, rho_v_A, err_A, rho_v_B,
 /// err_B).
 fn bidisperse_droplet(
     counts: [usize; 2],

@@ -262,8 +262,9 @@ impl SpeciesAccum {
     }
 }
 
-/// One species profile table: `r`, then `phi_<name>` and `err_<name>` of each species
-/// (`phi[s]`, `err[s]` on the bins `r`); with `no_error`, every error column is explained with
+/// One species profile table: `r`, then `rho_v_<name>` (the centre density times the sphere
+/// volume, not a volume fraction) and `err_<name>` of each species (`phi[s]`, `err[s]` on the
+/// bins `r`); with `no_error`, every error column is explained with
 /// that reason (it could not be estimated). Adds `file` to `files`.
 pub fn write_species_profile(
     out: &OutputDir,
@@ -277,7 +278,7 @@ pub fn write_species_profile(
 ) -> Result<()> {
     let mut cols: Vec<(String, &[f64])> = vec![("r".into(), r)];
     for (s, name) in names.iter().enumerate() {
-        cols.push((format!("phi_{name}"), &phi[s]));
+        cols.push((format!("rho_v_{name}"), &phi[s]));
         cols.push((format!("err_{name}"), &err[s]));
     }
     let refs: Vec<(&str, &[f64])> = cols.iter().map(|(n, v)| (n.as_str(), *v)).collect();

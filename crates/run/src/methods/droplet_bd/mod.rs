@@ -660,7 +660,7 @@ impl BdMethod<SpeciesInterface> for DropletObs {
             let reps = counts[j] as f64;
             let phi: Vec<f64> = sums[j].iter().map(|v| v / reps).collect();
             let name = profile_name(p.fractions[j]);
-            // phi: centres per shell volume times the particle volume (centre density, more
+            // rho_v: centres per shell volume times the particle volume (centre density, more
             // than 1 where a shell is thinner than a sphere); phi_overlap: the volume fraction
             // by sphere-shell overlap.
             match overlap.get(j).filter(|o| o.len() == phi.len()) {
@@ -675,21 +675,21 @@ impl BdMethod<SpeciesInterface> for DropletObs {
                             &name,
                             &[
                                 ("r", &r_axes[j]),
-                                ("phi", &phi),
+                                ("rho_v", &phi),
                                 ("phi_overlap", &o),
                                 ("phi_overlap_err", e),
                             ],
                         )?,
                         None => out.write_table(
                             &name,
-                            &[("r", &r_axes[j]), ("phi", &phi), ("phi_overlap", &o)],
+                            &[("r", &r_axes[j]), ("rho_v", &phi), ("phi_overlap", &o)],
                         )?,
                     };
                     overlaps.push(o);
                     overlap_errors.push(err);
                 }
                 None => {
-                    out.write_table(&name, &[("r", &r_axes[j]), ("phi", &phi)])?;
+                    out.write_table(&name, &[("r", &r_axes[j]), ("rho_v", &phi)])?;
                 }
             }
             files.push(name);
@@ -773,7 +773,7 @@ impl BdMethod<SpeciesInterface> for DropletObs {
                 let r = &r_axes[drawn[later[0]]];
                 out.write_table(
                     "profile_mean.csv",
-                    &[("r", r), ("phi", &mean), ("err", &err)],
+                    &[("r", r), ("rho_v", &mean), ("rho_v_err", &err)],
                 )?;
                 files.push("profile_mean.csv".into());
             }

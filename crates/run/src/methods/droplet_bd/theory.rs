@@ -222,7 +222,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
                         .map(|x| x * vp)
                         .collect();
                     let name = profile_name(fraction).replacen("profile", "equilibrium", 1);
-                    if let Err(e) = dir.write_table(&name, &[("r", &r), ("phi", &phi)]) {
+                    if let Err(e) = dir.write_table(&name, &[("r", &r), ("rho_v", &phi)]) {
                         write_err.get_or_insert(e.into());
                     }
                     equilibria.push(serde_json::json!({
@@ -376,7 +376,7 @@ fn write_snapshot(
         .iter()
         .map(|x| x * vp)
         .collect();
-    dir.write_table(&profile_name(fraction), &[("r", &r), ("phi", &phi)])?;
+    dir.write_table(&profile_name(fraction), &[("r", &r), ("rho_v", &phi)])?;
     // Fine profile up to one diameter beyond the interface's harmonic range.
     let edge = s.radius + p.offset + p.range + p.diameter;
     let m = grid.centres().iter().take_while(|x| **x <= edge).count();
@@ -386,14 +386,19 @@ fn write_snapshot(
     let name = format!("theory_{}", profile_name(fraction));
     dir.write_table(
         &name,
-        &[("r", rf), ("rho", rho), ("phi", &phif), ("n3", &s.n3[..m])],
+        &[
+            ("r", rf),
+            ("rho", rho),
+            ("rho_v", &phif),
+            ("n3", &s.n3[..m]),
+        ],
     )?;
     // The effective force of Eq. 16 in kT/d, with the volume fraction at the same faces.
     let force: Vec<f64> = s.force.force.iter().map(|f| f * p.diameter).collect();
     let phi_face: Vec<f64> = s.force.rho.iter().map(|x| x * vp).collect();
     dir.write_table(
         &force_name(fraction),
-        &[("r", &s.force.r), ("force", &force), ("phi", &phi_face)],
+        &[("r", &s.force.r), ("force", &force), ("rho_v", &phi_face)],
     )?;
     written.push(Written {
         fraction,
@@ -474,7 +479,7 @@ fn draw(
             let path = run_dir.join(profile_name(w.fraction));
             let (h, c) = read_table(&path).ok()?;
             let ir = h.iter().position(|x| x == "r")?;
-            let ip = h.iter().position(|x| x == "phi")?;
+            let ip = h.iter().position(|x| x == "rho_v")?;
             let (x, y) = plot::merged_shells(&c[ir], &c[ip], vp, replicas, plot::SHELL_PARTICLES);
             Some((format!("BD {:.0}%", 100.0 * w.fraction), x, y))
         })

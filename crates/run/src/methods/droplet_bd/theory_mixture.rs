@@ -121,7 +121,7 @@ pub(super) fn theory(
                     let label = format!("{name}, t = {:.0} %", fraction * 100.0);
                     shown.push((label, x, phi.clone()));
                 }
-                cols.push((format!("phi_{name}"), phi));
+                cols.push((format!("rho_v_{name}"), phi));
             }
             let mut refs: Vec<(&str, &[f64])> = vec![("r", &r)];
             refs.extend(cols.iter().map(|(n, v)| (n.as_str(), v.as_slice())));

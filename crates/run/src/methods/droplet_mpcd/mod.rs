@@ -653,16 +653,16 @@ impl Session for DropletSession {
             let mut by_overlap = true;
             for j in (0..cp.taken.len()).filter(|&j| cp.taken[j]) {
                 let name = crate::output::profile_name(p.profile.fractions[j]);
-                // phi: the centre density times the sphere volume (above 1 where a shell is
+                // rho_v: the centre density times the sphere volume (above 1 where a shell is
                 // thinner than a sphere); phi_overlap: the volume fraction by sphere-shell
                 // overlap (as droplet-bd's).
                 let overlap = cp.overlap.get(j).filter(|o| o.len() == cp.phi[j].len());
                 match overlap {
                     Some(o) => out.write_table(
                         &name,
-                        &[("r", &cp.r[j]), ("phi", &cp.phi[j]), ("phi_overlap", o)],
+                        &[("r", &cp.r[j]), ("rho_v", &cp.phi[j]), ("phi_overlap", o)],
                     )?,
-                    None => out.write_table(&name, &[("r", &cp.r[j]), ("phi", &cp.phi[j])])?,
+                    None => out.write_table(&name, &[("r", &cp.r[j]), ("rho_v", &cp.phi[j])])?,
                 };
                 files.push(name);
                 labels.push(format!(

@@ -666,7 +666,7 @@ impl Session for McSession {
             if let Some(h) = blocks.first().and_then(|b| b.profile.as_ref()) {
                 let r = h.centres();
                 let (phi, err) = columns(&per_block, r.len());
-                // phi: the centre density times the sphere volume (above 1 at a hard wall's
+                // rho_v: the centre density times the sphere volume (above 1 at a hard wall's
                 // contact layer); phi_overlap: the volume fraction by sphere-shell overlap,
                 // each with its standard error over the blocks.
                 let overlap_blocks: Vec<Vec<f64>> = blocks
@@ -682,15 +682,15 @@ impl Session for McSession {
                         "profile_mean.csv",
                         &[
                             ("r", &r),
-                            ("phi", &phi),
-                            ("err", &err),
+                            ("rho_v", &phi),
+                            ("rho_v_err", &err),
                             ("phi_overlap", o),
                             ("phi_overlap_err", oe),
                         ],
                     )?,
                     None => out.write_table(
                         "profile_mean.csv",
-                        &[("r", &r), ("phi", &phi), ("err", &err)],
+                        &[("r", &r), ("rho_v", &phi), ("rho_v_err", &err)],
                     )?,
                 };
                 files.push("profile_mean.csv".into());
