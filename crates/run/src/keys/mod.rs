@@ -369,6 +369,12 @@ pub(crate) const SEED_KEY: Spec = key(
 );
 /// Step counts and other integers a run can hold.
 pub(crate) const COUNT: i64 = 1 << 53;
+/// The most bins of a one-dimensional profile (a density along a ring, a radial profile): a
+/// million rows are some 25 MB of CSV per file, far finer than any run resolves. More would fill
+/// a disk with tables, not resolve anything (a fuzzed 1e8 bins wrote GBs).
+pub(crate) const MAX_BINS_1D: i64 = 1_000_000;
+/// The most radial bins of a droplet's profiles and g(r), of which several files are written.
+pub(crate) const MAX_BINS_RADIAL: i64 = 100_000;
 
 pub mod shared;
 pub mod species;

@@ -6,7 +6,7 @@
 
 use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
-use crate::keys::{COUNT, SEED_RANGE, Spec, key};
+use crate::keys::{COUNT, MAX_BINS_1D, SEED_RANGE, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["bcd", "bcd-chronological"]),
     "premerging BCD, O(N) per step, or the chronological event-driven update, O(N^2) (test oracle)");
@@ -161,14 +161,14 @@ pub const OBSERVE_DENSITY: Spec = key("observe.density", "-", Means("off"), Tabl
     "density histogram over one period of the potential (or over L): density.csv");
 
 pub const OBSERVE_DENSITY_BINS: Spec = key("observe.density.bins", "-",
-    Required, Integer(1, 100_000_000),
+    Required, Integer(1, MAX_BINS_1D),
     "number of bins");
 
 pub const OBSERVE_CONTACT_DENSITY: Spec = key("observe.contact_density", "-", Means("off"), Table,
     "two-particle density at contact (hard-rods paper Eq. 27): contact_density.csv");
 
 pub const OBSERVE_CONTACT_DENSITY_BINS: Spec = key("observe.contact_density.bins", "-",
-    Required, Integer(1, 100_000_000),
+    Required, Integer(1, MAX_BINS_1D),
     "number of bins");
 
 pub const OBSERVE_CONTACT_DENSITY_WINDOW: Spec = key("observe.contact_density.window", "length",

@@ -13,7 +13,7 @@ use crate::keys::shared::{
     RUN_SKIN, TRAJECTORY, TRAJECTORY_EVERY, VISCOSITY,
 };
 use crate::keys::species::*;
-use crate::keys::{SEED_KEY, Spec, key};
+use crate::keys::{MAX_BINS_RADIAL, SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-bd"]),
     "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics");
@@ -55,7 +55,7 @@ pub const OBSERVE_PROFILE: Spec = key("observe.profile", "-",
     "radial volume-fraction profiles: profile_<f>.csv");
 
 pub const OBSERVE_PROFILE_BINS: Spec = key("observe.profile.bins", "-",
-    Value("50"), Integer(1, 10_000_000),
+    Value("50"), Integer(1, MAX_BINS_RADIAL),
     "radial bins of equal width between 0 and R(t)");
 
 pub const OBSERVE_PROFILE_FRACTIONS: Spec = key("observe.profile.fractions", "-",

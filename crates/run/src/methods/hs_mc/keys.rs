@@ -8,7 +8,7 @@ use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS};
 use crate::keys::species::{SPECIES, SPECIES_COUNTS, SPECIES_DIAMETERS, SPECIES_VOLUME_FRACTIONS};
-use crate::keys::{COUNT, SEED_KEY, Spec, key};
+use crate::keys::{COUNT, MAX_BINS_RADIAL, SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["hs-mc"]),
     "hard-sphere NVT Monte Carlo, checkerboard cells (docs/mc.md)");
@@ -94,10 +94,10 @@ pub const MC_BLOCKS: Spec = key("mc.blocks", "-", Value("20"), Integer(2, 100_00
 pub const OUTPUT: Spec = key("output", "-", Means("-"), Table, "observables and files");
 
 pub const OUTPUT_PROFILE_BINS: Spec = key("output.profile_bins", "-",
-    Value("50"), Integer(1, 1_000_000),
+    Value("50"), Integer(1, MAX_BINS_RADIAL),
     "radial bins between 0 and R (droplets: profile_mean.csv)");
 
-pub const OUTPUT_GR_BINS: Spec = key("output.gr_bins", "-", Value("200"), Integer(1, 1_000_000),
+pub const OUTPUT_GR_BINS: Spec = key("output.gr_bins", "-", Value("200"), Integer(1, MAX_BINS_RADIAL),
     "bins of g(r) between 0 and gr_max (bulk: g_r.csv)");
 
 pub const OUTPUT_GR_MAX: Spec = key("output.gr_max", "length", Means("0.49 L"), Positive,
@@ -108,12 +108,12 @@ pub const OUTPUT_TRAJECTORY_EVERY: Spec = key("output.trajectory_every", "sweeps
     Value("0"), Integer(0, COUNT),
     "sweeps between frames of trajectory.gsd (0: none)");
 
-pub const OUTPUT_RHO2_R_BINS: Spec = key("output.rho2_r_bins", "-", Value("0"), Integer(0, 10_000),
+pub const OUTPUT_RHO2_R_BINS: Spec = key("output.rho2_r_bins", "-", Value("0"), Integer(0, 1000),
     "radial bins over [0, R] of the two-body density rho2(r1, r2, cos theta) and g2 (g2.csv; all pairs, O(N^2) per sample; 0: none)")
     .also("droplets of one species only");
 
 pub const OUTPUT_RHO2_COS_BINS: Spec = key("output.rho2_cos_bins", "-",
-    Value("20"), Integer(1, 10_000),
+    Value("20"), Integer(1, 1000),
     "bins of cos theta over [-1, 1] of the two-body density");
 
 pub const OBSERVE: Spec = key("observe", "-", Means("PNG pictures"), Table,
