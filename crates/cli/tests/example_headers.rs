@@ -2,14 +2,22 @@
 //! VALUE, ...` line of an example names a value of its summary.json (a dotted path) and the
 //! value the header prints; the example is run as a user runs it, and the value must read the
 //! same to the digits printed. A header that drifts from what its run gives fails here.
+//! `# header-check-slow:` lines name runs of a minute or more: an ignored test checks them
+//! (`cargo test --release -p colloidsim-cli --test integration example_headers:: -- --ignored`).
 
 use std::path::Path;
 use std::process::Command;
 
-/// The `(path, value as printed)` pairs of an example's `# header-check:` lines.
-fn checks(text: &str) -> Vec<(String, String)> {
+/// The `(path, value as printed)` pairs of an example's `# header-check:` lines, or of its
+/// `# header-check-slow:` lines with `slow`.
+fn checks(text: &str, slow: bool) -> Vec<(String, String)> {
+    let prefix = if slow {
+        "# header-check-slow:"
+    } else {
+        "# header-check:"
+    };
     text.lines()
-        .filter_map(|l| l.strip_prefix("# header-check:"))
+        .filter_map(|l| l.strip_prefix(prefix))
         .flat_map(|l| l.split(','))
         .map(|item| {
             let (path, value) = item.split_once('=').expect("PATH = VALUE");
@@ -26,6 +34,20 @@ fn as_printed(x: f64, printed: &str) -> String {
 
 #[test]
 fn example_headers_quote_what_their_runs_give() {
+    let checked = check_headers(false);
+    assert!(checked >= 3, "only {checked} header numbers checked");
+}
+
+/// The headers' numbers from runs of a minute or more (each example's whole run).
+#[test]
+#[ignore = "runs of minutes: cargo test --release ... example_headers:: -- --ignored"]
+fn slow_example_headers_quote_what_their_runs_give() {
+    let checked = check_headers(true);
+    assert!(checked >= 3, "only {checked} header numbers checked");
+}
+
+/// Run every example with header checks of the kind `slow` and compare; the count checked.
+fn check_headers(slow: bool) -> usize {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let mut checked = 0;
     for dir in std::fs::read_dir(&examples).unwrap() {
@@ -38,7 +60,7 @@ fn example_headers_quote_what_their_runs_give() {
             if file.extension().is_none_or(|e| e != "toml") {
                 continue;
             }
-            let wanted = checks(&std::fs::read_to_string(&file).unwrap());
+            let wanted = checks(&std::fs::read_to_string(&file).unwrap(), slow);
             if wanted.is_empty() {
                 continue;
             }
@@ -77,16 +99,18 @@ fn example_headers_quote_what_their_runs_give() {
             }
         }
     }
-    assert!(checked >= 3, "only {checked} header numbers checked");
+    checked
 }
 
 #[test]
 fn header_checks_are_read_and_rounded_as_printed() {
-    let c = checks("# x\n# header-check: a.b = 0.7218, c = 12\nseed = 1\n");
+    let text =
+        "# x\n# header-check: a.b = 0.7218, c = 12\n# header-check-slow: d = 1.5\nseed = 1\n";
     assert_eq!(
-        c,
+        checks(text, false),
         [("a.b".into(), "0.7218".into()), ("c".into(), "12".into())]
     );
+    assert_eq!(checks(text, true), [("d".into(), "1.5".into())]);
     assert_eq!(as_printed(0.721839, "0.7218"), "0.7218");
     assert_eq!(as_printed(0.0496255, "0.0496"), "0.0496");
     assert_ne!(as_printed(0.7229, "0.7218"), "0.7218");
