@@ -321,6 +321,7 @@ fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
     println!(
         "N\tthreads\tmono_step_s\tbi_step_s\tratio_of_medians\tmedian_of_round_ratios\tmono_neighbours\tbi_neighbours\tmono_lanczos_iters\tbi_lanczos_iters\tbi_fft_share"
     );
+    let mut parts = Vec::new();
     for &n in &a.bidisperse_sizes {
         for &t in &a.threads {
             let (mut mono, mut bi, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
@@ -346,6 +347,28 @@ fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
                 m.times.lanczos_iterations as f64 / 3.0,
                 b.times.lanczos_iterations as f64 / 3.0,
                 100.0 * b.times.fft / b.step_total
+            );
+            parts.push((n, t, m, b));
+        }
+    }
+    println!(
+        "# per part, milliseconds per step (last round): fft, spread, kernel and noise, interpolation, real space and Lanczos, set-up"
+    );
+    println!(
+        "N\tthreads\tsystem\tfft_ms\tspread_ms\tkernel_ms\tinterp_ms\treal_ms\tsetup_ms\tstep_ms"
+    );
+    for (n, t, m, b) in parts {
+        for (name, p) in [("mono", m), ("bi", b)] {
+            let ms = |x: f64| 1e3 * x / 3.0;
+            println!(
+                "{n}\t{t}\t{name}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}",
+                ms(p.times.fft),
+                ms(p.times.spread),
+                ms(p.times.kernel),
+                ms(p.times.interpolate),
+                ms(p.times.real),
+                ms(p.times.setup),
+                ms(p.step_total)
             );
         }
     }

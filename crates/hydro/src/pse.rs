@@ -447,12 +447,15 @@ pub struct Pse {
     skin: f64,
     /// Positions at the last candidate build.
     reference: Vec<[f64; 3]>,
-    /// Row `i` of the candidates and of the entries starts at `offsets[i]`.
+    /// Row `i` of the candidates starts at `offsets[i]`.
     offsets: Vec<usize>,
     candidates: Vec<u32>,
-    /// The first `counts[r]` entries of row r are the pairs within the cut-off; an entry's
-    /// `j` is the neighbour's row.
+    /// The pairs within the cut-off, row `r` at `entry_offsets[r]..entry_offsets[r + 1]`
+    /// (stored without gaps: the Lanczos iterations stream them); an entry's `j` is the
+    /// neighbour's row.
     entries: Entries,
+    entry_offsets: Vec<usize>,
+    /// Pairs within the cut-off per row.
     counts: Vec<u32>,
     /// Particle of each row, and row of each particle (cell order at the last candidate build).
     row_particle: Vec<u32>,
@@ -1053,6 +1056,7 @@ impl Pse {
             offsets: vec![0; n + 1],
             candidates: Vec::new(),
             entries: Entries::for_tolerance(params.tolerance),
+            entry_offsets: vec![0; n + 1],
             counts: vec![0; n],
             row_particle: (0..n as u32).collect(),
             row_of: (0..n as u32).collect(),
@@ -1106,7 +1110,7 @@ impl Pse {
 
     /// Real-space neighbour pairs within the cut-off (both directions).
     pub fn pairs(&self) -> usize {
-        self.counts.iter().map(|&c| c as usize).sum()
+        self.entry_offsets[self.n]
     }
 
     /// Candidate lists: for each particle, the others within `r_cut + skin` (cell list, each
@@ -1131,11 +1135,23 @@ impl Pse {
         // Rows are stored in cell order (row r holds particle cell_order[r]), so that a row's
         // neighbours lie close in memory; within a row the neighbours stay in increasing
         // particle index, which fixes the order of the sums whatever the storage.
+        // Each pair of species keeps the candidates within its own cut-off and the skin (the
+        // cells are those of the largest).
         let perm = &self.cell_order;
+        let species = &self.species;
+        let ranges2: Vec<f64> = self
+            .rc2s
+            .iter()
+            .map(|rc2| (rc2.sqrt() + self.skin).powi(2))
+            .collect();
+        let near = |i: usize, j: u32, r2: f64| {
+            r2 < ranges2[pair_index(species[i] as usize, species[j as usize] as usize)]
+        };
         let mut off = std::mem::take(&mut self.offsets);
         off[1..].par_iter_mut().enumerate().for_each(|(r, c)| {
+            let i = perm[r] as usize;
             let mut k = 0;
-            cells.visit(perm[r] as usize, &mut |_, _, _| k += 1);
+            cells.visit(i, &mut |j, _, r2| k += near(i, j, r2) as usize);
             *c = k;
         });
         off[0] = 0;
@@ -1143,15 +1159,17 @@ impl Pse {
             off[i + 1] += off[i];
         }
         self.candidates.resize(off[n], 0);
-        self.entries.resize(off[n]);
         for_row_chunks(&off, &mut self.candidates, |lo, hi, out| {
             let base = off[lo];
             for r in lo..hi {
                 let row = &mut out[off[r] - base..off[r + 1] - base];
+                let i = perm[r] as usize;
                 let mut k = 0;
-                cells.visit(perm[r] as usize, &mut |j, _, _| {
-                    row[k] = j;
-                    k += 1;
+                cells.visit(i, &mut |j, _, r2| {
+                    if near(i, j, r2) {
+                        row[k] = j;
+                        k += 1;
+                    }
                 });
                 row.sort_unstable();
             }
@@ -1195,9 +1213,16 @@ impl Pse {
             row_particle: &self.row_particle,
             row_of: &self.row_of,
         };
+        // The pairs within the cut-off counted, then their tensors computed in place.
+        geometry.count(&mut self.counts);
+        let eo = &mut self.entry_offsets;
+        for (r, &c) in self.counts.iter().enumerate() {
+            eo[r + 1] = eo[r] + c as usize;
+        }
+        self.entries.resize(eo[self.n]);
         match &mut self.entries {
-            Entries::Single(e) => geometry.fill(e, &mut self.counts),
-            Entries::Double(e) => geometry.fill(e, &mut self.counts),
+            Entries::Single(e) => geometry.fill(e, eo),
+            Entries::Double(e) => geometry.fill(e, eo),
         }
     }
 
@@ -1568,8 +1593,8 @@ impl Pse {
     /// `out (+)= M^r f`: the forces gathered into row (cell) order, the rows summed there,
     /// the velocities gathered back.
     fn real_product(&mut self, f: &[f64], out: &mut [f64], add: bool) {
-        let (offsets, s) = (&self.offsets, &self.self_rows);
-        let (counts, row_particle, row_of) = (&self.counts, &self.row_particle, &self.row_of);
+        let (offsets, s) = (&self.entry_offsets, &self.self_rows);
+        let (row_particle, row_of) = (&self.row_particle, &self.row_of);
         let (f_rows, u_rows) = (&mut self.f_rows, &mut self.u_rows);
         f_rows
             .par_chunks_mut(3)
@@ -1577,8 +1602,8 @@ impl Pse {
             .with_min_len(1024)
             .for_each(|(o, &p)| o.copy_from_slice(&f[3 * p as usize..3 * p as usize + 3]));
         match &self.entries {
-            Entries::Single(e) => sum_rows(e, offsets, counts, s, f_rows, u_rows),
-            Entries::Double(e) => sum_rows(e, offsets, counts, s, f_rows, u_rows),
+            Entries::Single(e) => sum_rows(e, offsets, s, f_rows, u_rows),
+            Entries::Double(e) => sum_rows(e, offsets, s, f_rows, u_rows),
         }
         let u_rows = &*u_rows;
         out.par_chunks_mut(3)
@@ -1644,20 +1669,34 @@ struct RealSpace<'a> {
 }
 
 impl RealSpace<'_> {
+    /// The candidates of each row within their pair's cut-off.
+    fn count(&self, counts: &mut [u32]) {
+        let (l, off, cand, pos) = (self.box_length, self.offsets, self.candidates, self.pos);
+        counts.par_iter_mut().enumerate().for_each(|(r, c)| {
+            let pi = self.row_particle[r] as usize;
+            let (xi, si) = (pos[pi], self.species[pi] as usize);
+            *c = cand[off[r]..off[r + 1]]
+                .iter()
+                .filter(|&&j| {
+                    let (_, r2) = nearest_image(xi, pos[j as usize], l);
+                    r2 < self.rc2s[pair_index(si, self.species[j as usize] as usize)]
+                })
+                .count() as u32;
+        });
+    }
+
     /// The pair tensors `M^r = M^RPY − M^w_free` of the candidates within the cut-off, each
-    /// row in increasing index, and their number per row (a function of the positions alone,
-    /// whenever the candidates were built).
-    fn fill<T: Stored>(&self, entries: &mut [Entry<T>], counts: &mut [u32]) {
+    /// row in increasing index, row `r` at `entry_offsets[r]` (from [`Self::count`]; a
+    /// function of the positions alone, whenever the candidates were built).
+    fn fill<T: Stored>(&self, entries: &mut [Entry<T>], entry_offsets: &[usize]) {
         let l = self.box_length;
         let (off, cand, pos) = (self.offsets, self.candidates, self.pos);
-        let mut rows: Vec<RowChunk<'_, Entry<T>, u32>> = Vec::new();
-        for_row_chunks_collect(off, entries, counts, &mut rows);
-        rows.into_par_iter().for_each(|(lo, hi, out, count)| {
-            let base = off[lo];
+        for_row_chunks(entry_offsets, entries, |lo, hi, out| {
+            let base = entry_offsets[lo];
             for r in lo..hi {
                 let pi = self.row_particle[r] as usize;
                 let (xi, si) = (pos[pi], self.species[pi] as usize);
-                let mut k = off[r] - base;
+                let mut k = entry_offsets[r] - base;
                 for &j in &cand[off[r]..off[r + 1]] {
                     let (d, r2) = nearest_image(xi, pos[j as usize], l);
                     let sj = self.species[j as usize] as usize;
@@ -1682,7 +1721,7 @@ impl RealSpace<'_> {
                         k += 1;
                     }
                 }
-                count[r - lo] = (k - (off[r] - base)) as u32;
+                debug_assert_eq!(base + k, entry_offsets[r + 1]);
             }
         });
     }
@@ -1722,7 +1761,6 @@ fn rpy_unequal_inv(r: f64, inv_r: f64, ai: f64, aj: f64, eta: f64) -> (f64, f64)
 fn sum_rows<T: Stored>(
     entries: &[Entry<T>],
     offsets: &[usize],
-    counts: &[u32],
     s: &[f64],
     f_rows: &[f64],
     u_rows: &mut [f64],
@@ -1738,7 +1776,7 @@ fn sum_rows<T: Stored>(
                 s * f_rows[3 * r + 1],
                 s * f_rows[3 * r + 2],
             ];
-            for e in &entries[offsets[r]..offsets[r] + counts[r] as usize] {
+            for e in &entries[offsets[r]..offsets[r + 1]] {
                 let j = e.j as usize;
                 let fj = [f_rows[3 * j], f_rows[3 * j + 1], f_rows[3 * j + 2]];
                 let (a, b) = (e.a.load(), e.b.load());
@@ -1833,29 +1871,6 @@ fn for_row_chunks<T: Send>(
     chunks
         .into_par_iter()
         .for_each(|(lo, hi, rows)| f(lo, hi, rows));
-}
-
-/// Rows `lo..hi` of a CSR array and of a per-row array: `(lo, hi, data, per_row)`.
-type RowChunk<'a, T, U> = (usize, usize, &'a mut [T], &'a mut [U]);
-
-/// The chunks of [`for_row_chunks`] of a CSR array and of a per-row array, collected.
-fn for_row_chunks_collect<'a, T, U>(
-    off: &[usize],
-    data: &'a mut [T],
-    per_row: &'a mut [U],
-    out: &mut Vec<RowChunk<'a, T, U>>,
-) {
-    const CH: usize = 256;
-    let n = off.len() - 1;
-    let (mut rest, mut rest_row) = (data, per_row);
-    for c in 0..n.div_ceil(CH) {
-        let (lo, hi) = (c * CH, ((c + 1) * CH).min(n));
-        let (head, tail) = rest.split_at_mut(off[hi] - off[lo]);
-        let (rh, rt) = rest_row.split_at_mut(hi - lo);
-        out.push((lo, hi, head, rh));
-        rest = tail;
-        rest_row = rt;
-    }
 }
 
 /// Largest window support (points per axis): tolerances down to 1e-30 need fewer
@@ -2071,7 +2086,7 @@ impl Mobility for Pse {
             + 16 * (self.spec.len() + 3 * self.work[0].len() + self.tmp.len())
             + 48 * self.plane_noise.len()
             + self.entries.bytes()
-            + 8 * (self.offsets.len())
+            + 8 * (self.offsets.len() + self.entry_offsets.len())
             + n * (24 + 12 + 4 * 4 + 2 * 24)
             + 4 * (self.cell_start.len() + self.plane_start.len())
             + self.fft.bytes()
