@@ -490,9 +490,10 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
-def alpha_figure(paths, path, fraction=1.0):
+def alpha_figure(paths, path, fraction=1.0, methods=None):
     """S against Pe_s at each phi0 for the data files of several size ratios (their `alpha`
-    column; the files of --tag runs): does the threshold move as 1 / alpha^2?"""
+    column; the files of --tag runs), of `methods` only when given: does the threshold move as
+    1 / alpha^2?"""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -500,7 +501,8 @@ def alpha_figure(paths, path, fraction=1.0):
     rows = []
     for p in paths:
         with open(p) as f:
-            rows += [r for r in csv.DictReader(f) if float(r["fraction"]) == fraction]
+            rows += [r for r in csv.DictReader(f) if float(r["fraction"]) == fraction
+                     and (methods is None or r["method"] in methods)]
     fig, ax = plt.subplots(figsize=(7.5, 4.0), layout="constrained")
     marks = {0.05: "o", 0.1: "s", 0.2: "^"}
     groups = sorted({(r["method"], float(r.get("alpha") or 2.0)) for r in rows})
@@ -606,11 +608,14 @@ def main():
                     help="the grid points whose profiles are drawn method by method")
     ap.add_argument("--compare-alpha", metavar="CSV,CSV,...",
                     help="only draw IMG/stratification-alpha<tag>.png from these data files")
+    ap.add_argument("--compare-methods", metavar="METHOD,...",
+                    help="with --compare-alpha: draw these methods only (default: all)")
     args = ap.parse_args()
     ALPHA = args.alpha
     if args.compare_alpha:
         alpha_figure(args.compare_alpha.split(","),
-                     os.path.join(args.img, f"stratification-alpha{args.tag}.png"))
+                     os.path.join(args.img, f"stratification-alpha{args.tag}.png"),
+                     methods=args.compare_methods and args.compare_methods.split(","))
         return
     args.methods = args.methods.split(",")
     args.peclet = [float(x) for x in args.peclet.split(",")]
