@@ -490,6 +490,20 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
+def from_csv(paths, methods):
+    """The rows of `methods` in the data files `paths` (numbers as numbers, empty as None), in
+    the order of `methods`."""
+    def value(k, v):
+        if k == "method":
+            return v
+        return float(v) if v != "" else None
+    rows = []
+    for p in paths:
+        with open(p) as f:
+            rows += [{k: value(k, v) for k, v in r.items()} for r in csv.DictReader(f)]
+    return [r for m in methods for r in rows if r["method"] == m]
+
+
 def alpha_figure(paths, path, fraction=1.0, methods=None):
     """S against Pe_s at each phi0 for the data files of several size ratios (their `alpha`
     column; the files of --tag runs), of `methods` only when given: does the threshold move as
@@ -608,6 +622,10 @@ def main():
                     help="the grid points whose profiles are drawn method by method")
     ap.add_argument("--compare-alpha", metavar="CSV,CSV,...",
                     help="only draw IMG/stratification-alpha<tag>.png from these data files")
+    ap.add_argument("--from-csv", metavar="CSV,...",
+                    help="take the rows of --methods from these data files (written by earlier "
+                         "invocations) instead of the run folders: the combined data file, "
+                         "thresholds and diagrams without the runs (no profile figures)")
     ap.add_argument("--compare-methods", metavar="METHOD,...",
                     help="with --compare-alpha: draw these methods only (default: all)")
     args = ap.parse_args()
@@ -620,13 +638,13 @@ def main():
     args.methods = args.methods.split(",")
     args.peclet = [float(x) for x in args.peclet.split(",")]
     args.phi0 = [float(x) for x in args.phi0.split(",")]
-    if not args.analyse_only:
+    if not args.analyse_only and not args.from_csv:
         os.makedirs(args.runs, exist_ok=True)
         with open(os.path.join(args.runs, "log.txt"), "a") as log:
             for method in args.methods:
                 for pe, phi0 in points(args, method):
                     run_point(args, method, pe, phi0, log)
-    rows, eq = analyse(args)
+    rows = from_csv(args.from_csv.split(","), args.methods) if args.from_csv else analyse(args)[0]
     os.makedirs(args.data, exist_ok=True)
     os.makedirs(args.img, exist_ok=True)
     write_csv(os.path.join(args.data, f"stratification_study{args.tag}.csv"), rows)
@@ -635,7 +653,8 @@ def main():
     shown = args.panels.split(",") if args.panels else args.methods
     for fraction in DRAWN:
         figures(rows, shown, args.img, fraction, args.tag)
-    for pe, phi0 in (map(float, x.split(":")) for x in args.profiles_at.split(",")):
+    for pe, phi0 in (map(float, x.split(":")) for x in args.profiles_at.split(",")
+                     if not args.from_csv):
         profile_figure(args, shown, pe, phi0, 1.0, os.path.join(
             args.img, f"stratification-profiles-pe{pe:g}-phi{phi0:g}{args.tag}.png"))
     print("| method | t/t_end | phi0 | Pe_s | Pe_s phi_s | Delta | Delta_ideal | S | Delta_eq | "
