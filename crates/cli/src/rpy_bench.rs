@@ -352,22 +352,23 @@ fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
         }
     }
     println!(
-        "# per part, milliseconds per step (last round): fft, spread, kernel and noise, interpolation, real space and Lanczos, set-up"
+        "# per part, milliseconds per step (last round): fft, spread, kernel and noise, interpolation, real space and Lanczos, set-up (of it the window weights and spreading order)"
     );
     println!(
-        "N\tthreads\tsystem\tfft_ms\tspread_ms\tkernel_ms\tinterp_ms\treal_ms\tsetup_ms\tstep_ms"
+        "N\tthreads\tsystem\tfft_ms\tspread_ms\tkernel_ms\tinterp_ms\treal_ms\tsetup_ms\tof_it_weights_ms\tstep_ms"
     );
     for (n, t, m, b) in parts {
         for (name, p) in [("mono", m), ("bi", b)] {
             let ms = |x: f64| 1e3 * x / 3.0;
             println!(
-                "{n}\t{t}\t{name}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}",
+                "{n}\t{t}\t{name}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}",
                 ms(p.times.fft),
                 ms(p.times.spread),
                 ms(p.times.kernel),
                 ms(p.times.interpolate),
                 ms(p.times.real),
                 ms(p.times.setup),
+                ms(p.times.setup_spreading),
                 ms(p.step_total)
             );
         }

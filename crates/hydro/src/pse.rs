@@ -333,6 +333,8 @@ pub struct PseTimes {
     pub real: f64,
     /// Neighbour lists, pair tensors and window weights (`set_positions`).
     pub setup: f64,
+    /// Of `setup`: the window weights and the spreading order.
+    pub setup_spreading: f64,
     /// Lanczos iterations.
     pub lanczos_iterations: u64,
 }
@@ -2020,8 +2022,10 @@ impl Mobility for Pse {
         }
         let t = Instant::now();
         self.build_real_space();
+        let t1 = Instant::now();
         self.build_spreading();
         self.times.setup += t.elapsed().as_secs_f64();
+        self.times.setup_spreading += t1.elapsed().as_secs_f64();
         Ok(())
     }
 
