@@ -284,9 +284,11 @@ fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
         for &t in &a.threads {
             let p = time_pse(n, a.phi, a.tolerance, t, reps)
                 .with_context(|| format!("PSE at N = {n}"))?;
-            let s = |x: f64| format!("{:.1}%", 100.0 * x / p.step_total);
+            let shares: Vec<String> = (p.times.parts().iter())
+                .map(|x| format!("{:.1}%", 100.0 * x / p.step_total))
+                .collect();
             println!(
-                "{n}\t{t}\t{:.2}\t{}\t{}\t{:.3}\t{:.1}\t{:.4e}\t{:.4e}\t{}\t{}\t{}\t{}\t{}\t{}\t{:.1}\t{:.0}",
+                "{n}\t{t}\t{:.2}\t{}\t{}\t{:.3}\t{:.1}\t{:.4e}\t{:.4e}\t{}\t{:.1}\t{:.0}",
                 p.box_length,
                 p.geometry.grid,
                 p.geometry.support,
@@ -294,12 +296,7 @@ fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
                 p.neighbours,
                 p.product,
                 p.step,
-                s(p.times.fft),
-                s(p.times.spread),
-                s(p.times.kernel),
-                s(p.times.interpolate),
-                s(p.times.real),
-                s(p.times.setup),
+                shares.join("\t"),
                 p.times.lanczos_iterations as f64 / reps as f64,
                 p.bytes_per_particle
             );
@@ -359,18 +356,11 @@ fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
     );
     for (n, t, m, b) in parts {
         for (name, p) in [("mono", m), ("bi", b)] {
-            let ms = |x: f64| 1e3 * x / 3.0;
-            println!(
-                "{n}\t{t}\t{name}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{:.2}",
-                ms(p.times.fft),
-                ms(p.times.spread),
-                ms(p.times.kernel),
-                ms(p.times.interpolate),
-                ms(p.times.real),
-                ms(p.times.setup),
-                ms(p.times.setup_spreading),
-                ms(p.step_total)
-            );
+            let ms: Vec<String> = (p.times.parts().iter())
+                .chain([&p.times.setup_spreading, &p.step_total])
+                .map(|x| format!("{:.2}", 1e3 * x / 3.0))
+                .collect();
+            println!("{n}\t{t}\t{name}\t{}", ms.join("\t"));
         }
     }
     Ok(())
@@ -419,7 +409,7 @@ fn bd_step(a: &BenchArgs, reps: usize) -> Result<()> {
                 .mobility()
                 .pse()
                 .map_or_else(Default::default, |p| *p.times());
-            let parts = [p.fft, p.spread, p.kernel, p.interpolate, p.real, p.setup];
+            let parts = p.parts();
             let other = total - parts.iter().sum::<f64>();
             let mut shares = [0.0; 7];
             for (s, x) in shares.iter_mut().zip(parts.iter().chain([&other])) {

@@ -339,6 +339,21 @@ pub struct PseTimes {
     pub lanczos_iterations: u64,
 }
 
+impl PseTimes {
+    /// The parts in the order of the benchmarks' profiles: FFTs, spreading, kernel and noise,
+    /// interpolation, real space and Lanczos, set-up.
+    pub fn parts(&self) -> [f64; 6] {
+        [
+            self.fft,
+            self.spread,
+            self.kernel,
+            self.interpolate,
+            self.real,
+            self.setup,
+        ]
+    }
+}
+
 /// One real-space pair of a neighbour list: `M^r_ij = a I + b e e^T`, stored in `T` (`f32`
 /// halves the data the Lanczos iterations stream; the sums are in `f64`).
 #[derive(Debug, Clone, Copy, Default)]
