@@ -446,6 +446,8 @@ pub struct Pse {
     tables: Vec<WaveTable>,
     /// Squared real-space cut-off of each pair of species (the largest is the geometry's).
     rc2s: Vec<f64>,
+    /// Squared candidate range of each pair of species: its cut-off and the skin.
+    candidate_ranges2: Vec<f64>,
     /// The general (species) wave-space path: the kernel without the sinc factors, which
     /// `filters` apply per species. Off for one species, which keeps `sinc^2` in the kernel.
     general: bool,
@@ -1056,6 +1058,7 @@ impl Pse {
             self_rows: vec![0.0; n],
             tables,
             rc2s: r_cuts.iter().map(|r| r * r).collect(),
+            candidate_ranges2: r_cuts.iter().map(|r| (r + skin) * (r + skin)).collect(),
             general,
             filters,
             tmp: if general {
@@ -1155,12 +1158,7 @@ impl Pse {
         // Each pair of species keeps the candidates within its own cut-off and the skin (the
         // cells are those of the largest).
         let perm = &self.cell_order;
-        let species = &self.species;
-        let ranges2: Vec<f64> = self
-            .rc2s
-            .iter()
-            .map(|rc2| (rc2.sqrt() + self.skin).powi(2))
-            .collect();
+        let (species, ranges2) = (&self.species, &self.candidate_ranges2);
         let near = |i: usize, j: u32, r2: f64| {
             r2 < ranges2[pair_index(species[i] as usize, species[j as usize] as usize)]
         };
