@@ -490,9 +490,8 @@ def figures(all_rows, methods, img, fraction, tag=""):
     plt.close(fig)
 
 
-def from_csv(paths, methods):
-    """The rows of `methods` in the data files `paths` (numbers as numbers, empty as None), in
-    the order of `methods`."""
+def read_rows(paths):
+    """The rows of the data files `paths` (numbers as numbers, empty as None)."""
     def value(k, v):
         if k == "method":
             return v
@@ -501,6 +500,12 @@ def from_csv(paths, methods):
     for p in paths:
         with open(p) as f:
             rows += [{k: value(k, v) for k, v in r.items()} for r in csv.DictReader(f)]
+    return rows
+
+
+def from_csv(paths, methods):
+    """The rows of `methods` in the data files `paths`, in the order of `methods`."""
+    rows = read_rows(paths)
     return [r for m in methods for r in rows if r["method"] == m]
 
 
@@ -512,23 +517,20 @@ def alpha_figure(paths, path, fraction=1.0, methods=None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rows = []
-    for p in paths:
-        with open(p) as f:
-            rows += [r for r in csv.DictReader(f) if float(r["fraction"]) == fraction
-                     and (methods is None or r["method"] in methods)]
+    rows = [r for r in read_rows(paths) if r["fraction"] == fraction
+            and (methods is None or r["method"] in methods)]
     fig, ax = plt.subplots(figsize=(7.5, 4.0), layout="constrained")
     marks = {0.05: "o", 0.1: "s", 0.2: "^"}
-    groups = sorted({(r["method"], float(r.get("alpha") or 2.0)) for r in rows})
+    groups = sorted({(r["method"], (r.get("alpha") or 2.0)) for r in rows})
     for k, (m, alpha) in enumerate(groups):
-        for phi0 in sorted({float(r["phi0"]) for r in rows}):
+        for phi0 in sorted({r["phi0"] for r in rows}):
             rs = sorted((r for r in rows if r["method"] == m
-                         and float(r.get("alpha") or 2.0) == alpha
-                         and float(r["phi0"]) == phi0), key=lambda r: float(r["pe_s"]))
+                         and (r.get("alpha") or 2.0) == alpha
+                         and r["phi0"] == phi0), key=lambda r: r["pe_s"])
             if not rs:
                 continue
-            ax.errorbar([float(r["pe_s"]) for r in rs], [float(r["S"]) for r in rs],
-                        yerr=[float(r["delta_err"] or 0.0) for r in rs], color=f"C{k}",
+            ax.errorbar([r["pe_s"] for r in rs], [r["S"] for r in rs],
+                        yerr=[(r["delta_err"] or 0.0) for r in rs], color=f"C{k}",
                         marker=marks.get(phi0, "o"), ms=5, lw=1, capsize=2,
                         label=f"{m}, $\\alpha$ = {alpha:g}, $\\phi_0$ = {phi0:g}")
     ax.axhline(0, color="k", lw=0.8)
