@@ -532,6 +532,9 @@ pub struct HardSphereMc {
     chain_cells: chain::ChainCells,
     /// Counts of the last sweep's chains.
     last_chain: chain::ChainStats,
+    /// The cells' slots hold the current positions (false after event chains, which move
+    /// `pos` alone: [`Self::bin`] brings them up to date).
+    binned: bool,
 }
 
 /// Half of `diameter` times `scale` (exactly `diameter / 2` at scale 1).
@@ -736,6 +739,7 @@ impl HardSphereMc {
             bucket_end: Vec::new(),
             chain: None,
             chain_cells: Default::default(),
+            binned: false,
             last_chain: Default::default(),
         };
         mc.delta = mc.delta.min(mc.max_delta());
@@ -1031,6 +1035,7 @@ impl HardSphereMc {
     /// finds the cell's corner again from the position it binned.
     fn rebin(&mut self, offset: [f64; 3]) {
         self.offset = offset;
+        self.binned = true;
         let pass = self.pass();
         let n = self.len();
         let cells = self.count.len();
@@ -1289,9 +1294,24 @@ impl HardSphereMc {
         window
     }
 
+    /// Bring the cells up to date with the positions after event chains (which move the
+    /// positions alone; the cells serve [`Self::for_each_pair`]). Binning at the last offset
+    /// gives the same cells as binning after every sweep would: observables do not depend on
+    /// how often this is called.
+    pub fn bin(&mut self) {
+        if !self.binned {
+            self.rebin(self.offset);
+        }
+    }
+
     /// Visit every unordered pair with centre distance `r < rcut` once: `f(i, j, r^2)`.
-    /// `rcut` is clamped so that the cell stencil fits the box (at most `L/2`).
+    /// `rcut` is clamped so that the cell stencil fits the box (at most `L/2`). After event
+    /// chains without [`Self::bin`] the pairs are found by visiting all `N^2 / 2` (correct,
+    /// slow): call `bin` first.
     pub fn for_each_pair(&self, rcut: f64, mut f: impl FnMut(usize, usize, f64)) {
+        if !self.binned {
+            return self.for_each_pair_direct(rcut, f);
+        }
         let pass = self.pass();
         let (nc, s, cap) = (self.nc, self.side, self.cap);
         let rcut = rcut.min(0.5 * self.edge);
@@ -1331,6 +1351,30 @@ impl HardSphereMc {
                             }
                         }
                     }
+                }
+            }
+        }
+    }
+
+    /// [`Self::for_each_pair`] over all pairs (the minimum image in bulk).
+    fn for_each_pair_direct(&self, rcut: f64, mut f: impl FnMut(usize, usize, f64)) {
+        let rcut = rcut.min(0.5 * self.edge);
+        let rc2 = rcut * rcut;
+        let l = self.edge;
+        let periodic = matches!(self.geometry, Geometry::Bulk { .. });
+        for i in 0..self.len() {
+            for j in i + 1..self.len() {
+                let r2 = (0..3)
+                    .map(|k| {
+                        let mut v = self.pos[k][i] - self.pos[k][j];
+                        if periodic {
+                            v -= l * (v / l).round();
+                        }
+                        v * v
+                    })
+                    .sum::<f64>();
+                if r2 < rc2 {
+                    f(i, j, r2);
                 }
             }
         }

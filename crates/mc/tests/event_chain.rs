@@ -169,6 +169,57 @@ fn event_chains_keep_every_hard_constraint() {
     }
 }
 
+/// Chains move the positions alone and leave the cells to [`HardSphereMc::bin`]: the pairs
+/// that `for_each_pair` finds before it and after it are those of the current positions
+/// (every pair computed here), at the same distances to rounding; local moves after chains
+/// start from binned cells. (Cells left as they were before the chains fail.)
+#[test]
+fn pairs_after_event_chains_are_those_of_the_positions() {
+    for (mut mc, name) in cases(4) {
+        chains(&mut mc, 3.0, 40);
+        mc.run(20);
+        let rc = 2.5;
+        let l = mc.box_edge();
+        let bulk = matches!(mc.geometry(), Geometry::Bulk { .. });
+        let mut want = Vec::new();
+        for i in 0..mc.len() {
+            for j in i + 1..mc.len() {
+                let (p, q) = (mc.position(i), mc.position(j));
+                let r2: f64 = (0..3)
+                    .map(|k| {
+                        let v = p[k] - q[k];
+                        let v = if bulk { v - l * (v / l).round() } else { v };
+                        v * v
+                    })
+                    .sum();
+                if r2 < rc * rc {
+                    want.push((i, j, r2));
+                }
+            }
+        }
+        assert!(want.len() > 5 * mc.len(), "{name}: {} pairs", want.len());
+        for stage in ["before bin", "after bin"] {
+            if stage == "after bin" {
+                mc.bin();
+            }
+            let mut got = Vec::new();
+            mc.for_each_pair(rc, |i, j, r2| got.push((i.min(j), i.max(j), r2)));
+            got.sort_by_key(|a| (a.0, a.1));
+            assert_eq!(got.len(), want.len(), "{name}, {stage}");
+            for (a, b) in got.iter().zip(&want) {
+                assert_eq!((a.0, a.1), (b.0, b.1), "{name}, {stage}");
+                assert!(
+                    (a.2 - b.2).abs() < 1e-12,
+                    "{name}, {stage}: {a:?} against {b:?}"
+                );
+            }
+        }
+        mc.set_event_chain(None).unwrap();
+        mc.run(5);
+        assert_eq!(mc.first_overlap(0.0), None, "{name}");
+    }
+}
+
 /// A run continued from its positions and sweep count (what a checkpoint holds) is bitwise
 /// the uninterrupted run; the positions pass the strict overlap check of a restart.
 #[test]

@@ -305,7 +305,8 @@ impl HardSphereMc {
         }
         self.chain_cells = cells;
         self.last_chain = total;
-        self.rebin(self.offset);
+        // The cells of the local moves and the pair observers are binned when next needed.
+        self.binned = false;
         self.sweep += 1;
         SweepStats::default()
     }

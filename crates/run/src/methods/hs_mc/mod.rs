@@ -331,6 +331,7 @@ impl McSession {
             // Sample k of the sampling part belongs to block k * blocks / sweeps.
             let k = sweep - p.warmup_sweeps - 1;
             let b = ((k as u128 * p.blocks as u128) / p.sweeps as u128) as usize;
+            self.mc.bin();
             let block = &mut self.acc.blocks[b.min(p.blocks - 1)];
             block.contact.sample(&self.mc);
             if let Some(h) = block.gr.as_mut() {
