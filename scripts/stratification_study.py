@@ -504,9 +504,14 @@ def read_rows(paths):
 
 
 def from_csv(paths, methods):
-    """The rows of `methods` in the data files `paths`, in the order of `methods`."""
-    rows = read_rows(paths)
-    return [r for m in methods for r in rows if r["method"] == m]
+    """The rows of `methods` in the data files `paths`, in the order of `methods`, each
+    method's by phi0, Pe_s and time (the order of a run's own data file); a point found in
+    more than one file is taken from the last."""
+    point = lambda r: (r["method"], r["phi0"], r["pe_s"], r["fraction"])
+    latest = {point(r): r for r in read_rows(paths)}
+    return [r for m in methods
+            for r in sorted((r for r in latest.values() if r["method"] == m),
+                            key=lambda r: (r["phi0"], r["pe_s"], r["fraction"]))]
 
 
 def alpha_figure(paths, path, fraction=1.0, methods=None):
