@@ -408,8 +408,11 @@ def thresholds(rows, methods, phi0s):
 def write_csv(path, rows):
     if not rows:
         return
+    # The columns of every row, in the order first seen (data files of older versions lack
+    # `alpha`: their rows leave it empty, the default size ratio).
+    fields = list(dict.fromkeys(k for r in rows for k in r))
     with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
         for r in rows:
             w.writerow({k: ("" if v is None else v) for k, v in r.items()})
@@ -509,6 +512,14 @@ def from_csv(paths, methods):
     more than one file is taken from the last."""
     point = lambda r: (r["method"], r["phi0"], r["pe_s"], r["fraction"])
     latest = {point(r): r for r in read_rows(paths)}
+    # The equilibrium reference depends on the droplet alone (phi0 and the time): rows written
+    # without it (runs analysed without `eq`) take it from the rows that have it.
+    reference = {(r["phi0"], r["fraction"], r.get("alpha") or 2.0): r["delta_eq"]
+                 for r in latest.values() if r.get("delta_eq") is not None}
+    for r in latest.values():
+        eq = reference.get((r["phi0"], r["fraction"], r.get("alpha") or 2.0))
+        if r.get("delta_eq") is None and eq is not None:
+            r["delta_eq"], r["S_eq"] = eq, r["delta"] - eq
     return [r for m in methods
             for r in sorted((r for r in latest.values() if r["method"] == m),
                             key=lambda r: (r["phi0"], r["pe_s"], r["fraction"]))]
