@@ -24,7 +24,8 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
 and any of them with `-k<stiffness>` appended (`bd-rpy-k500`): the same in an interface of that
 stiffness (kT/d^2, d the small diameter) instead of the example's (100 kT/d^2; the MPCD
 example's 100 kT/cell^2 = 400 kT/d^2 for the mpcd methods), to see whether the interface held
-the colloids.
+the colloids; `bd-fd-hard`: free draining with a hard wall (`interface.hard`, the limit of an
+infinitely stiff interface; droplet-bd has it for free draining only).
 
 The measure is the difference of the species' mean centre distances over R, Delta =
 <r>_s / R - <r>_l / R (colloidsim_analysis::stratification), at 50, 75 and 100 % of the drying
@@ -90,7 +91,9 @@ DDFT_DX = "0.05"
 
 def split(method):
     """A method name and its interface stiffness: `bd-rpy-k500` is bd-rpy in an interface of
-    500 kT/d^2 (None: the example's 100)."""
+    500 kT/d^2 (None: the example's 100; math.inf: `bd-fd-hard`, a hard wall)."""
+    if method.endswith("-hard"):
+        return method[: -len("-hard")], math.inf
     base, _, k = method.rpartition("-k")
     return (base, float(k)) if base and k.isdigit() else (method, None)
 
@@ -143,9 +146,13 @@ def scenario(pe, phi0, replicas, method, particles=900):
     text = rewritten(BASE, {
         "peclet": pe, "phi0": phi0, "replicas": replicas, "particles": particles,
         "diameters": f"[1.0, {ALPHA}]", "counts": f"[{particles - large}, {large}]",
-        "stiffness": stiffness,
+        "stiffness": None if stiffness == math.inf else stiffness,
     })
-    if stiffness is not None and stiffness > STIFF:
+    if stiffness == math.inf:
+        # A hard wall in place of the spring (the example's stiffness line), default step.
+        text = "\n".join("hard = true" if line.startswith("stiffness") else line
+                         for line in text.split("\n"))
+    elif stiffness is not None and stiffness > STIFF:
         # The default step 2e-4 d^2/D0 keeps k D0 dt / kT at 0.1 up to STIFF kT/d^2; above,
         # a step that keeps it there (D0 = kT / (3 pi eta d) with kT = eta = d = 1).
         text += f"\n[run]\ndt = {0.1 / stiffness * 3 * math.pi:.6g}\n"
@@ -290,11 +297,13 @@ def ideal_delta(p, radius):
     Delta > 0 only because small centres reach (d_l - d_s)/2 closer to the surface."""
     kt = p.get("kt", 1.0)
     k, rng = p["stiffness"] / kt, p["range"]
+    hard = p.get("hard_interface", False)
     diam = p["species"]["diameters"]
     means = []
     for d in diam:
         wall = radius + p["offset"] - 0.5 * (d - p["diameter"])
-        n, h = 4000, (wall + rng + 60.0 / (k * rng)) / 4000
+        # A hard wall: uniform up to the wall (the integral ends there).
+        n, h = 4000, (wall if hard else wall + rng + 60.0 / (k * rng)) / 4000
         num = den = 0.0
         for i in range(n):
             r = (i + 0.5) * h

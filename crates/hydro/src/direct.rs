@@ -48,6 +48,16 @@ struct Kernel {
     fz: Vec<f64>,
 }
 
+impl Kernel {
+    /// Radius of sphere `i`.
+    fn radius(&self, i: usize) -> f64 {
+        match &self.radii {
+            Radii::Equal(a) => *a,
+            Radii::Each(r) => r[i],
+        }
+    }
+}
+
 /// One lane of the monodisperse pair kernel, in units of `mu0`: `(A, B / r^2)` of
 /// `M = A I + B r̂r̂` for the separation with squared length `r2` (both branches; `r2 = 0`
 /// gives the self term `(1, 0)`).
@@ -353,11 +363,22 @@ impl Mobility for DirectRpy {
     }
 
     fn stokes_mobility(&self, i: usize) -> f64 {
-        let a = match &self.kernel.radii {
-            Radii::Equal(a) => *a,
-            Radii::Each(r) => r[i],
+        1.0 / (6.0 * PI * self.kernel.eta * self.kernel.radius(i))
+    }
+
+    fn pair_block(&self, i: usize, j: usize) -> ([f64; 3], crate::rpy::PairTensor) {
+        let k = &self.kernel;
+        let d = [k.x[i] - k.x[j], k.y[i] - k.y[j], k.z[i] - k.z[j]];
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let e = if r > 0.0 {
+            d.map(|c| c / r)
+        } else {
+            [0.0, 0.0, 1.0]
         };
-        1.0 / (6.0 * PI * self.kernel.eta * a)
+        (
+            e,
+            crate::rpy::rpy_unequal(r, k.radius(i), k.radius(j), k.eta),
+        )
     }
 
     fn bytes(&self) -> usize {

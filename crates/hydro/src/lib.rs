@@ -142,6 +142,14 @@ pub trait Mobility: Send + Sync {
     /// Self-mobility of an isolated particle `i` in an unbounded fluid, `1 / (6 pi eta a_i)`.
     fn stokes_mobility(&self, i: usize) -> f64;
 
+    /// The block `M_ij = A I + B r̂r̂` of two particles `i != j` at the positions last given,
+    /// with the unit separation `r̂`: the engines' hard-wall reflection solves with it. The
+    /// RPY operators give the unbounded fluid's pair tensor (a periodic one: of the nearest
+    /// image, without the other images' share); the default, free draining's, is zero.
+    fn pair_block(&self, _i: usize, _j: usize) -> ([f64; 3], rpy::PairTensor) {
+        ([0.0, 0.0, 1.0], rpy::PairTensor { a: 0.0, b: 0.0 })
+    }
+
     /// Bytes of memory the operator holds (buffers, lists, grids).
     fn bytes(&self) -> usize;
 }
@@ -223,6 +231,9 @@ impl Mobility for AnyMobility {
     }
     fn stokes_mobility(&self, i: usize) -> f64 {
         self.inner_ref().stokes_mobility(i)
+    }
+    fn pair_block(&self, i: usize, j: usize) -> ([f64; 3], rpy::PairTensor) {
+        self.inner_ref().pair_block(i, j)
     }
     fn bytes(&self) -> usize {
         self.inner_ref().bytes()

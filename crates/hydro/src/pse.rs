@@ -2092,6 +2092,21 @@ impl Mobility for Pse {
         self.mu0s[self.species[i] as usize]
     }
 
+    fn pair_block(&self, i: usize, j: usize) -> ([f64; 3], crate::rpy::PairTensor) {
+        let (d, r2) = nearest_image(self.pos[i], self.pos[j], self.params.box_length);
+        let r = r2.sqrt();
+        let e = if r > 0.0 {
+            d.map(|c| c / r)
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        let (ai, aj) = (
+            self.radii[self.species[i] as usize],
+            self.radii[self.species[j] as usize],
+        );
+        (e, rpy_pair(r, ai, aj, self.params.viscosity))
+    }
+
     fn bytes(&self) -> usize {
         let n = self.n;
         8 * (3 * self.real[0].len()

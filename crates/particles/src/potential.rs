@@ -226,6 +226,14 @@ pub trait External: Sync + Send {
     fn energy_of(&self, p: [f64; 3], t: f64, _d: f64) -> f64 {
         self.energy(p, t)
     }
+    /// A hard wall of the field: how far `s > 0` a particle of diameter `d` that a step ending
+    /// at time `t` left at `p` lies beyond it, and the wall's outward unit normal `n` there
+    /// (the engines reflect it to `p - 2 s n`, moving the others with it where the mobility
+    /// couples them); `None` inside, and for a field without one (the default).
+    #[inline(always)]
+    fn overshoot(&self, _p: [f64; 3], _t: f64, _d: f64) -> Option<(f64, [f64; 3])> {
+        None
+    }
 }
 
 /// No external field.
@@ -335,12 +343,19 @@ impl External for HarmonicInterface {
 /// spheres of `reference_diameter`, and a sphere of diameter `d` meets it `(d - reference) / 2`
 /// further in, so every sphere's surface (not its centre) stops at the same place:
 /// `wall(d) = R(t) + offset - (d - reference) / 2`. With one size it is [`HarmonicInterface`].
+///
+/// `hard`: the limit of an infinitely stiff interface instead, a hard wall at `wall(d)` (the
+/// spring's stiffness and range unused): no force, and a step that ends a distance `s` beyond
+/// the wall ends `s` inside it ([`External::confine`]: reflection, exact for a free Brownian
+/// step at a flat wall; here the wall is a sphere that moves in).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpeciesInterface {
     /// The interface for spheres of the reference diameter.
     pub interface: HarmonicInterface,
     /// The reference diameter (the smallest species').
     pub reference_diameter: f64,
+    /// A hard wall instead of the spring.
+    pub hard: bool,
 }
 
 impl SpeciesInterface {
@@ -355,19 +370,44 @@ impl SpeciesInterface {
 impl External for SpeciesInterface {
     #[inline(always)]
     fn force(&self, p: [f64; 3], t: f64) -> [f64; 3] {
-        self.interface.force(p, t)
+        self.force_on(p, t, self.reference_diameter)
     }
     #[inline]
     fn energy(&self, p: [f64; 3], t: f64) -> f64 {
-        self.interface.energy(p, t)
+        self.energy_of(p, t, self.reference_diameter)
     }
     #[inline(always)]
     fn force_on(&self, p: [f64; 3], t: f64, d: f64) -> [f64; 3] {
+        if self.hard {
+            return [0.0; 3];
+        }
         self.for_size(d).force(p, t)
     }
+    /// The hard wall's energy is 0 inside and infinite beyond.
     #[inline]
     fn energy_of(&self, p: [f64; 3], t: f64, d: f64) -> f64 {
-        self.for_size(d).energy(p, t)
+        match (self.hard, self.overshoot(p, t, d)) {
+            (false, _) => self.for_size(d).energy(p, t),
+            (true, None) => 0.0,
+            (true, Some(_)) => f64::INFINITY,
+        }
+    }
+    /// The hard wall: a centre at distance `r > wall(d)` from the centre of the droplet is
+    /// `s = r - wall(d)` beyond it, the normal radial.
+    #[inline(always)]
+    fn overshoot(&self, p: [f64; 3], t: f64, d: f64) -> Option<(f64, [f64; 3])> {
+        if !self.hard {
+            return None;
+        }
+        let w = self.for_size(d);
+        let c = [p[0] - w.centre[0], p[1] - w.centre[1], p[2] - w.centre[2]];
+        let r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        let wall = w.radius.radius(t) + w.offset;
+        if r2 <= wall * wall {
+            return None;
+        }
+        let r = r2.sqrt();
+        Some((r - wall, [c[0] / r, c[1] / r, c[2] / r]))
     }
 }
 
@@ -441,6 +481,7 @@ mod tests {
         let s = SpeciesInterface {
             interface: w,
             reference_diameter: 1.0,
+            hard: false,
         };
         let p = [0.5 + 4.4, 0.0, 0.0];
         assert_eq!(s.force_on(p, 0.0, 1.0), w.force(p, 0.0));

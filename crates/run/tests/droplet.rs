@@ -198,3 +198,121 @@ fn a_droplet_whose_interface_left_colloids_behind_says_so() {
     let w = run_warnings(&fast(3.0, 100.0));
     assert!(!w.iter().any(|w| w.contains("beyond R")), "{w:?}");
 }
+
+/// `interface.hard`: no centre ever ends a step beyond its species' wall
+/// `R(t) + offset - (d - d_min) / 2`, free draining and with RPY, while the drying front keeps
+/// pressing the outer spheres against it (not vacuous: some centres end within 0.05 d of their
+/// wall).
+#[test]
+fn a_hard_interface_keeps_every_centre_inside_its_wall() {
+    for (particles, counts, hydro) in [
+        (400, "[360, 40]", ""),
+        (
+            90,
+            "[80, 10]",
+            "[hydrodynamics]\nmodel = \"rpy\"\nmethod = \"direct\"\n",
+        ),
+    ] {
+        let text = format!(
+            "method = \"droplet-bd\"\nseed = 3\n[system]\nparticles = {particles}\nphi0 = 0.1\n\
+             [system.species]\ndiameters = [1.0, 2.0]\ncounts = {counts}\n\
+             [drying]\npeclet = 30\nfinal_volume_fraction = 0.35\n[interface]\nhard = true\n{hydro}"
+        );
+        let p = droplet_params(&text);
+        assert!(p.hard_interface && p.stiffness == 0.0);
+        let check = |t: f64, pos: &[[f64; 3]], d: &[f64], closest: &mut f64| {
+            for (x, &di) in pos.iter().zip(d) {
+                let wall = p.radius_at(t) + p.offset - 0.5 * (di - p.diameter);
+                let s = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - wall;
+                assert!(
+                    s <= 1e-12,
+                    "a centre of diameter {di} ended {s} beyond its wall at t = {t}"
+                );
+                *closest = closest.max(s);
+            }
+        };
+        let mut closest = f64::NEG_INFINITY;
+        let (mut done, every) = (0, 20);
+        if hydro.is_empty() {
+            let mut sim = p.build_replica(0).unwrap();
+            while done < p.steps {
+                let k = every.min(p.steps - done);
+                sim.run(k).unwrap();
+                done += k;
+                let s = sim.snapshot();
+                check(sim.time(), &s.pos, &s.diameter, &mut closest);
+            }
+        } else {
+            let h = p.hydrodynamics.clone().unwrap();
+            let mut sim = p.build_hydro_replica(0, &h).unwrap();
+            let steps = p.steps.min(3000);
+            while done < steps {
+                let k = every.min(steps - done);
+                sim.run(k).unwrap();
+                done += k;
+                let s = sim.particles();
+                check(sim.time(), &s.pos, &s.diameter, &mut closest);
+            }
+        }
+        assert!(
+            closest > -0.05,
+            "{hydro}: no centre came near its wall ({closest})"
+        );
+    }
+}
+
+/// A hard wall samples the uniform density of an ideal particle in the ball of radius
+/// `w = R0 + offset`: one sphere (no pair forces) in a static droplet, `<r^2> = 3 w^2 / 5`,
+/// within four standard errors of the mean over independent replicas. Without the reflection
+/// the sphere leaves (no interface force acts on it) and `<r^2>` grows without bound.
+#[test]
+fn a_hard_wall_samples_the_uniform_density_of_an_ideal_sphere() {
+    let p = droplet_params(
+        "method = \"droplet-bd\"\nseed = 9\n[system]\nparticles = 1\nradius = 2.5\n\
+         [drying]\npeclet = 0\nduration = 1.0\n[interface]\nhard = true\n",
+    );
+    let w = p.r0 + p.offset;
+    // 8 replicas of 60 relaxation times w^2 / (pi^2 D0) each, sampled every 50 steps.
+    let (replicas, steps, every) = (8, 200_000u64, 50u64);
+    let means: Vec<f64> = (0..replicas)
+        .map(|r| {
+            let mut sim = p.build_replica(r).unwrap();
+            let mut sum = 0.0;
+            for _ in 0..steps / every {
+                sim.run(every).unwrap();
+                let x = sim.snapshot().pos[0];
+                let r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+                assert!(
+                    r2 <= w * w * (1.0 + 1e-12),
+                    "the sphere left the droplet: r^2 = {r2}"
+                );
+                sum += r2 / (w * w);
+            }
+            sum / (steps / every) as f64
+        })
+        .collect();
+    let n = replicas as f64;
+    let mean = means.iter().sum::<f64>() / n;
+    let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    assert!(se < 0.02, "too few samples to test: standard error {se}");
+    assert!(
+        (mean - 0.6).abs() < 4.0 * se,
+        "<r^2> / w^2 = {mean} +- {se}, uniform density gives 3/5"
+    );
+}
+
+/// A hard interface has no spring: its stiffness or range is refused naming the key.
+#[test]
+fn a_hard_interface_with_a_spring_is_refused() {
+    for key in ["stiffness = 100.0", "range = 0.5"] {
+        let e = droplet_error(
+            &scenario("").replace("[run]", &format!("[interface]\nhard = true\n{key}\n[run]")),
+        );
+        assert_eq!(
+            e.key,
+            format!("interface.{}", key.split(' ').next().unwrap()),
+            "{e}"
+        );
+        assert!(e.to_string().contains("no spring"), "{e}");
+    }
+}

@@ -7,12 +7,13 @@
 use colloidsim_md::hydro::{HydroMethod, HydroModel, HydroParams};
 use colloidsim_md::{DropletParams, HydroBdParams};
 
-/// A static droplet of `N` WCA spheres at phi0 = 0.2 (R0 = 3.42 d) in the harmonic interface.
+/// A static droplet of `N` WCA spheres at phi0 = 0.2 (R0 = 3.42 d) in the harmonic interface,
+/// with the scenario lines `extra` added.
 const N: usize = 64;
-fn static_droplet() -> DropletParams {
+fn static_droplet(extra: &str) -> DropletParams {
     let text = format!(
         "method = \"droplet-bd\"\nseed = 11\n[system]\nparticles = {N}\nphi0 = 0.2\n\
-         [drying]\npeclet = 0\nduration = 1.0\n[run]\ndt = {DT}\n"
+         [drying]\npeclet = 0\nduration = 1.0\n[run]\ndt = {DT}\n{extra}"
     );
     droplet_params(&text)
 }
@@ -128,12 +129,15 @@ fn chi2(a: &Profile, b: &Profile) -> f64 {
 /// sum to N, so 11 would be closer: the bound is lenient by one degree of freedom).
 const CHI2_12_999: f64 = 32.91;
 
-#[test]
-fn a_static_droplet_has_the_same_profile_with_rpy_as_free_draining() {
-    let p = static_droplet();
+/// The free-draining and RPY profiles of `p` agree: chi^2 over the shells below its 0.999
+/// quantile, and the outermost shell (the contact layer: the part of the profile most
+/// sensitive to noise that does not match the mobility, to a drift, or to a wall that does not
+/// move the neighbours of the sphere it reflects) alone within 3.5 standard errors, resolved
+/// to 6 %.
+fn same_profiles(p: &DropletParams) {
     assert!(p.is_static());
-    let fd = free_draining(&p);
-    let hi = rpy(&p, p.kt);
+    let fd = free_draining(p);
+    let hi = rpy(p, p.kt);
     for s in 0..SHELLS {
         eprintln!(
             "shell {s}: free draining {:.3} +- {:.3}, RPY {:.3} +- {:.3}",
@@ -146,9 +150,6 @@ fn a_static_droplet_has_the_same_profile_with_rpy_as_free_draining() {
         x2 < CHI2_12_999,
         "RPY profile differs from free draining: chi^2 = {x2}"
     );
-    // The outermost shell lies in the interface (beyond R0 + offset): its occupation is the
-    // Boltzmann tail, the part of the profile most sensitive to noise that does not match the
-    // mobility, or to a drift. Alone: within 3.5 standard errors, and resolved to 6%.
     let o = SHELLS - 1;
     let (diff, se) = (hi.mean[o] - fd.mean[o], fd.se[o].hypot(hi.se[o]));
     assert!(se < 0.06 * fd.mean[o], "outer shell too noisy: {se}");
@@ -158,6 +159,23 @@ fn a_static_droplet_has_the_same_profile_with_rpy_as_free_draining() {
         hi.mean[o],
         fd.mean[o]
     );
+}
+
+/// In the harmonic interface the outermost shell lies beyond R0 + offset: its occupation is
+/// the Boltzmann tail.
+#[test]
+fn a_static_droplet_has_the_same_profile_with_rpy_as_free_draining() {
+    same_profiles(&static_droplet(""));
+}
+
+/// Behind a hard wall (`interface.hard`) the outermost shell is the layer in contact with it:
+/// RPY's reflection along the mobility keeps the equilibrium of free draining's along the
+/// normal (reflecting RPY steps along the normal alone presses pairs at the wall together).
+#[test]
+fn a_static_droplet_behind_a_hard_wall_has_the_same_profile_with_rpy_as_free_draining() {
+    let p = static_droplet("[interface]\nhard = true\n");
+    assert!(p.hard_interface);
+    same_profiles(&p);
 }
 
 /// A `droplet-bd` scenario read by the run layer (its keys through their declarations).

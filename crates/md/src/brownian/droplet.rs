@@ -80,6 +80,10 @@ pub struct DropletParams {
     pub range: f64,
     /// Interface offset.
     pub offset: f64,
+    /// A hard wall at `R(t) + offset` instead of the spring (the limit of an infinitely stiff
+    /// interface; `stiffness` and `range` unused).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub hard_interface: bool,
     /// Time step.
     pub dt: f64,
     /// Integrator of the free-draining engine ([`Integrator`]).
@@ -202,6 +206,7 @@ impl DropletParams {
         SpeciesInterface {
             interface: self.interface(),
             reference_diameter: self.diameter,
+            hard: self.hard_interface,
         }
     }
 

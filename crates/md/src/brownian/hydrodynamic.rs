@@ -105,6 +105,12 @@ pub struct HydroBrownian<P: Pair, E: External, M: Mobility> {
     forces: Vec<[f64; 3]>,
     unwrapped: Vec<[f64; 3]>,
     disp: Vec<[f64; 3]>,
+    /// A hard wall's reflection ([`Self::reflect_at_walls`]): the spheres beyond it, the
+    /// matrix of their couplings, the forces and their displacements.
+    crossers: Vec<(usize, f64, [f64; 3])>,
+    wall_matrix: Vec<f64>,
+    wall_force: Vec<[f64; 3]>,
+    wall_disp: Vec<[f64; 3]>,
     last_iterations: usize,
     /// Forces added to each particle's systematic force every step, in input order (empty:
     /// none).
@@ -160,6 +166,10 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             forces: vec![[0.0; 3]; n],
             unwrapped: vec![[0.0; 3]; n],
             disp: vec![[0.0; 3]; n],
+            crossers: Vec::new(),
+            wall_matrix: Vec::new(),
+            wall_force: vec![[0.0; 3]; n],
+            wall_disp: vec![[0.0; 3]; n],
             last_iterations: 0,
             extra: Vec::new(),
         };
@@ -332,6 +342,7 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             .mobility
             .displacement(&self.forces, p.dt, p.kt, key, &mut self.disp)?;
         self.last_iterations = rep.iterations;
+        self.reflect_at_walls((step + 1) as f64 * p.dt);
         let sbox = self.sbox;
         self.particles
             .pos
@@ -348,4 +359,106 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
         self.step += 1;
         Ok(())
     }
+
+    /// Reflect the step's displacements at a hard wall of the external field
+    /// ([`External::overshoot`]) along the mobility: the spheres `i` that would end `s_i`
+    /// beyond the wall (outward normals `n_i`) get the forces `-lambda_i n_i` whose
+    /// displacement `M F` moves each of them `2 s_i` back along its normal, and their
+    /// neighbours with them: `sum_j n_i.M_ij n_j lambda_j = 2 s_i` (the blocks from
+    /// [`Mobility::pair_block`]). For one sphere that is the mirror image of the step in the
+    /// metric of `M^-1`, in which the step's noise is isotropic (reflection along `M n`, the
+    /// co-normal): it keeps the equilibrium of a mobility that couples the spheres, where the
+    /// reflection along `n` alone presses pairs at the wall together. A sweep can push a
+    /// neighbour out: repeated while spheres are beyond, at most [`WALL_SWEEPS`] times, then
+    /// those still beyond are reflected along `n`.
+    fn reflect_at_walls(&mut self, t_end: f64) {
+        let p = &self.particles;
+        for sweep in 0..=WALL_SWEEPS {
+            self.crossers.clear();
+            for i in 0..p.len() {
+                let (x, d) = (p.pos[i], &mut self.disp[i]);
+                let y = [x[0] + d[0], x[1] + d[1], x[2] + d[2]];
+                if let Some((s, n)) = self.external.overshoot(y, t_end, p.diameter[i]) {
+                    if sweep == WALL_SWEEPS {
+                        *d = [
+                            d[0] - 2.0 * s * n[0],
+                            d[1] - 2.0 * s * n[1],
+                            d[2] - 2.0 * s * n[2],
+                        ];
+                    } else {
+                        self.crossers.push((i, s, n));
+                    }
+                }
+            }
+            if self.crossers.is_empty() {
+                return;
+            }
+            let lambda = wall_forces(&self.crossers, &self.mobility, &mut self.wall_matrix);
+            self.wall_force.iter_mut().for_each(|f| *f = [0.0; 3]);
+            for (&(i, _, n), l) in self.crossers.iter().zip(lambda) {
+                self.wall_force[i] = [-l * n[0], -l * n[1], -l * n[2]];
+            }
+            self.mobility.apply(&self.wall_force, &mut self.wall_disp);
+            for (d, w) in self.disp.iter_mut().zip(&self.wall_disp) {
+                *d = [d[0] + w[0], d[1] + w[1], d[2] + w[2]];
+            }
+        }
+    }
 }
+
+/// The `lambda` of [`HydroBrownian::reflect_at_walls`] for the spheres `(i, s_i, n_i)`
+/// beyond the wall: `A lambda = 2 s` with `A_ij = n_i.M_ij n_j` (`A_ii` the Stokes
+/// mobility), by Cholesky in `a` (returned in its first column). `A` is positive definite
+/// as `M` is; should rounding say otherwise, each sphere alone (`lambda_i = 2 s_i / A_ii`).
+fn wall_forces<'a, M: Mobility>(
+    crossers: &[(usize, f64, [f64; 3])],
+    mobility: &M,
+    a: &'a mut Vec<f64>,
+) -> &'a [f64] {
+    let m = crossers.len();
+    a.clear();
+    a.resize(m * (m + 1), 0.0);
+    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    for (r, &(i, _, ni)) in crossers.iter().enumerate() {
+        a[r * m + r] = mobility.stokes_mobility(i);
+        for (c, &(j, _, nj)) in crossers.iter().enumerate().take(r) {
+            let (e, t) = mobility.pair_block(i, j);
+            a[r * m + c] = t.a * dot(ni, nj) + t.b * dot(ni, e) * dot(nj, e);
+        }
+    }
+    // Lower Cholesky factor in place, then the two triangular solves into the last m numbers.
+    let (l, x) = a.split_at_mut(m * m);
+    let mut ok = true;
+    for r in 0..m {
+        for c in 0..=r {
+            let s = l[r * m + c] - (0..c).map(|k| l[r * m + k] * l[c * m + k]).sum::<f64>();
+            if c < r {
+                l[r * m + c] = s / l[c * m + c];
+            } else if s > 0.0 {
+                l[r * m + r] = s.sqrt();
+            } else {
+                ok = false;
+            }
+        }
+    }
+    for (r, &(i, s, _)) in crossers.iter().enumerate() {
+        x[r] = if ok {
+            2.0 * s
+        } else {
+            2.0 * s / mobility.stokes_mobility(i)
+        };
+    }
+    if ok {
+        for r in 0..m {
+            x[r] = (x[r] - (0..r).map(|k| l[r * m + k] * x[k]).sum::<f64>()) / l[r * m + r];
+        }
+        for r in (0..m).rev() {
+            x[r] = (x[r] - (r + 1..m).map(|k| l[k * m + r] * x[k]).sum::<f64>()) / l[r * m + r];
+        }
+    }
+    &a[m * m..]
+}
+
+/// Sweeps of [`HydroBrownian::reflect_at_walls`] along the mobility before the spheres still
+/// beyond a hard wall are reflected along its normal.
+pub const WALL_SWEEPS: usize = 4;

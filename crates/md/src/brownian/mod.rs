@@ -941,6 +941,7 @@ impl<P: Pair, E: External> Brownian<P, E> {
             external: &self.external,
             extra: &self.extra,
             t,
+            t_end: (step + 1) as f64 * self.params.dt,
             seed,
             step,
             key0,
@@ -1020,6 +1021,8 @@ struct StepPass<'a, E> {
     /// Extra forces by input index (empty: none).
     extra: &'a [[f64; 3]],
     t: f64,
+    /// Time at the end of the step (where a hard wall confines the new positions).
+    t_end: f64,
     seed: u32,
     step: u64,
     key0: u64,
@@ -1090,11 +1093,19 @@ impl<E: External> StepPass<'_, E> {
                         zig.sample(&mut rng),
                     ],
                 };
-                let q = [
+                let mut q = [
                     x[0] + drift[0] + amp * xi[0],
                     x[1] + drift[1] + amp * xi[1],
                     x[2] + drift[2] + amp * xi[2],
                 ];
+                // A hard wall reflects the step (free draining: along the wall's normal).
+                if let Some((s, n)) = self.external.overshoot(q, self.t_end, self.diameter[i]) {
+                    q = [
+                        q[0] - 2.0 * s * n[0],
+                        q[1] - 2.0 * s * n[1],
+                        q[2] - 2.0 * s * n[2],
+                    ];
+                }
                 let r = self.ref_pos[i];
                 let d = [q[0] - r[0], q[1] - r[1], q[2] - r[2]];
                 let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];

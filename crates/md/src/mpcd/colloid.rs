@@ -1502,6 +1502,7 @@ impl MpcdSystem {
                 let w = SpeciesInterface {
                     interface: *h,
                     reference_diameter: self.colloids.mixture.d_min(),
+                    hard: false,
                 };
                 self.colloids.advance(t0, tau, &w)?
             }
@@ -2292,6 +2293,7 @@ mod tests {
                 offset: -1.0,
             },
             reference_diameter: 2.0,
+            hard: false,
         };
         let x = [[0.0, 0.0, 12.0 - 1.0 + 0.3], [12.0 - 2.0 + 0.3, 0.0, 0.0]];
         let c = DiscreteColloids::new_mixture(cp, &mix, sbox, &x, 1.0, 3).unwrap();

@@ -15,6 +15,10 @@ use crate::keys::shared::{
 use crate::keys::species::*;
 use crate::keys::{MAX_BINS_RADIAL, SEED_KEY, Spec, key};
 
+pub const INTERFACE_HARD: Spec = key("interface.hard", "-", Value("false"), Bool,
+    "a hard wall at R(t) + offset instead of the spring, the limit of an infinitely stiff interface: a step that ends a distance s beyond the wall ends s inside it (reflection; with RPY along the mobility, moving the neighbours too); no interface force")
+    .also("without interface.stiffness and interface.range; not for colloidsim theory");
+
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-bd"]),
     "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics");
 
@@ -107,6 +111,7 @@ pub static KEYS: &[Spec] = &[
     INTERFACE_STIFFNESS,
     INTERFACE_RANGE,
     INTERFACE_OFFSET.also("in [-R0, R0] and R_end + offset > 0"),
+    INTERFACE_HARD,
     PAIR,
     PAIR_KIND,
     PAIR_EPSILON,

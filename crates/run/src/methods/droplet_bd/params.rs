@@ -178,7 +178,20 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
     }
 
     let it = shared::interface(r, d, kt)?;
-    let (stiffness, range) = (it.stiffness, it.range);
+    let hard_interface = r.flag(&INTERFACE_HARD)?;
+    let spring = [&INTERFACE_STIFFNESS, &INTERFACE_RANGE];
+    if let Some(k) = spring.into_iter().find(|k| hard_interface && r.has(k)) {
+        bail!(ParamError::new(
+            k.path,
+            "a hard interface (interface.hard = true) has no spring: leave it out",
+        ));
+    }
+    // A hard wall: no spring (stiffness and range 0; the wall is at R(t) + offset).
+    let (stiffness, range) = if hard_interface {
+        (0.0, 0.0)
+    } else {
+        (it.stiffness, it.range)
+    };
     if range > r0 {
         bail!(ParamError::new(
             INTERFACE_RANGE.path,
@@ -199,7 +212,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
     } else {
         range + (hold - 0.5 * stiffness * range * range) / (stiffness * range)
     };
-    if reach > r0 {
+    if !hard_interface && reach > r0 {
         bail!(ParamError::new(
             INTERFACE_STIFFNESS.path,
             format!(
@@ -290,7 +303,6 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
             .as_ref()
             .is_some_and(|h| h.model == HydroModel::Rpy),
     )?;
-
     let bins = r.count(&OBSERVE_PROFILE_BINS)? as usize;
     let fractions = r.numbers(&OBSERVE_PROFILE_FRACTIONS)?;
     if fractions.is_empty() {
@@ -337,6 +349,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
         stiffness,
         range,
         offset,
+        hard_interface,
         dt,
         integrator,
         steps,

@@ -166,6 +166,17 @@ fn parse_pair(pair: Option<&str>, hydro: Hydrodynamics) -> Result<PairCorrelatio
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
     let dx = topts.dx;
     let p = super::resolve(src, None)?;
+    if p.hard_interface {
+        bail!(
+            "{}: {}",
+            src.label(),
+            ParamError::new(
+                super::keys::INTERFACE_HARD.path,
+                "the DDFT has no hard wall: solve it in a stiff interface (interface.stiffness) \
+                 instead",
+            )
+        );
+    }
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
     let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;

@@ -118,6 +118,7 @@ impl DropletRun {
         SpeciesInterface {
             interface: self.harmonic(),
             reference_diameter: self.diameter,
+            hard: false,
         }
     }
 
