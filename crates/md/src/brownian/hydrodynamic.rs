@@ -106,9 +106,10 @@ pub struct HydroBrownian<P: Pair, E: External, M: Mobility> {
     unwrapped: Vec<[f64; 3]>,
     disp: Vec<[f64; 3]>,
     /// A hard wall's reflection ([`Self::reflect_at_walls`]): the spheres beyond it, the
-    /// matrix of their couplings, the forces and their displacements.
+    /// matrix of their couplings and its solution, the forces and their displacements.
     crossers: Vec<(usize, f64, [f64; 3])>,
-    wall_matrix: Vec<f64>,
+    wall_matrix: nalgebra::DMatrix<f64>,
+    wall_lambda: nalgebra::DVector<f64>,
     wall_force: Vec<[f64; 3]>,
     wall_disp: Vec<[f64; 3]>,
     last_iterations: usize,
@@ -167,7 +168,8 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             unwrapped: vec![[0.0; 3]; n],
             disp: vec![[0.0; 3]; n],
             crossers: Vec::new(),
-            wall_matrix: Vec::new(),
+            wall_matrix: nalgebra::DMatrix::zeros(0, 0),
+            wall_lambda: nalgebra::DVector::zeros(0),
             wall_force: vec![[0.0; 3]; n],
             wall_disp: vec![[0.0; 3]; n],
             last_iterations: 0,
@@ -372,9 +374,9 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
     /// neighbour out: repeated while spheres are beyond, at most [`WALL_SWEEPS`] times, then
     /// those still beyond are reflected along `n`.
     fn reflect_at_walls(&mut self, t_end: f64) {
-        let p = &self.particles;
         for sweep in 0..=WALL_SWEEPS {
             self.crossers.clear();
+            let p = &self.particles;
             for i in 0..p.len() {
                 let (x, d) = (p.pos[i], &mut self.disp[i]);
                 let y = [x[0] + d[0], x[1] + d[1], x[2] + d[2]];
@@ -393,9 +395,9 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             if self.crossers.is_empty() {
                 return;
             }
-            let lambda = wall_forces(&self.crossers, &self.mobility, &mut self.wall_matrix);
+            self.wall_forces();
             self.wall_force.iter_mut().for_each(|f| *f = [0.0; 3]);
-            for (&(i, _, n), l) in self.crossers.iter().zip(lambda) {
+            for (&(i, _, n), l) in self.crossers.iter().zip(self.wall_lambda.iter()) {
                 self.wall_force[i] = [-l * n[0], -l * n[1], -l * n[2]];
             }
             self.mobility.apply(&self.wall_force, &mut self.wall_disp);
@@ -404,59 +406,43 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             }
         }
     }
-}
 
-/// The `lambda` of [`HydroBrownian::reflect_at_walls`] for the spheres `(i, s_i, n_i)`
-/// beyond the wall: `A lambda = 2 s` with `A_ij = n_i.M_ij n_j` (`A_ii` the Stokes
-/// mobility), by Cholesky in `a` (returned in its first column). `A` is positive definite
-/// as `M` is; should rounding say otherwise, each sphere alone (`lambda_i = 2 s_i / A_ii`).
-fn wall_forces<'a, M: Mobility>(
-    crossers: &[(usize, f64, [f64; 3])],
-    mobility: &M,
-    a: &'a mut Vec<f64>,
-) -> &'a [f64] {
-    let m = crossers.len();
-    a.clear();
-    a.resize(m * (m + 1), 0.0);
-    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    for (r, &(i, _, ni)) in crossers.iter().enumerate() {
-        a[r * m + r] = mobility.stokes_mobility(i);
-        for (c, &(j, _, nj)) in crossers.iter().enumerate().take(r) {
-            let (e, t) = mobility.pair_block(i, j);
-            a[r * m + c] = t.a * dot(ni, nj) + t.b * dot(ni, e) * dot(nj, e);
+    /// The `lambda` of [`Self::reflect_at_walls`] for the spheres `(i, s_i, n_i)` beyond the
+    /// wall, into `wall_lambda`: `A lambda = 2 s` with `A_ij = n_i.M_ij n_j` (`A_ii` the
+    /// Stokes mobility), by Cholesky (the buffers kept from step to step). `A` is positive
+    /// definite as `M` is; should rounding say otherwise, each sphere alone
+    /// (`lambda_i = 2 s_i / A_ii`).
+    fn wall_forces(&mut self) {
+        let (c, mobility) = (&self.crossers, &self.mobility);
+        let m = c.len();
+        let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let mut a = std::mem::take(&mut self.wall_matrix);
+        a.resize_mut(m, m, 0.0);
+        for (r, &(i, _, ni)) in c.iter().enumerate() {
+            a[(r, r)] = mobility.stokes_mobility(i);
+            // The lower triangle, which the factorisation reads.
+            for (k, &(j, _, nj)) in c.iter().enumerate().take(r) {
+                let (e, t) = mobility.pair_block(i, j);
+                a[(r, k)] = t.a * dot(ni, nj) + t.b * dot(ni, e) * dot(nj, e);
+            }
         }
-    }
-    // Lower Cholesky factor in place, then the two triangular solves into the last m numbers.
-    let (l, x) = a.split_at_mut(m * m);
-    let mut ok = true;
-    for r in 0..m {
-        for c in 0..=r {
-            let s = l[r * m + c] - (0..c).map(|k| l[r * m + k] * l[c * m + k]).sum::<f64>();
-            if c < r {
-                l[r * m + c] = s / l[c * m + c];
-            } else if s > 0.0 {
-                l[r * m + r] = s.sqrt();
-            } else {
-                ok = false;
+        let lambda = &mut self.wall_lambda;
+        lambda.resize_vertically_mut(m, 0.0);
+        for (l, &(_, s, _)) in lambda.iter_mut().zip(c) {
+            *l = 2.0 * s;
+        }
+        match nalgebra::Cholesky::new(a) {
+            Some(ch) => {
+                ch.solve_mut(lambda);
+                self.wall_matrix = ch.unpack();
+            }
+            None => {
+                for (l, &(i, _, _)) in lambda.iter_mut().zip(c) {
+                    *l /= mobility.stokes_mobility(i);
+                }
             }
         }
     }
-    for (r, &(i, s, _)) in crossers.iter().enumerate() {
-        x[r] = if ok {
-            2.0 * s
-        } else {
-            2.0 * s / mobility.stokes_mobility(i)
-        };
-    }
-    if ok {
-        for r in 0..m {
-            x[r] = (x[r] - (0..r).map(|k| l[r * m + k] * x[k]).sum::<f64>()) / l[r * m + r];
-        }
-        for r in (0..m).rev() {
-            x[r] = (x[r] - (r + 1..m).map(|k| l[k * m + r] * x[k]).sum::<f64>()) / l[r * m + r];
-        }
-    }
-    &a[m * m..]
 }
 
 /// Sweeps of [`HydroBrownian::reflect_at_walls`] along the mobility before the spheres still
