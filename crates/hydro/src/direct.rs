@@ -508,6 +508,35 @@ mod tests {
     use super::*;
     use crate::rpy::{rpy, rpy_unequal};
 
+    /// `pair_block(i, j)` is the block of the operator: a force on `j` alone moves `i` by it,
+    /// for spheres of unequal radii apart and overlapping; free draining's is zero.
+    #[test]
+    fn pair_blocks_are_the_operators_blocks() {
+        let radii = [0.5, 1.0, 0.5];
+        let pos = [[0.0, 0.0, 0.0], [1.0, 0.6, -0.3], [0.3, -2.5, 1.1]];
+        let mut m = DirectRpy::with_radii(&radii, 0.7, LanczosParams::default(), 10).unwrap();
+        m.set_positions(&pos).unwrap();
+        for (i, j) in [(0, 1), (1, 0), (0, 2), (2, 1)] {
+            let (e, t) = m.pair_block(i, j);
+            for k in 0..3 {
+                let mut f = [[0.0; 3]; 3];
+                f[j][k] = 1.0;
+                let mut u = [[0.0; 3]; 3];
+                m.apply(&f, &mut u);
+                for c in 0..3 {
+                    let want = t.a * (c == k) as u8 as f64 + t.b * e[c] * e[k];
+                    assert!(
+                        (u[i][c] - want).abs() < 1e-12,
+                        "({i}, {j}) [{c}][{k}]: {} vs {want}",
+                        u[i][c]
+                    );
+                }
+            }
+        }
+        let fd = FreeDraining::new(&radii, 0.7).unwrap();
+        assert_eq!(fd.pair_block(0, 1).1.a, 0.0);
+    }
+
     fn config(n: usize, l: f64, seed: u64) -> Vec<[f64; 3]> {
         // A deterministic scatter (golden-ratio sequences).
         (0..n)
