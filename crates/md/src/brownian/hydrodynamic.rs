@@ -108,8 +108,8 @@ pub struct HydroBrownian<P: Pair, E: External, M: Mobility> {
     /// A hard wall's reflection ([`Self::reflect_at_walls`]): the spheres beyond it, the
     /// matrix of their couplings and its solution, the forces and their displacements.
     crossers: Vec<(usize, f64, [f64; 3])>,
-    wall_matrix: nalgebra::DMatrix<f64>,
-    wall_lambda: nalgebra::DVector<f64>,
+    wall_matrix: Vec<f64>,
+    wall_lambda: Vec<f64>,
     wall_force: Vec<[f64; 3]>,
     wall_disp: Vec<[f64; 3]>,
     last_iterations: usize,
@@ -168,8 +168,8 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
             unwrapped: vec![[0.0; 3]; n],
             disp: vec![[0.0; 3]; n],
             crossers: Vec::new(),
-            wall_matrix: nalgebra::DMatrix::zeros(0, 0),
-            wall_lambda: nalgebra::DVector::zeros(0),
+            wall_matrix: Vec::new(),
+            wall_lambda: Vec::new(),
             wall_force: vec![[0.0; 3]; n],
             wall_disp: vec![[0.0; 3]; n],
             last_iterations: 0,
@@ -366,8 +366,8 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
     /// ([`External::overshoot`]) along the mobility: the spheres `i` that would end `s_i`
     /// beyond the wall (outward normals `n_i`) get the forces `-lambda_i n_i` whose
     /// displacement `M F` moves each of them `2 s_i` back along its normal, and their
-    /// neighbours with them: `sum_j n_i.M_ij n_j lambda_j = 2 s_i` (the blocks from
-    /// [`Mobility::pair_block`]). For one sphere that is the mirror image of the step in the
+    /// neighbours with them: `sum_j n_i.M_ij n_j lambda_j = 2 s_i`, `lambda >= 0` (the blocks
+    /// from [`Mobility::pair_block`]; [`Self::wall_forces`]). For one sphere that is the mirror image of the step in the
     /// metric of `M^-1`, in which the step's noise is isotropic (reflection along `M n`, the
     /// co-normal): it keeps the equilibrium of a mobility that couples the spheres, where the
     /// reflection along `n` alone presses pairs at the wall together. A sweep can push a
@@ -409,41 +409,54 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
 
     /// The `lambda` of [`Self::reflect_at_walls`] for the spheres `(i, s_i, n_i)` beyond the
     /// wall, into `wall_lambda`: `A lambda = 2 s` with `A_ij = n_i.M_ij n_j` (`A_ii` the
-    /// Stokes mobility), by Cholesky (the buffers kept from step to step). `A` is positive
-    /// definite as `M` is; should rounding say otherwise, each sphere alone
-    /// (`lambda_i = 2 s_i / A_ii`).
+    /// Stokes mobility) and `lambda >= 0` (the wall pushes, never pulls), by projected
+    /// Gauss–Seidel (the linear complementarity problem of contact mechanics: where the
+    /// unconstrained solution is non-negative, it is that solution). Without the bound, two
+    /// nearly coincident spheres beyond the wall (`A` near singular) would get huge opposite
+    /// forces.
     fn wall_forces(&mut self) {
         let (c, mobility) = (&self.crossers, &self.mobility);
         let m = c.len();
         let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-        let mut a = std::mem::take(&mut self.wall_matrix);
-        a.resize_mut(m, m, 0.0);
+        let a = &mut self.wall_matrix;
+        a.clear();
+        a.resize(m * m, 0.0);
         for (r, &(i, _, ni)) in c.iter().enumerate() {
-            a[(r, r)] = mobility.stokes_mobility(i);
-            // The lower triangle, which the factorisation reads.
+            a[r * m + r] = mobility.stokes_mobility(i);
             for (k, &(j, _, nj)) in c.iter().enumerate().take(r) {
                 let (e, t) = mobility.pair_block(i, j);
-                a[(r, k)] = t.a * dot(ni, nj) + t.b * dot(ni, e) * dot(nj, e);
+                let v = t.a * dot(ni, nj) + t.b * dot(ni, e) * dot(nj, e);
+                (a[r * m + k], a[k * m + r]) = (v, v);
             }
         }
         let lambda = &mut self.wall_lambda;
-        lambda.resize_vertically_mut(m, 0.0);
-        for (l, &(_, s, _)) in lambda.iter_mut().zip(c) {
-            *l = 2.0 * s;
-        }
-        match nalgebra::Cholesky::new(a) {
-            Some(ch) => {
-                ch.solve_mut(lambda);
-                self.wall_matrix = ch.unpack();
+        lambda.clear();
+        lambda.resize(m, 0.0);
+        for _ in 0..WALL_SOLVE_SWEEPS {
+            let mut change: f64 = 0.0;
+            for (r, &(_, s, _)) in c.iter().enumerate() {
+                let row = &a[r * m..(r + 1) * m];
+                let off: f64 = row
+                    .iter()
+                    .zip(lambda.iter())
+                    .map(|(x, l)| x * l)
+                    .sum::<f64>()
+                    - row[r] * lambda[r];
+                let new = ((2.0 * s - off) / row[r]).max(0.0);
+                change = change.max((new - lambda[r]).abs() * row[r] / s.max(f64::MIN_POSITIVE));
+                lambda[r] = new;
             }
-            None => {
-                for (l, &(i, _, _)) in lambda.iter_mut().zip(c) {
-                    *l /= mobility.stokes_mobility(i);
-                }
+            if change < WALL_SOLVE_TOLERANCE {
+                break;
             }
         }
     }
 }
+
+/// Projected Gauss–Seidel sweeps of [`HydroBrownian::wall_forces`] at most, and the relative
+/// change of a sphere's push (in units of its overshoot) at which they stop.
+const WALL_SOLVE_SWEEPS: usize = 100;
+const WALL_SOLVE_TOLERANCE: f64 = 1e-10;
 
 /// Sweeps of [`HydroBrownian::reflect_at_walls`] along the mobility before the spheres still
 /// beyond a hard wall are reflected along its normal.
