@@ -569,6 +569,49 @@ def alpha_figure(paths, path, fraction=1.0, methods=None):
     plt.close(fig)
 
 
+def stiffness_figure(paths, path, peclets, base_stiffness, fraction=1.0):
+    """S against the interface's stiffness, free draining and RPY, one panel per Pe_s in
+    `peclets`, a line per phi0, from the data files `paths`: methods `bd-fd`, `bd-rpy` with a
+    `-k<stiffness>` or `-hard` suffix (none: `base_stiffness`, the example's). The hard wall
+    is drawn right of the stiffest spring: does S reach its hard-wall limit?"""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [r for r in read_rows(paths) if r["fraction"] == fraction]
+    kinds = {"bd-fd": ("free draining", "C0"), "bd-rpy": ("RPY", "C3")}
+    finite = [base_stiffness if k is None else k for r in rows for b, k in [split(r["method"])]
+              if b in kinds and k != math.inf]
+    hard_x = 2.5 * max(finite)
+    stiffness = lambda k: base_stiffness if k is None else (hard_x if k == math.inf else k)
+    marks = {0.05: "o", 0.1: "s", 0.2: "^"}
+    fig, axes = plt.subplots(1, len(peclets), figsize=(4.2 * len(peclets), 3.6),
+                             layout="constrained", sharey=True, squeeze=False)
+    for ax, pe in zip(axes[0], peclets):
+        for base, (label, colour) in kinds.items():
+            for phi0 in sorted({r["phi0"] for r in rows}):
+                pts = sorted((stiffness(k), r["S"], r["delta_err"] or 0.0)
+                             for r in rows for b, k in [split(r["method"])]
+                             if b == base and r["pe_s"] == pe and r["phi0"] == phi0)
+                if not pts:
+                    continue
+                x, y, e = zip(*pts)
+                ax.errorbar(x, y, yerr=e, color=colour, marker=marks.get(phi0, "o"), ms=5,
+                            lw=1, capsize=2, label=f"{label}, $\\phi_s$ = {phi0 / 2:g}")
+        ax.axhline(0, color="k", lw=0.8)
+        ax.axvline(math.sqrt(max(finite) * hard_x), color="0.6", lw=0.8, ls=":")
+        ax.set_xscale("log")
+        ticks = sorted(set(finite)) + [hard_x]
+        ax.set_xticks(ticks, [f"{t:g}" for t in ticks[:-1]] + ["hard"], fontsize=7)
+        ax.minorticks_off()
+        ax.set_xlabel(r"interface stiffness ($kT/d^2$)")
+        ax.set_title(f"$Pe_s$ = {pe:g}", fontsize=9)
+    axes[0][0].set_ylabel(r"$S = \Delta - \Delta_{ideal}$ ($>0$: small-on-top)")
+    axes[0][-1].legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 # The profiles are drawn from this r / R on.
 X_FROM = 0.4
 
@@ -655,8 +698,19 @@ def main():
                          "thresholds and diagrams without the runs (no profile figures)")
     ap.add_argument("--compare-methods", metavar="METHOD,...",
                     help="with --compare-alpha: draw these methods only (default: all)")
+    ap.add_argument("--compare-stiffness", metavar="CSV,CSV,...",
+                    help="only draw IMG/stratification-stiffness<tag>.png from these data files: "
+                         "S against the interface's stiffness at each --peclet")
+    ap.add_argument("--base-stiffness", type=float, default=100.0,
+                    help="with --compare-stiffness: the stiffness of methods without -k")
     args = ap.parse_args()
     ALPHA = args.alpha
+    if args.compare_stiffness:
+        os.makedirs(args.img, exist_ok=True)
+        stiffness_figure(args.compare_stiffness.split(","),
+                         os.path.join(args.img, f"stratification-stiffness{args.tag}.png"),
+                         [float(x) for x in args.peclet.split(",")], args.base_stiffness)
+        return
     if args.compare_alpha:
         alpha_figure(args.compare_alpha.split(","),
                      os.path.join(args.img, f"stratification-alpha{args.tag}.png"),

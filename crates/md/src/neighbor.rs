@@ -302,14 +302,16 @@ impl NeighborList {
                         }
                     }
                     *cnt = m.min(stride) as u32;
-                    if m <= stride {
+                    if m < stride {
                         slot[..m].sort_unstable_by_key(|&j| key[j as usize]);
                     }
                     m
                 })
                 .max()
                 .unwrap_or(0);
-            if overflow <= self.stride {
+            // Every candidate, hit or not, is written at the slot after the last hit: a row is
+            // whole only with that slot to spare (a full row may have lost its last hit).
+            if overflow < self.stride {
                 return Ok(());
             }
             self.stride = overflow + overflow / 4 + 4;
@@ -424,6 +426,40 @@ mod tests {
     use super::*;
     use colloidsim_core::rng::{Purpose, stream};
     use rand::RngExt;
+
+    /// Spheres with exactly as many neighbours as the list's first width (16) keep all of
+    /// them: the branch-free append writes every candidate, hit or not, at the slot after the
+    /// last hit, so the last slot is scratch and a full row must grow the list (found as a
+    /// sphere listed as its own neighbour, a NaN force, in a compressed droplet).
+    #[test]
+    fn a_row_filled_to_the_list_width_keeps_every_neighbour() {
+        // Sphere 0 at the origin, 16 on a sphere of radius 0.5 around it (all 16 apart by at
+        // most 1: each has 16 neighbours within range 1), a 17th beyond range of all, scanned
+        // last (one cell: the box is under 3 ranges).
+        let mut pos = vec![[0.0; 3]];
+        for k in 0..16 {
+            let z = -0.9 + 1.8 * k as f64 / 15.0;
+            let a = 2.4 * k as f64;
+            let r = (1.0 - z * z).sqrt();
+            pos.push([0.5 * r * a.cos(), 0.5 * r * a.sin(), 0.5 * z]);
+        }
+        pos.push([1.2, 1.2, 1.2]);
+        let sbox = SimBox::cube(2.5);
+        let key: Vec<u32> = (0..pos.len() as u32).collect();
+        let mut nl = NeighborList::new(1.0, 0.0);
+        nl.build(&sbox, &pos, &key).unwrap();
+        for i in 0..pos.len() {
+            let want: Vec<u32> = (0..pos.len() as u32)
+                .filter(|&j| {
+                    let (p, q) = (pos[i], pos[j as usize]);
+                    let d = sbox.min_image([p[0] - q[0], p[1] - q[1], p[2] - q[2]]);
+                    j as usize != i && d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < 1.0
+                })
+                .collect();
+            assert_eq!(nl.neighbors(i), &want[..], "sphere {i}");
+        }
+        assert_eq!(nl.neighbors(0).len(), 16);
+    }
 
     #[test]
     fn matches_brute_force_including_periodic_images() {
