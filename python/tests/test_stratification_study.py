@@ -26,7 +26,8 @@ def at_repo(monkeypatch):
 
 
 @pytest.mark.parametrize("alpha", [2.0, 4.0])
-@pytest.mark.parametrize("method", ["bd-fd", "bd-rpy-k500", "bd-fd-k2000", "mpcd-slip", "mpcd-noslip-k800"])
+@pytest.mark.parametrize("method", ["bd-fd", "bd-rpy-k500", "bd-fd-k2000", "bd-rpy-hard", "mpcd-slip",
+                                    "mpcd-noslip-k800"])
 def test_scenarios_are_valid(cli, tmp_path, at_repo, monkeypatch, method, alpha):
     monkeypatch.setattr(study, "ALPHA", alpha)
     if study.is_mpcd(method):
@@ -45,6 +46,9 @@ def test_scenarios_are_valid(cli, tmp_path, at_repo, monkeypatch, method, alpha)
         assert ("stiffness = 500.0" in text) == method.endswith("-k500")
         # Beyond 500 kT/d^2 the step shrinks to keep k D0 dt / kT = 0.1.
         assert ("dt = 0.000471239" in text) == method.endswith("-k2000")
+        # A hard wall in place of the spring, at the default step.
+        assert ("hard = true" in text) == method.endswith("-hard")
+        assert ("stiffness" not in text) == method.endswith("-hard")
     large = int(650 // (1 + alpha**3)) if not study.is_mpcd(method) else int(108 // (1 + alpha**3))
     total = 108 if study.is_mpcd(method) else 650
     assert f"counts = [{total - large}, {large}]" in text
@@ -66,6 +70,9 @@ def test_ideal_delta_of_a_hard_walled_uniform_mixture():
     # One size: no difference; a softer interface lets both out alike.
     p1 = dict(p, species={"diameters": [1.0, 1.0]}, stiffness=10.0)
     assert abs(study.ideal_delta(p1, radius)) < 1e-12
+    # The hard wall (`interface.hard`: stiffness and range 0) is the same limit.
+    hard = dict(p, stiffness=0.0, range=0.0, hard_interface=True)
+    assert study.ideal_delta(hard, radius) == pytest.approx(exact, rel=2e-3)
 
 
 def test_threshold_is_where_s_stays_positive():
