@@ -369,16 +369,7 @@ impl Mobility for DirectRpy {
     fn pair_block(&self, i: usize, j: usize) -> ([f64; 3], crate::rpy::PairTensor) {
         let k = &self.kernel;
         let d = [k.x[i] - k.x[j], k.y[i] - k.y[j], k.z[i] - k.z[j]];
-        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let e = if r > 0.0 {
-            d.map(|c| c / r)
-        } else {
-            [0.0, 0.0, 1.0]
-        };
-        (
-            e,
-            crate::rpy::rpy_unequal(r, k.radius(i), k.radius(j), k.eta),
-        )
+        crate::rpy::pair_block(d, k.radius(i), k.radius(j), k.eta)
     }
 
     fn bytes(&self) -> usize {

@@ -2093,18 +2093,9 @@ impl Mobility for Pse {
     }
 
     fn pair_block(&self, i: usize, j: usize) -> ([f64; 3], crate::rpy::PairTensor) {
-        let (d, r2) = nearest_image(self.pos[i], self.pos[j], self.params.box_length);
-        let r = r2.sqrt();
-        let e = if r > 0.0 {
-            d.map(|c| c / r)
-        } else {
-            [0.0, 0.0, 1.0]
-        };
-        let (ai, aj) = (
-            self.radii[self.species[i] as usize],
-            self.radii[self.species[j] as usize],
-        );
-        (e, rpy_pair(r, ai, aj, self.params.viscosity))
+        let (d, _) = nearest_image(self.pos[i], self.pos[j], self.params.box_length);
+        let radius = |k: usize| self.radii[self.species[k] as usize];
+        crate::rpy::pair_block(d, radius(i), radius(j), self.params.viscosity)
     }
 
     fn bytes(&self) -> usize {

@@ -104,6 +104,19 @@ pub fn rpy_unequal(r: f64, ai: f64, aj: f64, eta: f64) -> PairTensor {
     }
 }
 
+/// The pair block of [`crate::Mobility::pair_block`] for the separation `d = x_i - x_j` of
+/// spheres of radii `ai`, `aj`: the unit vector `r̂` (any unit vector at `d = 0`) and
+/// [`rpy_unequal`].
+pub fn pair_block(d: [f64; 3], ai: f64, aj: f64, eta: f64) -> ([f64; 3], PairTensor) {
+    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let e = if r > 0.0 {
+        d.map(|c| c / r)
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    (e, rpy_unequal(r, ai, aj, eta))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -346,7 +346,7 @@ impl External for HarmonicInterface {
 ///
 /// `hard`: the limit of an infinitely stiff interface instead, a hard wall at `wall(d)` (the
 /// spring's stiffness and range unused): no force, and a step that ends a distance `s` beyond
-/// the wall ends `s` inside it ([`External::confine`]: reflection, exact for a free Brownian
+/// the wall ends `s` inside it ([`External::overshoot`]: reflection, exact for a free Brownian
 /// step at a flat wall; here the wall is a sphere that moves in).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpeciesInterface {

@@ -367,12 +367,12 @@ impl<P: Pair, E: External, M: Mobility> HydroBrownian<P, E, M> {
     /// beyond the wall (outward normals `n_i`) get the forces `-lambda_i n_i` whose
     /// displacement `M F` moves each of them `2 s_i` back along its normal, and their
     /// neighbours with them: `sum_j n_i.M_ij n_j lambda_j = 2 s_i`, `lambda >= 0` (the blocks
-    /// from [`Mobility::pair_block`]; [`Self::wall_forces`]). For one sphere that is the mirror image of the step in the
-    /// metric of `M^-1`, in which the step's noise is isotropic (reflection along `M n`, the
-    /// co-normal): it keeps the equilibrium of a mobility that couples the spheres, where the
-    /// reflection along `n` alone presses pairs at the wall together. A sweep can push a
-    /// neighbour out: repeated while spheres are beyond, at most [`WALL_SWEEPS`] times, then
-    /// those still beyond are reflected along `n`.
+    /// from [`Mobility::pair_block`]; [`Self::wall_forces`]). For one sphere that is the
+    /// mirror image of the step in the metric of `M^-1`, in which the step's noise is isotropic
+    /// (reflection along `M n`, the co-normal): it keeps the equilibrium of a mobility that
+    /// couples the spheres, where the reflection along `n` alone presses pairs at the wall
+    /// together. A sweep can push a neighbour out: repeated while spheres are beyond, at most
+    /// [`WALL_SWEEPS`] times, then those still beyond are reflected along `n`.
     fn reflect_at_walls(&mut self, t_end: f64) {
         for sweep in 0..=WALL_SWEEPS {
             self.crossers.clear();
