@@ -24,8 +24,8 @@ from phi0 to phi = 0.5, on a grid of Pe_s and phi0 (phi_s = phi0 / 2), by each m
 and any of them with `-k<stiffness>` appended (`bd-rpy-k500`): the same in an interface of that
 stiffness (kT/d^2, d the small diameter) instead of the example's (100 kT/d^2; the MPCD
 example's 100 kT/cell^2 = 400 kT/d^2 for the mpcd methods), to see whether the interface held
-the colloids; `bd-fd-hard`: free draining with a hard wall (`interface.hard`, the limit of an
-infinitely stiff interface; droplet-bd has it for free draining only).
+the colloids; `-hard` (`bd-fd-hard`, `bd-rpy-hard`, `mpcd-slip-hard`, `mpcd-noslip-hard`): a hard
+wall instead (`interface.hard`, the limit of an infinitely stiff interface).
 
 The measure is the difference of the species' mean centre distances over R, Delta =
 <r>_s / R - <r>_l / R (colloidsim_analysis::stratification), at 50, 75 and 100 % of the drying
@@ -127,14 +127,30 @@ def mpcd_scenario(pe, phi0, method, particles, seed):
     droplets, with profiles at the study's times."""
     method, stiffness = split(method)
     large = large_count(particles)
-    return rewritten(MPCD_BASE, {
+    text = rewritten(MPCD_BASE, {
         "peclet": pe, "phi0": phi0, "seed": seed, "boundary": f'"{MPCD_BOUNDARY[method]}"',
         "particles": particles, "diameters": f"[{MPCD_CELLS_PER_D}, {MPCD_CELLS_PER_D * ALPHA}]",
         "counts": f"[{particles - large}, {large}]", "final_volume_fraction": 0.5,
-        "stiffness": None if stiffness is None else stiffness / MPCD_CELLS_PER_D**2,
+        "stiffness": None if stiffness in (None, math.inf) else stiffness / MPCD_CELLS_PER_D**2,
         "[observe.profile] bins": 20,
         "[observe.profile] fractions": "[0.0, 0.25, 0.5, 0.75, 1.0]",
     })
+    if stiffness == math.inf:
+        # A hard wall in place of the example's spring (its stiffness and range lines).
+        text = hard_wall(text)
+    return text
+
+
+def hard_wall(text):
+    """A scenario's `[interface]` spring (its stiffness and range lines) replaced by
+    `hard = true`."""
+    out = []
+    for line in text.split("\n"):
+        if line.startswith("stiffness"):
+            out.append("hard = true")
+        elif not line.startswith("range"):
+            out.append(line)
+    return "\n".join(out)
 
 
 def scenario(pe, phi0, replicas, method, particles=900):
@@ -150,8 +166,7 @@ def scenario(pe, phi0, replicas, method, particles=900):
     })
     if stiffness == math.inf:
         # A hard wall in place of the spring (the example's stiffness line), default step.
-        text = "\n".join("hard = true" if line.startswith("stiffness") else line
-                         for line in text.split("\n"))
+        text = hard_wall(text)
     elif stiffness is not None and stiffness > STIFF:
         # The default step 2e-4 d^2/D0 keeps k D0 dt / kT at 0.1 up to STIFF kT/d^2; above,
         # a step that keeps it there (D0 = kT / (3 pi eta d) with kT = eta = d = 1).
@@ -249,7 +264,7 @@ def mpcd_parameters(p):
     k, rng, offset = p["interface"]
     return {"stiffness": k, "range": rng, "offset": offset, "kt": p["solvent"]["srd"]["kt"],
             "diameter": p["diameter"], "species": p["species"], "particles": p["particles"],
-            "replicas": 1}
+            "hard_interface": p.get("hard_interface", False), "replicas": 1}
 
 
 def measures(folder):

@@ -27,7 +27,7 @@ def at_repo(monkeypatch):
 
 @pytest.mark.parametrize("alpha", [2.0, 4.0])
 @pytest.mark.parametrize("method", ["bd-fd", "bd-rpy-k500", "bd-fd-k2000", "bd-rpy-hard", "mpcd-slip",
-                                    "mpcd-noslip-k800"])
+                                    "mpcd-noslip-k800", "mpcd-noslip-hard"])
 def test_scenarios_are_valid(cli, tmp_path, at_repo, monkeypatch, method, alpha):
     monkeypatch.setattr(study, "ALPHA", alpha)
     if study.is_mpcd(method):
@@ -38,7 +38,10 @@ def test_scenarios_are_valid(cli, tmp_path, at_repo, monkeypatch, method, alpha)
         assert "final_volume_fraction = 0.5" in text
         # 800 kT/d^2 with d = 2 cells is 200 kT/cell^2 (the example's 100 kT/cell^2 else).
         assert ("stiffness = 200.0" in text) == method.endswith("-k800")
-        assert ("stiffness = 100.0" in text) != method.endswith("-k800")
+        assert ("stiffness = 100.0" in text) == (method == "mpcd-slip")
+        # A hard wall: neither stiffness nor range (the CLI refuses them beside it).
+        assert ("hard = true" in text) == method.endswith("-hard")
+        assert ("range" not in text) == method.endswith("-hard")
     else:
         text = study.scenario(10, 0.1, 4, method, 650)
         assert f"diameters = [1.0, {alpha}]" in text

@@ -234,6 +234,13 @@ pub trait External: Sync + Send {
     fn overshoot(&self, _p: [f64; 3], _t: f64, _d: f64) -> Option<(f64, [f64; 3])> {
         None
     }
+    /// The outward normal velocity at time `t` of the hard wall of [`External::overshoot`]
+    /// (negative for a wall moving in): engines with inertia reflect a velocity in the wall's
+    /// frame. 0 (the default): a wall at rest.
+    #[inline]
+    fn wall_speed(&self, _t: f64) -> f64 {
+        0.0
+    }
 }
 
 /// No external field.
@@ -282,6 +289,17 @@ impl SphereAreaLaw {
         (self.r0 * self.r0 - self.alpha * t / (4.0 * PI))
             .max(0.0)
             .sqrt()
+    }
+
+    /// `dR/dt = -alpha / (8 pi R)` (0 once the sphere has vanished).
+    #[inline]
+    pub fn speed(&self, t: f64) -> f64 {
+        let r = self.radius(t);
+        if r > 0.0 {
+            -self.alpha / (8.0 * PI * r)
+        } else {
+            0.0
+        }
     }
 }
 
@@ -408,6 +426,15 @@ impl External for SpeciesInterface {
         }
         let r = r2.sqrt();
         Some((r - wall, [c[0] / r, c[1] / r, c[2] / r]))
+    }
+    /// The hard wall moves with the radius, `dR/dt`.
+    #[inline]
+    fn wall_speed(&self, t: f64) -> f64 {
+        if self.hard {
+            self.interface.radius.speed(t)
+        } else {
+            0.0
+        }
     }
 }
 

@@ -4,7 +4,8 @@
 //! nearest neighbours on the mesh (120 edges) and to a central particle (42 spokes) by harmonic
 //! bonds `U = k/2 (r - r0)^2` with `r0` the bond's length in the ideal shape. Centres repel by
 //! WCA (`epsilon = kT`, `sigma = d`, cut at `2^(1/6) d`) and may feel the droplet's
-//! [`HarmonicInterface`] at `R(t)`. Between two collisions the `43 N` particles move by velocity
+//! [`HarmonicInterface`](crate::potential::HarmonicInterface) at `R(t)`, or its hard-wall limit
+//! (the whole colloid reflected when its centre crosses, [`SpeciesInterface::hard`]). Between two collisions the `43 N` particles move by velocity
 //! Verlet with `md_steps` steps of `dt = tau / md_steps`; in the collisions only the VERTICES
 //! join the cells ([`DiscreteColloids::embedded`]; the paper: "the colloidal particles were
 //! coupled to the solvent by including the vertex particles in the collision step"); the
@@ -23,9 +24,7 @@
 use super::boundary::Confinement;
 use super::srd::{Acceleration, CollisionStats, Embedded, Srd, StreamStats};
 use super::{Draw, MpcdError, draw};
-use crate::potential::{
-    External, HarmonicInterface, LennardJones, LjParams, NoExternal, Pair, SpeciesInterface,
-};
+use crate::potential::{External, LennardJones, LjParams, NoExternal, Pair, SpeciesInterface};
 use crate::state::SimBox;
 use colloidsim_core::rng::Ziggurat;
 use colloidsim_particles::Mixture;
@@ -1148,10 +1147,12 @@ impl DiscreteColloids {
 
     /// Velocity Verlet over one collision time: `md_steps` steps of `dt = tau / md_steps` from
     /// time `t0`, forces from the bonds, WCA between centres and `external` on the centres
-    /// (e.g. the droplet's [`HarmonicInterface`] or, for several sizes, its
-    /// [`SpeciesInterface`]: `External::force_on` with each colloid's diameter, evaluated at
-    /// the time of each force evaluation). The forces at `t0` are recomputed from the
-    /// positions, so the state is the positions and velocities alone. Advances the step counter.
+    /// (e.g. the droplet's [`HarmonicInterface`](crate::potential::HarmonicInterface) or, for
+    /// several sizes, its [`SpeciesInterface`]: `External::force_on` with each colloid's
+    /// diameter, evaluated at the time of each force evaluation); a colloid whose centre a drift
+    /// leaves beyond a hard wall of `external` (`External::overshoot`) is reflected whole, in
+    /// the frame of the moving wall. The forces at `t0` are recomputed from the positions, so
+    /// the state is the positions and velocities alone. Advances the step counter.
     pub fn advance<E: External>(
         &mut self,
         t0: f64,
@@ -1171,11 +1172,16 @@ impl DiscreteColloids {
         self.compute_forces(t0, external);
         for s in 0..steps {
             let sbox = self.sbox;
+            // The end of this drift, where a hard wall of `external` reflects a centre.
+            let t = t0 + (s + 1) as f64 * dt;
+            let wall_speed = external.wall_speed(t);
+            let masses = (self.params.centre_mass, self.params.vertex_mass);
             for sh in &self.shells {
                 let (c, v) = (
                     sh.first..sh.first + sh.count,
                     sh.first_vertex..sh.first_vertex + sh.count * sh.vertices,
                 );
+                let diameter = sh.diameter;
                 self.centre_pos[c.clone()]
                     .par_iter_mut()
                     .zip(self.centre_vel[c.clone()].par_iter_mut())
@@ -1188,6 +1194,15 @@ impl DiscreteColloids {
                         kick_drift(x, v, f, hc, dt);
                         for ((x, v), f) in xs.iter_mut().zip(vs.iter_mut()).zip(fs) {
                             kick_drift(x, v, f, hv, dt);
+                        }
+                        if let Some((over, n)) = external.overshoot(*x, t, diameter) {
+                            let colloid = Body {
+                                x,
+                                v,
+                                xs: &mut *xs,
+                                vs: &mut *vs,
+                            };
+                            colloid.reflect_at_wall(over, n, wall_speed, masses);
                         }
                         // Wrap the whole colloid with its centre.
                         let before = *x;
@@ -1202,7 +1217,7 @@ impl DiscreteColloids {
                         }
                     });
             }
-            self.compute_forces(t0 + (s + 1) as f64 * dt, external);
+            self.compute_forces(t, external);
             for sh in &self.shells {
                 let (c, v) = (
                     sh.first..sh.first + sh.count,
@@ -1391,6 +1406,45 @@ fn kick_drift(x: &mut [f64; 3], v: &mut [f64; 3], f: &[f64; 3], half_dt_over_m: 
     }
 }
 
+/// One colloid's centre and shell, lent for a reflection.
+struct Body<'a> {
+    x: &'a mut [f64; 3],
+    v: &'a mut [f64; 3],
+    xs: &'a mut [[f64; 3]],
+    vs: &'a mut [[f64; 3]],
+}
+
+impl Body<'_> {
+    /// The colloid whose centre lies `over` beyond a hard wall of outward normal `n` moving at
+    /// `wall_speed` along it, reflected as a rigid body by an infinitely massive wall: every
+    /// particle moved by `-2 over n` and given the same velocity change, which reverses the
+    /// centre of mass's normal velocity in the wall's frame, `V.n -> 2 w - V.n` (elastic:
+    /// the bonds are untouched and, at rest, the kinetic energy is kept). A colloid already
+    /// moving in faster than the wall is only moved back. `masses`: centre and vertex.
+    #[inline]
+    fn reflect_at_wall(self, over: f64, n: [f64; 3], wall_speed: f64, masses: (f64, f64)) {
+        let (mc, mv) = masses;
+        let mut p = [mc * self.v[0], mc * self.v[1], mc * self.v[2]];
+        for u in self.vs.iter() {
+            for k in 0..3 {
+                p[k] += mv * u[k];
+            }
+        }
+        let m = mc + self.vs.len() as f64 * mv;
+        let vn = (p[0] * n[0] + p[1] * n[1] + p[2] * n[2]) / m;
+        let dv = 2.0 * (vn - wall_speed).max(0.0);
+        let (dx, dv) = (n.map(|c| -2.0 * over * c), n.map(|c| -dv * c));
+        for (y, u) in std::iter::once((&mut *self.x, &mut *self.v))
+            .chain(self.xs.iter_mut().zip(self.vs.iter_mut()))
+        {
+            for k in 0..3 {
+                y[k] += dx[k];
+                u[k] += dv[k];
+            }
+        }
+    }
+}
+
 #[inline(always)]
 fn kick(v: &mut [f64; 3], f: &[f64; 3], half_dt_over_m: f64) {
     for k in 0..3 {
@@ -1449,8 +1503,9 @@ pub struct MpcdSystem {
     pub colloids: DiscreteColloids,
     /// Walls of the solvent.
     pub confinement: Confinement,
-    /// The droplet's interface force on the colloid centres, if any.
-    pub interface: Option<HarmonicInterface>,
+    /// The droplet's interface on the colloid centres, if any (placed for the smallest
+    /// colloids, met by each at its own size).
+    pub interface: Option<SpeciesInterface>,
 }
 
 impl MpcdSystem {
@@ -1459,7 +1514,7 @@ impl MpcdSystem {
         srd: Srd,
         colloids: DiscreteColloids,
         confinement: Confinement,
-        interface: Option<HarmonicInterface>,
+        interface: Option<SpeciesInterface>,
     ) -> Result<Self, MpcdError> {
         if srd.sbox() != &colloids.sbox {
             return Err(MpcdError::Invalid(format!(
@@ -1497,15 +1552,7 @@ impl MpcdSystem {
         let t0 = self.time();
         let st = self.srd.stream(t0 + tau, &self.confinement, accel)?;
         match &self.interface {
-            // The interface placed for the smallest colloids, met by each at its own size.
-            Some(h) => {
-                let w = SpeciesInterface {
-                    interface: *h,
-                    reference_diameter: self.colloids.mixture.d_min(),
-                    hard: false,
-                };
-                self.colloids.advance(t0, tau, &w)?
-            }
+            Some(w) => self.colloids.advance(t0, tau, w)?,
             None => self.colloids.advance(t0, tau, &NoExternal)?,
         }
         Ok(st)
@@ -1536,6 +1583,7 @@ impl MpcdSystem {
 mod tests {
     use super::*;
     use crate::mpcd::SrdParams;
+    use crate::potential::HarmonicInterface;
 
     /// A periodic cube of edge `l` with standard solvent and `n` random colloids of diameter `d`.
     fn system(l: f64, d: f64, n: usize, thermostat: bool, seed: u32) -> MpcdSystem {
@@ -2060,13 +2108,15 @@ mod tests {
 
     /// A drying droplet of `n` colloids of diameter `d` in a sphere of initial radius `r0`
     /// (slip wall, `alpha = 10`) in a cubic box of edge `edge`, solvent and colloids seeded by
-    /// `seed`, held by a harmonic interface (100 kT/d^2, range d/2, offset -d/2) on their centres.
+    /// `seed`, held by a harmonic interface (100 kT/d^2, range d/2, offset -d/2) on their
+    /// centres, or with `hard` by a hard wall at `R(t) - d/2`.
     fn drying_droplet(
         d: f64,
         r0: f64,
         edge: f64,
         n: usize,
         seed: u32,
+        hard: bool,
     ) -> (MpcdSystem, crate::potential::SphereAreaLaw) {
         use crate::mpcd::WallKind;
         use crate::potential::SphereAreaLaw;
@@ -2094,6 +2144,11 @@ mod tests {
             range: 0.5 * d,
             offset: -0.5 * d,
         };
+        let interface = SpeciesInterface {
+            interface,
+            reference_diameter: d,
+            hard,
+        };
         (MpcdSystem::new(srd, c, conf, Some(interface)).unwrap(), law)
     }
 
@@ -2103,7 +2158,7 @@ mod tests {
     #[test]
     fn colloids_in_a_drying_droplet_stay_inside_the_interface() {
         let (d, r0) = (2.0, 7.0);
-        let (mut sys, law) = drying_droplet(d, r0, 18.0, 20, 12);
+        let (mut sys, law) = drying_droplet(d, r0, 18.0, 20, 12, false);
         let mut virt = 0;
         for _ in 0..100 {
             virt += sys
@@ -2121,6 +2176,134 @@ mod tests {
         }
     }
 
+    /// Behind a hard wall (`SpeciesInterface::hard`) no centre is ever beyond `R(t) - d/2` at
+    /// the end of a step while the droplet dries (the spring of the test above lets them a
+    /// quarter diameter in), and the colloids are carried in with the wall.
+    #[test]
+    fn colloids_behind_a_hard_wall_never_cross_it_while_drying() {
+        let (d, r0) = (2.0, 7.0);
+        let (mut sys, law) = drying_droplet(d, r0, 18.0, 20, 12, true);
+        let mut deepest: f64 = f64::NEG_INFINITY;
+        for _ in 0..100 {
+            sys.step(&Acceleration::None).unwrap();
+            let wall = law.radius(sys.time()) - 0.5 * d;
+            for x in sys.colloids.centre_positions() {
+                deepest = deepest.max(dist(*x, [0.0; 3]) - wall);
+            }
+        }
+        assert!(law.radius(sys.time()) < 0.95 * r0);
+        assert!(deepest <= 1e-12, "a centre {deepest} beyond the wall");
+        // Some centre reached the wall (it was met, not avoided).
+        assert!(deepest > -0.1 * d, "{deepest}");
+    }
+
+    /// The reflection at a wall moving at `w`: the colloid's centre-of-mass normal velocity
+    /// becomes `2 w - V.n` (elastic in the wall's frame), its tangential velocity and the
+    /// velocities of its particles relative to each other are kept, every particle is moved by
+    /// the centre's mirror image in the wall; a colloid moving in faster than the wall is only
+    /// moved back.
+    #[test]
+    fn a_hard_wall_reflects_the_colloid_in_its_own_frame() {
+        let n = [0.6, 0.8, 0.0];
+        let t = [-0.8, 0.6, 0.0];
+        let at = |a: f64, b: f64, c: f64| -> [f64; 3] {
+            std::array::from_fn(|k| a * n[k] + b * t[k] + [0.0, 0.0, c][k])
+        };
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        // Centre of mass 2, vertices of mass 1: V = (2 v + v1 + v2) / 4.
+        let masses = (2.0, 1.0);
+        let com = |v: [f64; 3], vs: &[[f64; 3]]| -> [f64; 3] {
+            std::array::from_fn(|k| (2.0 * v[k] + vs[0][k] + vs[1][k]) / 4.0)
+        };
+        for w in [0.0, -0.05] {
+            let (mut x, mut v) = (at(3.1, 0.5, 0.2), at(0.1, 0.3, -0.2));
+            let mut xs = [at(3.6, 0.5, 0.2), at(2.6, 0.5, 0.2)];
+            let mut vs = [at(0.3, 0.1, 0.0), at(-0.1, 0.5, 0.0)];
+            let (v0, vs0) = (v, vs);
+            let body = Body {
+                x: &mut x,
+                v: &mut v,
+                xs: &mut xs,
+                vs: &mut vs,
+            };
+            body.reflect_at_wall(0.1, n, w, masses);
+            assert!((dot(x, n) - 2.9).abs() < 1e-12 && (dot(x, t) - 0.5).abs() < 1e-12);
+            assert!((dot(xs[0], n) - 3.4).abs() < 1e-12 && (dot(xs[1], n) - 2.4).abs() < 1e-12);
+            let (before, after) = (com(v0, &vs0), com(v, &vs));
+            assert!((dot(before, n) - 0.1).abs() < 1e-12);
+            assert!((dot(after, n) - (2.0 * w - 0.1)).abs() < 1e-12, "{after:?}");
+            assert!(
+                (dot(after, t) - dot(before, t)).abs() < 1e-12
+                    && (after[2] - before[2]).abs() < 1e-12
+            );
+            for k in 0..3 {
+                assert!(((vs[0][k] - v[k]) - (vs0[0][k] - v0[k])).abs() < 1e-12);
+                assert!(((vs[1][k] - v[k]) - (vs0[1][k] - v0[k])).abs() < 1e-12);
+            }
+        }
+        let (mut x, mut v) = (at(3.1, 0.0, 0.0), at(-0.2, 0.0, 0.0));
+        let (mut xs, mut vs) = ([at(3.1, 0.0, 0.0); 2], [at(-0.2, 0.0, 0.0); 2]);
+        let body = Body {
+            x: &mut x,
+            v: &mut v,
+            xs: &mut xs,
+            vs: &mut vs,
+        };
+        body.reflect_at_wall(0.1, n, -0.05, masses);
+        assert!((dot(x, n) - 2.9).abs() < 1e-12 && (dot(v, n) + 0.2).abs() < 1e-12);
+        assert!((dot(xs[1], n) - 2.9).abs() < 1e-12 && (dot(vs[1], n) + 0.2).abs() < 1e-12);
+    }
+
+    /// An isolated colloid sent at a static hard wall bounces back and forth inside it: it
+    /// never ends a step beyond the wall, its momentum turns at every bounce, and its energy
+    /// stays within velocity Verlet's bounded error (the reflection is elastic and leaves the
+    /// bonds as they were).
+    #[test]
+    fn an_isolated_colloid_bounces_elastically_off_a_static_hard_wall() {
+        use crate::potential::SphereAreaLaw;
+        let p = ColloidParams::standard(2.0, 1.0);
+        let sbox = SimBox::cube(12.0);
+        let c = DiscreteColloids::new(p, sbox, &[[0.0; 3]], 1.0, 4).unwrap();
+        // The whole colloid moving at 1 along x (far above its thermal speed).
+        let mut st = c.state();
+        for v in st.centre_vel.iter_mut().chain(st.vertex_vel.iter_mut()) {
+            v[0] += 1.0;
+        }
+        let mut c = DiscreteColloids::from_state(p, sbox, &st).unwrap();
+        let wall = SpeciesInterface {
+            interface: HarmonicInterface {
+                centre: [0.0; 3],
+                radius: SphereAreaLaw {
+                    r0: 4.0,
+                    alpha: 0.0,
+                },
+                stiffness: 0.0,
+                range: 0.0,
+                offset: -1.0,
+            },
+            reference_diameter: 2.0,
+            hard: true,
+        };
+        let e0 = c.kinetic_energy() + c.potential_energy();
+        let (mut spread, mut turns, mut last): (f64, usize, f64) = (0.0, 0, 1.0);
+        for _ in 0..300 {
+            c.advance(0.0, 0.1, &wall).unwrap();
+            let e = c.kinetic_energy() + c.potential_energy();
+            spread = spread.max((e - e0).abs());
+            let x = c.centre_positions()[0];
+            assert!(dist(x, [0.0; 3]) <= 3.0 + 1e-12, "{x:?}");
+            let px = c.momentum()[0];
+            if px * last < 0.0 {
+                turns += 1;
+            }
+            last = px;
+        }
+        eprintln!("{turns} turns, energy error {spread} of {e0}");
+        // 30 time units at speed 1 across a free path of 2 x 3: about 5 bounces.
+        assert!(turns >= 4, "{turns}");
+        assert!(spread < 0.01 * e0, "{spread} of {e0}");
+    }
+
     /// FNV-1a over the bits of the rows.
     fn digest(h: &mut u64, rows: &[[f64; 3]]) {
         for x in rows.iter().flatten() {
@@ -2135,7 +2318,7 @@ mod tests {
     /// constant was printed by this test on that code, commit 59068cd).
     #[test]
     fn one_species_reproduces_the_single_size_model_bitwise() {
-        let (mut sys, _) = drying_droplet(2.0, 6.0, 16.0, 25, 5);
+        let (mut sys, _) = drying_droplet(2.0, 6.0, 16.0, 25, 5, false);
         for _ in 0..8 {
             sys.step(&Acceleration::None).unwrap();
         }
@@ -2230,6 +2413,11 @@ mod tests {
                 stiffness: 100.0,
                 range: 1.0,
                 offset: -1.0,
+            };
+            let interface = SpeciesInterface {
+                interface,
+                reference_diameter: 2.0,
+                hard: false,
             };
             let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
             // The closest pair over its contact distance, the farthest surface beyond R(t).

@@ -49,26 +49,58 @@ pub const INTERFACE_OFFSET: Spec = key(
     "wall position relative to R(t) (-d/2: the colloid surface at R(t))",
 );
 
+/// `interface.hard` (the methods that have it say how they reflect, with [`Spec::also`]).
+pub const INTERFACE_HARD: Spec = key(
+    "interface.hard",
+    "-",
+    Value("false"),
+    Bool,
+    "a hard wall at R(t) + offset instead of the spring, the limit of an infinitely stiff interface: a centre that a step leaves a distance s beyond the wall ends s inside it; no interface force",
+);
+
 /// The interface's parameters as read: the keys given, else the defaults of the declarations
 /// for spheres of diameter `d` at thermal energy `kt`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Interface {
-    /// Spring constant k (energy / length^2).
+    /// Spring constant k (energy / length^2); 0 for a hard wall.
     pub stiffness: f64,
-    /// Range of the harmonic part Delta (length).
+    /// Range of the harmonic part Delta (length); 0 for a hard wall.
     pub range: f64,
     /// Wall position relative to R(t) (length).
     pub offset: f64,
+    /// A hard wall instead of the spring (`interface.hard`).
+    pub hard: bool,
 }
 
-/// Read `[interface]` for spheres of diameter `d` at thermal energy `kt`.
-pub fn interface(r: &Reader, d: f64, kt: f64) -> Result<Interface> {
+/// Read `[interface]` for spheres of diameter `d` at thermal energy `kt`; `hard` is the
+/// method's declaration of `interface.hard` where it has one (a hard wall has no spring, so
+/// `interface.stiffness` and `interface.range` are refused beside it).
+pub fn interface(r: &Reader, d: f64, kt: f64, hard: Option<&Spec>) -> Result<Interface> {
+    let offset = r.opt_number(&INTERFACE_OFFSET)?.unwrap_or(-0.5 * d);
+    if let Some(h) = hard
+        && r.flag(h)?
+    {
+        let spring = [&INTERFACE_STIFFNESS, &INTERFACE_RANGE];
+        if let Some(k) = spring.into_iter().find(|k| r.has(k)) {
+            bail!(ParamError::new(
+                k.path,
+                "a hard interface (interface.hard = true) has no spring: leave it out",
+            ));
+        }
+        return Ok(Interface {
+            stiffness: 0.0,
+            range: 0.0,
+            offset,
+            hard: true,
+        });
+    }
     Ok(Interface {
         stiffness: r
             .opt_number(&INTERFACE_STIFFNESS)?
             .unwrap_or(50.0 * kt / (d * d)),
         range: r.opt_number(&INTERFACE_RANGE)?.unwrap_or(0.5 * d),
-        offset: r.opt_number(&INTERFACE_OFFSET)?.unwrap_or(-0.5 * d),
+        offset,
+        hard: false,
     })
 }
 

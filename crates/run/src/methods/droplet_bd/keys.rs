@@ -15,9 +15,9 @@ use crate::keys::shared::{
 use crate::keys::species::*;
 use crate::keys::{MAX_BINS_RADIAL, SEED_KEY, Spec, key};
 
-pub const INTERFACE_HARD: Spec = key("interface.hard", "-", Value("false"), Bool,
-    "a hard wall at R(t) + offset instead of the spring, the limit of an infinitely stiff interface: a step that ends a distance s beyond the wall ends s inside it (reflection; with RPY along the mobility, moving the neighbours too); no interface force")
-    .also("without interface.stiffness and interface.range; not for colloidsim theory");
+/// `interface.hard` (with its conditions here).
+pub const INTERFACE_HARD: Spec = shared::INTERFACE_HARD
+    .also("without interface.stiffness and interface.range; a step reflected along the normal (with RPY along the mobility, moving the neighbours too); not for colloidsim theory");
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["droplet-bd"]),
     "Brownian dynamics of a drying (or static) droplet, free draining or with RPY hydrodynamics");

@@ -177,21 +177,8 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<DropletParams> 
         ));
     }
 
-    let it = shared::interface(r, d, kt)?;
-    let hard_interface = r.flag(&INTERFACE_HARD)?;
-    let spring = [&INTERFACE_STIFFNESS, &INTERFACE_RANGE];
-    if let Some(k) = spring.into_iter().find(|k| hard_interface && r.has(k)) {
-        bail!(ParamError::new(
-            k.path,
-            "a hard interface (interface.hard = true) has no spring: leave it out",
-        ));
-    }
-    // A hard wall: no spring (stiffness and range 0; the wall is at R(t) + offset).
-    let (stiffness, range) = if hard_interface {
-        (0.0, 0.0)
-    } else {
-        (it.stiffness, it.range)
-    };
+    let it = shared::interface(r, d, kt, Some(&INTERFACE_HARD))?;
+    let (stiffness, range, hard_interface) = (it.stiffness, it.range, it.hard);
     if range > r0 {
         bail!(ParamError::new(
             INTERFACE_RANGE.path,

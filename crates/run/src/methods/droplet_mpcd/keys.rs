@@ -71,6 +71,11 @@ pub const INTERFACE_RANGE: Spec = shared::INTERFACE_RANGE.also("at most R0");
 /// `interface.offset` (with its condition here).
 pub const INTERFACE_OFFSET: Spec = shared::INTERFACE_OFFSET.also("in [-R0, R0]");
 
+/// `interface.hard` (with its conditions here).
+pub const INTERFACE_HARD: Spec = shared::INTERFACE_HARD.also(
+    "without interface.stiffness and interface.range; the whole colloid reflected when its centre crosses: moved by the centre's mirror step, its centre-of-mass normal velocity reversed in the frame of the wall (moving at dR/dt)",
+);
+
 /// `observe`.
 pub const OBSERVE: Spec = key("observe", "-", Means("-"), Table, "observables");
 
@@ -149,6 +154,7 @@ pub static KEYS: &[Spec] = &[
     INTERFACE_STIFFNESS,
     INTERFACE_RANGE,
     INTERFACE_OFFSET,
+    INTERFACE_HARD,
     COLLOID,
     COLLOID_VERTEX_MASS,
     COLLOID_CENTRE_MASS,

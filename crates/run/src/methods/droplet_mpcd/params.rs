@@ -79,6 +79,10 @@ pub struct DropletRun {
     pub colloid: ColloidParams,
     /// Interface spring constant, range and offset (`s = r - (R(t) + offset)`).
     pub interface: [f64; 3],
+    /// A hard wall at `R(t) + offset` instead of the spring (`interface.hard`; stiffness and
+    /// range 0).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub hard_interface: bool,
     /// Collisions `ceil(t_end / tau)`.
     pub collisions: u64,
     /// Solvent particles at the start.
@@ -118,7 +122,7 @@ impl DropletRun {
         SpeciesInterface {
             interface: self.harmonic(),
             reference_diameter: self.diameter,
-            hard: false,
+            hard: self.hard_interface,
         }
     }
 
@@ -285,7 +289,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
             ),
         ));
     }
-    let it = shared::interface(r, d, kt)?;
+    let it = shared::interface(r, d, kt, Some(&INTERFACE_HARD))?;
     // The interface's spring on each centre adds at most stiffness / m_centre to the bonds'
     // omega^2 (Weyl): velocity Verlet must still resolve it (as the bonds, `shared::colloid`).
     let dt = srd.tau / colloid.md_steps as f64;
@@ -508,6 +512,7 @@ pub fn resolve(r: &Reader, seed: Option<u64>) -> Result<DropletRun> {
         phi_end,
         colloid,
         interface: [it.stiffness, it.range, it.offset],
+        hard_interface: it.hard,
         collisions,
         solvent_particles: solvent_particles as usize,
         profile,
@@ -644,6 +649,23 @@ mod tests {
         }
         let e = fail("method = \"droplet-mpcd\"\n[system]\nparticles = 10\n");
         assert!(e.starts_with("system.radius: missing"), "{e}");
+    }
+
+    /// `interface.hard`: no spring (stiffness and range 0, the offset kept), the centres
+    /// reflected at the wall (`SpeciesInterface::hard`); a spring beside it refused naming its
+    /// key.
+    #[test]
+    fn a_hard_interface_has_no_spring() {
+        let r = droplet("[interface]\nhard = true\noffset = -1.5\n").unwrap();
+        assert!(r.hard_interface && r.species_interface().hard);
+        assert_eq!(r.interface, [0.0, 0.0, -1.5]);
+        assert!(!droplet("").unwrap().species_interface().hard);
+        for key in ["stiffness = 10", "range = 1"] {
+            let e = droplet(&format!("[interface]\nhard = true\n{key}\n")).unwrap_err();
+            let want = format!("interface.{}:", key.split(' ').next().unwrap());
+            assert!(format!("{e:#}").starts_with(&want), "{e:#}");
+            assert!(format!("{e:#}").contains("no spring"), "{e:#}");
+        }
     }
 
     #[test]

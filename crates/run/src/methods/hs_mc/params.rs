@@ -139,7 +139,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
         ));
     }
     let interface = if geometry == "interface" {
-        let i = shared::interface(r, d, kt)?;
+        let i = shared::interface(r, d, kt, None)?;
         Some([i.stiffness, i.range, i.offset])
     } else {
         if r.has(&INTERFACE) {
