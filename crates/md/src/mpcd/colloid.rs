@@ -2304,6 +2304,59 @@ mod tests {
         assert!(spread < 0.01 * e0, "{spread} of {e0}");
     }
 
+    /// One colloid in the solvent behind the static hard wall of a droplet samples the
+    /// uniform density of its centre inside the wall, `<r^2> = 3 w^2 / 5` (w = R0 - d/2),
+    /// within 4 standard errors of 20 block means: the reflection keeps the equilibrium of a
+    /// colloid thermalised by the solvent. The solvent fills the periodic box (no boundary of
+    /// its own, which would add the solvent's structure at a surface), so the wall alone
+    /// confines the colloid. Long (about two minutes at the default 2e5 collisions;
+    /// `HARD_WALL_COLLISIONS` sets them); docs/mpcd.md records a run.
+    #[test]
+    #[ignore]
+    fn one_colloid_behind_a_static_hard_wall_fills_it_uniformly() {
+        use crate::potential::SphereAreaLaw;
+        let collisions: usize = std::env::var("HARD_WALL_COLLISIONS")
+            .ok()
+            .map_or(200_000, |s| s.parse().unwrap());
+        let (d, r0) = (2.0, 2.0);
+        let law = SphereAreaLaw { r0, alpha: 0.0 };
+        let conf = Confinement::None;
+        let p = SrdParams::standard(17);
+        let sbox = SimBox::cube(8.0);
+        let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
+        let c = DiscreteColloids::new(ColloidParams::standard(d, p.kt), sbox, &[[0.0; 3]], 1.0, 17)
+            .unwrap();
+        let interface = SpeciesInterface {
+            interface: HarmonicInterface {
+                centre: [0.0; 3],
+                radius: law,
+                stiffness: 0.0,
+                range: 0.0,
+                offset: -0.5 * d,
+            },
+            reference_diameter: d,
+            hard: true,
+        };
+        let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
+        for _ in 0..2000 {
+            sys.step(&Acceleration::None).unwrap();
+        }
+        let mut r2 = Vec::with_capacity(collisions);
+        for _ in 0..collisions {
+            sys.step(&Acceleration::None).unwrap();
+            let x = sys.colloids.centre_positions()[0];
+            r2.push(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        }
+        let (m, e) = block_mean(&r2, 20);
+        let w = r0 - 0.5 * d;
+        let exact = 0.6 * w * w;
+        eprintln!("<r^2> = {m} +- {e} against 3 w^2 / 5 = {exact} ({collisions} collisions)");
+        assert!(
+            (m - exact).abs() < 4.0 * e && e < 0.05 * exact,
+            "{m} +- {e} vs {exact}"
+        );
+    }
+
     /// FNV-1a over the bits of the rows.
     fn digest(h: &mut u64, rows: &[[f64; 3]]) {
         for x in rows.iter().flatten() {
