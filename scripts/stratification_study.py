@@ -86,6 +86,8 @@ MPCD_BASE = "examples/droplet/bidisperse-mpcd.toml"
 # that in kT/cell^2.
 MPCD_CELLS_PER_D = 2.0
 MPCD_BOUNDARY = {"mpcd-slip": "slip", "mpcd-noslip": "no-slip"}
+# The MPCD example's interface, 100 kT/cell^2, in kT/d^2.
+MPCD_BASE_STIFFNESS = 100.0 * MPCD_CELLS_PER_D**2
 DDFT_DX = "0.05"
 
 
@@ -584,28 +586,33 @@ def alpha_figure(paths, path, fraction=1.0, methods=None):
     plt.close(fig)
 
 
-def stiffness_figure(paths, path, peclets, base_stiffness, fraction=1.0):
-    """S against the interface's stiffness, free draining and RPY, one panel per Pe_s in
-    `peclets`, a line per phi0, from the data files `paths`: methods `bd-fd`, `bd-rpy` with a
-    `-k<stiffness>` or `-hard` suffix (none: `base_stiffness`, the example's). The hard wall
-    is drawn right of the stiffest spring: does S reach its hard-wall limit?"""
+def stiffness_figure(paths, path, peclets, base_stiffness, methods=None, fraction=1.0):
+    """S against the interface's stiffness, one panel per Pe_s in `peclets`, a line per method
+    and phi0, from the data files `paths`: methods `bd-fd`, `bd-rpy`, `mpcd-slip`,
+    `mpcd-noslip` with a `-k<stiffness>` or `-hard` suffix (none: the example's, `base_stiffness`
+    for BD, MPCD_BASE_STIFFNESS for MPCD; `methods`: those to draw, default the two BD ones).
+    The hard wall is drawn right of the stiffest spring: does S reach its hard-wall limit?"""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rows = [r for r in read_rows(paths) if r["fraction"] == fraction]
-    kinds = {"bd-fd": ("free draining", "C0"), "bd-rpy": ("RPY", "C3")}
-    finite = [base_stiffness if k is None else k for r in rows for b, k in [split(r["method"])]
+    kinds = {"bd-fd": ("free draining", "C0"), "bd-rpy": ("RPY", "C3"),
+             "mpcd-slip": ("MPCD slip", "C2"), "mpcd-noslip": ("MPCD no-slip", "C4")}
+    kinds = {b: kinds[b] for b in methods or ["bd-fd", "bd-rpy"]}
+    # The example's stiffness of each method (the MPCD example's 100 kT/cell^2 in kT/d^2).
+    base_of = lambda b: MPCD_BASE_STIFFNESS if b in MPCD_BOUNDARY else base_stiffness
+    finite = [base_of(b) if k is None else k for r in rows for b, k in [split(r["method"])]
               if b in kinds and k != math.inf]
     hard_x = 2.5 * max(finite)
-    stiffness = lambda k: base_stiffness if k is None else (hard_x if k == math.inf else k)
+    stiffness = lambda b, k: base_of(b) if k is None else (hard_x if k == math.inf else k)
     marks = {0.05: "o", 0.1: "s", 0.2: "^"}
     fig, axes = plt.subplots(1, len(peclets), figsize=(4.2 * len(peclets), 3.6),
                              layout="constrained", sharey=True, squeeze=False)
     for ax, pe in zip(axes[0], peclets):
         for base, (label, colour) in kinds.items():
             for phi0 in sorted({r["phi0"] for r in rows}):
-                pts = sorted((stiffness(k), r["S"], r["delta_err"] or 0.0)
+                pts = sorted((stiffness(b, k), r["S"], r["delta_err"] or 0.0)
                              for r in rows for b, k in [split(r["method"])]
                              if b == base and r["pe_s"] == pe and r["phi0"] == phi0)
                 if not pts:
@@ -617,7 +624,8 @@ def stiffness_figure(paths, path, peclets, base_stiffness, fraction=1.0):
         ax.axvline(math.sqrt(max(finite) * hard_x), color="0.6", lw=0.8, ls=":")
         ax.set_xscale("log")
         ticks = sorted(set(finite)) + [hard_x]
-        ax.set_xticks(ticks, [f"{t:g}" for t in ticks[:-1]] + ["hard"], fontsize=7)
+        ax.set_xticks(ticks, [f"{t:g}" for t in ticks[:-1]] + ["hard"], fontsize=7,
+                      rotation=90)
         ax.minorticks_off()
         ax.set_xlabel(r"interface stiffness ($kT/d^2$)")
         ax.set_title(f"$Pe_s$ = {pe:g}", fontsize=9)
@@ -712,7 +720,9 @@ def main():
                          "invocations) instead of the run folders: the combined data file, "
                          "thresholds and diagrams without the runs (no profile figures)")
     ap.add_argument("--compare-methods", metavar="METHOD,...",
-                    help="with --compare-alpha: draw these methods only (default: all)")
+                    help="with --compare-alpha: draw these methods only (default: all); with "
+                         "--compare-stiffness: these of bd-fd, bd-rpy, mpcd-slip, mpcd-noslip "
+                         "(default: the first two)")
     ap.add_argument("--compare-stiffness", metavar="CSV,CSV,...",
                     help="only draw IMG/stratification-stiffness<tag>.png from these data files: "
                          "S against the interface's stiffness at each --peclet")
@@ -724,7 +734,8 @@ def main():
         os.makedirs(args.img, exist_ok=True)
         stiffness_figure(args.compare_stiffness.split(","),
                          os.path.join(args.img, f"stratification-stiffness{args.tag}.png"),
-                         [float(x) for x in args.peclet.split(",")], args.base_stiffness)
+                         [float(x) for x in args.peclet.split(",")], args.base_stiffness,
+                         methods=args.compare_methods and args.compare_methods.split(","))
         return
     if args.compare_alpha:
         alpha_figure(args.compare_alpha.split(","),
