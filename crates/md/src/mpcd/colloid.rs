@@ -5,8 +5,9 @@
 //! bonds `U = k/2 (r - r0)^2` with `r0` the bond's length in the ideal shape. Centres repel by
 //! WCA (`epsilon = kT`, `sigma = d`, cut at `2^(1/6) d`) and may feel the droplet's
 //! [`HarmonicInterface`](crate::potential::HarmonicInterface) at `R(t)`, or its hard-wall limit
-//! (the whole colloid reflected when its centre crosses, [`SpeciesInterface::hard`]). Between two collisions the `43 N` particles move by velocity
-//! Verlet with `md_steps` steps of `dt = tau / md_steps`; in the collisions only the VERTICES
+//! (the whole colloid reflected when its centre crosses, [`SpeciesInterface::hard`]). Between
+//! two collisions the `43 N` particles move by velocity Verlet with `md_steps` steps of
+//! `dt = tau / md_steps`; in the collisions only the VERTICES
 //! join the cells ([`DiscreteColloids::embedded`]; the paper: "the colloidal particles were
 //! coupled to the solvent by including the vertex particles in the collision step"); the
 //! solvent streams through the colloids (no excluded region). [`MpcdSystem`] does one
