@@ -2255,6 +2255,21 @@ mod tests {
         assert!((dot(xs[1], n) - 2.9).abs() < 1e-12 && (dot(vs[1], n) + 0.2).abs() < 1e-12);
     }
 
+    /// A hard wall at `R(t) - d/2` for colloids of diameter `d` (no spring).
+    fn hard_wall(law: crate::potential::SphereAreaLaw, d: f64) -> SpeciesInterface {
+        SpeciesInterface {
+            interface: HarmonicInterface {
+                centre: [0.0; 3],
+                radius: law,
+                stiffness: 0.0,
+                range: 0.0,
+                offset: -0.5 * d,
+            },
+            reference_diameter: d,
+            hard: true,
+        }
+    }
+
     /// An isolated colloid sent at a static hard wall bounces back and forth inside it: it
     /// never ends a step beyond the wall, its momentum turns at every bounce, and its energy
     /// stays within velocity Verlet's bounded error (the reflection is elastic and leaves the
@@ -2271,20 +2286,13 @@ mod tests {
             v[0] += 1.0;
         }
         let mut c = DiscreteColloids::from_state(p, sbox, &st).unwrap();
-        let wall = SpeciesInterface {
-            interface: HarmonicInterface {
-                centre: [0.0; 3],
-                radius: SphereAreaLaw {
-                    r0: 4.0,
-                    alpha: 0.0,
-                },
-                stiffness: 0.0,
-                range: 0.0,
-                offset: -1.0,
+        let wall = hard_wall(
+            SphereAreaLaw {
+                r0: 4.0,
+                alpha: 0.0,
             },
-            reference_diameter: 2.0,
-            hard: true,
-        };
+            2.0,
+        );
         let e0 = c.kinetic_energy() + c.potential_energy();
         let (mut spread, mut turns, mut last): (f64, usize, f64) = (0.0, 0, 1.0);
         for _ in 0..300 {
@@ -2327,17 +2335,7 @@ mod tests {
         let srd = Srd::new(p, sbox, &conf, 0.0).unwrap();
         let c = DiscreteColloids::new(ColloidParams::standard(d, p.kt), sbox, &[[0.0; 3]], 1.0, 17)
             .unwrap();
-        let interface = SpeciesInterface {
-            interface: HarmonicInterface {
-                centre: [0.0; 3],
-                radius: law,
-                stiffness: 0.0,
-                range: 0.0,
-                offset: -0.5 * d,
-            },
-            reference_diameter: d,
-            hard: true,
-        };
+        let interface = hard_wall(law, d);
         let mut sys = MpcdSystem::new(srd, c, conf, Some(interface)).unwrap();
         for _ in 0..2000 {
             sys.step(&Acceleration::None).unwrap();
