@@ -147,3 +147,39 @@ fn the_dense_mixture_flux_dries_a_bidisperse_droplet_further_than_the_dilute_one
         "dilute {phi_dilute}, dense {phi_dense}"
     );
 }
+
+/// The DDFT is of hard spheres: a scenario with another pair interaction (or a WCA of another
+/// depth) is refused naming the key, not solved as hard spheres; the default written out is
+/// accepted by the same check.
+#[test]
+fn the_theory_refuses_a_pair_interaction_it_does_not_have() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |pair: &str, name: &str| {
+        let sc = Scenario::from_toml(&format!("{DROPLET}[pair]\n{pair}\n"), dir.path()).unwrap();
+        let opts = TheoryOptions {
+            out: Some(dir.path().join(name)),
+            dx: Some(0.05),
+            force: false,
+            hydrodynamics: None,
+            pair: None,
+        };
+        colloidsim_run::theory(&sc, &opts, &Control::default())
+    };
+    for (pair, key) in [
+        (
+            "kind = \"morse\"\ndepth = 3.0\nkappa = 10.0\nh0 = 0.0\nrange = 0.5",
+            "pair.kind",
+        ),
+        (
+            "kind = \"ao\"\ndepletant_diameter = 0.2\ndepletant_fraction = 0.1",
+            "pair.kind",
+        ),
+        ("kind = \"wca\"\nepsilon = [5.0]", "pair.epsilon"),
+    ] {
+        let e = format!("{:#}", run(pair, "refused").unwrap_err());
+        assert!(e.contains(key) && e.contains("hard spheres"), "{pair}: {e}");
+        assert!(!dir.path().join("refused").exists(), "{pair}: wrote output");
+    }
+    let r = run("kind = \"wca\"\nepsilon = [1.0]", "default").unwrap();
+    assert_eq!(r.summary["status"], "ok", "{}", r.summary["message"]);
+}

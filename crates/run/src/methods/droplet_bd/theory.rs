@@ -33,6 +33,7 @@ use crate::control::Control;
 use crate::keys::shared::{
     DIAMETER, DRYING_ALPHA, DRYING_PECLET, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS,
 };
+use crate::keys::species::{PAIR_EPSILON, PAIR_KIND};
 use crate::keys::{Spec, rekey};
 use crate::output::plot::{self, Scale, Series};
 use crate::output::profile_name;
@@ -162,6 +163,33 @@ fn parse_pair(pair: Option<&str>, hydro: Hydrodynamics) -> Result<PairCorrelatio
     Ok(parsed)
 }
 
+/// The DDFT's functional is of hard spheres: a scenario's `[pair]` is refused unless it is
+/// the default it stands for (WCA with `eps = kT` for every pair), rather than silently
+/// solved as hard spheres.
+fn check_hard_spheres(p: &DropletParams) -> Result<(), ParamError> {
+    use colloidsim_particles::interaction::PairSpec;
+    let msg = |what: String| {
+        format!(
+            "the DDFT is of hard spheres and has no {what}: remove [pair] (the default WCA, \
+             eps = kT, is what the functional stands for) to compare with it"
+        )
+    };
+    match &p.pair {
+        None => Ok(()),
+        Some(PairSpec::Wca { epsilon }) => match epsilon.iter().find(|&&e| e != p.kt) {
+            None => Ok(()),
+            Some(e) => Err(ParamError::new(
+                PAIR_EPSILON.path,
+                msg(format!("WCA of depth {e} (kT = {})", p.kt)),
+            )),
+        },
+        Some(other) => Err(ParamError::new(
+            PAIR_KIND.path,
+            msg(format!("'{}' interaction", other.kind())),
+        )),
+    }
+}
+
 /// `colloidsim theory SCENARIO` for a drying droplet.
 pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Report> {
     let dx = topts.dx;
@@ -177,6 +205,7 @@ pub fn theory(src: &Source, topts: &TheoryOptions, ctl: &Control) -> Result<Repo
             )
         );
     }
+    check_hard_spheres(&p).map_err(|e| anyhow!("{}: {e}", src.label()))?;
     let hydro = parse_hydrodynamics(topts.hydrodynamics.as_deref(), &p)?;
     let pair = parse_pair(topts.pair.as_deref(), hydro)?;
     let dr = grid_spacing(&p, dx)?;
