@@ -412,6 +412,38 @@ fn bidisperse_pse_self_mobilities_are_per_species() {
     assert_eq!(m.species_radii(), &[0.5, 1.0, 2.0]);
 }
 
+/// Hasimoto per radius: the mobility is pairwise, so the self block of each sphere of a
+/// bidisperse PSE is that sphere's periodic self-mobility alone, `mu0_i hasimoto(a_i, L)`
+/// (radii 0.5, 1 and 2 in one box, a force on one sphere at a time), at both tolerances.
+#[test]
+fn bidisperse_pse_self_mobility_of_each_radius_follows_hasimoto() {
+    let (eta, l) = (1.0, 20.0);
+    let radii = [0.5, 1.0, 2.0];
+    let pos = [[0.3, -4.1, 2.2], [5.7, 3.3, -6.0], [-6.2, 6.4, 5.1]];
+    for tol in [1e-3, 1e-5] {
+        let mut p = PseParams::paper(0.5, eta, l);
+        p.tolerance = tol;
+        let mut m = Pse::with_radii(&radii, p).unwrap();
+        m.set_positions(&pos).unwrap();
+        let mut u = [[0.0; 3]; 3];
+        for (i, &a) in radii.iter().enumerate() {
+            let mu0 = 1.0 / (6.0 * PI * eta * a);
+            let want = hasimoto(a, l);
+            let x = a / l;
+            for k in 0..3 {
+                let mut f = [[0.0; 3]; 3];
+                f[i][k] = 1.0;
+                m.apply(&f, &mut u);
+                let mu = u[i][k] / mu0;
+                assert!(
+                    (mu - want).abs() < tol + 27.4 * x.powi(6),
+                    "a {a}, tolerance {tol}, axis {k}: mu/mu0 {mu} vs Hasimoto {want}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn one_species_given_as_radii_is_the_monodisperse_operator_bit_for_bit() {
     let (a, eta, l, n) = (0.5, 1.0, 10.0, 120);
