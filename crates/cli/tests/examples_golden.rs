@@ -29,6 +29,15 @@ const EXAMPLES: &[(&str, &[&str])] = &[
         &["replicas=2", "drying.final_volume_fraction=0.06"],
     ),
     (
+        "droplet/bidisperse-mpcd.toml",
+        &[
+            "system.particles=9",
+            "system.species.counts=[8, 1]",
+            "drying.final_volume_fraction=0.11",
+            "observe.solvent.window=10",
+        ],
+    ),
+    (
         "droplet/bidisperse-rpy.toml",
         &[
             "replicas=1",
