@@ -52,9 +52,13 @@ pub struct BenchArgs {
     /// Particle numbers of the bidisperse PSE comparison.
     #[arg(long, value_delimiter = ',', default_value = "10000,30000")]
     pub bidisperse_sizes: Vec<usize>,
-    /// Radius ratio of the bidisperse PSE comparison (half of the spheres this much larger).
+    /// Radius ratio of the bidisperse PSE comparison.
     #[arg(long, default_value_t = 2.0)]
     pub ratio: f64,
+    /// Number fraction of the larger spheres in the bidisperse PSE comparison (0.5: half;
+    /// 1 / (1 + ratio^3): equal volumes of the two sizes, the droplet study's mixture).
+    #[arg(long, default_value_t = 0.5)]
+    pub large_fraction: f64,
     /// Parts to run: direct, pse, bidisperse (PSE with two radii against one), periodic (PSE's
     /// accuracy against pystokes.periodic), bd.
     #[arg(
@@ -309,8 +313,15 @@ fn pse(a: &BenchArgs, reps: usize) -> Result<()> {
 /// tolerance: the runs alternate (one monodisperse, one bidisperse, `reps` rounds, each the
 /// median of 3 steps).
 fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
+    if !(a.large_fraction > 0.0 && a.large_fraction <= 1.0) {
+        anyhow::bail!(
+            "--large-fraction must be in (0, 1], got {}",
+            a.large_fraction
+        );
+    }
     println!(
-        "## bidisperse PSE: half of the spheres of radius {RADIUS}, half {} (same N, box as phi = {} of radius {RADIUS}, xi = 0.5/{RADIUS}, tolerance {}); step = new positions + displacement; the two alternate, {reps} rounds of 3 steps each",
+        "## bidisperse PSE: a fraction {} of the spheres of radius {}, the rest {RADIUS} (same N, box as phi = {} of radius {RADIUS}, xi = 0.5/{RADIUS}, tolerance {}); step = new positions + displacement; the two alternate, {reps} rounds of 3 steps each",
+        a.large_fraction,
         a.ratio * RADIUS,
         a.phi,
         a.tolerance
@@ -324,9 +335,9 @@ fn bidisperse(a: &BenchArgs, reps: usize) -> Result<()> {
             let (mut mono, mut bi, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
             let mut last = None;
             for _ in 0..reps {
-                let m = time_pse_radii(n, a.phi, a.tolerance, t, 3, 1.0)
+                let m = time_pse_radii(n, a.phi, a.tolerance, t, 3, 1.0, 0.0)
                     .with_context(|| format!("PSE at N = {n}"))?;
-                let b = time_pse_radii(n, a.phi, a.tolerance, t, 3, a.ratio)
+                let b = time_pse_radii(n, a.phi, a.tolerance, t, 3, a.ratio, a.large_fraction)
                     .with_context(|| format!("bidisperse PSE at N = {n}, ratio {}", a.ratio))?;
                 mono.push(m.step);
                 bi.push(b.step);

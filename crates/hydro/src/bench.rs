@@ -139,18 +139,26 @@ pub fn time_pse(
     threads: usize,
     repeats: usize,
 ) -> Result<PseTiming, HydroError> {
-    time_pse_radii(n, phi, tol, threads, repeats, 1.0)
+    time_pse_radii(n, phi, tol, threads, repeats, 1.0, 0.0)
 }
 
-/// The radii of the bidisperse benchmark: every other particle [`RADIUS`], the rest `ratio`
-/// times larger (`ratio = 1`: all [`RADIUS`]).
-pub fn bidisperse_radii(n: usize, ratio: f64) -> Vec<f64> {
+/// The radii of the bidisperse benchmark: a number fraction `large` of the particles, spread
+/// evenly through the list, `ratio` times [`RADIUS`], the rest [`RADIUS`] (`large = 0.5`: every
+/// other particle; `ratio = 1`: all [`RADIUS`]).
+pub fn bidisperse_radii(n: usize, ratio: f64, large: f64) -> Vec<f64> {
+    let count = |i: usize| (i as f64 * large).floor();
     (0..n)
-        .map(|i| if i % 2 == 0 { RADIUS } else { ratio * RADIUS })
+        .map(|i| {
+            if count(i + 1) > count(i) {
+                ratio * RADIUS
+            } else {
+                RADIUS
+            }
+        })
         .collect()
 }
 
-/// [`time_pse`] with half of the spheres `ratio` times larger ([`bidisperse_radii`],
+/// [`time_pse`] with a number fraction `large` of the spheres `ratio` times larger ([`bidisperse_radii`],
 /// [`Pse::with_radii`]) in the same box (the monodisperse system's at `phi`), with the same
 /// splitting `0.5 / RADIUS` and tolerance; `ratio = 1` is [`time_pse`] ([`Pse::new`]).
 pub fn time_pse_radii(
@@ -160,6 +168,7 @@ pub fn time_pse_radii(
     threads: usize,
     repeats: usize,
     ratio: f64,
+    large: f64,
 ) -> Result<PseTiming, HydroError> {
     let l = box_edge(n, phi);
     let (pos, f) = random_system(n, l, 1);
@@ -169,7 +178,7 @@ pub fn time_pse_radii(
         let mut m = if ratio == 1.0 {
             Pse::new(n, p)?
         } else {
-            Pse::with_radii(&bidisperse_radii(n, ratio), p)?
+            Pse::with_radii(&bidisperse_radii(n, ratio, large), p)?
         };
         m.set_positions(&pos)?;
         let mut u = vec![[0.0; 3]; n];
@@ -321,7 +330,7 @@ mod tests {
         let p = time_pse(200, 0.1, 1e-2, 1, 1).unwrap();
         assert!(p.step > 0.0 && p.product > 0.0 && p.bytes_per_particle > 0.0);
         assert!(p.times.fft > 0.0 && p.times.fft < p.step_total);
-        let b = time_pse_radii(200, 0.1, 1e-2, 1, 1, 2.0).unwrap();
+        let b = time_pse_radii(200, 0.1, 1e-2, 1, 1, 2.0, 0.5).unwrap();
         assert!(b.step > 0.0 && b.geometry.grid == p.geometry.grid);
         assert_eq!(median(&mut [3.0, 1.0, 2.0, 10.0]), 2.5);
     }
