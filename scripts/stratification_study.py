@@ -711,6 +711,9 @@ def main():
     ap.add_argument("--analyse-only", action="store_true")
     ap.add_argument("--tag", default="", help="appended to the names of the data and figures")
     ap.add_argument("--panels", help="the methods the figures show (default: --methods)")
+    ap.add_argument("--drawn", default=",".join(f"{f:g}" for f in DRAWN), metavar="F,...",
+                    help="the fractions of the drying time whose diagrams are drawn (of 0.5, "
+                         "0.75, 1)")
     ap.add_argument("--profiles-at", default="30:0.2", metavar="PE:PHI0,...",
                     help="the grid points whose profiles are drawn method by method")
     ap.add_argument("--compare-alpha", metavar="CSV,CSV,...",
@@ -758,7 +761,7 @@ def main():
     th = thresholds(rows, [m for m in args.methods if m != "eq"], args.phi0)
     write_csv(os.path.join(args.data, f"stratification_thresholds{args.tag}.csv"), th)
     shown = args.panels.split(",") if args.panels else args.methods
-    for fraction in DRAWN:
+    for fraction in (float(f) for f in args.drawn.split(",")):
         figures(rows, shown, args.img, fraction, args.tag)
     for pe, phi0 in (map(float, x.split(":")) for x in args.profiles_at.split(",")
                      if not args.from_csv):
