@@ -656,11 +656,12 @@ pub fn third_virial(mayer: impl Fn(f64) -> f64, r_max: f64, steps: usize) -> f64
     // cum[k] = int_0^(k h) t f(t) dt; beyond r_max, f = 0.
     let mut cum = vec![0.0; 2 * steps + 1];
     for k in 1..cum.len() {
-        let (a, b) = (
-            tf.get(k - 1).copied().unwrap_or(0.0),
-            tf.get(k).copied().unwrap_or(0.0),
-        );
-        cum[k] = cum[k - 1] + 0.5 * h * (a + b);
+        cum[k] = cum[k - 1]
+            + if k <= steps {
+                0.5 * h * (tf[k - 1] + tf[k])
+            } else {
+                0.0
+            };
     }
     let weight = |k: usize| if k == 0 || k == steps { 0.5 } else { 1.0 };
     let mut sum = 0.0;
