@@ -118,3 +118,24 @@ def test_an_mpcd_point_averages_its_seeds(tmp_path):
     assert got[0.5][:2] == pytest.approx((0.12, 0.02))
     assert params["replicas"] == 2 and params["stiffness"] == 100.0 and params["kt"] == 1.0
     assert study.run_costs(str(point)) == (25.0, 1)
+
+
+def test_from_csv_draws_only_the_fractions_asked(tmp_path):
+    """`--from-csv` with `--drawn 0.5` redraws the data file, its thresholds and the diagram half
+    way through drying from a committed data file, and no other diagram."""
+    import subprocess
+    import sys
+
+    data = REPO / "docs" / "data" / "stratification_study-n108-hard.csv"
+    subprocess.run(
+        [sys.executable, str(REPO / "scripts" / "stratification_study.py"), "--runs", str(tmp_path),
+         "--from-csv", str(data), "--methods", "bd-fd-hard,bd-rpy-hard", "--peclet", "3,10,30,100",
+         "--drawn", "0.5", "--tag=-t", "--data", str(tmp_path), "--img", str(tmp_path)],
+        check=True, capture_output=True)
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert "stratification-diagram-t050-t.png" in names, names
+    assert not any(n.startswith("stratification-diagram-t100") for n in names), names
+    with open(tmp_path / "stratification_study-t.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert {r["method"] for r in rows} == {"bd-fd-hard", "bd-rpy-hard"}
+    assert {float(r["fraction"]) for r in rows} == {0.5, 0.75, 1.0}
