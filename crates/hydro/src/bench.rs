@@ -158,8 +158,8 @@ pub fn bidisperse_radii(n: usize, ratio: f64, large: f64) -> Vec<f64> {
         .collect()
 }
 
-/// [`time_pse`] with a number fraction `large` of the spheres `ratio` times larger ([`bidisperse_radii`],
-/// [`Pse::with_radii`]) in the same box (the monodisperse system's at `phi`), with the same
+/// [`time_pse`] with a number fraction `large` of the spheres `ratio` times larger
+/// ([`bidisperse_radii`], [`Pse::with_radii`]) in the same box (the monodisperse system's at `phi`), with the same
 /// splitting `0.5 / RADIUS` and tolerance; `ratio = 1` is [`time_pse`] ([`Pse::new`]).
 pub fn time_pse_radii(
     n: usize,

@@ -23,7 +23,18 @@ fn theory(
     hydro: Option<&str>,
     pair: Option<&str>,
 ) -> anyhow::Result<colloidsim_run::Report> {
-    let sc = Scenario::from_toml(DROPLET, dir).unwrap();
+    theory_of(DROPLET, dir, name, hydro, pair)
+}
+
+/// `colloidsim theory` of the scenario `text` into `dir/name`, at dx = 0.05.
+fn theory_of(
+    text: &str,
+    dir: &std::path::Path,
+    name: &str,
+    hydro: Option<&str>,
+    pair: Option<&str>,
+) -> anyhow::Result<colloidsim_run::Report> {
+    let sc = Scenario::from_toml(text, dir).unwrap();
     let opts = TheoryOptions {
         out: Some(dir.join(name)),
         dx: Some(0.05),
@@ -155,15 +166,13 @@ fn the_dense_mixture_flux_dries_a_bidisperse_droplet_further_than_the_dilute_one
 fn the_theory_refuses_a_pair_interaction_it_does_not_have() {
     let dir = tempfile::tempdir().unwrap();
     let run = |pair: &str, name: &str| {
-        let sc = Scenario::from_toml(&format!("{DROPLET}[pair]\n{pair}\n"), dir.path()).unwrap();
-        let opts = TheoryOptions {
-            out: Some(dir.path().join(name)),
-            dx: Some(0.05),
-            force: false,
-            hydrodynamics: None,
-            pair: None,
-        };
-        colloidsim_run::theory(&sc, &opts, &Control::default())
+        theory_of(
+            &format!("{DROPLET}[pair]\n{pair}\n"),
+            dir.path(),
+            name,
+            None,
+            None,
+        )
     };
     for (pair, key) in [
         (
