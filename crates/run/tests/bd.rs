@@ -580,56 +580,36 @@ fn dilute_pair_fluids_follow_the_exact_virial_series() {
     // (below it the engine continues the first force, which is this force).
     let dir = tempfile::tempdir().unwrap();
     let table = dir.path().join("soft.csv");
-    let grid: Vec<f64> = (1..=600).map(|k| 0.002 * k as f64).collect();
-    let soft_u: Vec<f64> = grid.iter().map(|r| 5.0 * (1.2 - r).powi(2)).collect();
-    let soft_f: Vec<f64> = grid.iter().map(|r| 10.0 * (1.2 - r)).collect();
     let mut csv = String::from("r,U_AA,F_AA\n");
-    for k in 0..grid.len() {
-        csv += &format!("{},{},{}\n", grid[k], soft_u[k], soft_f[k]);
+    for k in 1..=600 {
+        let r = 0.002 * k as f64;
+        csv += &format!("{r},{},{}\n", 5.0 * (1.2 - r).powi(2), 10.0 * (1.2 - r));
     }
     std::fs::write(&table, csv).unwrap();
+    // (the [pair] lines, rho, dt, time); the interaction whose virials are computed is the one
+    // the run reads from them.
     let cases = [
         (
             format!("kind = \"table\"\ntable = \"{}\"", table.display()),
-            PairSpec::Table {
-                r: grid.clone(),
-                energy: vec![soft_u],
-                force: vec![soft_f],
-            },
             0.05,
             0.002,
             400.0,
         ),
         (
-            "kind = \"yukawa\"\ncharges = [10.0]\nbjerrum_length = 0.1\ndebye_length = 0.5\nrange = 2.0".into(),
-            PairSpec::Yukawa {
-                charges: vec![10.0],
-                bjerrum_length: 0.1,
-                debye_length: 0.5,
-                range: 2.0,
-            },
+            "kind = \"yukawa\"\ncharges = [10.0]\nbjerrum_length = 0.1\ndebye_length = 0.5\nrange = 2.0"
+                .into(),
             0.02,
             0.002,
             400.0,
         ),
         (
             "kind = \"ao\"\ndepletant_diameter = 0.2\ndepletant_fraction = 0.2".into(),
-            PairSpec::Ao {
-                depletant_diameter: 0.2,
-                depletant_fraction: 0.2,
-            },
             0.1,
             0.002,
             400.0,
         ),
         (
             "kind = \"morse\"\ndepth = 0.5\nkappa = 10.0\nh0 = 0.0\nrange = 0.5".into(),
-            PairSpec::Morse {
-                depth: 0.5,
-                kappa: 10.0,
-                h0: 0.0,
-                h_cut: 0.5,
-            },
             0.1,
             0.0005,
             200.0,
@@ -645,8 +625,10 @@ fn dilute_pair_fluids_follow_the_exact_virial_series() {
         )
     };
     let (b2_wca, b3_wca) = virials(&PairSpec::wca(1.0, 1));
-    for (pair, spec, rho, dt, time) in cases {
-        let s = run(&dilute_gas(&pair, rho, dt, time));
+    for (pair, rho, dt, time) in cases {
+        let text = dilute_gas(&pair, rho, dt, time);
+        let spec = read_bd(&text).unwrap().pair.expect("a [pair] table");
+        let s = run(&text);
         let p = &s["pressure"];
         let ideal = p["ideal"].as_f64().unwrap();
         let (z, err) = (
