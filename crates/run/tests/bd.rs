@@ -580,12 +580,7 @@ fn dilute_pair_fluids_follow_the_exact_virial_series() {
     // (below it the engine continues the first force, which is this force).
     let dir = tempfile::tempdir().unwrap();
     let table = dir.path().join("soft.csv");
-    let mut csv = String::from("r,U_AA,F_AA\n");
-    for k in 1..=600 {
-        let r = 0.002 * k as f64;
-        csv += &format!("{r},{},{}\n", 5.0 * (1.2 - r).powi(2), 10.0 * (1.2 - r));
-    }
-    std::fs::write(&table, csv).unwrap();
+    crate::species::harmonic_table(&table, 5.0, 1.2, 0.002, 0.002, 600);
     // (the [pair] lines, rho, dt, time); the interaction whose virials are computed is the one
     // the run reads from them.
     let cases = [

@@ -202,17 +202,31 @@ fn bad_species_and_pairs_are_refused_naming_the_key() {
     }
 }
 
+/// A `pair.table` file at `path` of harmonic soft spheres, `U = k (sigma - r)^2` and its force
+/// `2 k (sigma - r)` below `sigma` (zero beyond), on `points` values of r from `r_first` in
+/// steps of `dr`.
+pub(crate) fn harmonic_table(
+    path: &std::path::Path,
+    k: f64,
+    sigma: f64,
+    r_first: f64,
+    dr: f64,
+    points: usize,
+) {
+    let mut csv = String::from("r,U_AA,F_AA\n");
+    for i in 0..points {
+        let r = r_first + dr * i as f64;
+        let h = (sigma - r).max(0.0);
+        csv += &format!("{r},{},{}\n", k * h.powi(2), 2.0 * k * h);
+    }
+    std::fs::write(path, csv).unwrap();
+}
+
 #[test]
 fn each_pair_kind_runs_a_static_droplet() {
     let dir = tempfile::tempdir().unwrap();
     let table = dir.path().join("soft.csv");
-    let mut csv = String::from("r,U_AA,F_AA\n");
-    for k in 0..=100 {
-        let r = 0.9 + 0.005 * k as f64;
-        let u = 10.0 * (1.4 - r).max(0.0).powi(2);
-        csv += &format!("{r},{u},{}\n", 20.0 * (1.4 - r).max(0.0));
-    }
-    std::fs::write(&table, csv).unwrap();
+    harmonic_table(&table, 10.0, 1.4, 0.9, 0.005, 101);
     for pair in [
         "kind = \"lj\"\nepsilon = [0.5]\ncutoff = 2.5".to_string(),
         "kind = \"yukawa\"\ncharges = [20.0]\nbjerrum_length = 0.01\ndebye_length = 0.2".into(),
