@@ -178,6 +178,17 @@ const EXAMPLES: &[(&str, &[&str])] = &[
         ],
     ),
     (
+        "mc/charged-spheres.toml",
+        &[
+            "mc.sweeps=200",
+            "mc.warmup_sweeps=50",
+            "system.particles=300",
+            "system.box=14.42",
+            "mc.blocks=4",
+            "output.gr_max=3.0",
+        ],
+    ),
+    (
         "mc/droplet-static.toml",
         &[
             "mc.sweeps=200",

@@ -47,6 +47,7 @@
 //! sweep (only when a cell overflows its capacity, which grows).
 
 pub mod chain;
+pub mod pair;
 
 use crate::geometry::Geometry;
 use colloidsim_core::ParamError;
@@ -54,6 +55,8 @@ use colloidsim_core::param::{positive, show};
 use colloidsim_core::resources::ensure_fits;
 use colloidsim_core::rng::{Purpose, stream};
 pub use colloidsim_particles::Mixture;
+use colloidsim_particles::PairSpec;
+use pair::{SoftPair, SoftPass};
 use rand::Rng;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -142,6 +145,23 @@ impl std::ops::AddAssign for SweepStats {
         self.trials += o.trials;
         self.accepted += o.accepted;
         self.left_cell += o.left_cell;
+    }
+}
+
+/// What the moves of a cell, a layer or a sweep did: moves accepted, moves rejected for
+/// leaving their cell, and the sum of the accepted moves' `beta dU` of the pair interaction.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tally {
+    accepted: u64,
+    left: u64,
+    beta_pair_du: f64,
+}
+
+impl std::ops::AddAssign for Tally {
+    fn add_assign(&mut self, o: Self) {
+        self.accepted += o.accepted;
+        self.left += o.left;
+        self.beta_pair_du += o.beta_pair_du;
     }
 }
 
@@ -266,6 +286,25 @@ impl Pass {
         })
     }
 
+    /// The first slot (global index) and the slots to scan of the 27 cells around (index
+    /// `9 dz + 3 dy + dx`, the own cell at 13; `around`: the grid coordinates below, at and
+    /// above along each axis): the slots up to the count rounded up to whole vectors of eight.
+    #[inline(always)]
+    fn stencil(&self, around: [&[usize; 3]; 3], counts: &[u32]) -> ([usize; 27], [usize; 27]) {
+        let mut base = [0usize; 27];
+        let mut len = [0usize; 27];
+        for (dz, &jz) in around[2].iter().enumerate() {
+            for (dy, &jy) in around[1].iter().enumerate() {
+                for (dx, &jx) in around[0].iter().enumerate() {
+                    let j = self.id([jx, jy, jz]);
+                    base[9 * dz + 3 * dy + dx] = j * self.cap;
+                    len[9 * dz + 3 * dy + dx] = (counts[j] as usize).next_multiple_of(8);
+                }
+            }
+        }
+        (base, len)
+    }
+
     /// The trial moves of one active layer: the `k`-th layer of parity `parity` (grid layer
     /// `iz = 2 k + parity`), whose `nc^2` cells' slots are `layer`, cell after cell in storage
     /// order; one random stream per layer, `(seed, sweep, Moves, 1 + parity h + k)`. Returns
@@ -278,11 +317,12 @@ impl Pass {
         radii: &[f64],
         counts: &[u32],
         frozen: &Frozen<'_>,
-    ) -> (u64, u64) {
+        soft: Option<&SoftPass<'_>>,
+    ) -> Tally {
         let (h, nc, cap) = (self.half, self.nc, self.cap);
         let first = (parity * h + k) * nc * nc;
         if counts[first..first + nc * nc].iter().all(|&c| c == 0) {
-            return (0, 0);
+            return Tally::default();
         }
         let around = |i: usize| {
             [
@@ -299,7 +339,7 @@ impl Pass {
             1 + (parity * h + k) as u64,
         );
         let [mut lx, mut ly, mut lz] = layer;
-        let (mut accepted, mut left) = (0, 0);
+        let mut tally = Tally::default();
         for iy in 0..nc {
             let ys = around(iy);
             for ix in 0..nc {
@@ -308,7 +348,7 @@ impl Pass {
                     continue;
                 }
                 let xs = around(ix);
-                let (a, l) = self.cell_moves(
+                tally += self.cell_moves(
                     [&xs, &ys, &zs],
                     [&mut lx, &mut ly, &mut lz],
                     radii,
@@ -316,13 +356,12 @@ impl Pass {
                     n,
                     counts,
                     frozen,
+                    soft,
                     &mut rng,
                 );
-                accepted += a;
-                left += l;
             }
         }
-        (accepted, left)
+        tally
     }
 
     /// The trial moves of one active cell (`around`: the grid coordinates below, at and above
@@ -349,32 +388,20 @@ impl Pass {
         n: usize,
         counts: &[u32],
         frozen: &Frozen<'_>,
+        pair: Option<&SoftPass<'_>>,
         rng: &mut impl Rng,
-    ) -> (u64, u64) {
+    ) -> Tally {
         let [lx, ly, lz] = layer;
         let (s, cap) = (self.side, self.cap);
         let c = [around[0][1], around[1][1], around[2][1]];
         let own = self.id(c) * cap - layer_base;
-        // Slots of the 27 cells around (index 9 dz + 3 dy + dx, own cell at 13), and whether
-        // each holds anyone.
-        let mut base = [0usize; 27];
-        let mut len = [0usize; 27];
-        for (dz, &jz) in around[2].iter().enumerate() {
-            for (dy, &jy) in around[1].iter().enumerate() {
-                for (dx, &jx) in around[0].iter().enumerate() {
-                    let j = self.id([jx, jy, jz]);
-                    base[9 * dz + 3 * dy + dx] = j * cap;
-                    // Whole vectors of eight: the slots up to the count rounded up.
-                    len[9 * dz + 3 * dy + dx] = (counts[j] as usize).next_multiple_of(8);
-                }
-            }
-        }
+        let (base, len) = self.stencil(around, counts);
         let centre = self.cell_centre(c);
         let half_side = 0.5 * s;
         let at =
             |u: [f64; 3]| -> [f64; 3] { std::array::from_fn(|a| centre[a] + u[a] - half_side) };
-        let soft = self.geometry.is_soft();
-        let (mut accepted, mut left) = (0u64, 0u64);
+        let soft_wall = self.geometry.is_soft();
+        let mut tally = Tally::default();
         let own_radii = &radii[layer_base..];
         for _ in 0..n * self.nselect {
             let p = own + below(rng.next_u64(), n);
@@ -390,7 +417,7 @@ impl Pass {
                 lz[p] + step(rng.next_u64()),
             ];
             if !new.iter().all(|&u| (0.0..s).contains(&u)) {
-                left += 1;
+                tally.left += 1;
                 continue;
             }
             let r = at(new);
@@ -402,58 +429,81 @@ impl Pass {
             if r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > confine * confine {
                 continue;
             }
-            // The own cell, without p itself.
-            let mut hit = false;
-            for q in own..own + len[13] {
-                let (a, b, cc) = (new[0] - lx[q], new[1] - ly[q], new[2] - lz[q]);
-                let contact = rp + own_radii[q];
-                hit |= (a * a + b * b + cc * cc < contact * contact) & (q != p);
-            }
-            let (xr, yr, zr) = (range(new[0]), range(new[1]), range(new[2]));
-            'scan: for dz in zr.0..=zr.1 {
-                for dy in yr.0..=yr.1 {
-                    for dx in xr.0..=xr.1 {
-                        let k = 9 * dz + 3 * dy + dx;
-                        if hit {
-                            break 'scan;
+            // Hard spheres: an overlap is a rejection; a pair interaction: its energy change.
+            let mut beta_du = 0.0;
+            if let Some(pair) = pair {
+                let old = [lx[p], ly[p], lz[p]];
+                let layer = [&*lx, &*ly, &*lz];
+                beta_du = self.pair_energy_change(
+                    pair,
+                    (p, old, new),
+                    own,
+                    &base,
+                    layer,
+                    layer_base,
+                    radii,
+                    counts,
+                    frozen,
+                );
+            } else {
+                // The own cell, without p itself.
+                let mut hit = false;
+                for q in own..own + len[13] {
+                    let (a, b, cc) = (new[0] - lx[q], new[1] - ly[q], new[2] - lz[q]);
+                    let contact = rp + own_radii[q];
+                    hit |= (a * a + b * b + cc * cc < contact * contact) & (q != p);
+                }
+                let (xr, yr, zr) = (range(new[0]), range(new[1]), range(new[2]));
+                'scan: for dz in zr.0..=zr.1 {
+                    for dy in yr.0..=yr.1 {
+                        for dx in xr.0..=xr.1 {
+                            let k = 9 * dz + 3 * dy + dx;
+                            if hit {
+                                break 'scan;
+                            }
+                            if k == 13 || len[k] == 0 {
+                                continue;
+                            }
+                            let [x, y, z] = if dz == 1 {
+                                let b = base[k] - layer_base..base[k] - layer_base + len[k];
+                                [&lx[b.clone()], &ly[b.clone()], &lz[b]]
+                            } else {
+                                frozen.cell(base[k], len[k])
+                            };
+                            // The sphere's position relative to our corner is its own plus the
+                            // offset of its cell; move the offset to the trial position instead.
+                            let q = [
+                                new[0] - (dx as f64 - 1.0) * s,
+                                new[1] - (dy as f64 - 1.0) * s,
+                                new[2] - (dz as f64 - 1.0) * s,
+                            ];
+                            let rq = &radii[base[k]..base[k] + len[k]];
+                            hit = any_within(x, y, z, rq, q, rp);
                         }
-                        if k == 13 || len[k] == 0 {
-                            continue;
-                        }
-                        let [x, y, z] = if dz == 1 {
-                            let b = base[k] - layer_base..base[k] - layer_base + len[k];
-                            [&lx[b.clone()], &ly[b.clone()], &lz[b]]
-                        } else {
-                            frozen.cell(base[k], len[k])
-                        };
-                        // The sphere's position relative to our corner is its own plus the
-                        // offset of its cell; move the offset to the trial position instead.
-                        let q = [
-                            new[0] - (dx as f64 - 1.0) * s,
-                            new[1] - (dy as f64 - 1.0) * s,
-                            new[2] - (dz as f64 - 1.0) * s,
-                        ];
-                        let rq = &radii[base[k]..base[k] + len[k]];
-                        hit = any_within(x, y, z, rq, q, rp);
                     }
                 }
-            }
-            if hit {
-                continue;
-            }
-            if soft {
-                let du = self.geometry.beta_energy_of(r, h)
-                    - self.geometry.beta_energy_of(at([lx[p], ly[p], lz[p]]), h);
-                if du > 0.0 && unit(rng.next_u64()) >= (-du).exp() {
+                if hit {
                     continue;
                 }
+            }
+            let pair_du = beta_du;
+            if soft_wall {
+                beta_du += self.geometry.beta_energy_of(r, h)
+                    - self.geometry.beta_energy_of(at([lx[p], ly[p], lz[p]]), h);
+            }
+            // Metropolis (NaN, infinite energies on both sides, is a rejection too).
+            if (pair.is_some() || soft_wall)
+                && !(beta_du <= 0.0 || unit(rng.next_u64()) < (-beta_du).exp())
+            {
+                continue;
             }
             lx[p] = new[0];
             ly[p] = new[1];
             lz[p] = new[2];
-            accepted += 1;
+            tally.accepted += 1;
+            tally.beta_pair_du += pair_du;
         }
-        (accepted, left)
+        tally
     }
 }
 
@@ -535,6 +585,10 @@ pub struct HardSphereMc {
     /// The cells' slots hold the current positions (false after event chains, which move
     /// `pos` alone: [`Self::bin`] brings them up to date).
     binned: bool,
+    /// A pair interaction in place of the hard cores ([`Self::with_pair`]).
+    pair: Option<SoftPair>,
+    /// The pair energy change of the last sweep's accepted moves (with a pair interaction).
+    last_pair_energy_change: Option<f64>,
 }
 
 /// Half of `diameter` times `scale` (exactly `diameter / 2` at scale 1).
@@ -604,7 +658,23 @@ impl HardSphereMc {
     /// in messages; other errors name the parameter: `diameter`, `diameters`, `counts`, `delta`,
     /// `radius`, `box`).
     pub fn new(params: &McParams, positions: &[[f64; 3]], key: &str) -> Result<Self, McError> {
-        Self::new_scaled(params, positions, key, 1.0)
+        Self::new_scaled(params, positions, key, 1.0, None)
+    }
+
+    /// Spheres at `positions` as [`Self::new`], interacting by the pair interaction `pair` at
+    /// thermal energy `kt` in place of the hard cores (the container stays as it is; module
+    /// [`pair`]): the cells are at least the interaction's range. Errors as `new`, and: the
+    /// range beyond half the box (key `box`) or, in a droplet, beyond eight largest diameters
+    /// (`pair_range`); a pair of the positions at infinite energy (`key`); the interaction's own
+    /// parameters (named as in [`PairSpec::build`]).
+    pub fn with_pair(
+        params: &McParams,
+        positions: &[[f64; 3]],
+        key: &str,
+        pair: &PairSpec,
+        kt: f64,
+    ) -> Result<Self, McError> {
+        Self::new_scaled(params, positions, key, 1.0, Some((pair, kt)))
     }
 
     /// [`Self::new`] with every diameter times `scale` (in (0, 1]): the compressed start that
@@ -614,6 +684,7 @@ impl HardSphereMc {
         positions: &[[f64; 3]],
         key: &str,
         scale: f64,
+        pair: Option<(&PairSpec, f64)>,
     ) -> Result<Self, McError> {
         let d = positive("diameter", params.diameter)?;
         positive("delta", params.delta)?;
@@ -691,9 +762,19 @@ impl HardSphereMc {
             )
             .into());
         }
-        let nc = cells_per_edge(edge, d_max);
+        let pair = pair
+            .map(|(spec, kt)| SoftPair::new(spec, &diameters, kt))
+            .transpose()?;
+        // Cells at least the pair's range (CELL_MIN reaches apart, as for the diameters).
+        let reach = pair
+            .as_ref()
+            .map_or(d_max, |p| d_max.max(p.r_cut / CELL_MIN));
+        let nc = cells_per_edge(edge, reach);
+        if let Some(p) = &pair {
+            p.check_range(&params.geometry, edge, edge / nc as f64, d_max)?;
+        }
         let cells = (nc as f64).powi(3);
-        check_cell_count(edge, d_max, n)?;
+        check_cell_count(edge, reach, n)?;
         // Slots (3 coordinates, a radius, a tag) at the initial capacity, counts, particle
         // arrays.
         let cap0 = 8usize;
@@ -741,6 +822,8 @@ impl HardSphereMc {
             chain_cells: Default::default(),
             binned: false,
             last_chain: Default::default(),
+            pair,
+            last_pair_energy_change: None,
         };
         mc.delta = mc.delta.min(mc.max_delta());
         for (i, p) in positions.iter().enumerate() {
@@ -773,7 +856,18 @@ impl HardSphereMc {
             }
         }
         mc.rebin([0.0; 3]);
-        if let Some((i, j, r)) = mc.first_overlap(0.0) {
+        if let Some((i, j, r)) = mc.first_infinite_energy() {
+            return Err(ParamError::new(
+                key,
+                format!(
+                    "spheres {i} and {j} at distance {r:.6} have an infinite or undefined pair energy"
+                ),
+            )
+            .into());
+        }
+        if mc.pair.is_none()
+            && let Some((i, j, r)) = mc.first_overlap(0.0)
+        {
             return Err(McError::Overlap {
                 key: key.into(),
                 i,
@@ -1222,8 +1316,13 @@ impl HardSphereMc {
         let pass = self.pass();
         let layer = pass.nc * pass.nc * self.cap;
         let span = pass.half * layer;
-        let (mut accepted, mut left) = (0, 0);
+        let mut tally = Tally::default();
         let (counts, radii) = (&self.count, &self.slot_r);
+        let soft = self.pair.as_ref().map(|pair| SoftPass {
+            pair,
+            tag: &self.tag,
+            types: &self.types,
+        });
         for parity in parities {
             let (lo, hi) = (parity * span, (parity + 1) * span);
             let [sx, sy, sz] = &mut self.slot;
@@ -1239,24 +1338,26 @@ impl HardSphereMc {
                 lo,
                 hi,
             };
-            let (a, b) = xc
+            tally += xc
                 .par_chunks_mut(layer)
                 .zip(yc.par_chunks_mut(layer))
                 .zip(zc.par_chunks_mut(layer))
                 .enumerate()
                 .map(|(k, ((x, y), z))| {
-                    pass.layer_moves(parity, k, [x, y, z], radii, counts, &frozen)
+                    pass.layer_moves(parity, k, [x, y, z], radii, counts, &frozen, soft.as_ref())
                 })
-                .reduce(|| (0, 0), |p, q| (p.0 + q.0, p.1 + q.1));
-            accepted += a;
-            left += b;
+                .reduce(Tally::default, |mut p, q| {
+                    p += q;
+                    p
+                });
         }
         self.scatter();
         self.sweep += 1;
+        self.last_pair_energy_change = self.pair.as_ref().map(|p| tally.beta_pair_du / p.beta);
         SweepStats {
             trials: (self.len() * self.nselect) as u64,
-            accepted,
-            left_cell: left,
+            accepted: tally.accepted,
+            left_cell: tally.left,
         }
     }
 

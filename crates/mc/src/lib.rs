@@ -7,6 +7,9 @@
 //!   overlap below the pair's mean diameter), checkerboard cell sweeps (Anderson et al., J. Comput. Phys.
 //!   254, 27 (2013)) with counter-based random streams keyed by (seed, sweep, cell), so that a
 //!   run is fixed by its seed whatever the number of threads; move-size tuning in the warm-up.
+//! - [`engine::pair`]: a pair interaction of `colloidsim-particles` (the BD engines' `[pair]`)
+//!   in place of the hard cores, local moves with the Metropolis test on the pair energy, and
+//!   the pair virial.
 //! - [`engine::chain`]: event-chain Monte Carlo (Bernard, Krauth & Wilson 2009), the move type
 //!   beside the local moves, with its exact pressure.
 //! - [`init`]: lattice starting configurations (melted by the warm-up).

@@ -6,6 +6,7 @@ use crate::engine::{HardSphereMc, McError, McParams, Mixture};
 use crate::geometry::Geometry;
 use crate::init::{fcc_in_box, fcc_in_sphere, shuffled};
 use colloidsim_core::ParamError;
+use colloidsim_particles::PairSpec;
 
 use serde::Serialize;
 
@@ -80,6 +81,10 @@ pub struct McRun {
     pub rho2_bins: Option<(usize, usize)>,
     /// Starting configuration file, if any.
     pub initial: Option<PathBuf>,
+    /// A pair interaction in place of the hard cores (`None`: hard spheres; not serialised
+    /// then): the spheres sample `exp(-U / kT)` ([`HardSphereMc::with_pair`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pair: Option<PairSpec>,
 }
 
 impl McRun {
@@ -123,7 +128,9 @@ impl McRun {
     /// the shuffled sites, so at random). The lattice's neighbour distance is at least the
     /// largest diameter when that fits (one species always does, below `MAX_PHI`); else the
     /// mixture starts on a lattice at every diameter scaled down to fit and is inflated to its
-    /// full diameters by Monte Carlo sweeps ([`HardSphereMc::grow`], at most [`GROW_SWEEPS`]).
+    /// full diameters by Monte Carlo sweeps ([`HardSphereMc::grow`], at most [`GROW_SWEEPS`]);
+    /// with a pair interaction it starts at full diameters on that closer lattice (soft cores
+    /// may overlap; the warm-up relaxes them).
     pub fn engine(
         &self,
         positions: Option<&[[f64; 3]]>,
@@ -208,7 +215,13 @@ impl McRun {
                 &lattice
             }
         };
-        let mut mc = HardSphereMc::new_scaled(&params, pos, key, scale)?;
+        let mut mc = match &self.pair {
+            None => HardSphereMc::new_scaled(&params, pos, key, scale, None)?,
+            Some(pair) => {
+                scale = 1.0;
+                HardSphereMc::with_pair(&params, pos, key, pair, self.kt)?
+            }
+        };
         if scale < 1.0 {
             mc.grow(GROW_SWEEPS, self.delta)?;
         }

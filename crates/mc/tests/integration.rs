@@ -4,5 +4,6 @@
 
 mod event_chain;
 mod mixture;
+mod pair;
 mod trokhymchuk;
 mod validation;

@@ -135,6 +135,7 @@ fn bulk_run(n: usize, xl: f64, phi: f64, seed: u32) -> McRun {
         trajectory_every: 0,
         rho2_bins: None,
         initial: None,
+        pair: None,
     }
 }
 

@@ -563,63 +563,71 @@ fn dilute_gas(pair: &str, rho: f64, dt: f64, time: f64) -> String {
     )
 }
 
-/// The virial pressure of dilute gases of a tabulated (harmonic soft spheres), the
-/// screened-Coulomb (Yukawa), the Asakura–Oosawa and the Morse interaction against the virial series `Z = 1 + B2 rho + B3 rho^2`, with the exact
-/// `B2` and `B3` of the same interaction (Mayer-function quadratures of its energy,
-/// `second_virial`, `third_virial`): within 3 block errors. The next term, `B4 rho^3`, is
-/// about one error for the Yukawa gas if `B4 / B2^3` is the hard spheres' 0.29, and far
-/// below it for the others. Each fails when its interaction is replaced by the bare WCA core (which
-/// the measured `Z` is more than 10 errors from), and the Yukawa gas resolves `B3` (its `Z` is
-/// more than 4 errors from `1 + B2 rho`). Morse's narrow well (1 / kappa = 0.1 d) needs the
-/// smaller step: at dt = 0.002 it read 3 errors high.
-#[test]
-fn dilute_pair_fluids_follow_the_exact_virial_series() {
-    use colloidsim_particles::interaction::{second_virial, third_virial};
-    use colloidsim_particles::{Pair, PairSpec};
-    // Harmonic soft spheres, U = 5 kT (1.2 - r)^2 below r = 1.2, as a table from r = 0.002
-    // (below it the engine continues the first force, which is this force).
-    let dir = tempfile::tempdir().unwrap();
-    let table = dir.path().join("soft.csv");
-    crate::species::harmonic_table(&table, 5.0, 1.2, 0.002, 0.002, 600);
-    // (the [pair] lines, rho, dt, time); the interaction whose virials are computed is the one
-    // the run reads from them.
-    let cases = [
+/// The dilute pair fluids of the virial-series checks (BD here, Monte Carlo in
+/// tests/hs_mc_pair.rs), spheres of d = 1 at kT = 1: the `[pair]` lines and the number density.
+/// Harmonic soft spheres `U = 5 kT (1.2 - r)^2` below r = 1.2 are tabulated into `table` from
+/// r = 0.002 (below it the engine continues the first force, which is this force).
+pub(crate) fn dilute_pair_fluids(table: &std::path::Path) -> [(String, f64); 4] {
+    crate::species::harmonic_table(table, 5.0, 1.2, 0.002, 0.002, 600);
+    [
         (
             format!("kind = \"table\"\ntable = \"{}\"", table.display()),
             0.05,
-            0.002,
-            400.0,
         ),
         (
             "kind = \"yukawa\"\ncharges = [10.0]\nbjerrum_length = 0.1\ndebye_length = 0.5\nrange = 2.0"
                 .into(),
             0.02,
-            0.002,
-            400.0,
         ),
         (
             "kind = \"ao\"\ndepletant_diameter = 0.2\ndepletant_fraction = 0.2".into(),
             0.1,
-            0.002,
-            400.0,
         ),
         (
             "kind = \"morse\"\ndepth = 0.5\nkappa = 10.0\nh0 = 0.0\nrange = 0.5".into(),
             0.1,
-            0.0005,
-            200.0,
         ),
+    ]
+}
+
+/// The exact `B2` and `B3` of a one-species interaction (d = 1, kT = 1): Mayer-function
+/// quadratures of its energy (`second_virial`, `third_virial`).
+pub(crate) fn exact_virials(spec: &colloidsim_particles::PairSpec) -> (f64, f64) {
+    use colloidsim_particles::Pair;
+    use colloidsim_particles::interaction::{second_virial, third_virial};
+    let p = spec.build(&[1.0], 1.0).unwrap();
+    let rc = p.r_cut_max();
+    let mayer = |r: f64| (-p.energy(r * r, 0, 0, 1.0, 1.0)).exp() - 1.0;
+    (
+        second_virial(&p, 0, 0, 1.0, 1.0, 1.0, 20_000),
+        third_virial(|r| if r == 0.0 { -1.0 } else { mayer(r) }, rc, 3000),
+    )
+}
+
+/// The virial pressure of dilute gases of a tabulated (harmonic soft spheres), the
+/// screened-Coulomb (Yukawa), the Asakura–Oosawa and the Morse interaction
+/// ([`dilute_pair_fluids`]) against the virial series `Z = 1 + B2 rho + B3 rho^2`, with the
+/// exact `B2` and `B3` of the same interaction ([`exact_virials`]): within 3 block errors. The
+/// next term, `B4 rho^3`, is about one error for the Yukawa gas if `B4 / B2^3` is the hard
+/// spheres' 0.29, and far below it for the others. Each fails when its interaction is replaced
+/// by the bare WCA core (which the measured `Z` is more than 10 errors from), and the Yukawa
+/// gas resolves `B3` (its `Z` is more than 4 errors from `1 + B2 rho`). Morse's narrow well
+/// (1 / kappa = 0.1 d) needs the smaller step: at dt = 0.002 it read 3 errors high.
+#[test]
+fn dilute_pair_fluids_follow_the_exact_virial_series() {
+    let dir = tempfile::tempdir().unwrap();
+    // The interaction whose virials are computed is the one the run reads from the scenario;
+    // (dt, time) per fluid.
+    let steps = [
+        (0.002, 400.0),
+        (0.002, 400.0),
+        (0.002, 400.0),
+        (0.0005, 200.0),
     ];
-    let virials = |spec: &PairSpec| {
-        let p = spec.build(&[1.0], 1.0).unwrap();
-        let rc = p.r_cut_max();
-        let mayer = |r: f64| (-p.energy(r * r, 0, 0, 1.0, 1.0)).exp() - 1.0;
-        (
-            second_virial(&p, 0, 0, 1.0, 1.0, 1.0, 20_000),
-            third_virial(|r| if r == 0.0 { -1.0 } else { mayer(r) }, rc, 3000),
-        )
-    };
-    let (b2_wca, b3_wca) = virials(&PairSpec::wca(1.0, 1));
+    let cases = dilute_pair_fluids(&dir.path().join("soft.csv"))
+        .into_iter()
+        .zip(steps)
+        .map(|((pair, rho), (dt, time))| (pair, rho, dt, time));
     for (pair, rho, dt, time) in cases {
         let text = dilute_gas(&pair, rho, dt, time);
         let spec = read_bd(&text).unwrap().pair.expect("a [pair] table");
@@ -630,28 +638,41 @@ fn dilute_pair_fluids_follow_the_exact_virial_series() {
             p["value"].as_f64().unwrap() / ideal,
             p["error"].as_f64().unwrap() / ideal,
         );
-        let (b2, b3) = virials(&spec);
-        let series = 1.0 + b2 * rho + b3 * rho * rho;
-        let wca = 1.0 + b2_wca * rho + b3_wca * rho * rho;
-        eprintln!(
-            "{}: rho {rho}: Z = {z:.4} +- {err:.4}; B2 = {b2:.4}, B3 = {b3:.4}: series {series:.4} \
-             ({:+.1} err), 1 + B2 rho {:.4}, bare WCA {wca:.4}",
-            spec.kind(),
-            (z - series) / err,
-            1.0 + b2 * rho
-        );
-        assert!(
-            (z - series).abs() < 3.0 * err,
-            "{}: Z = {z} +- {err} vs the series {series}",
-            spec.kind()
-        );
-        assert!(
-            (z - wca).abs() > 10.0 * err,
-            "{}: too short to tell from WCA",
-            spec.kind()
-        );
-        if spec.kind() == "yukawa" {
-            assert!((z - 1.0 - b2 * rho).abs() > 4.0 * err, "B3 not resolved");
-        }
+        follows_the_virial_series(&spec, rho, (z, err));
+    }
+}
+
+/// Assert that `Z = z +- err` measured at number density `rho` with the pair interaction
+/// `spec` (one species, d = 1, kT = 1) is within 3 errors of its exact `1 + B2 rho + B3 rho^2`
+/// and more than 10 errors from the bare WCA core's; a Yukawa gas more than 4 errors from
+/// `1 + B2 rho` (it resolves `B3`).
+pub(crate) fn follows_the_virial_series(
+    spec: &colloidsim_particles::PairSpec,
+    rho: f64,
+    (z, err): (f64, f64),
+) {
+    let (b2, b3) = exact_virials(spec);
+    let (b2_wca, b3_wca) = exact_virials(&colloidsim_particles::PairSpec::wca(1.0, 1));
+    let series = 1.0 + b2 * rho + b3 * rho * rho;
+    let wca = 1.0 + b2_wca * rho + b3_wca * rho * rho;
+    eprintln!(
+        "{}: rho {rho}: Z = {z:.4} +- {err:.4}; B2 = {b2:.4}, B3 = {b3:.4}: series {series:.4} \
+         ({:+.1} err), 1 + B2 rho {:.4}, bare WCA {wca:.4}",
+        spec.kind(),
+        (z - series) / err,
+        1.0 + b2 * rho
+    );
+    assert!(
+        (z - series).abs() < 3.0 * err,
+        "{}: Z = {z} +- {err} vs the series {series}",
+        spec.kind()
+    );
+    assert!(
+        (z - wca).abs() > 10.0 * err,
+        "{}: too short to tell from WCA",
+        spec.kind()
+    );
+    if spec.kind() == "yukawa" {
+        assert!((z - 1.0 - b2 * rho).abs() > 4.0 * err, "B3 not resolved");
     }
 }

@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 /// Run `text` into `dir/run`; its summary.
-fn run_in(dir: &Path, text: &str) -> Value {
+pub(crate) fn run_in(dir: &Path, text: &str) -> Value {
     let sc = Scenario::from_toml(text, dir).unwrap();
     let opts = RunOptions {
         out: Some(dir.join("run")),
@@ -27,7 +27,7 @@ fn run_in(dir: &Path, text: &str) -> Value {
 }
 
 /// The message `text` is refused with by `colloidsim check`'s path.
-fn refused(text: &str) -> String {
+pub(crate) fn refused(text: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let sc = Scenario::from_toml(text, dir.path()).unwrap();
     match colloidsim_run::check(&sc) {

@@ -23,6 +23,7 @@ mod estimate;
 mod extrapolate;
 mod figures;
 mod fuzz;
+mod hs_mc_pair;
 mod hs_mc_species;
 mod hydro_bd;
 mod keys;

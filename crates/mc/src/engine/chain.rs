@@ -260,6 +260,12 @@ impl HardSphereMc {
                     format!("must be positive and finite, got {}", show(c.length)),
                 ));
             }
+            if self.pair.is_some() {
+                return Err(ParamError::new(
+                    "move",
+                    "event chains here are for hard spheres: with a pair interaction use local moves",
+                ));
+            }
             if matches!(self.geometry, Geometry::Tabulated { .. }) {
                 return Err(ParamError::new(
                     "move",

@@ -8,6 +8,9 @@ use crate::keys::Allowed::*;
 use crate::keys::Omitted::*;
 use crate::keys::shared::{INTERFACE, INTERFACE_OFFSET, INTERFACE_RANGE, INTERFACE_STIFFNESS};
 use crate::keys::species::{SPECIES, SPECIES_COUNTS, SPECIES_DIAMETERS, SPECIES_VOLUME_FRACTIONS};
+use crate::keys::species::{PAIR, PAIR_KIND, PAIR_EPSILON, PAIR_CUTOFF, PAIR_CHARGES, PAIR_BJERRUM,
+    PAIR_DEBYE, PAIR_RANGE, PAIR_DEPTH, PAIR_KAPPA, PAIR_H0, PAIR_DEPLETANT_DIAMETER,
+    PAIR_DEPLETANT_FRACTION, PAIR_TABLE};
 use crate::keys::{COUNT, MAX_BINS_RADIAL, SEED_KEY, Spec, key};
 
 pub const METHOD: Spec = key("method", "-", Required, OneOf(&["hs-mc"]),
@@ -49,6 +52,14 @@ pub const SYSTEM_KT: Spec = key("system.kT", "energy", Value("1"), Positive,
 pub const SYSTEM_INITIAL: Spec = key("system.initial", "-", Means("FCC lattice"), Path,
     "start from the last frame of this GSD file")
     .also("N spheres, no overlap, centres inside the wall");
+
+/// `[pair]` as the BD methods declare it, in place of the hard cores.
+pub const MC_PAIR: Spec = Spec {
+    default: Means("hard spheres: additive cores at each pair's mean diameter"),
+    doc: "a pair interaction of every species pair in place of the hard cores: the spheres sample exp(-U/kT), U as BD integrates it (docs/mc.md, \"Pair interactions\")",
+    also: "local moves only; its range at most half the box (bulk) or 8 of the largest diameters (droplets)",
+    ..PAIR
+};
 
 pub const MC: Spec = key("mc", "-", Means("-"), Table, "sweeps, warm-up and tuning");
 
@@ -140,6 +151,20 @@ pub static KEYS: &[Spec] = &[
     INTERFACE_STIFFNESS,
     INTERFACE_RANGE,
     INTERFACE_OFFSET.also("above -radius"),
+    MC_PAIR,
+    PAIR_KIND,
+    PAIR_EPSILON,
+    PAIR_CUTOFF,
+    PAIR_CHARGES,
+    PAIR_BJERRUM,
+    PAIR_DEBYE,
+    PAIR_RANGE,
+    PAIR_DEPTH,
+    PAIR_KAPPA,
+    PAIR_H0,
+    PAIR_DEPLETANT_DIAMETER,
+    PAIR_DEPLETANT_FRACTION,
+    PAIR_TABLE,
     MC,
     MC_SWEEPS,
     MC_NSELECT,

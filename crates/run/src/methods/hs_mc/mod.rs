@@ -3,7 +3,9 @@
 //! the compressibility factor with block-average errors; in a droplet the radial volume-fraction
 //! profile on droplet-bd's file names (and, with a hard wall, the exact virial sum rule at the
 //! wall). A mixture (`[system.species]`) adds each species' profile, its partial contact values
-//! and the virial Z beside BMCSL (docs/mc.md, "Mixtures"). Checkpoints hold the positions
+//! and the virial Z beside BMCSL (docs/mc.md, "Mixtures"). A pair interaction (`[pair]`)
+//! replaces the hard cores: Z and the wall's sum rule from the pair virial, the mean pair energy
+//! (docs/mc.md, "Pair interactions"). Checkpoints hold the positions
 //! exactly: a restart continues bitwise.
 
 use crate::checkpoint::Envelope;
@@ -84,7 +86,7 @@ const HEADLINE: &[Headline] = &[
         labels: None,
         unit: "-",
         doc: "compressibility factor Z = P / (rho kT), from the contact value (from the \
-              event chains' pressure with mc.chain_length)",
+              event chains' pressure with mc.chain_length; from the pair virial with [pair])",
         absent: "measured in the bulk only (system.geometry = \"bulk\")",
     },
     Headline {
@@ -210,6 +212,26 @@ struct Block {
     /// written without it).
     #[serde(default)]
     overlap: Option<(Vec<f64>, u64)>,
+    /// The pair energy and virial summed over the samples (with `[pair]`).
+    #[serde(default)]
+    pair: Option<PairSums>,
+}
+
+/// Sums over a block's samples of the pair energy `U` and the pair virial
+/// `W = sum_{i<j} r_ij F(r_ij)`.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+struct PairSums {
+    energy: f64,
+    virial: f64,
+    samples: u64,
+}
+
+impl PairSums {
+    /// The block's mean `(U, W)` (NaN without samples).
+    fn means(&self) -> (f64, f64) {
+        let k = self.samples as f64;
+        (self.energy / k, self.virial / k)
+    }
 }
 
 /// Everything a run accumulates, saved in every checkpoint.
@@ -261,6 +283,7 @@ impl Accum {
                 .zip(p.radius)
                 .map(|(m, r)| vec![RadialHistogram::new(0.0, r, p.profile_bins); m.len()]),
             partial: p.mixture.as_ref().map(|_| PartialContacts::new(mc)),
+            pair: p.pair.as_ref().map(|_| PairSums::default()),
             species_wall: p
                 .mixture
                 .as_ref()
@@ -364,6 +387,12 @@ impl McSession {
             }
             if let Some(h) = block.partial.as_mut() {
                 h.sample(&self.mc);
+            }
+            if let (Some(s), Some((u, w))) = (block.pair.as_mut(), self.mc.pair_energy_and_virial())
+            {
+                s.energy += u;
+                s.virial += w;
+                s.samples += 1;
             }
         }
         if let Some(w) = self.gsd.as_mut()
@@ -570,7 +599,20 @@ impl Session for McSession {
         }
         if p.is_bulk() {
             let volume = self.mc.box_edge().powi(3);
-            if let Some(m) = &p.mixture {
+            if p.pair.is_some() {
+                // beta P / rho = 1 + beta W / (3 N) per block.
+                let z: Vec<f64> = pair_means(&blocks)
+                    .iter()
+                    .map(|(_, w)| 1.0 + w / (3.0 * n as f64 * p.kt))
+                    .collect();
+                summary["compressibility"] = value_error_or(out, "compressibility", &z, NO_PAIR);
+                summary["contact_value"] = json!({ "value": null });
+                out.explain(
+                    "summary.json",
+                    "contact_value.value",
+                    "no contact with [pair]: the spheres have no hard core (compressibility is from the pair virial)",
+                );
+            } else if let Some(m) = &p.mixture {
                 mixture_bulk(m, &blocks, volume, &mut summary, out);
             } else {
                 let contact: Vec<f64> = blocks
@@ -615,25 +657,31 @@ impl Session for McSession {
                     z["value"].as_f64().unwrap_or(f64::NAN),
                     z["standard_error"].as_f64().unwrap_or(f64::NAN),
                 );
-                let drawn = if p.mixture.is_some() {
-                    // No one-component reference for the pairs of a mixture.
+                let drawn = if p.mixture.is_some() || p.pair.is_some() {
+                    // No one-component hard-sphere reference for the pairs of a mixture or a
+                    // pair interaction.
                     let x: Vec<f64> = r.iter().map(|v| v / d).collect();
-                    line_plot_with_errors(
+                    let label = format!("Monte Carlo, Z = {}", value_with_error(z.0, z.1));
+                    line_plot_styled(
                         &out.join("g_r.png"),
                         &format!(
-                            "Hard spheres (all pairs), Monte Carlo: N = {n}, phi = {:.3}",
+                            "{} (all pairs): N = {n}, phi = {:.3}; bars: standard errors over the blocks",
+                            spheres(p),
                             p.volume_fraction
                         ),
                         "r / d",
                         "g(r)",
                         &[Series {
-                            label: "Monte Carlo (bars: standard error over the blocks)",
+                            label: &label,
                             x: &x,
                             y: &g,
                             points: false,
                         }],
                         &[Some(err.as_slice())],
                         Scale::Linear,
+                        Style {
+                            legend_outside: true,
+                        },
                     )
                 } else {
                     gr_picture(out, n, p.volume_fraction, d, (&r, &g, &err), z)
@@ -705,8 +753,10 @@ impl Session for McSession {
                 let radius = p.radius.unwrap_or(1.0);
                 let x: Vec<f64> = r.iter().map(|v| v / radius).collect();
                 let title = format!(
-                    "Static droplet, hard-sphere MC ({}): N = {n}, phi = {:.3}",
-                    p.geometry, p.volume_fraction
+                    "Static droplet, {} ({}): N = {n}, phi = {:.3}",
+                    method_name(p),
+                    p.geometry,
+                    p.volume_fraction
                 );
                 let series = [Series {
                     label: "equilibrium (bars: standard error over the blocks)",
@@ -804,10 +854,16 @@ impl Session for McSession {
                     .filter_map(|b| b.wall.as_ref())
                     .map(|h| 4.0 * PI * rc.powi(3) * wall_contact_density(h, rc))
                     .collect();
-                let virial: Vec<f64> = blocks
-                    .iter()
-                    .map(|b| 3.0 * n as f64 + d * contact_pairs(&b.contact, d))
-                    .collect();
+                let virial: Vec<f64> = match p.pair {
+                    Some(_) => pair_means(&blocks)
+                        .iter()
+                        .map(|(_, w)| 3.0 * n as f64 + w / p.kt)
+                        .collect(),
+                    None => blocks
+                        .iter()
+                        .map(|b| 3.0 * n as f64 + d * contact_pairs(&b.contact, d))
+                        .collect(),
+                };
                 let ratio: Vec<f64> = wall.iter().zip(&virial).map(|(a, b)| a / b - 1.0).collect();
                 let contact: Vec<f64> = blocks
                     .iter()
@@ -822,6 +878,14 @@ impl Session for McSession {
                 });
             }
         }
+        if p.pair.is_some() {
+            let u: Vec<f64> = pair_means(&blocks)
+                .iter()
+                .map(|(u, _)| u / n as f64)
+                .collect();
+            summary["pair_energy_per_sphere"] =
+                value_error_or(out, "pair_energy_per_sphere", &u, NO_PAIR);
+        }
         if self.acc.frames > 0 {
             files.push("trajectory.gsd".into());
         }
@@ -835,8 +899,9 @@ impl Session for McSession {
             )
         } else {
             format!(
-                "{} sweeps of {n} hard spheres ({}) in {wall_s:.1} s ({:.3e} trial moves/s), acceptance {:.3}; outputs in {}",
+                "{} sweeps of {n} {} ({}) in {wall_s:.1} s ({:.3e} trial moves/s), acceptance {:.3}; outputs in {}",
                 self.mc.sweeps(),
+                spheres(p).to_lowercase(),
                 p.geometry,
                 (self.mc.sweeps() * n as u64) as f64 / wall_s.max(1e-9),
                 self.acc.sampling.acceptance(),
@@ -874,6 +939,34 @@ fn value_error_or(out: &OutputDir, path: &str, v: &[f64], why: &str) -> serde_js
     }
     json!({ "value": m, "standard_error": e })
 }
+
+/// What the spheres are, for titles: hard spheres or the kind of `[pair]`.
+fn spheres(p: &McRun) -> String {
+    match &p.pair {
+        None => "Hard spheres".into(),
+        Some(pair) => format!("Spheres with the {} pair interaction", pair.kind()),
+    }
+}
+
+/// The method in a droplet picture's title: hard-sphere MC, or MC with the kind of `[pair]`.
+fn method_name(p: &McRun) -> String {
+    match &p.pair {
+        None => "hard-sphere MC".into(),
+        Some(pair) => format!("MC with the {} pair interaction", pair.kind()),
+    }
+}
+
+/// Each block's mean pair energy and virial (with `[pair]`).
+fn pair_means(blocks: &[&Block]) -> Vec<(f64, f64)> {
+    blocks
+        .iter()
+        .filter_map(|b| b.pair.as_ref())
+        .map(PairSums::means)
+        .collect()
+}
+
+/// Why the pair virial's pressure or the pair energy is missing.
+const NO_PAIR: &str = "a block without samples of the pair virial (sample longer)";
 
 /// Why a partial contact value is missing.
 const NO_CONTACT: &str = "no pair of this species pair (a species of one sphere), or a block without pairs in some bin within 10 % of contact: nothing to extrapolate to contact (sample longer or more spheres)";
@@ -962,7 +1055,8 @@ fn mixture_droplet(
     crate::output::species::draw_species_profiles(
         out,
         &format!(
-            "Static droplet, hard-sphere MC ({}): species {}, N = {:?}, phi = {:.3} (bars: standard error over the blocks)",
+            "Static droplet, {} ({}): species {}, N = {:?}, phi = {:.3} (bars: standard error over the blocks)",
+            method_name(p),
             p.geometry,
             m.names.join(", "),
             m.counts,
@@ -1013,11 +1107,15 @@ fn mixture_droplet(
                 w += 4.0 * PI * rc.powi(3) * rho;
             }
             let mut v = 3.0 * n;
-            for a in 0..m.len() {
-                for c in a..m.len() {
-                    let dab = 0.5 * (m.diameters[a] + m.diameters[c]);
-                    if pc.pair(a, c).counts().iter().any(|&k| k > 0) {
-                        v += dab * contact_pairs(pc.pair(a, c), dab);
+            if let Some(sums) = &b.pair {
+                v += sums.means().1 / p.kt;
+            } else {
+                for a in 0..m.len() {
+                    for c in a..m.len() {
+                        let dab = 0.5 * (m.diameters[a] + m.diameters[c]);
+                        if pc.pair(a, c).counts().iter().any(|&k| k > 0) {
+                            v += dab * contact_pairs(pc.pair(a, c), dab);
+                        }
                     }
                 }
             }
@@ -1248,9 +1346,13 @@ impl crate::Engine for McEngine {
     fn velocities(&self) -> Option<Vec<f64>> {
         None
     }
-    /// Hard spheres exert no systematic force away from contact: zeros.
+    /// The pair interaction's forces with `[pair]`; hard spheres exert no systematic force
+    /// away from contact: zeros.
     fn forces(&self) -> Result<Vec<f64>> {
-        Ok(vec![0.0; 3 * self.mc.len()])
+        Ok(match self.mc.pair_forces() {
+            Some(f) => f.concat(),
+            None => vec![0.0; 3 * self.mc.len()],
+        })
     }
     fn box_lengths(&self) -> Vec<f64> {
         vec![self.mc.box_edge(); 3]

@@ -14,6 +14,7 @@ use colloidsim_core::param::show;
 use colloidsim_core::resources::ensure_fits;
 use colloidsim_mc::geometry::Geometry;
 use colloidsim_mc::params::{MAX_PHI, McRun};
+use colloidsim_particles::Mixture;
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -34,6 +35,8 @@ const ENGINE_NAMES: &[(&str, &crate::keys::Spec)] = &[
     ("counts", &SPECIES_COUNTS),
     ("chain_length", &MC_CHAIN_LENGTH),
     ("move", &MC_MOVE),
+    ("box", &SYSTEM_BOX),
+    ("pair_range", &crate::keys::species::PAIR_RANGE),
 ];
 
 /// An engine's error about one of its parameters, naming the scenario key instead.
@@ -293,6 +296,16 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
             "applies to the droplet geometries only (give 0 or leave it out in bulk)",
         ));
     }
+    // The pair interaction, built for the species (one of the final diameter without a
+    // mixture) to check it; event chains are for hard spheres.
+    let one = Mixture::one(diameters[0], particles);
+    let pair = crate::keys::species::pair(r, species.as_ref().unwrap_or(&one), kt, base)?;
+    if pair.is_some() && chain_length.is_some() {
+        bail!(ParamError::new(
+            MC_MOVE.path,
+            "event chains are for hard spheres: with [pair] use mc.move = \"local\"",
+        ));
+    }
     let species = species.filter(|m| !m.is_single());
     if let Some(m) = &species
         && rho2_bins.is_some()
@@ -344,6 +357,7 @@ fn resolve(r: &Reader, base: &Path, seed: Option<u64>) -> Result<McRun> {
         trajectory_every: r.count(&OUTPUT_TRAJECTORY_EVERY)?,
         rho2_bins,
         initial: r.file(&SYSTEM_INITIAL).map(|f| base.join(f)),
+        pair,
     })
 }
 
@@ -376,12 +390,12 @@ rho2_r_bins = 4
         let t = table(FULL);
         let r = Reader::new(&t, KEYS).unwrap();
         resolve(&r, Path::new("."), None).unwrap();
-        // The species keys are read by kind (counts or volume fractions): tests/hs_mc_species.rs
-        // reads each.
+        // The species keys are read by kind (counts or volume fractions) and the pair keys by
+        // pair.kind: tests/hs_mc_species.rs and tests/species.rs read each.
         let unread: Vec<&str> = r
             .unread()
             .into_iter()
-            .filter(|k| !k.starts_with("system.species."))
+            .filter(|k| !k.starts_with("system.species.") && !k.starts_with("pair"))
             .collect();
         assert_eq!(unread, Vec::<&str>::new());
     }
