@@ -194,23 +194,35 @@ pub const SPECIES_KEYS: [Spec; 4] = [
     SPECIES_VOLUME_FRACTIONS,
 ];
 
+/// A method's key list (a `&[Spec]` expression) with the `[pair]` block spliced in once: the
+/// keys `head`, then the table `pair` (`PAIR`, or a method's own declaration of it) and every key
+/// under it, then `tail`.
+macro_rules! keys_with_pair {
+    ([$($head:expr),* $(,)?], $pair:expr, [$($tail:expr),* $(,)?]) => {
+        &[
+            $($head,)*
+            $pair,
+            $crate::keys::species::PAIR_KIND,
+            $crate::keys::species::PAIR_EPSILON,
+            $crate::keys::species::PAIR_CUTOFF,
+            $crate::keys::species::PAIR_CHARGES,
+            $crate::keys::species::PAIR_BJERRUM,
+            $crate::keys::species::PAIR_DEBYE,
+            $crate::keys::species::PAIR_RANGE,
+            $crate::keys::species::PAIR_DEPTH,
+            $crate::keys::species::PAIR_KAPPA,
+            $crate::keys::species::PAIR_H0,
+            $crate::keys::species::PAIR_DEPLETANT_DIAMETER,
+            $crate::keys::species::PAIR_DEPLETANT_FRACTION,
+            $crate::keys::species::PAIR_TABLE,
+            $($tail),*
+        ]
+    };
+}
+pub(crate) use keys_with_pair;
+
 /// The `[pair]` keys.
-pub const PAIR_KEYS: [Spec; 14] = [
-    PAIR,
-    PAIR_KIND,
-    PAIR_EPSILON,
-    PAIR_CUTOFF,
-    PAIR_CHARGES,
-    PAIR_BJERRUM,
-    PAIR_DEBYE,
-    PAIR_RANGE,
-    PAIR_DEPTH,
-    PAIR_KAPPA,
-    PAIR_H0,
-    PAIR_DEPLETANT_DIAMETER,
-    PAIR_DEPLETANT_FRACTION,
-    PAIR_TABLE,
-];
+pub const PAIR_KEYS: &[Spec] = keys_with_pair!([], PAIR, []);
 
 /// The smallest species diameter when the scenario has `[system.species]` (the derived
 /// default of `system.diameter`), the diameters checked first.
