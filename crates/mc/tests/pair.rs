@@ -187,22 +187,26 @@ fn a_pair_the_cells_or_the_box_cannot_resolve_is_refused() {
     assert!(e.starts_with("system.initial: spheres 0 and 1"), "{e}");
 }
 
-/// In a dense soft-sphere mixture (WCA, sizes 1 and 1.2, eight cells a side) the accepted
+/// WCA spheres (kT = 1) of d = 1 and 1.2, `counts` of each, on an FCC lattice of neighbour
+/// distance `a` in a periodic cube of edge `l`.
+fn wca_mixture(l: f64, a: f64, counts: [usize; 2], seed: u32) -> HardSphereMc {
+    let pos = colloidsim_mc::init::fcc_in_box(counts[0] + counts[1], a, l).unwrap();
+    let params = McParams {
+        diameter: 1.0,
+        geometry: Geometry::Bulk { edge: l },
+        seed,
+        delta: 0.1,
+        mixture: Some(Mixture::new(vec![1.0, 1.2], counts.to_vec())),
+    };
+    HardSphereMc::with_pair(&params, &pos, "test", &PairSpec::wca(1.0, 2), 1.0).unwrap()
+}
+
+/// In a dense soft-sphere mixture (WCA, sizes 1 and 1.2, four cells a side) the accepted
 /// moves' energy changes add up to the change of the total pair energy, sweep by sweep: no
 /// neighbour within the range of the old or the new position is missed.
 #[test]
 fn the_moves_energy_changes_add_up_to_the_total_energy_change() {
-    let l = 10.0;
-    let pos = colloidsim_mc::init::fcc_in_box(700, 1.1, l).unwrap();
-    let params = McParams {
-        diameter: 1.0,
-        geometry: Geometry::Bulk { edge: l },
-        seed: 9,
-        delta: 0.15,
-        mixture: Some(Mixture::new(vec![1.0, 1.2], vec![500, 200])),
-    };
-    let mut mc =
-        HardSphereMc::with_pair(&params, &pos, "test", &PairSpec::wca(1.0, 2), 1.0).unwrap();
+    let mut mc = wca_mixture(10.0, 1.1, [500, 200], 9);
     assert!(mc.cells_per_edge() >= 4, "{}", mc.cells_per_edge());
     mc.warm_up(100, 20, 0.3);
     let mut u = mc.pair_energy_and_virial().unwrap().0;
@@ -230,18 +234,7 @@ fn soft_runs_do_not_depend_on_the_thread_count() {
             .build()
             .unwrap()
             .install(|| {
-                let l = 8.0;
-                let pos = colloidsim_mc::init::fcc_in_box(200, 1.2, l).unwrap();
-                let params = McParams {
-                    diameter: 1.0,
-                    geometry: Geometry::Bulk { edge: l },
-                    seed: 3,
-                    delta: 0.1,
-                    mixture: Some(Mixture::new(vec![1.0, 1.2], vec![150, 50])),
-                };
-                let mut mc =
-                    HardSphereMc::with_pair(&params, &pos, "test", &PairSpec::wca(1.0, 2), 1.0)
-                        .unwrap();
+                let mut mc = wca_mixture(8.0, 1.2, [150, 50], 3);
                 let s = mc.run(50);
                 assert!(s.accepted > 0 && s.accepted < s.trials, "{s:?}");
                 let (u, w) = mc.pair_energy_and_virial().unwrap();
