@@ -101,10 +101,10 @@ pub(crate) struct SoftPass<'a> {
 
 impl Pass {
     /// `beta [U(x') - U(x)]` of the move of the sphere in slot `p` (of the active layer, whose
-    /// first slot has global index `layer_base`) from `x` to `x'` (`moved`: positions relative
-    /// to the corner of its cell, whose first slot is `own`), summed over the spheres within the
-    /// range of either position: the 27 cells `base` around, those of the layer in `layer`,
-    /// the others in `frozen` ([`Pass::cell_moves`]).
+    /// first slot has global index `layer_base`) from `old` to `new` (positions relative to the
+    /// corner of its cell, whose first slot is `own`), summed over the spheres within the range
+    /// of either position: the 27 cells `base` around, those of the layer in `layer`, the others
+    /// in `frozen` ([`Pass::cell_moves`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn pair_energy_change(
