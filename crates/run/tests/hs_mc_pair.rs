@@ -187,3 +187,63 @@ fn the_lennard_jones_fluid_by_monte_carlo_follows_the_jzg_equation_of_state() {
         "cannot tell eps 1.1: {wrong}"
     );
 }
+
+/// The Monte Carlo engine (what Python's `MonteCarlo` drives) returns the pair forces with
+/// `[pair]`: equal to a direct sum over all pairs (minimum image) of the interaction the run
+/// read, summing to zero; for hard spheres zeros.
+#[test]
+fn the_engine_s_forces_are_the_pair_forces() {
+    use colloidsim_particles::Pair;
+    let text = dilute_gas(
+        "kind = \"yukawa\"\ncharges = [10.0]\nbjerrum_length = 0.1\ndebye_length = 0.5\nrange = 2.0",
+        0.2,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let sc = colloidsim_run::Scenario::from_toml(&text, dir.path()).unwrap();
+    let mut e = colloidsim_run::engine(&sc, None).unwrap();
+    e.step(20).unwrap();
+    let (x, f, n, l) = (
+        e.positions(),
+        e.forces().unwrap(),
+        e.particles(),
+        e.box_lengths()[0],
+    );
+    let spec = colloidsim_run::methods::hs_mc::params::read(
+        &toml::from_str(&text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
+    .pair
+    .unwrap();
+    let u = spec.build(&[1.0], 1.0).unwrap();
+    let mut direct = vec![0.0; 3 * n];
+    for i in 0..n {
+        for j in i + 1..n {
+            let v: Vec<f64> = (0..3)
+                .map(|k| {
+                    let d = x[3 * i + k] - x[3 * j + k];
+                    d - l * (d / l).round()
+                })
+                .collect();
+            let g = u.force_over_r(v.iter().map(|a| a * a).sum(), 0, 0, 1.0, 1.0);
+            for k in 0..3 {
+                direct[3 * i + k] += g * v[k];
+                direct[3 * j + k] -= g * v[k];
+            }
+        }
+    }
+    let largest = direct.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(largest > 0.1, "{largest}");
+    for (a, b) in f.iter().zip(&direct) {
+        assert!((a - b).abs() < 1e-9 * largest, "{a} vs the direct sum {b}");
+    }
+    let total: f64 = (0..3)
+        .map(|k| (0..n).map(|i| f[3 * i + k]).sum::<f64>().abs())
+        .sum();
+    assert!(total < 1e-9 * largest * n as f64, "{total}");
+    let hard = &text[..text.find("[pair]").unwrap()];
+    let sc = colloidsim_run::Scenario::from_toml(hard, dir.path()).unwrap();
+    let e = colloidsim_run::engine(&sc, None).unwrap();
+    assert!(e.forces().unwrap().iter().all(|&v| v == 0.0));
+}
