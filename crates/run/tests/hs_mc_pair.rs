@@ -69,8 +69,8 @@ fn monte_carlo_with_a_pair_interaction_follows_the_exact_virial_series() {
 
 /// Charged spheres (Yukawa) behind a hard spherical wall obey the exact sum rule
 /// `4 pi Rc^3 rho(Rc) = 3 N + W / kT` (the pair virial W in place of hard spheres' contact
-/// term, docs/mc.md) within 3 errors; hard spheres' contact term instead (`W` left out) misses
-/// it by far more.
+/// term, docs/mc.md) within 3 errors; its ideal part `3 N` alone (the pairs left out) is more
+/// than 10 errors from the wall's side.
 #[test]
 fn a_droplet_of_charged_spheres_obeys_the_wall_sum_rule() {
     let text = r#"
