@@ -12,6 +12,18 @@ fn run(text: &str) -> Value {
     run_in(tempfile::tempdir().unwrap().path(), text)
 }
 
+/// The pair interaction an `hs-mc` scenario's `[pair]` reads into (the one its run uses).
+fn pair_of(text: &str) -> colloidsim_particles::PairSpec {
+    colloidsim_run::methods::hs_mc::params::read(
+        &toml::from_str(text).unwrap(),
+        std::path::Path::new("."),
+        None,
+    )
+    .unwrap()
+    .pair
+    .expect("a [pair] table")
+}
+
 /// 300 spheres (d = 1, kT = 1) with the pair interaction `pair` at number density `rho` in a
 /// periodic cube: 8,000 sampling sweeps in 20 blocks.
 fn dilute_gas(pair: &str, rho: f64) -> String {
@@ -34,14 +46,7 @@ fn monte_carlo_with_a_pair_interaction_follows_the_exact_virial_series() {
     let dir = tempfile::tempdir().unwrap();
     for (pair, rho) in dilute_pair_fluids(&dir.path().join("soft.csv")) {
         let text = dilute_gas(&pair, rho);
-        let spec = colloidsim_run::methods::hs_mc::params::read(
-            &toml::from_str(&text).unwrap(),
-            std::path::Path::new("."),
-            None,
-        )
-        .unwrap()
-        .pair
-        .expect("a [pair] table");
+        let spec = pair_of(&text);
         let s = run(&text);
         let z = &s["compressibility"];
         let z = (
@@ -208,14 +213,7 @@ fn the_engine_s_forces_are_the_pair_forces() {
         e.particles(),
         e.box_lengths()[0],
     );
-    let spec = colloidsim_run::methods::hs_mc::params::read(
-        &toml::from_str(&text).unwrap(),
-        std::path::Path::new("."),
-        None,
-    )
-    .unwrap()
-    .pair
-    .unwrap();
+    let spec = pair_of(&text);
     let u = spec.build(&[1.0], 1.0).unwrap();
     let mut direct = vec![0.0; 3 * n];
     for i in 0..n {
